@@ -1,0 +1,346 @@
+"""Standard trials as rudder/propeller command generators.
+
+A manoeuvre is evaluated at the sample times: `command(t, state, memory)` sees the
+sampled state (closed-loop logic such as zig-zag switching or an autopilot) and
+returns the command held until the next sample. Angles are radians and propeller
+rates rev/s; degrees and rpm belong to the CLI and the file formats.
+"""
+
+import abc
+
+import equinox as eqx
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import ArrayLike
+
+from ._kinematics import ssa
+from ._state import Command
+
+
+class AbstractManoeuvre(eqx.Module):
+    """Base of all manoeuvres.
+
+    Every manoeuvre has `duration` [s], a sample interval `dt` [s], the time `start`
+    [s] of its first sample, a propeller command `n` [rev/s] (`None`: hold the
+    initial rate) and `num_samples` (static; by default `round(duration/dt) + 1`,
+    larger to pad a batch of manoeuvres to one length).
+    """
+
+    duration: eqx.AbstractVar[ArrayLike]
+    dt: eqx.AbstractVar[ArrayLike]
+    start: eqx.AbstractVar[ArrayLike]
+    n: eqx.AbstractVar[ArrayLike | None]
+    num_samples: eqx.AbstractVar[int | None]
+
+    def __post_init__(self):
+        if self.num_samples is None:
+            self.num_samples = int(round(float(self.duration) / float(self.dt))) + 1
+        if self.num_samples < 2:
+            raise ValueError(f"`duration` ({self.duration} s) must cover at least one `dt`.")
+
+    def init(self, x0):
+        """Controller memory at the first sample: initial rpm, initial heading, own state."""
+        return (x0.n, x0.psi, self.init_memory(x0))
+
+    def command(self, t, state, memory):
+        n0, psi0, own = memory
+        delta, own = self.rudder(t - self.start, state, psi0, own)
+        n = n0 if self.n is None else self.n
+        return Command(delta, self.propeller(t - self.start, n)), (n0, psi0, own)
+
+    def propeller(self, tau, n):
+        """Propeller command at time `tau` since the start; constant unless overridden."""
+        del tau
+        return n
+
+    @abc.abstractmethod
+    def init_memory(self, x0):
+        """Initial controller memory (a pytree; `None` for open-loop manoeuvres)."""
+
+    @abc.abstractmethod
+    def rudder(self, tau, state, psi0, memory):
+        """Rudder command [rad] at `tau` seconds after the start, and the new memory."""
+
+
+def _step(tau, execute):
+    return jnp.where(tau >= execute, 1.0, 0.0)
+
+
+class Turn(AbstractManoeuvre):
+    """Turning circle: rudder `angle` ordered at `execute` and held (ITTC 7.5-04-02-01 2.2.1)."""
+
+    angle: ArrayLike  # delta [rad]; positive turns to starboard
+    duration: ArrayLike
+    dt: ArrayLike = 0.1
+    execute: ArrayLike = 0.0  # time of the rudder order after `start` [s]
+    start: ArrayLike = 0.0
+    n: ArrayLike | None = None
+    num_samples: int | None = eqx.field(static=True, default=None)
+
+    def init_memory(self, x0):
+        return None
+
+    def rudder(self, tau, state, psi0, memory):
+        return self.angle * _step(tau, self.execute), memory
+
+
+class ZigZag(AbstractManoeuvre):
+    """Kempf zig-zag `angle`/`heading` (IMO MSC.137(76) 4.2.7; ITTC 2.2.2).
+
+    The rudder goes to `angle` at `execute` (negative `angle`: port first) and is
+    reversed whenever the heading change from the initial heading passes
+    `heading` on the side the rudder is turning the ship to.
+    """
+
+    angle: ArrayLike  # delta_0 [rad], sign gives the first side
+    heading: ArrayLike  # psi_switch [rad] > 0
+    duration: ArrayLike
+    dt: ArrayLike = 0.1
+    execute: ArrayLike = 0.0
+    start: ArrayLike = 0.0
+    n: ArrayLike | None = None
+    num_samples: int | None = eqx.field(static=True, default=None)
+
+    def init_memory(self, x0):
+        return jnp.sign(jnp.asarray(self.angle, dtype=float))
+
+    def rudder(self, tau, state, psi0, side):
+        change = state.psi - psi0
+        side = jnp.where((side > 0) & (change >= self.heading), -1.0, side)
+        side = jnp.where((side < 0) & (change <= -self.heading), 1.0, side)
+        side = jnp.where(tau >= self.execute, side, jnp.sign(self.angle))
+        return side * jnp.abs(self.angle) * _step(tau, self.execute), side
+
+
+class Schedule(AbstractManoeuvre):
+    """Open-loop piecewise-linear rudder schedule through the points `(times, angles)`.
+
+    The building block of the direct spiral, pull-out, 3-2-1-1, PRBS and the thesis
+    manoeuvre; before the first time the first angle holds, after the last the last.
+    Steps are written as two points at the same time.
+    """
+
+    times: ArrayLike  # [s] after start, non-decreasing
+    angles: ArrayLike  # [rad]
+    duration: ArrayLike
+    dt: ArrayLike = 0.1
+    start: ArrayLike = 0.0
+    n: ArrayLike | None = None
+    num_samples: int | None = eqx.field(static=True, default=None)
+
+    def init_memory(self, x0):
+        return None
+
+    def rudder(self, tau, state, psi0, memory):
+        times, angles = jnp.asarray(self.times), jnp.asarray(self.angles)
+        # right-continuous interpolation so that a step at t_k is already taken at t_k
+        k = jnp.clip(jnp.searchsorted(times, tau, side="right") - 1, 0, times.shape[0] - 2)
+        t_a, t_b, a_a, a_b = times[k], times[k + 1], angles[k], angles[k + 1]
+        w = jnp.where(t_b > t_a, jnp.clip((tau - t_a) / jnp.where(t_b > t_a, t_b - t_a, 1.0), 0, 1), 1.0)
+        value = a_a + w * (a_b - a_a)
+        value = jnp.where(tau < times[0], angles[0], value)
+        return jnp.where(tau >= times[-1], angles[-1], value), memory
+
+
+def _staircase(levels, durations):
+    """Knots of a staircase from t = 0: `levels[i]` held for `durations[i]` seconds."""
+    levels = np.asarray(levels, dtype=float)
+    edges = np.concatenate([[0.0], np.cumsum(np.broadcast_to(durations, levels.shape))])
+    return np.repeat(edges, 2)[1:-1], np.repeat(levels, 2)
+
+
+def spiral(max_angle=np.deg2rad(25), step=np.deg2rad(5), hold=300.0, *, dt=0.1, n=None):
+    """Direct (Dieudonne) spiral: `max_angle` down to `-max_angle` and back in `step`s,
+    each held `hold` s (MSC/Circ.1053 app. 4; steady yaw rate read at the end of each)."""
+    k = int(round(max_angle / step))
+    down = np.arange(k, -k - 1, -1) * step
+    levels = np.concatenate([down, down[::-1][1:]])
+    times, angles = _staircase(levels, hold)
+    return Schedule(times, angles, duration=float(times[-1]), dt=dt, n=n)
+
+
+def pull_out(angle=np.deg2rad(20), turn_time=300.0, release_time=300.0, *, dt=0.1, n=None):
+    """Pull-out (ITTC 2.2.6): steady turn at `angle`, rudder to midships at `turn_time`."""
+    times = np.array([0.0, 0.0, turn_time, turn_time])
+    angles = np.array([0.0, angle, angle, 0.0])
+    return Schedule(times, angles, duration=turn_time + release_time, dt=dt, n=n)
+
+
+def multi_step_3211(amplitude=np.deg2rad(10), unit=5.0, *, settle=None, dt=0.1, n=None):
+    """3-2-1-1 multi-step: +A for 3 units, -A for 2, +A for 1, -A for 1, then midships."""
+    levels = [amplitude, -amplitude, amplitude, -amplitude, 0.0]
+    settle = 10 * unit if settle is None else settle
+    times, angles = _staircase(levels, np.array([3, 2, 1, 1, settle / unit]) * unit)
+    return Schedule(times, angles, duration=7 * unit + settle, dt=dt, n=n)
+
+
+def prbs(amplitude=np.deg2rad(10), bit_time=5.0, duration=600.0, *, order=7, seed=1,
+         dt=0.1, n=None):
+    """Pseudo-random binary rudder sequence of +-`amplitude`, one bit every `bit_time` s.
+
+    A maximum-length linear-feedback shift register of `order` bits (period
+    $2^{order} - 1$) drawn from the nonzero `seed` state; Ljung (1999, sec. 13.3).
+    """
+    taps = {5: (5, 3), 6: (6, 5), 7: (7, 6), 8: (8, 6, 5, 4), 9: (9, 5), 10: (10, 7)}
+    if order not in taps:
+        raise ValueError(f"`order` must be one of {sorted(taps)}, got {order}.")
+    if not 0 < seed < 2**order:
+        raise ValueError(f"`seed` must be in [1, {2**order - 1}], got {seed}.")
+    state, bits = seed, []
+    for _ in range(int(np.ceil(duration / bit_time))):
+        bits.append(state & 1)
+        feedback = 0
+        for tap in taps[order]:
+            feedback ^= (state >> (order - tap)) & 1
+        state = (state >> 1) | (feedback << (order - 1))
+    times, angles = _staircase(amplitude * (2.0 * np.array(bits) - 1.0), bit_time)
+    return Schedule(times, angles, duration=duration, dt=dt, n=n)
+
+
+def thesis_manoeuvre(steps_deg=(5, 10, 20, 40, 45), hold_per_deg=2.0, ramp_deg_per_s=0.3,
+                     end_hold=300.0, *, dt=0.1, n=None):
+    """The identification manoeuvre of the thesis (Table 3.1, Fig. 3.4).
+
+    For each step angle a (5, 10, 20, 40, 45 deg), first to starboard, then to port:
+    rudder ordered to a, held 2 s per degree, then reduced to zero at 0.3 deg/s;
+    finally midships for `end_hold` s. The order "to either side" of each step is
+    our reading of Fig. 3.4 (about 1600 s of manoeuvre).
+    """
+    times, angles, t = [0.0], [0.0], 0.0
+    for a in steps_deg:
+        for side in (1.0, -1.0):
+            hold, ramp = hold_per_deg * a, a / ramp_deg_per_s
+            times += [t, t + hold, t + hold + ramp]
+            angles += [np.deg2rad(side * a)] * 2 + [0.0]
+            t += hold + ramp
+    times.append(t + end_hold)
+    angles.append(0.0)
+    return Schedule(np.array(times), np.array(angles), duration=t + end_hold, dt=dt, n=n)
+
+
+class Stop(AbstractManoeuvre):
+    """Crash stop (ITTC 2.2.7): propeller ordered to `astern_n` [rev/s] at `execute`, rudder midships."""
+
+    astern_n: ArrayLike  # n_astern [rev/s], negative
+    duration: ArrayLike
+    dt: ArrayLike = 0.1
+    execute: ArrayLike = 0.0
+    start: ArrayLike = 0.0
+    n: ArrayLike | None = None
+    num_samples: int | None = eqx.field(static=True, default=None)
+
+    def init_memory(self, x0):
+        return None
+
+    def rudder(self, tau, state, psi0, memory):
+        return jnp.zeros_like(tau), memory
+
+    def propeller(self, tau, n):
+        return jnp.where(tau >= self.execute, self.astern_n, n)
+
+
+class ReverseSpiral(AbstractManoeuvre):
+    """Bech's reverse spiral: a yaw-rate controller holds each rate in `rates` [rad/s]
+    for `hold` s; the mean rudder needed gives the delta(r) curve (MSC/Circ.1053 app. 4).
+
+    Rudder law (PI on yaw rate): $\\delta_c = k_p e + k_i \\int e\\,dt$, $e = r_{ref} - r$.
+    """
+
+    rates: ArrayLike  # r_ref levels [rad/s]
+    hold: ArrayLike  # [s] per level
+    kp: ArrayLike  # [s] (rad of rudder per rad/s of yaw-rate error)
+    ki: ArrayLike  # [-] (rad of rudder per rad of integrated error)
+    duration: ArrayLike
+    dt: ArrayLike = 0.1
+    start: ArrayLike = 0.0
+    max_angle: ArrayLike = np.deg2rad(35)  # anti-windup limit of the controller [rad]
+    n: ArrayLike | None = None
+    num_samples: int | None = eqx.field(static=True, default=None)
+
+    def reference(self, tau):
+        rates = jnp.asarray(self.rates)
+        k = jnp.clip(jnp.floor(tau / self.hold).astype(int), 0, rates.shape[0] - 1)
+        return rates[k]
+
+    def init_memory(self, x0):
+        return jnp.zeros_like(jnp.asarray(x0.r, dtype=float))
+
+    def rudder(self, tau, state, psi0, integral):
+        error = self.reference(tau) - state.r
+        limit = self.max_angle / jnp.maximum(self.ki, 1e-12)
+        integral = jnp.clip(integral + error * self.dt, -limit, limit)
+        delta = jnp.clip(self.kp * error + self.ki * integral, -self.max_angle, self.max_angle)
+        return delta, integral
+
+
+class HeadingAutopilot(AbstractManoeuvre):
+    """Heading-reference perturbations under a PID autopilot (Astrom & Kallstrom 1979, sec. 4).
+
+    Reference: initial heading plus a square wave of `amplitude` [rad] and `period`
+    [s]. Rudder law: $\\delta_c = k_p e + k_i \\int e\\,dt - k_d r$ with
+    $e = \\mathrm{ssa}(\\psi_{ref} - \\psi)$.
+    """
+
+    amplitude: ArrayLike
+    period: ArrayLike
+    kp: ArrayLike  # [-]
+    ki: ArrayLike  # [1/s]
+    kd: ArrayLike  # [s]
+    duration: ArrayLike
+    dt: ArrayLike = 0.1
+    start: ArrayLike = 0.0
+    max_angle: ArrayLike = np.deg2rad(35)
+    n: ArrayLike | None = None
+    num_samples: int | None = eqx.field(static=True, default=None)
+
+    def init_memory(self, x0):
+        return jnp.zeros_like(jnp.asarray(x0.psi, dtype=float))
+
+    def reference(self, tau, psi0):
+        phase = jnp.floor(2 * tau / self.period) % 2
+        return psi0 + self.amplitude * (1 - 2 * phase)
+
+    def rudder(self, tau, state, psi0, integral):
+        error = ssa(self.reference(tau, psi0) - state.psi)
+        limit = self.max_angle / jnp.maximum(self.ki, 1e-12)
+        integral = jnp.clip(integral + error * self.dt, -limit, limit)
+        delta = self.kp * error + self.ki * integral - self.kd * state.r
+        return jnp.clip(delta, -self.max_angle, self.max_angle), integral
+
+
+class Replay(AbstractManoeuvre):
+    """Open-loop replay of recorded rudder and propeller commands (zero-order hold).
+
+    Used to drive a model with measured inputs (estimation replays inputs even for
+    zig-zags). `delta` [rad] and `n` [rev/s] are sampled every `dt` from `start`.
+    """
+
+    delta_record: ArrayLike
+    n_record: ArrayLike
+    dt: ArrayLike
+    start: ArrayLike = 0.0
+    duration: ArrayLike | None = None
+    n: None = None
+    num_samples: int | None = eqx.field(static=True, default=None)
+
+    def __post_init__(self):
+        length = np.shape(self.delta_record)[0]
+        if np.shape(self.n_record)[0] != length:
+            raise ValueError("`delta_record` and `n_record` must have the same length.")
+        if self.duration is None:
+            self.duration = (length - 1) * float(self.dt)
+        if self.num_samples is None:
+            self.num_samples = length
+
+    def init_memory(self, x0):
+        return None
+
+    def _index(self, tau):
+        last = np.shape(self.delta_record)[0] - 1
+        return jnp.clip(jnp.round(tau / self.dt).astype(int), 0, last)
+
+    def rudder(self, tau, state, psi0, memory):
+        return jnp.asarray(self.delta_record)[self._index(tau)], memory
+
+    def propeller(self, tau, n):
+        return jnp.asarray(self.n_record)[self._index(tau)]

@@ -1,0 +1,110 @@
+"""The vessel interface: vessels return forces and a mass matrix, never integrate."""
+
+import abc
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jaxtyping import Array
+
+from .._actuators import RudderServo, Shaft
+from .._environment import Environment
+from .._state import Command, ShipState
+
+
+class AbstractVessel(eqx.Module):
+    """A 3-DOF (surge, sway, yaw) vessel model.
+
+    The equations of motion are $M \\dot\\nu = \\tau(\\nu, \\delta, n) + \\tau_{env}$ with
+    $\\nu = (u, v, r)$ relative to the water at the vessel's reference point
+    (Fossen 2021, eq. 6.1). Subclasses give the constant mass matrix $M$ (rigid body
+    plus added mass) and the hydrodynamic, rudder, propeller and Coriolis loads
+    $\\tau$; the simulator owns the numerics.
+
+    Sign convention for every vessel: positive rudder angle turns the ship to
+    starboard ($r > 0$); x forward, y to starboard, z down.
+    """
+
+    length: eqx.AbstractVar[float]  # L_pp [m]
+    rudder: eqx.AbstractVar[RudderServo]
+    shaft: eqx.AbstractVar[Shaft]
+    nominal_speed: eqx.AbstractVar[float]  # approach speed U_0 [m/s]
+    nominal_n: eqx.AbstractVar[float]  # propeller rate at U_0 in straight run [rev/s]
+    frontal_wind_area: eqx.AbstractVar[float]  # A_F [m^2], 0 for no windage
+    lateral_wind_area: eqx.AbstractVar[float]  # A_L [m^2]
+
+    @abc.abstractmethod
+    def mass_matrix(self) -> Array:
+        """The 3x3 matrix $M = M_{RB} + M_A$ in SI units [kg, kg m, kg m^2]."""
+
+    @abc.abstractmethod
+    def forces(self, u, v, r, delta, n) -> Array:
+        """Loads $\\tau = (X, Y, N)$ [N, N, N m] at velocities `u, v` [m/s], `r`
+        [rad/s], rudder angle `delta` [rad] and propeller rate `n` [rev/s],
+        including the Coriolis-centripetal terms, i.e. everything except $M\\dot\\nu$."""
+
+
+def state_derivative(
+    vessel: AbstractVessel, state: ShipState, command: Command, environment: Environment
+) -> ShipState:
+    """Time derivative of the full state: dynamics, kinematics and actuators."""
+    tau = vessel.forces(state.u, state.v, state.r, state.delta, state.n)
+    xdot, ydot = environment.ground_velocity(state.u, state.v, state.psi)
+    cn, ce = environment.current.velocity()
+    ug, vg = _ground_body_velocity(state, cn, ce)
+    wind = environment.wind.loads(
+        ug, vg, state.psi, vessel.frontal_wind_area, vessel.lateral_wind_area, vessel.length
+    )
+    nudot = jnp.linalg.solve(vessel.mass_matrix(), tau + jnp.stack(jnp.broadcast_arrays(*wind)))
+    return ShipState(
+        u=nudot[0], v=nudot[1], r=nudot[2], x=xdot, y=ydot, psi=state.r,
+        delta=vessel.rudder.rate(state.delta, command.delta),
+        n=vessel.shaft.rate(state.n, command.n),
+    )
+
+
+def _ground_body_velocity(state, current_north, current_east):
+    c, s = jnp.cos(state.psi), jnp.sin(state.psi)
+    return (
+        state.u + current_north * c + current_east * s,
+        state.v - current_north * s + current_east * c,
+    )
+
+
+def surge_force(vessel: AbstractVessel, u, n) -> Array:
+    """Net surge force [N] in straight motion at speed `u` and propeller rate `n`."""
+    zero = jnp.zeros_like(u)
+    return vessel.forces(u, zero, zero, zero, n)[0]
+
+
+def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> ShipState:
+    """Steady straight-run state (v = r = delta = 0, X = 0).
+
+    Give `speed` [m/s] to solve for the self-propulsion rate `n`, or `n` [rev/s] to
+    solve for the equilibrium speed; with neither, the vessel's nominal approach.
+    Vessels without a propeller term keep `n` as given and `speed` as given.
+    """
+    from .._state import straight_state
+
+    if speed is None and n is None:
+        speed, n = vessel.nominal_speed, vessel.nominal_n
+    if n is None:
+        n = _newton(lambda nn: surge_force(vessel, jnp.asarray(speed, float), nn), vessel.nominal_n)
+    elif speed is None:
+        speed = _newton(lambda uu: surge_force(vessel, uu, jnp.asarray(n, float)),
+                        vessel.nominal_speed)
+    return straight_state(speed, n, psi)
+
+
+def _newton(f, x0, iterations=50):
+    """Scalar Newton iteration with a guard for functions that do not depend on x."""
+    x = jnp.asarray(x0, dtype=float)
+    for _ in range(iterations):
+        fx, dfx = jax.value_and_grad(f)(x)
+        if float(abs(dfx)) < 1e-300:
+            return x
+        step = fx / dfx
+        x = x - step
+        if float(abs(step)) <= 1e-12 * max(1.0, float(abs(x))):
+            break
+    return x
