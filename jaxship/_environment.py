@@ -44,17 +44,28 @@ class Wind(eqx.Module):
     cn: ArrayLike = 0.125  # c_n [-]
 
     def loads(self, u_ground, v_ground, psi, frontal_area, lateral_area, length):
-        """Body-fixed wind force and moment `(X, Y, N)` [N, N, N m] on a moving ship."""
-        # wind velocity (towards) in body axes, minus ship ground velocity
+        """Body-fixed wind force and moment `(X, Y, N)` [N, N, N m] on a moving ship.
+
+        The still-air load of the ship's own motion is taken as part of the vessel's
+        calm-water resistance, so only the difference it makes is returned: zero
+        when `speed` is zero, and straight runs stay in equilibrium in calm weather.
+        """
+        # wind velocity (blowing towards) in body axes
         wn, we = -self.speed * jnp.cos(self.direction), -self.speed * jnp.sin(self.direction)
         uw, vw = earth_to_body(wn, we, psi)
-        u_rw, v_rw = u_ground - uw, v_ground - vw  # relative wind seen on board (from bow = +)
-        gamma = jnp.arctan2(v_rw, u_rw)
+        windy = self._coefficient_loads(u_ground - uw, v_ground - vw)
+        still = self._coefficient_loads(u_ground, v_ground)
+        scale = (frontal_area, lateral_area, lateral_area * length)
+        return tuple(s * (a - b) for s, a, b in zip(scale, windy, still))
+
+    def _coefficient_loads(self, u_rw, v_rw):
+        """Loads per unit area (and length) for a relative wind `(u_rw, v_rw)` seen on board."""
+        gamma = jnp.arctan2(v_rw, u_rw)  # angle the relative wind comes from, + from starboard
         q = 0.5 * RHO_AIR * (u_rw**2 + v_rw**2)
         return (
-            -self.cx * jnp.cos(gamma) * q * frontal_area,
-            -self.cy * jnp.sin(gamma) * q * lateral_area,
-            -self.cn * jnp.sin(2 * gamma) * q * lateral_area * length,
+            -self.cx * jnp.cos(gamma) * q,
+            -self.cy * jnp.sin(gamma) * q,
+            -self.cn * jnp.sin(2 * gamma) * q,
         )
 
 

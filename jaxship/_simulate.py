@@ -63,7 +63,6 @@ def simulate(
     *,
     environment: Environment = Environment(),
     simulator: Simulator = Simulator(),
-    t0: float = 0.0,
 ) -> Trajectory:
     """Simulate `vessel` through `manoeuvre` from the initial state `x0`.
 
@@ -75,13 +74,12 @@ def simulate(
     - `x0`: initial `ShipState` (e.g. from `straight_run(vessel)`).
     - `environment`: current and wind; calm water by default.
     - `simulator`: the numerics; see `Simulator`.
-    - `t0`: time of the first sample [s].
 
     **Returns:** a `Trajectory` with `manoeuvre.num_samples` samples.
 
     Parameter values are traced, never baked in: changing them does not recompile.
     """
-    return _simulate(*_as_arrays((vessel, manoeuvre, x0, environment, t0)), simulator)
+    return _simulate(*_as_arrays((vessel, manoeuvre, x0, environment)), simulator)
 
 
 def _as_arrays(tree):
@@ -91,7 +89,8 @@ def _as_arrays(tree):
 
 
 @eqx.filter_jit
-def _simulate(vessel, manoeuvre, x0, environment, t0, simulator):
+def _simulate(vessel, manoeuvre, x0, environment, simulator):
+    t0 = manoeuvre.start
     x0 = jax.tree.map(lambda a: jnp.asarray(a, dtype=float), x0)
     memory = manoeuvre.init(x0)
     dt = jnp.asarray(manoeuvre.dt, dtype=float)
