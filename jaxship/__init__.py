@@ -1,6 +1,17 @@
 """jaxship: differentiable ship-manoeuvring simulation and steering-model identification."""
 
 from ._actuators import RudderServo as RudderServo, Shaft as Shaft
+from ._data import (
+    Dataset as Dataset,
+    Experiment as Experiment,
+    read_esso_osaka as read_esso_osaka,
+    read_hsva_kvlcc2 as read_hsva_kvlcc2,
+    read_marin_kvlcc2 as read_marin_kvlcc2,
+    read_measured as read_measured,
+    read_trial_csv as read_trial_csv,
+    shared_data_dir as shared_data_dir,
+    write_trial_csv as write_trial_csv,
+)
 from ._environment import Current as Current, Environment as Environment, Wind as Wind
 from ._kinematics import body_to_earth as body_to_earth, ssa as ssa
 from ._manoeuvres import (

@@ -45,7 +45,7 @@ class Simulator(eqx.Module):
                 incr = jax.tree.map(lambda a, b, c, d: (a + 2 * b + 2 * c + d) / 6, k1, k2, k3, k4)
                 return tree_axpy(h, incr, y), None
 
-            y, _ = jax.lax.scan(rk4, state, None, length=self.substeps)
+            y, _ = jax.lax.scan(rk4, state, None, length=self.substeps, unroll=self.substeps <= 8)
             return y, jnp.array(True)
         sol = dfx.diffeqsolve(
             dfx.ODETerm(lambda t, y, args: rhs(y)),

@@ -55,12 +55,21 @@ def state_derivative(
     wind = environment.wind.loads(
         ug, vg, state.psi, vessel.frontal_wind_area, vessel.lateral_wind_area, vessel.length
     )
-    nudot = jnp.linalg.solve(vessel.mass_matrix(), tau + jnp.stack(jnp.broadcast_arrays(*wind)))
+    nudot = solve3(vessel.mass_matrix(), tau + jnp.stack(jnp.broadcast_arrays(*wind)))
     return ShipState(
         u=nudot[0], v=nudot[1], r=nudot[2], x=xdot, y=ydot, psi=state.r,
         delta=vessel.rudder.rate(state.delta, command.delta),
         n=vessel.shaft.rate(state.n, command.n),
     )
+
+
+def solve3(m: Array, b: Array) -> Array:
+    """Solve the 3x3 system `m x = b` by Cramer's rule (no LAPACK call on the hot path)."""
+    c0 = jnp.cross(m[:, 1], m[:, 2])
+    det = jnp.dot(m[:, 0], c0)
+    return jnp.stack([
+        jnp.dot(b, c0), jnp.dot(m[:, 0], jnp.cross(b, m[:, 2])), jnp.dot(m[:, 0], jnp.cross(m[:, 1], b))
+    ]) / det
 
 
 def _ground_body_velocity(state, current_north, current_east):

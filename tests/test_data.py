@@ -1,0 +1,482 @@
+"""Trial CSV format, Experiment/Dataset containers and the measured-data readers."""
+
+import jax
+import numpy as np
+import pytest
+from helpers import linear_test_vessel
+
+import jaxship as js
+from jaxship._data import (
+    CHANNELS,
+    Dataset,
+    Experiment,
+    read_esso_osaka,
+    read_hsva_kvlcc2,
+    read_marin_kvlcc2,
+    read_measured,
+    read_trial_csv,
+    shared_data_dir,
+    write_trial_csv,
+)
+
+
+def synthetic_experiment(num=201, dt=0.1, t0=5.0):
+    """Smooth trajectory-like signals in every channel (SI)."""
+    t = t0 + dt * np.arange(num)
+    s = t - t0
+    rng = np.random.default_rng(0)
+    return Experiment(
+        t, np.deg2rad(20) * np.sin(0.2 * s), psi=0.3 * np.sin(0.05 * s) + 0.01 * s,
+        r=0.015 * np.cos(0.05 * s) + 0.01, u=7.5 + 0.1 * np.cos(0.03 * s),
+        v=-0.2 * np.sin(0.1 * s), x=7.5 * s + rng.normal(0, 1e-3, num), y=0.3 * s**1.5,
+        n=1.5 + 0.01 * np.sin(s), delta_c=np.deg2rad(20) * np.sign(np.sin(0.2 * s) + 1e-9),
+        wind_speed=5.0 + 0.1 * np.sin(s), wind_dir=np.deg2rad(135.0) + 0.01 * s,
+        name="synthetic",
+    )
+
+
+def assert_channels_equal(a: Experiment, b: Experiment, rtol=1e-12):
+    assert a.channels == b.channels
+    for key in CHANNELS:
+        x, y = getattr(a, key), getattr(b, key)
+        scale = np.max(np.abs(x)) + 1e-300
+        np.testing.assert_allclose(y, x, rtol=0, atol=rtol * scale, err_msg=key)
+
+
+# --- trial CSV round trip ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("units", ["display", "si"])
+def test_round_trip_all_channels(tmp_path, units):
+    exp = synthetic_experiment()
+    path = tmp_path / "trial.csv"
+    write_trial_csv(path, exp, units=units)
+    header = path.read_text().splitlines()[0]
+    if units == "display":
+        assert "psi [deg]" in header and "r [deg/s]" in header and "n [rpm]" in header
+    else:
+        assert "psi [rad]" in header and "r [rad/s]" in header and "n [rps]" in header
+    back = read_trial_csv(path, require_uniform=True)
+    assert back.name == "trial"
+    assert back.derived == ()
+    assert_channels_equal(exp, back)
+    # writing the read-back again gives the same file (SI) or values (display)
+    again = tmp_path / "again.csv"
+    write_trial_csv(again, back, units=units)
+    assert_channels_equal(exp, read_trial_csv(again))
+
+
+def test_round_trip_keeps_derived_channels_derived(tmp_path):
+    t = np.arange(50) * 0.2
+    exp = Experiment(t, 0.1 * np.ones(50), r=0.02 + 0.001 * t, name="rate only")
+    assert exp.channels == ("delta", "r")
+    assert exp.derived == ("psi",)
+    # cumulative trapezoid of a linear r is exact
+    np.testing.assert_allclose(exp.psi, 0.02 * t + 0.0005 * t**2, rtol=0, atol=1e-14)
+    path = tmp_path / "rate.csv"
+    write_trial_csv(path, exp)
+    assert path.read_text().splitlines()[0] == "t [s],delta [deg],r [deg/s]"
+    back = read_trial_csv(path)
+    assert back.derived == ("psi",)
+    assert_channels_equal(exp, back)
+
+
+def test_r_from_psi_by_differencing():
+    t = np.arange(0.0, 100.0, 0.1)
+    exp = Experiment(t, np.zeros_like(t), psi=np.sin(0.1 * t))
+    assert exp.derived == ("r",) and not exp.has("r")
+    # central differences: error 0.1^3 * dt^2 / 6 inside, first order at the two ends
+    np.testing.assert_allclose(exp.r[1:-1], 0.1 * np.cos(0.1 * t[1:-1]), atol=2e-6)
+    np.testing.assert_allclose(exp.r[[0, -1]], 0.1 * np.cos(0.1 * t[[0, -1]]), atol=1e-3)
+    assert not exp.has("u") and np.all(exp.u == 0.0)
+
+
+@pytest.fixture(scope="module")
+def turn():
+    """A starboard turn of the linear test vessel, started at t0 = 100 s."""
+    vessel = linear_test_vessel()
+    x0 = js.straight_run(vessel)
+    manoeuvre = js.Turn(np.deg2rad(20.0), duration=60.0, dt=0.5, execute=2.0, start=100.0)
+    trajectory = js.simulate(vessel, manoeuvre, x0)
+    assert bool(trajectory.success)
+    return vessel, trajectory
+
+
+def test_write_trajectory_round_trip(turn, tmp_path):
+    _, trajectory = turn
+    path = tmp_path / "sim.csv"
+    write_trial_csv(path, trajectory)
+    assert path.read_text().splitlines()[0] == (
+        "t [s],delta [deg],delta_c [deg],psi [deg],r [deg/s],u [m/s],v [m/s],x [m],y [m],n [rpm]"
+    )
+    back = read_trial_csv(path, require_uniform=True)
+    np.testing.assert_allclose(back.t, trajectory.t, rtol=1e-15)
+    np.testing.assert_allclose(back.delta_c, trajectory.command.delta, rtol=1e-12)
+    for key in ("delta", "psi", "r", "u", "v", "x", "y", "n"):
+        np.testing.assert_allclose(getattr(back, key), getattr(trajectory.state, key),
+                                   rtol=1e-12, atol=1e-300, err_msg=key)
+    assert back.psi[-1] > np.deg2rad(30.0)  # it did turn to starboard
+
+
+def test_batched_trajectory_is_rejected(turn, tmp_path):
+    _, trajectory = turn
+    batched = jax.tree.map(lambda a: np.stack([a, a]), trajectory)
+    with pytest.raises(ValueError, match="batched"):
+        write_trial_csv(tmp_path / "x.csv", batched)
+
+
+def test_replay_reproduces_the_simulation(turn):
+    """Open-loop replay of the recorded commands from the recorded initial state gives
+    back the same trajectory (the t0/start offset included)."""
+    vessel, trajectory = turn
+    exp = Experiment.from_trajectory(trajectory)
+    replay = exp.replay(rudder="delta_c")
+    assert replay.num_samples == exp.num_samples and replay.start == 100.0
+    assert replay.dt == pytest.approx(0.5, rel=1e-14)
+    again = js.simulate(vessel, replay, exp.initial_state())
+    for key in ("psi", "r", "u", "v", "x", "y", "delta"):
+        np.testing.assert_allclose(getattr(again.state, key), getattr(trajectory.state, key),
+                                   rtol=1e-10, atol=1e-10, err_msg=key)
+
+
+def test_initial_state_defaults():
+    t = np.arange(10) * 0.5
+    exp = Experiment(t, np.full(10, 0.1), psi=0.02 * t + 1.0, name="no speed")
+    with pytest.raises(ValueError, match="'no speed'.*default_u"):
+        exp.initial_state()
+    x0 = exp.initial_state(default_u=3.0, default_n=2.0)
+    assert float(x0.u) == 3.0 and float(x0.n) == 2.0 and float(x0.v) == 0.0
+    assert float(x0.psi) == 1.0 and float(x0.delta) == pytest.approx(0.1)
+    assert float(x0.r) == pytest.approx(0.02, rel=1e-12)  # from d(psi)/dt
+    with pytest.raises(ValueError, match="no measured 'delta_c'"):
+        exp.replay(rudder="delta_c")
+    assert np.all(np.asarray(exp.replay(n=1.25).n_record) == 1.25)
+    uneven = Experiment(np.array([0.0, 0.1, 0.3]), np.zeros(3), psi=np.zeros(3))
+    with pytest.raises(ValueError, match="not uniformly sampled"):
+        uneven.replay()
+
+
+def test_experiment_validation():
+    with pytest.raises(ValueError, match="heading `psi` or a yaw rate `r`"):
+        Experiment(np.arange(3.0), np.zeros(3))
+    with pytest.raises(ValueError, match="channel 'r' has 2 samples"):
+        Experiment(np.arange(3.0), np.zeros(3), r=np.zeros(2))
+    with pytest.raises(ValueError, match="channel 'delta' sample 1 is nan"):
+        Experiment(np.arange(3.0), np.array([0.0, np.nan, 0.0]), r=np.zeros(3))
+    with pytest.raises(ValueError, match=r"t\[2\] = 1.0 s follows t\[1\] = 1.0 s"):
+        Experiment(np.array([0.0, 1.0, 1.0]), np.zeros(3), r=np.zeros(3))
+
+
+# --- errors name the file, the column and the row --------------------------------------
+
+GOOD = "t [s],delta [deg],psi [deg]\n0.0,0.0,0.0\n0.1,1.0,0.1\n0.2,2.0,0.3\n"
+
+ERROR_CASES = {
+    "missing delta": (
+        "t [s],psi [deg]\n0,0\n0.1,0\n",
+        r"bad\.csv: header row \(line 1\): missing required column 'delta'",
+    ),
+    "missing psi and r": (
+        "t [s],delta [deg]\n0,0\n0.1,0\n",
+        r"bad\.csv: header row \(line 1\): missing required column 'psi' or 'r'",
+    ),
+    "unknown unit": (
+        "t [s],delta [grad],psi [deg]\n0,0,0\n0.1,0,0\n",
+        r"bad\.csv: column 'delta \[grad\]' \(header row, line 1\): unknown unit 'grad'",
+    ),
+    "unknown column": (
+        "t [s],delta [deg],psi [deg],foo [m]\n0,0,0,1\n0.1,0,0,2\n",
+        r"bad\.csv: column 'foo \[m\]' \(header row, line 1\): unknown column name 'foo'",
+    ),
+    "duplicate column": (
+        "t [s],delta [deg],psi [deg],psi [rad]\n0,0,0,0\n0.1,0,0,0\n",
+        r"bad\.csv: column 'psi \[rad\]' \(header row, line 1\): column 'psi' appears twice",
+    ),
+    "header without unit": (
+        "t,delta [deg],psi [deg]\n0,0,0\n0.1,0,0\n",
+        r"bad\.csv: column 't' \(header row, line 1\): a header must read 'name \[unit\]'",
+    ),
+    "nan": (
+        "t [s],delta [deg],psi [deg]\n0.0,0,0\n0.1,nan,0\n0.2,0,0\n",
+        r"bad\.csv: column 'delta \[deg\]', row 2 \(line 3\): value 'nan' is not finite",
+    ),
+    "infinite": (
+        "t [s],delta [deg],psi [deg]\n0.0,0,0\n0.1,0,0\n0.2,0,-inf\n",
+        r"bad\.csv: column 'psi \[deg\]', row 3 \(line 4\): value '-inf' is not finite",
+    ),
+    "empty cell": (
+        "t [s],delta [deg],psi [deg]\n0.0,0,0\n0.1,,0\n0.2,0,0\n",
+        r"bad\.csv: column 'delta \[deg\]', row 2 \(line 3\): empty value",
+    ),
+    "text": (
+        "t [s],delta [deg],psi [deg]\n0.0,0,0\n0.1,abc,0\n",
+        r"bad\.csv: column 'delta \[deg\]', row 2 \(line 3\): cannot read 'abc' as a number",
+    ),
+    "field count": (
+        "t [s],delta [deg],psi [deg]\n0.0,0,0\n0.1,0\n",
+        r"bad\.csv: row 2 \(line 3\) has 2 fields but the header has 3 columns",
+    ),
+    "time not increasing": (
+        "t [s],delta [deg],psi [deg]\n0.0,0,0\n0.1,0,0\n0.1,0,0\n0.2,0,0\n",
+        r"bad\.csv: column 't \[s\]', row 3 \(line 4\): time 0\.1 is not greater",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(ERROR_CASES))
+def test_errors_name_file_column_and_row(tmp_path, case):
+    text, message = ERROR_CASES[case]
+    path = tmp_path / "bad.csv"
+    path.write_text(text)
+    with pytest.raises(ValueError, match=message):
+        read_trial_csv(path)
+
+
+def test_non_uniform_sampling(tmp_path):
+    path = tmp_path / "bad.csv"
+    path.write_text("t [s],delta [deg],psi [deg]\n0,0,0\n0.1,0,0\n0.2,0,0\n0.4,0,0\n0.5,0,0\n")
+    assert read_trial_csv(path).num_samples == 5  # fine unless uniformity is required
+    with pytest.raises(ValueError, match=r"bad\.csv: column 't \[s\]', row 4 \(line 5\): "
+                                         r"sampling interval 0\.2.*require_uniform=True"):
+        read_trial_csv(path, require_uniform=True)
+
+
+def test_unknown_columns_allowed_and_trailing_empty_rows(tmp_path):
+    path = tmp_path / "extra.csv"
+    path.write_text("t [s],delta [deg],psi [deg],depth [m]\n0,1,0,20\n0.1,2,0,21\n\n,,,\n,,,\n")
+    exp = read_trial_csv(path, allow_unknown=True)
+    assert exp.num_samples == 2 and exp.channels == ("delta", "psi")
+    np.testing.assert_array_equal(exp.extra["depth"], [20.0, 21.0])
+    np.testing.assert_allclose(exp.delta, np.deg2rad([1.0, 2.0]), rtol=1e-15)
+
+
+def test_units_are_converted(tmp_path):
+    path = tmp_path / "units.csv"
+    path.write_text("n [rpm],t [s],r [rad/s],delta [rad],wind_dir [deg]\n"
+                    "90,0,0.01,0.1,180\n120,1,0.02,0.2,90\n")
+    exp = read_trial_csv(path)
+    np.testing.assert_allclose(exp.n, [1.5, 2.0], rtol=1e-15)
+    np.testing.assert_allclose(exp.wind_dir, [np.pi, np.pi / 2], rtol=1e-15)
+    np.testing.assert_allclose(exp.psi, [0.0, 0.015], rtol=1e-15)  # trapezoid of r
+
+
+# --- Dataset -------------------------------------------------------------------------------
+
+
+def test_dataset_padding_and_mask():
+    long, short = synthetic_experiment(num=120), synthetic_experiment(num=80, dt=0.2, t0=0.0)
+    data = Dataset.from_experiments([long, short])
+    assert data.num_experiments == 2 and data.num_samples == 120
+    arrays, mask = data.stack()
+    assert set(arrays) == set(CHANNELS)
+    assert all(a.shape == (2, 120) for a in arrays.values()) and mask.shape == (2, 120)
+    np.testing.assert_array_equal(mask.sum(axis=1), [120, 80])
+    assert np.all(np.isfinite(np.stack(list(arrays.values()))))
+    np.testing.assert_allclose(np.diff(data.t[1]), 0.2, rtol=1e-9)  # time continues
+    np.testing.assert_allclose(data.dt, [0.1, 0.2], rtol=1e-12)
+    assert np.all(data.delta[1, 80:] == short.delta[-1])
+    assert data.channels == long.channels
+    for i, exp in enumerate([long, short]):
+        assert_channels_equal(exp, data.experiment(i), rtol=0.0)
+    with pytest.raises(ValueError, match="shorter than the longest"):
+        Dataset.from_experiments([long, short], num_samples=100)
+
+
+def test_dataset_vmap_replay_matches_original(turn):
+    """Replaying two segments of a simulation in one vmapped batch gives back the
+    original trajectory on the unmasked samples."""
+    vessel, trajectory = turn
+    full = Experiment.from_trajectory(trajectory)
+    first, later = full.segment(stop=120.0), full.segment(start=110.0)
+    data = Dataset.from_experiments([first, later])
+    assert data.lengths == (41, 101)
+    batch = jax.vmap(lambda m, x0: js.simulate(vessel, m, x0))(
+        data.replays(rudder="delta_c"), data.initial_states()
+    )
+    np.testing.assert_array_equal(np.asarray(batch.valid), data.mask)
+    np.testing.assert_allclose(np.asarray(batch.t), data.t, rtol=1e-14)
+    for key in ("psi", "r", "u", "v", "x", "y"):
+        got = np.asarray(getattr(batch.state, key))[data.mask]
+        want = np.concatenate([getattr(first, key), getattr(later, key)])
+        np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-10, err_msg=key)
+
+
+# --- measured data sets ------------------------------------------------------------------
+
+DATA = shared_data_dir()
+needs_data = pytest.mark.skipif(DATA is None, reason="shared/data not found (set JAXSHIP_DATA)")
+
+
+def data_file(*parts):
+    path = DATA.joinpath(*parts)
+    if not path.exists():
+        pytest.skip(f"{path} not found")
+    return path
+
+
+def test_shared_data_dir_env(tmp_path, monkeypatch):
+    monkeypatch.setenv("JAXSHIP_DATA", str(tmp_path))
+    assert shared_data_dir() == tmp_path
+    monkeypatch.setenv("JAXSHIP_DATA", str(tmp_path / "missing"))
+    assert shared_data_dir() is None
+
+
+@needs_data
+def test_esso_trailing_empty_rows():
+    """README: zigzag_31-Jul-2020_13_50_28.csv has 1701 rows (0-170.0 s) and then 327
+    empty rows."""
+    exp = read_esso_osaka(data_file("esso_osaka_frt", "zigzag", "zigzag_31-Jul-2020_13_50_28.csv"))
+    assert exp.num_samples == 1701
+    assert exp.t[0] == 0.0 and exp.t[-1] == pytest.approx(170.0)
+    assert exp.is_uniform() and exp.dt == pytest.approx(0.1, rel=1e-9)
+    assert exp.derived == () and set(exp.channels) == {
+        "delta", "psi", "r", "u", "v", "x", "y", "n", "wind_speed", "wind_dir"}
+    assert all(np.all(np.isfinite(getattr(exp, k))) for k in CHANNELS)
+    assert set(exp.extra) == {"wind_speed_relative", "wind_dir_relative"}
+    # README summary: n 0-12 rps, delta -30.3..29.6 deg, u up to 0.33 m/s
+    assert np.max(exp.n) == pytest.approx(12.0)
+    assert np.rad2deg(exp.delta.min()) == pytest.approx(-30.3, abs=0.05)
+    assert np.rad2deg(exp.delta.max()) == pytest.approx(29.6, abs=0.05)
+
+
+@needs_data
+def test_esso_late_start_and_sign():
+    path = data_file("esso_osaka_frt", "random", "random_06-Aug-2020_16_24_25_3.csv")
+    exp = read_esso_osaka(path)
+    assert exp.num_samples == 7179 and exp.t[0] == pytest.approx(1176.1)
+    assert exp.replay().start == pytest.approx(1176.1)
+
+
+@needs_data
+def test_esso_turns_unwrapped_and_signed():
+    """The files' psi_hat is wrapped to [-180, 180] deg; after unwrapping, every turning
+    run turns to the side of its rudder and psi is the integral of r (README: r = dpsi/dt,
+    +35 deg turns reach psi ~ +640 deg)."""
+    paths = sorted((DATA / "esso_osaka_frt" / "turning").glob("*.csv"))
+    if not paths:
+        pytest.skip("Esso Osaka turning runs not found")
+    for path in paths:
+        exp = read_esso_osaka(path)
+        turned = exp.psi[-1] - exp.psi[0]
+        # no 2 pi jumps left (the heading estimate has glitches of up to ~10 deg per step)
+        assert np.max(np.abs(np.diff(exp.psi))) < np.deg2rad(20.0), path.name
+        assert np.sign(turned) == np.sign(np.median(exp.delta)), path.name
+        assert abs(turned) > np.deg2rad(250.0), path.name
+        steps = 0.5 * (exp.r[1:] + exp.r[:-1]) * np.diff(exp.t)
+        heading = np.concatenate([[0.0], np.cumsum(steps)])  # integral of r
+        assert turned == pytest.approx(heading[-1], rel=0.05), path.name
+        # over 2 s windows (the heading estimate is noisy): d(psi)/dt = 1.00-1.03 x mean r
+        w = 20
+        rate, mean_r = (exp.psi[w:] - exp.psi[:-w]) / 2.0, (heading[w:] - heading[:-w]) / 2.0
+        assert np.corrcoef(rate, mean_r)[0, 1] > 0.93, path.name
+        assert np.polyfit(mean_r, rate, 1)[0] == pytest.approx(1.015, abs=0.025), path.name
+
+
+HSVA_RUNS = [
+    "Z_05_01", "Z_10_01", "Z_10_05", "Z_10_10_S", "Z_10_10_P", "Z_15_01", "Z_15_05", "Z_20_05",
+    "Z_20_10_S", "Z_20_10_P", "Z_25_05", "Z_30_05", "Z_35_05",
+]
+
+
+@needs_data
+@pytest.mark.parametrize("run", HSVA_RUNS)
+def test_hsva_kvlcc2(run):
+    exp = read_hsva_kvlcc2(data_file("kvlcc2_simman2008_hsva", f"HSVA_CPMC_KVLCC2_{run}.dat"))
+    assert exp.is_uniform() and exp.dt == pytest.approx(0.05, rel=1e-6)
+    # column 7 is the yaw rate
+    assert np.corrcoef(np.gradient(exp.psi, exp.t), exp.r)[0, 1] > 0.99
+    # body-fixed velocities at the start: straight ahead at about 1.178 m/s
+    assert exp.u[0] == pytest.approx(1.178, abs=0.01) and abs(exp.v[0]) < 0.01
+    assert exp.n[0] == pytest.approx(10.2295)
+    # the first rudder goes to the starting side (starboard unless "_P") and the heading follows
+    side = -1.0 if run.endswith("_P") else 1.0
+    first = np.argmax(np.abs(exp.delta) > np.deg2rad(1.0))
+    assert np.sign(exp.delta[first]) == side
+    reverse = first + np.argmax(np.sign(exp.delta[first:]) == -side)
+    assert side * (exp.psi[reverse] - exp.psi[0]) > np.deg2rad(0.5)
+
+
+@pytest.fixture(scope="module")
+def marin():
+    if DATA is None:
+        pytest.skip("shared/data not found (set JAXSHIP_DATA)")
+    folder = DATA / "kvlcc2_simman2008_marin"
+    runs = {}
+    for key in ("tc_-35", "zz_10"):
+        path = folder / f"MARIN_FREE_KVLCC2_{key}_m.dat"
+        if not path.exists():
+            pytest.skip(f"{path} not found")
+        runs[key] = read_marin_kvlcc2(path)
+    runs["tc_-35 model"] = read_marin_kvlcc2(folder / "MARIN_FREE_KVLCC2_tc_-35_m.dat",
+                                             model_scale=True)
+    return runs
+
+
+def test_marin_time_and_speed(marin):
+    turn = marin["tc_-35"]
+    assert turn.num_samples == 15753  # README rows
+    np.testing.assert_allclose(np.diff(turn.t), 0.13526, rtol=0, atol=1e-11)
+    assert turn.t[-1] == pytest.approx(2131, abs=1.0)
+    for exp in (turn, marin["zz_10"]):
+        assert exp.u[0] == pytest.approx(8.0, abs=0.15)  # body surge at approach
+        assert abs(exp.v[0]) < 0.1
+        assert exp.n[0] == pytest.approx(91.4 / 60, abs=0.01)
+
+
+def test_marin_starboard_turn(marin):
+    """`tc_-35` is the 35 deg turn to starboard: positive rudder and yaw rate in our
+    convention, heading up to about +764 deg."""
+    turn = marin["tc_-35"]
+    steady = (turn.t > 300.0) & (turn.t < 1200.0)
+    assert np.rad2deg(np.median(turn.delta[steady])) == pytest.approx(35.0, abs=1.0)
+    assert np.all(turn.r[steady] > 0.0)
+    assert np.rad2deg(turn.psi.max()) > 700.0
+    assert np.median(turn.v[steady]) < 0.0  # drift outwards: sway to port at midship
+
+
+def test_marin_zigzag_port_first(marin):
+    """`zz_10` starts with +10 deg in MARIN's convention = rudder to port: ours is -10 deg
+    and the heading first decreases."""
+    exp = marin["zz_10"]
+    first = np.argmax(np.abs(exp.delta) > np.deg2rad(3.0))
+    assert np.rad2deg(exp.delta[first + 20]) == pytest.approx(-10.0, abs=1.5)
+    reverse = first + np.argmax(exp.delta[first:] > 0.0)
+    assert exp.psi[reverse] - exp.psi[0] < -np.deg2rad(5.0)
+
+
+def test_marin_model_scale(marin):
+    full, model = marin["tc_-35"], marin["tc_-35 model"]
+    root = np.sqrt(45.714)
+    assert model.dt == pytest.approx(0.02, rel=1e-3)
+    assert model.u[0] == pytest.approx(1.179, abs=0.03)  # HSVA's model approach speed
+    assert model.n[0] * 60 == pytest.approx(614, rel=0.02)  # HSVA: 614 rpm model
+    np.testing.assert_allclose(model.x, full.x / 45.714, rtol=1e-14)
+    np.testing.assert_allclose(model.r, full.r * root, rtol=1e-14)
+    np.testing.assert_allclose(model.psi, full.psi, rtol=0)
+    assert model.meta["lpp"] == pytest.approx(7.0, rel=1e-4)
+
+
+@needs_data
+def test_read_measured_dispatch(tmp_path):
+    cases = {
+        data_file("esso_osaka_frt", "zigzag", "zigzag_31-Jul-2020_13_04_24.csv"): "esso_osaka",
+        data_file("kvlcc2_simman2008_hsva", "HSVA_CPMC_KVLCC2_Z_10_10_P.dat"): "hsva_kvlcc2",
+        data_file("kvlcc2_simman2008_marin", "MARIN_FREE_KVLCC2_zz_-20_m.dat"): "marin_kvlcc2",
+    }
+    trial = tmp_path / "trial.csv"
+    trial.write_text(GOOD)
+    cases[trial] = "trial csv"
+    for path, kind in cases.items():
+        assert read_measured(path).meta["format"] == kind
+    with pytest.raises(ValueError, match="zz_-20_m.dat: no such file"):
+        read_measured(tmp_path / "zz_-20_m.dat")
+
+
+def test_read_measured_unknown_format(tmp_path):
+    path = tmp_path / "notes.txt"
+    path.write_text("hello, world\n1,2\n")
+    with pytest.raises(ValueError, match=r"notes\.txt: unknown measurement format"):
+        read_measured(path)
+    trial = tmp_path / "trial.csv"
+    trial.write_text(GOOD)
+    assert read_measured(trial).num_samples == 3
