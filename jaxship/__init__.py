@@ -13,6 +13,18 @@ from ._data import (
     write_trial_csv as write_trial_csv,
 )
 from ._environment import Current as Current, Environment as Environment, Wind as Wind
+from ._indices import (
+    format_table as format_table,
+    imo_criteria as imo_criteria,
+    initial_turning_indices as initial_turning_indices,
+    loop_width as loop_width,
+    pull_out_indices as pull_out_indices,
+    reverse_spiral_curve as reverse_spiral_curve,
+    spiral_curve as spiral_curve,
+    stopping_indices as stopping_indices,
+    turning_indices as turning_indices,
+    zigzag_indices as zigzag_indices,
+)
 from ._kinematics import body_to_earth as body_to_earth, ssa as ssa
 from ._manoeuvres import (
     AbstractManoeuvre as AbstractManoeuvre,

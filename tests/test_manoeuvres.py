@@ -1,0 +1,233 @@
+"""Manoeuvre generators: the command histories they produce, open and closed loop."""
+
+import jax
+import numpy as np
+import pytest
+from helpers import linear_test_vessel
+
+import jaxship as js
+from jaxship._indices import reverse_spiral_curve
+
+
+DEG = np.pi / 180
+
+
+@pytest.fixture(scope="module")
+def vessel():
+    return linear_test_vessel()
+
+
+@pytest.fixture(scope="module")
+def x0(vessel):
+    return js.straight_run(vessel)
+
+
+def open_loop(manoeuvre, tau):
+    """Rudder and propeller orders of an open-loop manoeuvre at `tau` s after its start."""
+    state = js.straight_state(5.0, n=1.25)
+    memory = manoeuvre.init(state)
+    command = jax.vmap(lambda s: manoeuvre.command(manoeuvre.start + s, state, memory)[0])
+    out = command(np.asarray(tau, dtype=float))
+    return np.asarray(out.delta), np.asarray(out.n)
+
+
+def staircase(levels, durations, tau):
+    """Reference: `levels[i]` on [edge_i, edge_{i+1}), the last level after the end."""
+    edges = np.concatenate([[0.0], np.cumsum(durations)])
+    k = np.clip(np.searchsorted(edges, tau, side="right") - 1, 0, len(levels) - 1)
+    return np.asarray(levels)[k]
+
+
+# --------------------------------------------------------------------------- open loop
+
+
+def test_turn_orders_the_rudder_at_execute(vessel, x0):
+    traj = js.simulate(vessel, js.Turn(-20 * DEG, duration=60.0, dt=0.5, execute=12.5), x0)
+    t = np.asarray(traj.t)
+    np.testing.assert_array_equal(traj.command.delta, np.where(t >= 12.5, -20 * DEG, 0.0))
+    np.testing.assert_array_equal(traj.command.n, np.full_like(t, x0.n))  # rpm held
+    assert traj.state.delta[t <= 12.5].max() == 0.0 and traj.state.delta[-1] < 0
+    assert traj.t.shape == (121,) and bool(np.all(traj.valid))
+    geared = js.simulate(vessel, js.Turn(20 * DEG, duration=60.0, dt=0.5, n=2.0), x0)
+    np.testing.assert_array_equal(geared.command.n, 2.0)
+    np.testing.assert_array_equal(geared.command.delta, 20 * DEG)  # execute 0: from the start
+
+
+def test_spiral_staircase():
+    m = js.spiral(10 * DEG, 5 * DEG, hold=50.0, dt=1.0)
+    levels = np.array([10, 5, 0, -5, -10, -5, 0, 5, 10]) * DEG
+    assert m.duration == 9 * 50.0 and m.num_samples == 451
+    tau = np.arange(m.num_samples) * 1.0
+    delta, _ = open_loop(m, tau)
+    np.testing.assert_allclose(delta, staircase(levels, np.full(9, 50.0), tau), atol=1e-15)
+    # each level held exactly `hold` (50 samples), the last one to the end
+    changes = np.nonzero(np.diff(delta))[0] + 1
+    np.testing.assert_array_equal(changes, 50 * np.arange(1, 9))
+
+
+def test_pull_out():
+    m = js.pull_out(-15 * DEG, turn_time=100.0, release_time=200.0, dt=0.5)
+    assert m.duration == 300.0
+    tau = np.arange(m.num_samples) * 0.5
+    delta, _ = open_loop(m, tau)
+    np.testing.assert_array_equal(delta, np.where(tau < 100.0, -15 * DEG, 0.0))
+
+
+def test_multi_step_3211():
+    A, unit = 8 * DEG, 4.0
+    m = js.multi_step_3211(A, unit, settle=30.0, dt=0.5)
+    assert m.duration == 7 * unit + 30.0
+    tau = np.arange(m.num_samples) * 0.5
+    delta, _ = open_loop(m, tau)
+    expected = staircase([A, -A, A, -A, 0.0], np.array([3, 2, 1, 1, 30 / unit]) * unit, tau)
+    np.testing.assert_array_equal(delta, expected)
+    assert delta[tau == 11.5] == A and delta[tau == 12.0] == -A  # 3 units of +A
+
+
+@pytest.mark.parametrize("order", [5, 6, 7, 8, 9, 10])
+def test_prbs_is_maximum_length_and_balanced(order):
+    A, bit_time, period = 3 * DEG, 2.0, 2**order - 1
+    m = js.prbs(A, bit_time, duration=2 * period * bit_time, order=order, seed=3, dt=bit_time)
+    delta, _ = open_loop(m, bit_time * (np.arange(2 * period) + 0.5))  # bit centres
+    assert set(np.unique(delta)) == {-A, A}
+    bits = delta > 0
+    np.testing.assert_array_equal(bits[:period], bits[period:])  # repeats after 2^order - 1
+    for p in range(1, period):  # and no shorter period divides it
+        if period % p == 0:
+            assert not np.array_equal(bits[:period - p], bits[p:period]), p
+    assert bits[:period].sum() == 2 ** (order - 1)  # ones - zeros = 1 over a period
+    # constant within a bit
+    fine, _ = open_loop(m, np.arange(0.0, 2 * period * bit_time, 0.5))
+    np.testing.assert_array_equal(fine, np.repeat(delta, 4))
+
+
+def test_prbs_bad_arguments():
+    with pytest.raises(ValueError, match="order"):
+        js.prbs(order=4)
+    with pytest.raises(ValueError, match="seed"):
+        js.prbs(order=5, seed=32)
+
+
+def test_thesis_manoeuvre_table_3_1():
+    """Steps 5, 10, 20, 40, 45 deg to both sides, held 2 s/deg, ramped down at 0.3 deg/s."""
+    m = js.thesis_manoeuvre(end_hold=300.0, dt=0.1)
+    steps = (5, 10, 20, 40, 45)
+    # sum over steps and sides of (2 a + a / 0.3) s, then 300 s midships
+    np.testing.assert_allclose(m.duration, 2 * sum(2 * a + a / 0.3 for a in steps) + 300.0)
+    np.testing.assert_allclose(m.duration, 1580.0)
+    tau = np.arange(m.num_samples) * 0.1
+    delta, _ = open_loop(m, tau)
+    expected, start = np.zeros_like(tau), 0.0
+    for a in steps:
+        for side in (1.0, -1.0):
+            hold, ramp = 2.0 * a, a / 0.3
+            on = (tau >= start) & (tau < start + hold)
+            down = (tau >= start + hold) & (tau < start + hold + ramp)
+            expected[on] = side * a
+            expected[down] = side * (a - 0.3 * (tau[down] - start - hold))
+            start += hold + ramp
+    np.testing.assert_allclose(delta / DEG, expected, atol=1e-9)
+    assert delta.max() == 45 * DEG and delta.min() == -45 * DEG
+    np.testing.assert_array_equal(delta[tau > start], 0.0)  # midships at the end
+    slope = np.abs(np.diff(delta)) / 0.1 / DEG
+    moving = (slope > 0) & (slope < 1)  # ramps, away from the steps
+    # all ramp intervals at 0.3 deg/s except the one that ends each of the 10 ramps
+    assert np.count_nonzero(moving & (np.abs(slope - 0.3) > 1e-9)) <= 10
+    assert np.count_nonzero(np.abs(slope - 0.3) <= 1e-9) > 0.9 * 2 * sum(steps) / 0.3 / 0.1
+
+
+def test_stop_orders_astern_at_execute(vessel, x0):
+    traj = js.simulate(vessel, js.Stop(-1.2, duration=100.0, dt=0.5, execute=20.0), x0)
+    t = np.asarray(traj.t)
+    np.testing.assert_array_equal(traj.command.n, np.where(t >= 20.0, -1.2, x0.n))
+    np.testing.assert_array_equal(traj.command.delta, 0.0)
+    assert traj.state.n[-1] < 0 and traj.state.u[-1] < traj.state.u[0]
+
+
+def test_replay_reproduces_a_closed_loop_run_and_pads(vessel, x0):
+    zigzag = js.simulate(vessel, js.ZigZag(15 * DEG, 5 * DEG, duration=150.0, dt=0.5), x0)
+    rec_delta, rec_n = np.asarray(zigzag.command.delta), np.asarray(zigzag.command.n)
+    replay = js.Replay(rec_delta, rec_n, dt=0.5)
+    assert replay.duration == 150.0 and replay.num_samples == rec_delta.size
+    again = js.simulate(vessel, replay, x0)
+    for name in ("u", "v", "r", "x", "y", "psi", "delta", "n"):
+        np.testing.assert_allclose(getattr(again.state, name), getattr(zigzag.state, name),
+                                   rtol=1e-12, atol=1e-12, err_msg=name)
+    # padded to a longer batch length, starting at 100 s
+    padded = js.simulate(vessel, js.Replay(rec_delta, rec_n, dt=0.5, start=100.0,
+                                           num_samples=rec_delta.size + 40), x0)
+    np.testing.assert_allclose(padded.t[0], 100.0)
+    np.testing.assert_array_equal(padded.command.delta[:rec_delta.size], rec_delta)
+    np.testing.assert_array_equal(padded.command.delta[rec_delta.size:], rec_delta[-1])
+    np.testing.assert_array_equal(padded.command.n[rec_delta.size:], rec_n[-1])
+    np.testing.assert_array_equal(padded.valid, np.arange(rec_delta.size + 40) < rec_delta.size)
+    with pytest.raises(ValueError, match="same length"):
+        js.Replay(rec_delta, rec_n[:-1], dt=0.5)
+
+
+# --------------------------------------------------------------------------- closed loop
+
+
+@pytest.mark.parametrize("angle", [20 * DEG, -20 * DEG])
+def test_zigzag_switches_when_the_heading_passes_the_switch_angle(vessel, x0, angle):
+    psi_s, execute, dt = 10 * DEG, 5.0, 0.5
+    traj = js.simulate(
+        vessel, js.ZigZag(angle, psi_s, duration=500.0, dt=dt, execute=execute),
+        js.straight_state(x0.u, x0.n, psi=0.3),
+    )
+    t, psi, order = np.asarray(traj.t), np.asarray(traj.state.psi), np.asarray(traj.command.delta)
+    change = psi - psi[0]
+    side, switches = np.sign(angle), []
+    for k in range(t.size):
+        if t[k] < execute:
+            assert order[k] == 0.0
+            continue
+        if side * change[k] >= psi_s:  # passed on the side the rudder turns the ship to
+            assert side * change[k - 1] < psi_s  # ... at this sample, not before
+            side, switches = -side, switches + [k]
+        assert order[k] == side * abs(angle), k
+    assert order[t >= execute][0] == angle  # port first for a negative angle
+    assert len(switches) >= 4
+    # between switches the heading swings beyond the switch angle (the overshoot)
+    for a, b in zip(switches[:-1], switches[1:]):
+        turning_to = -np.sign(order[a])  # the side the rudder turned the ship to before a
+        assert np.max(turning_to * change[a:b]) > psi_s
+
+
+def test_reverse_spiral_reaches_the_yaw_rate_levels(vessel, x0):
+    rates = np.array([0.3, 0.1, -0.1, -0.3]) * DEG
+    m = js.ReverseSpiral(rates, 400.0, kp=50.0, ki=2.0, duration=1600.0, dt=0.5)
+    traj = js.simulate(vessel, m, x0)
+    t, r = np.asarray(traj.t), np.asarray(traj.state.r)
+    ends = np.searchsorted(t, 400.0 * np.arange(1, 5))
+    np.testing.assert_allclose(r[ends], rates, rtol=5e-3)
+    assert np.all(np.abs(np.asarray(traj.command.delta)) <= 35 * DEG)
+    curve = reverse_spiral_curve(traj, rates=rates, hold=400.0)
+    assert np.all(np.sign(curve.delta) == np.sign(rates))  # course-stable: rudder with rate
+    # the mean rudder of the last level holds that rate in an open-loop steady turn
+    turn = js.simulate(vessel, js.Turn(curve.delta[-1], duration=1500.0, dt=0.5), x0)
+    np.testing.assert_allclose(turn.state.r[-1], rates[-1], rtol=2e-2)
+
+
+def test_heading_autopilot_tracks_the_square_wave(vessel, x0):
+    A, period, dt = 10 * DEG, 600.0, 0.5
+    pd = js.HeadingAutopilot(A, period, kp=2.0, ki=0.0, kd=100.0, duration=1200.0, dt=dt)
+    traj = js.simulate(vessel, pd, js.straight_state(x0.u, x0.n, psi=1.0))
+    t, psi = np.asarray(traj.t), np.asarray(traj.state.psi)
+    for k in range(1, 5):  # at the end of each half period, heading within 0.1 deg of the ref
+        i = np.searchsorted(t, k * period / 2) - 1
+        reference = 1.0 + A * (1 if k % 2 else -1)
+        assert abs(psi[i] - reference) < 0.1 * DEG, (k, (psi[i] - reference) / DEG)
+    # the rudder law, recomputed from the sampled states (PID with anti-windup clip)
+    kp, ki, kd = 2.0, 0.005, 60.0
+    pid = js.HeadingAutopilot(A, period, kp=kp, ki=ki, kd=kd, duration=600.0, dt=dt)
+    traj = js.simulate(vessel, pid, x0)
+    t, psi = np.asarray(traj.t), np.asarray(traj.state.psi)
+    r, order = np.asarray(traj.state.r), np.asarray(traj.command.delta)
+    reference = np.where(np.floor(2 * t / period) % 2 == 0, A, -A)
+    integral, limit, expected = 0.0, 35 * DEG / ki, []
+    for e, rk in zip(reference - psi, r):
+        integral = np.clip(integral + e * dt, -limit, limit)
+        expected.append(np.clip(kp * e + ki * integral - kd * rk, -35 * DEG, 35 * DEG))
+    np.testing.assert_allclose(order, expected, atol=1e-12)
+    assert np.any(np.abs(order) == 35 * DEG)  # the limit is exercised
