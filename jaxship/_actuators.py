@@ -8,8 +8,8 @@ from jaxtyping import Array, ArrayLike
 class RudderServo(eqx.Module):
     """Rudder servo with angle and rate limits (Fossen 2021, sec. 9.3; MSS `mariner.m`).
 
-    $\\dot\\delta = \\mathrm{sat}_{\\dot\\delta_{max}}\\big((\\mathrm{sat}_{\\delta_{max}}(\\delta_c)
-    - \\delta)/T_\\delta\\big)$.
+    $\\dot\\delta = \\mathrm{sat}_{\\dot\\delta_{max}}\\big((\\mathrm{sat}_{\\delta_{max}}
+    (\\delta_c) - \\delta)/T_\\delta\\big)$.
     """
 
     max_angle: ArrayLike  # delta_max [rad]

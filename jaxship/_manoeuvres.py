@@ -136,7 +136,9 @@ class Schedule(AbstractManoeuvre):
         # right-continuous interpolation so that a step at t_k is already taken at t_k
         k = jnp.clip(jnp.searchsorted(times, tau, side="right") - 1, 0, times.shape[0] - 2)
         t_a, t_b, a_a, a_b = times[k], times[k + 1], angles[k], angles[k + 1]
-        w = jnp.where(t_b > t_a, jnp.clip((tau - t_a) / jnp.where(t_b > t_a, t_b - t_a, 1.0), 0, 1), 1.0)
+        w = jnp.where(
+            t_b > t_a, jnp.clip((tau - t_a) / jnp.where(t_b > t_a, t_b - t_a, 1.0), 0, 1), 1.0
+        )
         value = a_a + w * (a_b - a_a)
         value = jnp.where(tau < times[0], angles[0], value)
         return jnp.where(tau >= times[-1], angles[-1], value), memory
@@ -174,8 +176,9 @@ def multi_step_3211(amplitude=np.deg2rad(10), unit=5.0, *, settle=None, dt=0.1, 
     return Schedule(times, angles, duration=7 * unit + settle, dt=dt, n=n)
 
 
-def prbs(amplitude=np.deg2rad(10), bit_time=5.0, duration=600.0, *, order=7, seed=1,
-         dt=0.1, n=None):
+def prbs(
+    amplitude=np.deg2rad(10), bit_time=5.0, duration=600.0, *, order=7, seed=1, dt=0.1, n=None
+):
     """Pseudo-random binary rudder sequence of +-`amplitude`, one bit every `bit_time` s.
 
     A maximum-length linear-feedback shift register of `order` bits (period
@@ -197,8 +200,15 @@ def prbs(amplitude=np.deg2rad(10), bit_time=5.0, duration=600.0, *, order=7, see
     return Schedule(times, angles, duration=duration, dt=dt, n=n)
 
 
-def thesis_manoeuvre(steps_deg=(5, 10, 20, 40, 45), hold_per_deg=2.0, ramp_deg_per_s=0.3,
-                     end_hold=300.0, *, dt=0.1, n=None):
+def thesis_manoeuvre(
+    steps_deg=(5, 10, 20, 40, 45),
+    hold_per_deg=2.0,
+    ramp_deg_per_s=0.3,
+    end_hold=300.0,
+    *,
+    dt=0.1,
+    n=None,
+):
     """The identification manoeuvre of the thesis (Table 3.1, Fig. 3.4).
 
     For each step angle a (5, 10, 20, 40, 45 deg), first to starboard, then to port:
@@ -219,7 +229,7 @@ def thesis_manoeuvre(steps_deg=(5, 10, 20, 40, 45), hold_per_deg=2.0, ramp_deg_p
 
 
 class Stop(AbstractManoeuvre):
-    """Crash stop (ITTC 2.2.7): propeller ordered to `astern_n` [rev/s] at `execute`, rudder midships."""
+    """Crash stop (ITTC 2.2.7): propeller to `astern_n` [rev/s] at `execute`, rudder midships."""
 
     astern_n: ArrayLike  # n_astern [rev/s], negative
     duration: ArrayLike

@@ -25,9 +25,7 @@ class Simulator(eqx.Module):
 
     solver: dfx.AbstractSolver | None = None
     substeps: int = eqx.field(static=True, default=1)
-    stepsize_controller: dfx.AbstractStepSizeController = dfx.PIDController(
-        rtol=1e-8, atol=1e-8
-    )
+    stepsize_controller: dfx.AbstractStepSizeController = dfx.PIDController(rtol=1e-8, atol=1e-8)
     adjoint: dfx.AbstractAdjoint = dfx.RecursiveCheckpointAdjoint()
     max_steps: int = eqx.field(static=True, default=4096)
 
@@ -49,9 +47,15 @@ class Simulator(eqx.Module):
             return y, jnp.array(True)
         sol = dfx.diffeqsolve(
             dfx.ODETerm(lambda t, y, args: rhs(y)),
-            self.solver, t0, t0 + dt, dt / self.substeps, state,
-            stepsize_controller=self.stepsize_controller, adjoint=self.adjoint,
-            max_steps=self.max_steps, throw=False,
+            self.solver,
+            t0,
+            t0 + dt,
+            dt / self.substeps,
+            state,
+            stepsize_controller=self.stepsize_controller,
+            adjoint=self.adjoint,
+            max_steps=self.max_steps,
+            throw=False,
         )
         return jax.tree.map(lambda leaf: leaf[-1], sol.ys), sol.result == dfx.RESULTS.successful
 
@@ -108,12 +112,17 @@ def _simulate(vessel, manoeuvre, x0, environment, simulator):
         step, (x0, memory, jnp.array(True)), jnp.arange(num - 1)
     )
     last_command, _ = manoeuvre.command(t0 + (num - 1) * dt, last, memory)
-    last_command = Command(jnp.asarray(last_command.delta, float), jnp.asarray(last_command.n, float))
+    last_command = Command(
+        jnp.asarray(last_command.delta, float), jnp.asarray(last_command.n, float)
+    )
     append = lambda seq, item: jax.tree.map(lambda a, b: jnp.concatenate([a, b[None]]), seq, item)
     states, commands = append(states, last), append(commands, last_command)
     t = t0 + jnp.arange(num) * dt
     finite = jnp.all(jnp.stack([jnp.all(jnp.isfinite(leaf)) for leaf in jax.tree.leaves(states)]))
     return Trajectory(
-        t=t, state=states, command=commands,
-        valid=t - t0 <= manoeuvre.duration + 1e-9 * dt, success=ok & finite,
+        t=t,
+        state=states,
+        command=commands,
+        valid=t - t0 <= manoeuvre.duration + 1e-9 * dt,
+        success=ok & finite,
     )

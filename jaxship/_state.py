@@ -28,8 +28,14 @@ def straight_state(u: ArrayLike, n: ArrayLike = 0.0, psi: ArrayLike = 0.0) -> Sh
     """Steady straight-ahead state at surge speed `u` [m/s] and propeller rate `n` [rev/s]."""
     zero = jnp.zeros_like(jnp.asarray(u, dtype=float))
     return ShipState(
-        u=jnp.asarray(u, dtype=float), v=zero, r=zero, x=zero, y=zero,
-        psi=zero + psi, delta=zero, n=zero + n,
+        u=jnp.asarray(u, dtype=float),
+        v=zero,
+        r=zero,
+        x=zero,
+        y=zero,
+        psi=zero + psi,
+        delta=zero,
+        n=zero + n,
     )
 
 

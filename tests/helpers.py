@@ -46,9 +46,9 @@ class LinearTestVessel(js.AbstractVessel):
 
     def mass_matrix(self):
         L, m, half = self.length, self.mass, 0.5 * 1025 * self.length**3
-        return jnp.diag(jnp.array(
-            [1.05 * m, m + 0.00748 * half, m * (0.25 * L) ** 2 + 0.000438 * half * L**2]
-        ))
+        return jnp.diag(
+            jnp.array([1.05 * m, m + 0.00748 * half, m * (0.25 * L) ** 2 + 0.000438 * half * L**2])
+        )
 
     def forces(self, u, v, r, delta, n):
         L, q = self.length, 0.5 * 1025 * self.length**2

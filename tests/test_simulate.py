@@ -63,7 +63,9 @@ def test_steady_turn_is_reached(vessel, x0):
 def test_kinetic_energy_decays_without_thrust(vessel):
     """With n = 0 and rudder midships, hull damping only removes energy (C(nu) is skew)."""
     start = js.ShipState(u=6.0, v=0.5, r=0.01, x=0.0, y=0.0, psi=0.0, delta=0.0, n=0.0)
-    traj = js.simulate(vessel, js.Turn(0.0, duration=300.0, n=0.0), start, simulator=js.Simulator(substeps=4))
+    traj = js.simulate(
+        vessel, js.Turn(0.0, duration=300.0, n=0.0), start, simulator=js.Simulator(substeps=4)
+    )
     nu = jnp.stack([traj.state.u, traj.state.v, traj.state.r])
     energy = 0.5 * jnp.einsum("it,ij,jt->t", nu, vessel.mass_matrix(), nu)
     assert np.all(np.diff(energy) <= 1e-9 * energy[0])
@@ -87,7 +89,10 @@ def test_diffrax_fixed_step_matches_fast_path(vessel, x0):
     man = js.Turn(35 * DEG, duration=100.0)
     fast = js.simulate(vessel, man, x0)
     slow = js.simulate(
-        vessel, man, x0, simulator=js.Simulator(dfx.Tsit5(), stepsize_controller=dfx.ConstantStepSize())
+        vessel,
+        man,
+        x0,
+        simulator=js.Simulator(dfx.Tsit5(), stepsize_controller=dfx.ConstantStepSize()),
     )
     np.testing.assert_allclose(fast.state.psi, slow.state.psi, rtol=1e-7, atol=1e-9)
 
@@ -109,8 +114,13 @@ def test_vmap_over_parameters_and_initial_states(vessel, x0):
     starts = eqx.filter_vmap(lambda u: js.straight_state(u, x0.n))(jnp.array([6.0, 7.0]))
     man = js.Turn(20 * DEG, duration=100.0)
     batch = eqx.filter_vmap(lambda v, s: js.simulate(v, man, s))(vessels, starts)
-    single = js.simulate(eqx.tree_at(lambda s: s.nr, vessel, -0.002), man, starts.__class__(
-        **{k: getattr(starts, k)[1] for k in ("u", "v", "r", "x", "y", "psi", "delta", "n")}))
+    single = js.simulate(
+        eqx.tree_at(lambda s: s.nr, vessel, -0.002),
+        man,
+        starts.__class__(
+            **{k: getattr(starts, k)[1] for k in ("u", "v", "r", "x", "y", "psi", "delta", "n")}
+        ),
+    )
     np.testing.assert_allclose(batch.state.r[1], single.state.r, rtol=1e-12)
 
 
@@ -127,7 +137,9 @@ def test_padded_batch_marks_valid_samples(vessel, x0):
 def _final_heading(vessel, x0, simulator):
     def f(nr):
         v = eqx.tree_at(lambda s: s.nr, vessel, nr)
-        return js.simulate(v, js.Turn(20 * DEG, duration=60.0, dt=0.5), x0, simulator=simulator).state.psi[-1]
+        return js.simulate(
+            v, js.Turn(20 * DEG, duration=60.0, dt=0.5), x0, simulator=simulator
+        ).state.psi[-1]
 
     return f
 

@@ -57,7 +57,12 @@ def state_derivative(
     )
     nudot = solve3(vessel.mass_matrix(), tau + jnp.stack(jnp.broadcast_arrays(*wind)))
     return ShipState(
-        u=nudot[0], v=nudot[1], r=nudot[2], x=xdot, y=ydot, psi=state.r,
+        u=nudot[0],
+        v=nudot[1],
+        r=nudot[2],
+        x=xdot,
+        y=ydot,
+        psi=state.r,
         delta=vessel.rudder.rate(state.delta, command.delta),
         n=vessel.shaft.rate(state.n, command.n),
     )
@@ -67,9 +72,16 @@ def solve3(m: Array, b: Array) -> Array:
     """Solve the 3x3 system `m x = b` by Cramer's rule (no LAPACK call on the hot path)."""
     c0 = jnp.cross(m[:, 1], m[:, 2])
     det = jnp.dot(m[:, 0], c0)
-    return jnp.stack([
-        jnp.dot(b, c0), jnp.dot(m[:, 0], jnp.cross(b, m[:, 2])), jnp.dot(m[:, 0], jnp.cross(m[:, 1], b))
-    ]) / det
+    return (
+        jnp.stack(
+            [
+                jnp.dot(b, c0),
+                jnp.dot(m[:, 0], jnp.cross(b, m[:, 2])),
+                jnp.dot(m[:, 0], jnp.cross(m[:, 1], b)),
+            ]
+        )
+        / det
+    )
 
 
 def _ground_body_velocity(state, current_north, current_east):
@@ -100,8 +112,9 @@ def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> Ship
     if n is None:
         n = _newton(lambda nn: surge_force(vessel, jnp.asarray(speed, float), nn), vessel.nominal_n)
     elif speed is None:
-        speed = _newton(lambda uu: surge_force(vessel, uu, jnp.asarray(n, float)),
-                        vessel.nominal_speed)
+        speed = _newton(
+            lambda uu: surge_force(vessel, uu, jnp.asarray(n, float)), vessel.nominal_speed
+        )
     return straight_state(speed, n, psi)
 
 
