@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship.cli import main
 from jaxship._vessel.catalogue import VESSELS
+from jaxship.cli import main
 
 
 def test_vessels_lists_every_preset_with_source(capsys):
