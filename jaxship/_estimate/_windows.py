@@ -1,0 +1,220 @@
+"""Host-side preparation of a fit: data checks and the prediction windows.
+
+A record of N samples is cut into windows of L samples (L = round(T_p / dt), at
+least 1, at most N - 1). Window w starts at sample s = wL from the measured state
+and predicts samples s + 1 .. s + L with the measured inputs held over each
+interval, so every sample but the first of each experiment is predicted exactly once.
+L = N - 1 (one window) is output error (simulation error); L = 1 is equation error
+(one-step-ahead prediction). Experiments of different lengths and sample intervals
+are padded to common (windows, steps) shapes with a mask.
+"""
+
+import math
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .._data import Dataset, Experiment
+from .._steering._base import AuxInputs, WindowStart
+
+
+CHANNEL_NAMES = ("psi", "r")
+
+
+def as_dataset(data) -> Dataset:
+    """An `Experiment`, a sequence of them or a `Dataset` as a `Dataset`."""
+    if isinstance(data, Dataset):
+        return data
+    if isinstance(data, Experiment):
+        return Dataset.from_experiments([data])
+    if isinstance(data, (list, tuple)):
+        for i, e in enumerate(data):
+            if not isinstance(e, Experiment):
+                raise ValueError(f"`dataset[{i}]` is a {type(e).__name__}, not a "
+                                 "jaxship.Experiment.")
+        return Dataset.from_experiments(list(data))
+    raise ValueError(
+        f"`dataset` must be a jaxship Dataset, an Experiment or a list of Experiments, got "
+        f"{type(data).__name__}."
+    )
+
+
+def check_data(ds: Dataset, rudder: str, channels, *, rtol: float = 1e-6) -> None:
+    """Raise `ValueError` naming the experiment for non-finite values, a missing
+    rudder record, non-uniform sampling or too few samples."""
+    if rudder not in ("delta", "delta_c"):
+        raise ValueError(f"`rudder` must be 'delta' or 'delta_c', got {rudder!r}.")
+    for c in channels:
+        if c not in CHANNEL_NAMES:
+            raise ValueError(f"unknown output channel {c!r}; choose from {CHANNEL_NAMES}.")
+    if not channels:
+        raise ValueError("`channels` is empty; choose from ('psi', 'r').")
+    for i, name in enumerate(ds.names):
+        n = ds.lengths[i]
+        where = f"experiment {name!r} (dataset entry {i})"
+        if n < 2:
+            raise ValueError(f"{where}: needs at least 2 samples, has {n}.")
+        if rudder not in ds.experiment_channels[i]:
+            raise ValueError(f"{where}: no measured rudder channel {rudder!r}; estimation "
+                             "replays the recorded rudder.")
+        t = np.asarray(ds.t)[i, :n]
+        for key in ("t", rudder, "psi", "r", "u", "v", "n"):
+            a = np.asarray(getattr(ds, key))[i, :n]
+            bad = np.nonzero(~np.isfinite(a))[0]
+            if bad.size:
+                k = int(bad[0])
+                raise ValueError(
+                    f"{where}: channel {key!r} is {a[k]} at sample {k} (t = {t[k]!r} s) and at "
+                    f"{bad.size - 1} more samples; all values must be finite (cut the record "
+                    "with Experiment.segment or repair the file)."
+                )
+        steps = np.diff(t)
+        dt = float(np.asarray(ds.dt)[i])
+        off = np.nonzero(np.abs(steps - dt) > rtol * dt)[0]
+        if off.size:
+            k = int(off[0]) + 1
+            raise ValueError(
+                f"{where}: sampling is not uniform (t[{k}] - t[{k - 1}] = {steps[k - 1]!r} s, "
+                f"mean interval {dt!r} s); the rudder is replayed with a zero-order hold at a "
+                "constant interval: resample the record first."
+            )
+
+
+class Windows(eqx.Module):
+    """The prediction windows of a dataset, as arrays for the jitted fit.
+
+    `delta`, `aux` leaves, `mask`: shape (E, W, L); `start` (a `WindowStart` with
+    leaves (E, W)) and `dt`: (E, W); `targets`: (C, E, W, L) measured outputs at the
+    ends of the intervals; `weights`: (C,).
+    """
+
+    delta: jax.Array
+    aux: AuxInputs
+    dt: jax.Array
+    start: WindowStart
+    targets: jax.Array
+    mask: jax.Array
+    weights: jax.Array
+    channels: tuple[str, ...] = eqx.field(static=True)
+    substeps: int = eqx.field(static=True)
+
+
+def window_lengths(ds: Dataset, horizon) -> tuple[int, ...]:
+    """Samples per window for each experiment: round(horizon / dt) clipped to
+    [1, N - 1]; N - 1 (output error) for `horizon=None`."""
+    out = []
+    for i, n in enumerate(ds.lengths):
+        if horizon is None:
+            out.append(n - 1)
+            continue
+        horizon = float(horizon)
+        if not (horizon >= 0 and math.isfinite(horizon)):
+            raise ValueError(f"`horizon` must be None or a non-negative number of seconds, "
+                             f"got {horizon}.")
+        steps = int(round(horizon / float(np.asarray(ds.dt)[i])))
+        out.append(min(max(steps, 1), n - 1))
+    return tuple(out)
+
+
+def channel_weights(ds: Dataset, channels, weights) -> np.ndarray:
+    """Residual weights: given, or 1/std of each measured channel (the within-experiment
+    standard deviation over valid samples, pooled), 1 for a constant channel."""
+    if weights is not None:
+        if isinstance(weights, dict):
+            missing = [c for c in channels if c not in weights]
+            if missing:
+                raise ValueError(f"`weights` has no entry for channel {missing[0]!r}.")
+            w = np.array([float(weights[c]) for c in channels])
+        else:
+            w = np.asarray(weights, dtype=float).reshape(-1)
+            if w.shape[0] != len(channels):
+                raise ValueError(f"`weights` has {w.shape[0]} entries for {len(channels)} "
+                                 "channels.")
+        if not np.all(np.isfinite(w) & (w > 0)):
+            raise ValueError(f"`weights` must be positive and finite, got {w}.")
+        return w
+    mask = np.asarray(ds.mask)
+    out = []
+    for c in channels:
+        y = np.asarray(getattr(ds, c))
+        count = mask.sum(axis=1)
+        mean = np.sum(np.where(mask, y, 0.0), axis=1) / count
+        var = np.sum(np.where(mask, (y - mean[:, None]) ** 2, 0.0)) / mask.sum()
+        out.append(1.0 / math.sqrt(var) if var > 0 else 1.0)
+    return np.array(out)
+
+
+def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "delta",
+                  substeps: int = 1):
+    """`(Windows, layout)`; `layout` holds the NumPy index arrays to map window
+    predictions back onto the samples: `target` (E, W, L) sample index, `mask`."""
+    lengths = window_lengths(ds, horizon)
+    num_exp, num = ds.num_experiments, ds.num_samples
+    counts = [len(range(0, n - 1, L)) for n, L in zip(ds.lengths, lengths)]
+    num_w, num_l = max(counts), max(lengths)
+    w_idx = np.arange(num_w)[None, :, None]
+    l_idx = np.arange(num_l)[None, None, :]
+    size = np.array(lengths)[:, None, None]
+    start = w_idx * size  # (E, W, 1)
+    target = start + l_idx + 1
+    valid_len = np.array(ds.lengths)[:, None, None]
+    mask = (l_idx < size) & (target <= valid_len - 1) & (w_idx < np.array(counts)[:, None, None])
+    step_index = np.clip(start + l_idx, 0, num - 1)
+    target_index = np.clip(target, 0, num - 1)
+    start_index = np.clip(start[..., 0], 0, num - 1)  # (E, W)
+    rows = np.arange(num_exp)[:, None, None]
+    rows2 = np.arange(num_exp)[:, None]
+
+    def at(name, index, r):
+        return np.asarray(getattr(ds, name), dtype=np.float64)[r, index]
+
+    weights = channel_weights(ds, channels, weights)
+    dt_e = np.asarray(ds.dt, dtype=np.float64)
+    dt = np.broadcast_to(dt_e[:, None], (num_exp, num_w))
+    rud = np.asarray(getattr(ds, rudder), dtype=np.float64)
+    # integral of the held rudder from the first sample to sample k
+    integral = np.concatenate([np.zeros((num_exp, 1)), np.cumsum(rud[:, :-1], axis=1)], axis=1)
+    integral = integral * dt_e[:, None]
+    first = lambda name: np.broadcast_to(
+        np.asarray(getattr(ds, name), dtype=np.float64)[:, :1], (num_exp, num_w))
+    f = lambda a: jnp.asarray(a, dtype=float)
+    start_values = WindowStart(
+        r=f(at("r", start_index, rows2)),
+        psi=f(at("psi", start_index, rows2)),
+        delta=f(rud[rows2, start_index]),
+        r_first=f(first("r")),
+        psi_first=f(first("psi")),
+        delta_integral=f(integral[rows2, start_index]),
+        elapsed=f(start_index * dt_e[:, None]),
+        aux=AuxInputs(u=f(at("u", start_index, rows2)), v=f(at("v", start_index, rows2)),
+                      n=f(at("n", start_index, rows2))),
+    )
+    windows = Windows(
+        delta=f(at(rudder, step_index, rows)),
+        aux=AuxInputs(u=f(at("u", step_index, rows)), v=f(at("v", step_index, rows)),
+                      n=f(at("n", step_index, rows))),
+        dt=f(dt),
+        start=start_values,
+        targets=f(np.stack([at(c, target_index, rows) for c in channels])),
+        mask=jnp.asarray(mask),
+        weights=f(weights),
+        channels=tuple(channels),
+        substeps=int(substeps),
+    )
+    layout = {"target": target_index, "mask": mask, "lengths": lengths, "weights": weights}
+    return windows, layout
+
+
+def to_timeline(values, layout, shape) -> tuple[np.ndarray, np.ndarray]:
+    """Scatter window values (E, W, L) onto the samples (E, N); returns
+    `(timeline, predicted_mask)` (samples never predicted, e.g. sample 0, are False)."""
+    values = np.asarray(values)
+    out = np.zeros(shape)
+    hit = np.zeros(shape, dtype=bool)
+    mask = layout["mask"]
+    e_idx = np.broadcast_to(np.arange(shape[0])[:, None, None], mask.shape)
+    out[e_idx[mask], layout["target"][mask]] = values[mask]
+    hit[e_idx[mask], layout["target"][mask]] = True
+    return out, hit
