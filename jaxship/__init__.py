@@ -1,6 +1,7 @@
 """jaxship: differentiable ship-manoeuvring simulation and steering-model identification."""
 
 from ._actuators import RudderServo as RudderServo, Shaft as Shaft
+from ._batch import simulate_batch as simulate_batch, stack as stack
 from ._data import (
     Dataset as Dataset,
     Experiment as Experiment,
@@ -13,6 +14,15 @@ from ._data import (
     write_trial_csv as write_trial_csv,
 )
 from ._environment import Current as Current, Environment as Environment, Wind as Wind
+from ._estimate._fit import (
+    ConvergenceWarning as ConvergenceWarning,
+    FitResult as FitResult,
+    IdentifiabilityWarning as IdentifiabilityWarning,
+    PredictionError as PredictionError,
+    fit as fit,
+)
+from ._estimate._linear import initial_estimate as initial_estimate
+from ._estimate._params import Free as Free, param as param
 from ._indices import (
     format_table as format_table,
     imo_criteria as imo_criteria,
@@ -48,11 +58,34 @@ from ._state import (
     Trajectory as Trajectory,
     straight_state as straight_state,
 )
+from ._steering import (
+    AbstractSteeringModel as AbstractSteeringModel,
+    AuxInputs as AuxInputs,
+    Nomoto1 as Nomoto1,
+    Nomoto2 as Nomoto2,
+    NonlinearNomoto as NonlinearNomoto,
+    SteeringTrajectory as SteeringTrajectory,
+    simulate_steering as simulate_steering,
+)
+from ._validate import (
+    ValidationReport as ValidationReport,
+    final_prediction_error as final_prediction_error,
+    fit_percent as fit_percent,
+    parameter_report as parameter_report,
+    validate as validate,
+)
 from ._vessel._base import (
     AbstractVessel as AbstractVessel,
     state_derivative as state_derivative,
     straight_run as straight_run,
 )
+from ._vessel.catalogue import VESSELS as VESSELS, get_vessel as get_vessel
+from ._vessel.esso_osaka import LowSpeedMMGVessel as LowSpeedMMGVessel
+from ._vessel.mariner import Mariner as Mariner
+from ._vessel.mmg import MMGVessel as MMGVessel
+from ._vessel.nomoto import NomotoVessel as NomotoVessel
+from ._vessel.ross import RossVessel as RossVessel
+from ._vessel.sway_yaw import SwayYawVessel as SwayYawVessel
 
 
 __version__ = "0.1.0"

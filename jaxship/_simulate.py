@@ -4,10 +4,11 @@ import diffrax as dfx
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from ._environment import Environment
-from ._state import Command, ShipState, Trajectory, tree_axpy
-from ._vessel._base import AbstractVessel, state_derivative
+from ._state import Command, ShipState, Trajectory
+from ._vessel._base import AbstractVessel, _state_derivative, inverse3
 
 
 class Simulator(eqx.Module):
@@ -31,19 +32,26 @@ class Simulator(eqx.Module):
 
     def advance(self, vessel, environment, state, command, t0, dt):
         """Integrate one sample interval `[t0, t0 + dt]` with a held `command`."""
-        rhs = lambda y: state_derivative(vessel, y, command, environment)
+        mass_inverse = inverse3(vessel.mass_matrix())
+        rhs = lambda y: _flatten(
+            _state_derivative(vessel, _unflatten(y), command, environment, mass_inverse)
+        )
+        y, success = self._integrate(rhs, _flatten(state), t0, dt)
+        return _unflatten(y), success
+
+    def _integrate(self, rhs, y, t0, dt):
+        """Advance the flat state vector `y` over `[t0, t0 + dt]` under `dy/dt = rhs(y)`."""
         if self.solver is None:
             h = dt / self.substeps
 
             def rk4(y, _):
                 k1 = rhs(y)
-                k2 = rhs(tree_axpy(h / 2, k1, y))
-                k3 = rhs(tree_axpy(h / 2, k2, y))
-                k4 = rhs(tree_axpy(h, k3, y))
-                incr = jax.tree.map(lambda a, b, c, d: (a + 2 * b + 2 * c + d) / 6, k1, k2, k3, k4)
-                return tree_axpy(h, incr, y), None
+                k2 = rhs(y + (h / 2) * k1)
+                k3 = rhs(y + (h / 2) * k2)
+                k4 = rhs(y + h * k3)
+                return y + (h / 6) * (k1 + 2 * k2 + 2 * k3 + k4), None
 
-            y, _ = jax.lax.scan(rk4, state, None, length=self.substeps, unroll=self.substeps <= 8)
+            y, _ = jax.lax.scan(rk4, y, None, length=self.substeps, unroll=self.substeps <= 8)
             return y, jnp.array(True)
         sol = dfx.diffeqsolve(
             dfx.ODETerm(lambda t, y, args: rhs(y)),
@@ -51,13 +59,27 @@ class Simulator(eqx.Module):
             t0,
             t0 + dt,
             dt / self.substeps,
-            state,
+            y,
             stepsize_controller=self.stepsize_controller,
             adjoint=self.adjoint,
             max_steps=self.max_steps,
             throw=False,
         )
-        return jax.tree.map(lambda leaf: leaf[-1], sol.ys), sol.result == dfx.RESULTS.successful
+        return sol.ys[-1], sol.result == dfx.RESULTS.successful
+
+
+# The state travels through the integrator as one vector: far fewer (and larger) XLA
+# operations per step than a pytree of eight scalars, which is what makes the fast path
+# fast on CPU (see benchmarks/README.md).
+_FIELDS = ("u", "v", "r", "x", "y", "psi", "delta", "n")
+
+
+def _flatten(state: ShipState):
+    return jnp.stack([jnp.asarray(getattr(state, k), dtype=float) for k in _FIELDS])
+
+
+def _unflatten(y) -> ShipState:
+    return ShipState(*(y[..., i] for i in range(len(_FIELDS))))
 
 
 def simulate(
@@ -83,46 +105,69 @@ def simulate(
 
     Parameter values are traced, never baked in: changing them does not recompile.
     """
-    return _simulate(*_as_arrays((vessel, manoeuvre, x0, environment)), simulator)
+    wind = not _is_static_zero(environment.wind.speed)
+    return _simulate(*_as_arrays((vessel, manoeuvre, x0, environment)), simulator, wind=wind)
+
+
+def _is_static_zero(x) -> bool:
+    """A plain Python (or NumPy) zero: known before tracing, so the work it zeroes is skipped."""
+    return isinstance(x, (int, float, np.number)) and not isinstance(x, bool) and x == 0
 
 
 def _as_arrays(tree):
     """Turn Python numbers in a pytree into arrays so that `filter_jit` traces them."""
+    # NumPy scalars, not `jnp.asarray`: a device transfer per number costs ~25 us, i.e.
+    # milliseconds per call for a vessel with 60 coefficients; jit transfers them at once.
+    dtype = jax.dtypes.canonicalize_dtype(np.float64)
     is_number = lambda x: isinstance(x, (float, int)) and not isinstance(x, bool)
-    return jax.tree.map(lambda x: jnp.asarray(x, dtype=float) if is_number(x) else x, tree)
+    return jax.tree.map(lambda x: np.asarray(x, dtype=dtype) if is_number(x) else x, tree)
 
 
 @eqx.filter_jit
-def _simulate(vessel, manoeuvre, x0, environment, simulator):
+def _simulate(vessel, manoeuvre, x0, environment, simulator, wind=True, per_field=False):
+    """The jitted body of `simulate`.
+
+    Static options: `wind=False` skips the wind loads (a static zero wind speed);
+    `per_field=True` has the time loop emit each state and command component as its own
+    output, which saves a strided copy of the whole batch when the call is vmapped
+    (the batching layer uses it) but costs a little per step for a single run.
+    """
     t0 = manoeuvre.start
-    x0 = jax.tree.map(lambda a: jnp.asarray(a, dtype=float), x0)
-    memory = manoeuvre.init(x0)
+    y0 = _flatten(x0)
+    memory = manoeuvre.init(_unflatten(y0))
     dt = jnp.asarray(manoeuvre.dt, dtype=float)
+    mass_inverse = inverse3(vessel.mass_matrix())  # once per run, outside the time loop
+    num = manoeuvre.num_samples
 
     def step(carry, k):
-        state, memory, ok = carry
+        y, memory, ok = carry
         t = t0 + k * dt
-        command, memory = manoeuvre.command(t, state, memory)
-        command = Command(jnp.asarray(command.delta, float), jnp.asarray(command.n, float))
-        new_state, success = simulator.advance(vessel, environment, state, command, t, dt)
-        return (new_state, memory, ok & success), (state, command)
+        command, memory = manoeuvre.command(t, _unflatten(y), memory)
+        delta, n = jnp.asarray(command.delta, float), jnp.asarray(command.n, float)
+        held = Command(delta, n)
+        rhs = lambda z: _flatten(
+            _state_derivative(vessel, _unflatten(z), held, environment, mass_inverse, wind=wind)
+        )
+        new_y, success = simulator._integrate(rhs, y, t, dt)
+        # the last sample's step is integrated but thrown away: no concatenation
+        # (a copy of the whole output) after the loop
+        ok = ok & (success | (k == num - 1))
+        if per_field:
+            out = tuple(y[i] for i in range(len(_FIELDS))) + (delta, n)
+        else:
+            out = jnp.concatenate([y, jnp.stack([delta, n])])
+        return (new_y, memory, ok), out
 
-    num = manoeuvre.num_samples
-    (last, memory, ok), (states, commands) = jax.lax.scan(
-        step, (x0, memory, jnp.array(True)), jnp.arange(num - 1)
-    )
-    last_command, _ = manoeuvre.command(t0 + (num - 1) * dt, last, memory)
-    last_command = Command(
-        jnp.asarray(last_command.delta, float), jnp.asarray(last_command.n, float)
-    )
-    append = lambda seq, item: jax.tree.map(lambda a, b: jnp.concatenate([a, b[None]]), seq, item)
-    states, commands = append(states, last), append(commands, last_command)
+    (_, _, ok), out = jax.lax.scan(step, (y0, memory, jnp.array(True)), jnp.arange(num))
+    if not per_field:
+        out = tuple(out[:, i] for i in range(len(_FIELDS) + 2))
+    state, command = ShipState(*out[:-2]), Command(*out[-2:])
     t = t0 + jnp.arange(num) * dt
-    finite = jnp.all(jnp.stack([jnp.all(jnp.isfinite(leaf)) for leaf in jax.tree.leaves(states)]))
+    finite = jnp.all(jnp.stack([jnp.all(jnp.isfinite(a)) for a in out[:-2]]))
     return Trajectory(
         t=t,
-        state=states,
-        command=commands,
+        state=state,
+        command=command,
         valid=t - t0 <= manoeuvre.duration + 1e-9 * dt,
         success=ok & finite,
     )

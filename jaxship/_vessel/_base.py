@@ -48,14 +48,32 @@ def state_derivative(
     vessel: AbstractVessel, state: ShipState, command: Command, environment: Environment
 ) -> ShipState:
     """Time derivative of the full state: dynamics, kinematics and actuators."""
+    return _state_derivative(vessel, state, command, environment, inverse3(vessel.mass_matrix()))
+
+
+def _state_derivative(
+    vessel: AbstractVessel,
+    state: ShipState,
+    command: Command,
+    environment: Environment,
+    mass_inverse: Array,
+    *,
+    wind: bool = True,
+) -> ShipState:
+    """`state_derivative` with $M^{-1}$ given (the simulator inverts $M$ once per run, not
+    four times per step) and, with `wind=False`, without the wind loads (the simulator
+    passes it when the wind speed is a static zero, where the loads vanish identically)."""
     tau = vessel.forces(state.u, state.v, state.r, state.delta, state.n)
     xdot, ydot = environment.ground_velocity(state.u, state.v, state.psi)
-    cn, ce = environment.current.velocity()
-    ug, vg = _ground_body_velocity(state, cn, ce)
-    wind = environment.wind.loads(
-        ug, vg, state.psi, vessel.frontal_wind_area, vessel.lateral_wind_area, vessel.length
-    )
-    nudot = solve3(vessel.mass_matrix(), tau + jnp.stack(jnp.broadcast_arrays(*wind)))
+    if wind:
+        cn, ce = environment.current.velocity()
+        ug, vg = _ground_body_velocity(state, cn, ce)
+        loads = environment.wind.loads(
+            ug, vg, state.psi, vessel.frontal_wind_area, vessel.lateral_wind_area, vessel.length
+        )
+        tau = tau + jnp.stack(jnp.broadcast_arrays(*loads))
+    # written out: a 3x3 `dot` is a library call per evaluation on CPU, this fuses
+    nudot = mass_inverse[:, 0] * tau[0] + mass_inverse[:, 1] * tau[1] + mass_inverse[:, 2] * tau[2]
     return ShipState(
         u=nudot[0],
         v=nudot[1],
@@ -66,6 +84,14 @@ def state_derivative(
         delta=vessel.rudder.rate(state.delta, command.delta),
         n=vessel.shaft.rate(state.n, command.n),
     )
+
+
+def inverse3(m: Array) -> Array:
+    """Inverse of a 3x3 matrix by its adjugate (no LAPACK call on the hot path)."""
+    c0 = jnp.cross(m[:, 1], m[:, 2])
+    c1 = jnp.cross(m[:, 2], m[:, 0])
+    c2 = jnp.cross(m[:, 0], m[:, 1])
+    return jnp.stack([c0, c1, c2]) / jnp.dot(m[:, 0], c0)
 
 
 def solve3(m: Array, b: Array) -> Array:

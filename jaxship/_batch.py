@@ -1,0 +1,260 @@
+"""The batching layer: many simulations in one compiled call, sharded over all devices.
+
+`simulate_batch` vmaps `simulate` over a leading batch axis of any of its inputs and
+splits that axis across the devices of a `jax.sharding.Mesh` with `jax.shard_map`
+(one device: plain vmap). Multi-host runs use the same code after
+`jax.distributed.initialize()`; see `benchmarks/README.md`.
+"""
+
+from collections.abc import Callable, Sequence
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jax.sharding import Mesh, PartitionSpec as P
+
+from ._environment import Environment
+from ._simulate import Simulator, _as_arrays, _is_static_zero, _simulate
+from ._state import Trajectory, straight_state
+from ._vessel._base import surge_force
+
+
+_AXIS = "batch"  # name of the mesh axis the batch is split over
+
+
+def stack(modules: Sequence) -> eqx.Module:
+    """Stack modules of one structure (vessels, manoeuvres, states...) along a new leading axis.
+
+    Numbers and arrays become arrays with a leading batch axis; everything else (static
+    fields, `None`) must be equal across the modules. Manoeuvres of different durations
+    stack when they share `num_samples` (pass it explicitly to pad them to one length).
+    """
+    modules = list(modules)
+    if not modules:
+        raise ValueError("`stack` needs at least one module.")
+    leaves0, treedef = jax.tree.flatten(modules[0])
+    for i, m in enumerate(modules[1:], start=1):
+        if jax.tree.structure(m) != treedef:
+            raise ValueError(
+                f"module {i} differs in structure (type, static fields such as `num_samples`, "
+                f"or which fields are None) from module 0:\n{jax.tree.structure(m)}\nvs\n{treedef}"
+            )
+    columns = zip(*(jax.tree.leaves(m) for m in modules))
+
+    def stack_leaf(xs):
+        if any(isinstance(x, jax.Array) for x in xs):
+            return jnp.stack([jnp.asarray(x) for x in xs])
+        if all(isinstance(x, (int, float, complex, np.ndarray, np.generic)) for x in xs):
+            return np.stack([np.asarray(x) for x in xs])
+        raise ValueError(f"cannot stack leaves of type {type(xs[0]).__name__}.")
+
+    return jax.tree.unflatten(treedef, [stack_leaf(xs) for xs in columns])
+
+
+def simulate_batch(
+    vessel,
+    manoeuvre,
+    x0,
+    *,
+    environment: Environment = Environment(),
+    simulator: Simulator = Simulator(),
+    in_axes=(None, 0, 0, None),
+    output: Callable | None = None,
+    chunk_size: int | None = None,
+    devices: Sequence | None = None,
+):
+    """Simulate a batch of runs in one compiled call, split across devices.
+
+    **Arguments:**
+
+    - `vessel`, `manoeuvre`, `x0`, `environment`, `simulator`: as for `simulate`; the
+      batched ones carry a leading batch axis on their array leaves (build them with
+      `stack`, or with arrays in place of numbers, e.g. `straight_state(speeds)`).
+    - `in_axes`: which of `(vessel, manoeuvre, x0, environment)` are batched: `0` for
+      a leading batch axis, `None` for shared by all runs, as in `jax.vmap`; each entry
+      may also be a pytree prefix of its argument (e.g. a vessel with `0` on some
+      fields and `None` on the rest). The default batches the manoeuvre and the initial
+      state, with one vessel in one environment. All batched leaves must share the
+      batch size; 0-d leaves of a batched argument are shared by all runs (so
+      `ZigZag(angles, 20 * DEG, duration=600.0)` batches the angle only).
+    - `output`: optional function of one run's `Trajectory` returning what to keep
+      (e.g. `batch_turning_indices`); computed inside the compiled call, so the full
+      trajectories of a large sweep need never leave it.
+    - `chunk_size`: simulate at most this many runs at a time on each device
+      (`jax.lax.map` with `batch_size`), to bound the memory of large batches; `None`
+      runs each device's share at once.
+    - `devices`: the devices to split the batch over (default: `jax.devices()`, all
+      devices of all processes). The batch is padded to a multiple of their number by
+      repeating the last run, and the padding trimmed from the result.
+
+    **Returns:** the `Trajectory` (or `output`) of every run, with the batch axis in front.
+
+    Values never trigger recompilation; the batch size, the shapes and the static
+    structure (manoeuvre type, `num_samples`, `simulator`) do.
+    """
+    wind = not _is_static_zero(getattr(getattr(environment, "wind", None), "speed", None))
+    args = _as_arrays((vessel, manoeuvre, x0, environment))
+    if not (isinstance(in_axes, tuple) and len(in_axes) == 4):
+        raise ValueError("`in_axes` must be a 4-tuple for (vessel, manoeuvre, x0, environment).")
+    names = ("vessel", "manoeuvre", "x0", "environment")
+    axes = tuple(_resolve_axes(a, arg, name) for a, arg, name in zip(in_axes, args, names))
+    is_none = lambda x: x is None
+    # a 0-d leaf cannot carry a batch axis: it is shared even inside a batched argument
+    axes = jax.tree.map(
+        lambda ax, x: None if np.ndim(x) == 0 else ax, axes, args, is_leaf=is_none
+    )
+    batched = jax.tree.map(lambda ax, x: x if ax == 0 else None, axes, args, is_leaf=is_none)
+    shared = jax.tree.map(lambda ax, x: None if ax == 0 else x, axes, args, is_leaf=is_none)
+    sizes = {np.shape(leaf)[0] for leaf in jax.tree.leaves(batched)}
+    if not sizes:
+        raise ValueError("nothing is batched: set an entry of `in_axes` to 0.")
+    if len(sizes) > 1:
+        detail = {
+            name: sorted({np.shape(x)[0] for x in jax.tree.leaves(b)})
+            for name, b in zip(names, batched)
+            if jax.tree.leaves(b)
+        }
+        raise ValueError(f"batched inputs disagree on the batch size: {detail}.")
+    size = sizes.pop()
+    devices = tuple(jax.devices() if devices is None else devices)
+    mesh = Mesh(np.array(devices), (_AXIS,)) if len(devices) > 1 else None
+    b_dyn, b_static = eqx.partition(batched, eqx.is_array)
+    s_dyn, s_static = eqx.partition(shared, eqx.is_array)
+    return _batched(
+        b_dyn, s_dyn, b_static, s_static, simulator, output, wind, size, mesh, chunk_size
+    )
+
+
+def _resolve_axes(prefix, tree, name):
+    """Per-leaf batch axes (0 or None) from a `vmap`-style prefix."""
+    def broadcast(ax, sub):
+        if ax not in (0, None):
+            raise ValueError(f"`in_axes` for {name} may only hold 0 or None, got {ax!r}.")
+        return jax.tree.map(lambda _: ax, sub)
+
+    try:
+        return jax.tree.map(broadcast, prefix, tree, is_leaf=lambda x: x is None)
+    except ValueError as e:
+        raise ValueError(f"`in_axes` for {name} is not a prefix of it: {e}") from None
+
+
+@eqx.filter_jit
+def _batched(b_dyn, s_dyn, b_static, s_static, simulator, output, wind, size, mesh, chunk_size):
+    def one(b, s):
+        vessel, manoeuvre, x0, environment = eqx.combine(b, b_static, s, s_static)
+        traj = _simulate.__wrapped__(
+            vessel, manoeuvre, x0, environment, simulator, wind=wind, per_field=True
+        )
+        return traj if output is None else output(traj)
+
+    def local(b, s):  # the runs of one device (all runs without a mesh)
+        if chunk_size is None:
+            return jax.vmap(one, in_axes=(0, None))(b, s)
+        return jax.lax.map(lambda bi: one(bi, s), b, batch_size=chunk_size)
+
+    if mesh is None:
+        return local(b_dyn, s_dyn)
+    count = mesh.devices.size
+    padded = -(-size // count) * count
+    if padded != size:  # repeat the last run: padding that is a valid, finite run
+        b_dyn = jax.tree.map(
+            lambda a: jnp.concatenate([a, jnp.repeat(a[-1:], padded - size, axis=0)]), b_dyn
+        )
+    out = jax.shard_map(
+        local, mesh=mesh, in_specs=(P(_AXIS), P()), out_specs=P(_AXIS), check_vma=False
+    )(b_dyn, s_dyn)
+    # trimming the padding gathers the result (XLA shards only evenly): choose batch
+    # sizes divisible by the device count to keep large outputs split over the devices
+    return out if padded == size else jax.tree.map(lambda a: a[:size], out)
+
+
+def straight_run_batch(vessel, *, speed=None, n=None, iterations: int = 40):
+    """Straight runs for arrays of propeller rates `n` [rev/s] or speeds `speed` [m/s].
+
+    The vectorised counterpart of `jaxship.straight_run` (one compiled Newton
+    iteration on the surge force for all values at once): give `n` to solve for the
+    equilibrium speed, or `speed` to solve for the self-propulsion rate. Returns a
+    `ShipState` with the batch axis of the input. For vessels without a propeller term
+    give both (nothing to solve).
+    """
+    if speed is None and n is None:
+        raise ValueError("give `speed` or `n` (arrays).")
+    speed = None if speed is None else jnp.asarray(speed, dtype=float)
+    n = None if n is None else jnp.asarray(n, dtype=float)
+    u, rate = _straight_runs(_as_arrays(vessel), speed, n, iterations)
+    return straight_state(u, rate)
+
+
+@eqx.filter_jit
+def _straight_runs(vessel, speed, n, iterations):
+    def newton(f, x):
+        def body(_, x):
+            fx, dfx = jax.value_and_grad(f)(x)
+            return jnp.where(jnp.abs(dfx) > 1e-300, x - fx / jnp.where(dfx == 0, 1.0, dfx), x)
+
+        return jax.lax.fori_loop(0, iterations, body, x)
+
+    if speed is not None and n is not None:
+        return speed, n
+    if n is None:
+        guess = jnp.asarray(vessel.nominal_n, dtype=float)
+        rate = jax.vmap(lambda uu: newton(lambda nn: surge_force(vessel, uu, nn), guess))(speed)
+        return speed, rate
+    guess = jnp.asarray(vessel.nominal_speed, dtype=float)
+    return jax.vmap(lambda nn: newton(lambda uu: surge_force(vessel, uu, nn), guess))(n), n
+
+
+# --------------------------------------------------------------------------- indices
+
+
+def batch_turning_indices(traj: Trajectory) -> dict:
+    """Advance, transfer, tactical diameter and more of turning circles, in JAX.
+
+    The jit- and vmap-friendly counterpart of `jaxship.turning_indices` (same
+    definitions: rudder order at the first sample whose rudder command leaves the
+    initial rudder angle, positions rotated into the course frame there, 90 and 180 deg
+    heading change located by linear interpolation between samples; steady diameter
+    $2U/|r|$ and speed loss from the last valid sample). Works on any leading batch axes;
+    indices that are not reached are NaN. Returns a dict of arrays in SI units:
+    `advance`, `transfer`, `tactical_diameter`, `steady_turning_diameter` [m],
+    `time_to_90`, `time_to_180`, `execute_time` [s], `speed_loss` [-].
+    """
+    s, t = traj.state, jnp.broadcast_to(traj.t, traj.state.psi.shape)
+    take = lambda a, i: jnp.take_along_axis(a, i[..., None], axis=-1)[..., 0]
+    num = s.psi.shape[-1]
+    valid = traj.valid & jnp.isfinite(s.psi)
+    moved = (jnp.abs(traj.command.delta - s.delta[..., :1]) > 1e-9) & valid
+    i_e = jnp.argmax(moved, axis=-1)
+    i_last = jnp.sum(valid, axis=-1) - 1
+    psi_e, t_e = take(s.psi, i_e), take(t, i_e)
+    c, sn = jnp.cos(psi_e)[..., None], jnp.sin(psi_e)[..., None]
+    dx, dy = s.x - take(s.x, i_e)[..., None], s.y - take(s.y, i_e)[..., None]
+    along, athwart = c * dx + sn * dy, -sn * dx + c * dy
+    change = s.psi - psi_e[..., None]
+    side = jnp.sign(take(change, i_last))
+    h = side[..., None] * change
+    after = (jnp.arange(num) >= i_e[..., None]) & valid
+
+    def at_heading(level):
+        hit = (h >= level) & after
+        j = jnp.argmax(hit, axis=-1)
+        jm = jnp.maximum(j - 1, 0)
+        h0, h1 = take(h, jm), take(h, j)
+        w = jnp.where(j > i_e, (level - h0) / jnp.where(h1 > h0, h1 - h0, 1.0), 1.0)
+        found = jnp.any(hit, axis=-1) & (side != 0)
+        return lambda a: jnp.where(found, take(a, jm) + w * (take(a, j) - take(a, jm)), jnp.nan)
+
+    at90, at180 = at_heading(jnp.pi / 2), at_heading(jnp.pi)
+    speed = jnp.hypot(s.u, s.v)
+    u_end, r_end = take(speed, i_last), take(s.r, i_last)
+    return dict(
+        advance=at90(along),
+        transfer=side * at90(athwart),
+        tactical_diameter=side * at180(athwart),
+        steady_turning_diameter=2 * u_end / jnp.abs(r_end),
+        speed_loss=1 - u_end / take(speed, i_e),
+        time_to_90=at90(t) - t_e,
+        time_to_180=at180(t) - t_e,
+        execute_time=t_e,
+    )
