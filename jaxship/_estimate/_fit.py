@@ -53,6 +53,10 @@ class PredictionError(eqx.Module):
     - `channels`: fitted outputs, `"psi"` (heading, rad) and/or `"r"` (yaw rate,
       rad/s). Both are unwrapped records, so the heading error is a plain
       difference (no angle wrapping, which would make output error periodic).
+      `"u"` and `"v"` (surge and sway velocity, m/s; measured in every experiment)
+      are outputs of vessels and of steering models with a state of that name.
+      `None` (default): `("psi", "r")` for steering models, `("psi", "r", "u", "v")`
+      for vessels.
     - `weights`: per-channel residual weights (dict or sequence); default
       1 / (standard deviation of the measured channel), which makes the residuals
       dimensionless.
@@ -69,10 +73,13 @@ class PredictionError(eqx.Module):
       but counted in the FPE), which removes the errors-in-variables bias of a noisy
       start sample: use it for output error on noisy data (MATLAB's
       `InitialState='estimate'`). Costs two parameters per window.
+    - `wind`: vessels only: replay the measured true wind (`wind_speed`,
+      `wind_dir`, held over each interval) as loads of `jaxship.Wind` on the
+      vessel's wind areas. Default False: calm water.
     """
 
     horizon: float | None = None
-    channels: tuple[str, ...] = ("psi", "r")
+    channels: tuple[str, ...] | None = None
     weights: dict | tuple | None = None
     rudder: str = "delta"
     substeps: int = 1
@@ -80,6 +87,7 @@ class PredictionError(eqx.Module):
     max_steps: int = 256
     max_lag: int = 25
     initial: str = "measured"
+    wind: bool = False
 
 
 def _predict(model, w: Windows, offsets=None):
@@ -92,8 +100,12 @@ def _predict(model, w: Windows, offsets=None):
         if offset is not None:
             x0 = x0.at[0].add(offset[0])
             psi0 = psi0 + offset[1]
-        psi, r, _ = propagate(model, x0, psi0, delta, aux, dt, w.substeps)
-        return {"psi": psi, "r": r}
+        psi, r, states = propagate(model, x0, psi0, delta, aux, dt, w.substeps)
+        out = {"psi": psi, "r": r}
+        for c in w.channels:  # "u", "v": the model state of that name
+            if c not in out:
+                out[c] = states[:, model.state_names.index(c)]
+        return out
 
     out = jax.vmap(jax.vmap(one))(w.start, w.delta, w.aux, w.dt, offsets)
     return jnp.stack([out[c] for c in w.channels])
@@ -173,7 +185,7 @@ class FitResult(eqx.Module):
     - `names`, `values`, `std`, `covariance`, `correlation`: shortcuts.
     """
 
-    model: AbstractSteeringModel
+    model: eqx.Module  # an AbstractSteeringModel or an AbstractVessel
     parameters: ParameterReport
     metrics: dict
     predictions: dict
@@ -265,8 +277,13 @@ class FitResult(eqx.Module):
 
 
 def _field_names(model):
+    from .._vessel._base import AbstractVessel
     from ._params import parameter_fields
 
+    if isinstance(model, AbstractVessel):
+        from ._vessel_fit import vessel_coefficients
+
+        return tuple(vessel_coefficients(model))
     return tuple(parameter_fields(model))
 
 
@@ -357,13 +374,25 @@ def fit(model: AbstractSteeringModel, dataset, *, estimator: PredictionError = P
     correlations, large relative errors, undetermined combinations, no excitation);
     `ConvergenceWarning` when the optimiser did not converge.
     """
-    if not isinstance(model, AbstractSteeringModel):
-        raise ValueError(f"`model` must be a jaxship steering model (AbstractSteeringModel), "
-                         f"got {type(model).__name__}.")
+    from .._vessel._base import AbstractVessel
+
     if not isinstance(estimator, PredictionError):
         raise ValueError(f"`estimator` must be a PredictionError, got {type(estimator).__name__}.")
+    if isinstance(model, AbstractVessel):
+        from ._vessel_fit import fit_vessel
+
+        return fit_vessel(model, dataset, estimator=estimator, free=free, verbose=verbose)
+    if not isinstance(model, AbstractSteeringModel):
+        raise ValueError(f"`model` must be a jaxship steering model (AbstractSteeringModel) "
+                         f"or vessel (AbstractVessel), got {type(model).__name__}.")
+    if estimator.wind:
+        raise ValueError("`wind=True` is for vessels; steering models have no wind loads.")
     ds = as_dataset(dataset)
-    channels = tuple(estimator.channels)
+    channels = ("psi", "r") if estimator.channels is None else tuple(estimator.channels)
+    for c in channels:
+        if c in ("u", "v") and c not in model.state_names:
+            raise ValueError(f"unknown output channel {c!r} for {type(model).__name__}, whose "
+                             f"outputs are psi, r and its states {model.state_names}.")
     check_data(ds, estimator.rudder, channels)
     if int(estimator.substeps) < 1:
         raise ValueError(f"`substeps` must be a positive integer, got {estimator.substeps}.")
@@ -379,7 +408,6 @@ def fit(model: AbstractSteeringModel, dataset, *, estimator: PredictionError = P
         raise ValueError("`initial='estimate'` needs windows of at least 2 samples (with one "
                          "sample the estimated start explains every residual); use a longer "
                          "`horizon` or initial='measured'.")
-    d = len(specs)
     start = np.array([s.start for s in specs])
     z0 = transform.to_unconstrained(start)
     offset_scale = None
@@ -395,6 +423,17 @@ def fit(model: AbstractSteeringModel, dataset, *, estimator: PredictionError = P
     z, result, num_steps = _solve(z0, base, transform, windows, offset_scale, solver,
                                   int(estimator.max_steps))
     p, pred, jac = _evaluate(z, base, transform, windows, offset_scale)
+    return _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
+                   result, num_steps, estimate_starts=estimate_starts, verbose=verbose,
+                   stacklevel=3)
+
+
+def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac, result,
+            num_steps, *, estimate_starts=False, verbose=False, stacklevel=2) -> FitResult:
+    """The `FitResult` from the optimum: residuals, covariance, identifiability and
+    validation metrics on the host (shared by steering-model and vessel fits)."""
+    channels = windows.channels
+    d = len(specs)
     values = np.asarray(p, dtype=np.float64)
     fitted = rebuild(model, transform.names, [float(v) for v in values])
 
@@ -442,8 +481,8 @@ def fit(model: AbstractSteeringModel, dataset, *, estimator: PredictionError = P
         print(out.summary())
     if not out.success:
         warnings.warn(f"fit of {type(model).__name__}: the optimiser stopped without "
-                      f"converging ({out.message}).", ConvergenceWarning, stacklevel=2)
+                      f"converging ({out.message}).", ConvergenceWarning, stacklevel=stacklevel)
     if report.flags:
         warnings.warn(f"fit of {type(model).__name__}: " + " ".join(report.flags),
-                      IdentifiabilityWarning, stacklevel=2)
+                      IdentifiabilityWarning, stacklevel=stacklevel)
     return out

@@ -20,7 +20,9 @@ from .._data import Dataset, Experiment
 from .._steering._base import AuxInputs, WindowStart
 
 
-CHANNEL_NAMES = ("psi", "r")
+# fittable outputs: heading and yaw rate for every model; surge and sway velocity for
+# vessels and for steering models with a state of that name (see `_fit._predict`)
+CHANNEL_NAMES = ("psi", "r", "u", "v")
 
 
 def as_dataset(data) -> Dataset:
@@ -50,7 +52,7 @@ def check_data(ds: Dataset, rudder: str, channels, *, rtol: float = 1e-6) -> Non
         if c not in CHANNEL_NAMES:
             raise ValueError(f"unknown output channel {c!r}; choose from {CHANNEL_NAMES}.")
     if not channels:
-        raise ValueError("`channels` is empty; choose from ('psi', 'r').")
+        raise ValueError(f"`channels` is empty; choose from {CHANNEL_NAMES}.")
     for i, name in enumerate(ds.names):
         n = ds.lengths[i]
         where = f"experiment {name!r} (dataset entry {i})"
@@ -59,6 +61,10 @@ def check_data(ds: Dataset, rudder: str, channels, *, rtol: float = 1e-6) -> Non
         if rudder not in ds.experiment_channels[i]:
             raise ValueError(f"{where}: no measured rudder channel {rudder!r}; estimation "
                              "replays the recorded rudder.")
+        for c in channels:
+            if c in ("u", "v") and c not in ds.experiment_channels[i]:
+                raise ValueError(f"{where}: output channel {c!r} is fitted but was not "
+                                 "measured; drop it from `channels` or use data with it.")
         t = np.asarray(ds.t)[i, :n]
         for key in ("t", rudder, "psi", "r", "u", "v", "n"):
             a = np.asarray(getattr(ds, key))[i, :n]

@@ -1,0 +1,86 @@
+"""`predict`: a model's prediction-error outputs on (new) data, for validation.
+
+The same windows as `fit` with the same `PredictionError` (horizon, channels,
+replayed rudder, wind): `horizon=None` is a free simulation of each experiment from
+its first sample (output error); a finite horizon restarts from the measured state
+every `horizon` seconds (k-step-ahead prediction). Works for steering models and
+vessels alike.
+"""
+
+import dataclasses
+
+import equinox as eqx
+import numpy as np
+
+from .._validate import ValidationReport, validate
+from .._vessel._base import AbstractVessel
+from ._fit import PredictionError, _predict as _steering_predict
+from ._params import as_arrays
+from ._vessel_fit import _check_vessel_data, _predict as _vessel_predict, _vessel_inputs
+from ._windows import as_dataset, build_windows, check_data, to_timeline
+
+
+_steering = eqx.filter_jit(lambda model, w: _steering_predict(model, w))
+_vessel = eqx.filter_jit(_vessel_predict)
+
+
+@dataclasses.dataclass(frozen=True)
+class Prediction:
+    """Result of `predict`: `predictions` `{channel: (E, N)}` at the dataset's samples,
+    `predicted` (E, N) mask of predicted samples, `metrics` `{channel:
+    ValidationReport}` (fit %, loss, whiteness...), the estimator's `horizon` [s],
+    `window_samples` per experiment and the `experiment_names`."""
+
+    predictions: dict
+    predicted: np.ndarray
+    metrics: dict[str, ValidationReport]
+    horizon: float | None
+    window_samples: tuple[int, ...]
+    experiment_names: tuple[str, ...]
+
+    def fit_percent(self) -> dict[str, float]:
+        """`{channel: fit %}` pooled over the experiments."""
+        return {c: m.fit_percent for c, m in self.metrics.items()}
+
+    def fit_per_experiment(self) -> dict[str, dict[str, float]]:
+        """`{experiment: {channel: fit %}}`."""
+        return {name: {c: float(m.fit_per_experiment[i]) for c, m in self.metrics.items()}
+                for i, name in enumerate(self.experiment_names)}
+
+
+def predict(model, dataset, *, estimator: PredictionError = PredictionError()) -> Prediction:
+    """Predict the measured outputs of `dataset` with `model` (a steering model or a
+    vessel) as `fit` does with `estimator`, and validate them (see `Prediction`).
+
+    Raises `ValueError` for bad data as `fit` does.
+    """
+    ds = as_dataset(dataset)
+    is_vessel = isinstance(model, AbstractVessel)
+    channels = estimator.channels
+    if channels is None:
+        channels = ("psi", "r", "u", "v") if is_vessel else ("psi", "r")
+    channels = tuple(channels)
+    check_data(ds, estimator.rudder, channels)
+    windows, layout = build_windows(ds, horizon=estimator.horizon, channels=channels,
+                                    weights=estimator.weights, rudder=estimator.rudder,
+                                    substeps=int(estimator.substeps))
+    if is_vessel:
+        _check_vessel_data(ds, estimator)
+        inputs = _vessel_inputs(ds, model, layout, bool(estimator.wind), estimator.rudder)
+        pred = _vessel(as_arrays(model), windows, inputs)
+    else:
+        for c in channels:
+            if c in ("u", "v") and c not in model.state_names:
+                raise ValueError(f"unknown output channel {c!r} for {type(model).__name__}.")
+        pred = _steering(as_arrays(model), windows)
+    pred = np.asarray(pred, dtype=np.float64)
+    shape = (ds.num_experiments, ds.num_samples)
+    u = np.asarray(getattr(ds, estimator.rudder), dtype=np.float64)
+    predictions, metrics = {}, {}
+    for c, name in enumerate(channels):
+        timeline, hit = to_timeline(pred[c], layout, shape)
+        predictions[name] = timeline
+        metrics[name] = validate(np.asarray(getattr(ds, name), dtype=np.float64), timeline, hit,
+                                 u=u, max_lag=estimator.max_lag, channel=name)
+    return Prediction(predictions, hit, metrics, estimator.horizon, tuple(layout["lengths"]),
+                      tuple(ds.names))

@@ -1,0 +1,75 @@
+"""Identification on the measured data sets (skipped when `shared/data` is absent)."""
+
+import numpy as np
+import pytest
+
+import jaxship as js
+from jaxship._real_data import (
+    ESSO_TEST,
+    decimate,
+    esso_osaka_split,
+    hsva_split,
+    identify_esso_osaka,
+    identify_kvlcc2_hsva,
+)
+
+
+DATA = js.shared_data_dir()
+needs_esso = pytest.mark.skipif(DATA is None or not (DATA / "esso_osaka_frt").is_dir(),
+                                reason="Esso Osaka data (shared/data/esso_osaka_frt) absent")
+needs_hsva = pytest.mark.skipif(DATA is None or not (DATA / "kvlcc2_simman2008_hsva").is_dir(),
+                                reason="HSVA KVLCC2 data (shared/data) absent")
+
+
+def test_decimate_keeps_measured_channels():
+    t = np.arange(10) * 0.1
+    e = js.Experiment(t, np.sin(t), psi=t, u=np.ones(10), name="x")
+    d = decimate(e, 3)
+    np.testing.assert_allclose(d.t, t[::3])
+    assert d.channels == e.channels and d.name == "x" and d.derived == ("r",)
+    with pytest.raises(ValueError, match="positive integer"):
+        decimate(e, 0)
+
+
+def test_missing_data_folder_raises(tmp_path):
+    with pytest.raises(FileNotFoundError, match="esso_osaka_frt"):
+        esso_osaka_split(tmp_path)
+
+
+@needs_esso
+def test_esso_osaka_split():
+    train, test = esso_osaka_split(factor=5)
+    assert tuple(e.name for e in test) == ESSO_TEST
+    assert len(train) == 8 and not {e.name for e in train} & set(ESSO_TEST)
+    for e in train + test:
+        assert e.is_uniform() and abs(e.dt - 0.5) < 1e-9
+        assert {"u", "v", "n", "wind_speed", "wind_dir"} <= set(e.channels)
+
+
+@needs_hsva
+def test_hsva_nomoto_generalises_to_held_out_zigzags():
+    """Nomoto 1 and 2 by output error on three HSVA zig-zags predict four others by
+    simulation better than the mean (fit > 0) in yaw rate, and Nomoto 2 fits the
+    training data at least as well as Nomoto 1 (it contains it)."""
+    train, test = hsva_split()
+    assert len(train) == 3 and len(test) == 4
+    report = identify_kvlcc2_hsva()
+    n1, n2 = report.models
+    assert n1.result.success and n2.result.success
+    assert n2.result.cost <= n1.result.cost * (1 + 1e-6)
+    for m in report.models:
+        assert m.validation["simulation"].metrics["r"].fit_percent > 50.0
+    assert "| Nomoto2 | simulation | all |" in report.table()
+
+
+@pytest.mark.slow
+@needs_esso
+def test_esso_osaka_3dof_beats_the_preset_on_held_out_runs():
+    """The identified 3-DOF model predicts the held-out runs (20 s ahead) better than
+    the unfitted preset in every channel."""
+    report = identify_esso_osaka()
+    fitted = report.models[0]
+    assert fitted.result.success
+    for c in ("psi", "r", "u", "v"):
+        assert (fitted.validation["T_p = 20 s"].metrics[c].fit_percent
+                > report.baseline["T_p = 20 s"].metrics[c].fit_percent), c
