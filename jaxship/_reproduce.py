@@ -3,7 +3,10 @@
 Simulates the experiment design of the thesis (section 4.1): turning circles at 5, 10,
 20 and 40 deg, zig-zags 5/5 to 40/40 and the thesis manoeuvre, each at 200 and 500
 rpm, writes every trial as a trial CSV with its indices, a summary table, and the
-figures that correspond to the thesis' figs. 4.2-4.7.
+figures that correspond to the thesis' figs. 4.2-4.7; then identifies the Nomoto and
+Ross steering models from noisy records of the same design (sections 4.2-4.3,
+`jaxship._thesis_identification`) and writes their fit % next to the thesis' numbers
+(`identification.json`, and a table in `summary.md`).
 """
 
 import json
@@ -14,6 +17,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ._data import write_trial_csv
+from ._thesis_identification import identification_study, markdown_table, to_json
 from ._trials import run_trial, trial_indices
 from ._vessel.catalogue import get_vessel
 from .plotting import plot_trajectory
@@ -45,8 +49,11 @@ def _file_name(spec, rpm):
     return f"{spec.replace(':', '').replace('/', '-')}_{rpm:.0f}rpm"
 
 
-def reproduce(out, *, quick=False, progress=False) -> dict:
-    """Run the pipeline into the folder `out`; returns the summary {file name: indices}."""
+def reproduce(out, *, quick=False, progress=False, identification=True) -> dict:
+    """Run the pipeline into the folder `out`; returns the summary {file name: indices}.
+
+    `identification`: also run the identification study (`quick`: its reduced design,
+    two trials per family)."""
     out = pathlib.Path(out)
     (out / "trials").mkdir(parents=True, exist_ok=True)
     (out / "figures").mkdir(exist_ok=True)
@@ -71,11 +78,26 @@ def reproduce(out, *, quick=False, progress=False) -> dict:
             fig.savefig(out / "figures" / f"{name}.png", dpi=110)
             plt.close(fig)
     (out / "indices.json").write_text(json.dumps(summary, indent=2) + "\n")
-    (out / "summary.md").write_text(summary_table(summary))
+    text = summary_table(summary)
+    if identification:
+        bar = tqdm(desc="identification", disable=not progress, unit="fit",
+                   total=2 * 3 * 3)
+        study = identification_study(vessel, quick=quick, progress=lambda msg: (
+            bar.set_postfix_str(msg), bar.update()))
+        bar.close()
+        (out / "identification.json").write_text(json.dumps(to_json(study), indent=2) + "\n")
+        text += ("\n## Steering models identified (thesis chapter 4)\n\nSimulation fit % of "
+                 "the yaw rate (thesis eq. 3.23) on the 40 deg, 500 rpm record of each family "
+                 "and pooled over the family's records; noise (SI): "
+                 + ", ".join(f"{k} {v:.3g}" for k, v in study["noise"].items())
+                 + ("; quick design (2 trials per family)" if quick else "") + ".\n\n"
+                 + markdown_table(study))
+    (out / "summary.md").write_text(text)
     if progress:
-        print(summary_table(summary))
+        print(text)
         print(
             f"wrote {out}/trials/*.csv, {out}/indices.json, {out}/summary.md, {out}/figures/*.png"
+            + (f", {out}/identification.json" if identification else "")
         )
     return summary
 

@@ -21,6 +21,7 @@ import math
 import numpy as np
 
 from .._steering.nomoto import Nomoto1, NonlinearNomoto
+from .._steering.ross import RossAutopilot, ross_initial_estimate
 from ._params import resolve_free
 from ._windows import as_dataset, check_data
 
@@ -57,7 +58,8 @@ def _lstsq(x, y, names, what):
 def initial_estimate(model, dataset, *, free=None, rudder: str = "delta"):
     """Equation-error least-squares start values for `model`'s free parameters
     (`free` as in `fit`); frozen parameters keep their values and enter the
-    regression as known. Supported: `Nomoto1`, `NonlinearNomoto`.
+    regression as known. Supported: `Nomoto1`, `NonlinearNomoto`, `RossAutopilot`
+    (`jaxship._steering.ross.ross_initial_estimate`, one-interval span).
 
     **Returns:** a model of the same type with the estimates.
 
@@ -71,8 +73,11 @@ def initial_estimate(model, dataset, *, free=None, rudder: str = "delta"):
         return _nomoto1(model, ds, names, rudder)
     if isinstance(model, NonlinearNomoto):
         return _midpoint(model, ds, names, rudder)
+    if isinstance(model, RossAutopilot):
+        return ross_initial_estimate(model, ds, free=free, rudder=rudder)
     raise ValueError(f"no linear least-squares start for {type(model).__name__}; supported: "
-                     "Nomoto1, NonlinearNomoto (start Nomoto2 from a fitted Nomoto1).")
+                     "Nomoto1, NonlinearNomoto, RossAutopilot (start Nomoto2 from a fitted "
+                     "Nomoto1).")
 
 
 def _nomoto1(model, ds, names, rudder):
