@@ -1,0 +1,217 @@
+"""ARMAX models of ship steering (Astrom & Kallstrom 1979, eq. 7; seed 001)
+
+$$A(q^{-1})\\,y(t) = B(q^{-1})\\,u(t - n_k) + C(q^{-1})\\,e(t),$$
+
+$A = 1 + a_1q^{-1} + \\dots + a_{n_a}q^{-n_a}$, $B = b_0 + b_1q^{-1} + \\dots +
+b_{n_b-1}q^{-(n_b-1)}$, $C = 1 + c_1q^{-1} + \\dots + c_{n_c}q^{-n_c}$, $\\{e(t)\\}$
+white with variance $\\lambda^2$ (their $\\lambda C e$ with unit-variance $e$). Usually
+$y = r$ [rad/s] and $u = \\delta$ [rad] with $n_k = 1$ (eq. 7 writes $u(t-1)$).
+
+Identified by the prediction-error method (Ljung 1999, secs. 7.2, 10.2): the
+one-step predictor $\\hat y(t|\\theta) = y(t) - \\varepsilon(t, \\theta)$ with
+$C\\varepsilon = Ay - Bu$, minimising $\\sum\\varepsilon^2$ (the maximum-likelihood
+estimate for Gaussian $e$, as Astrom & Kallstrom use). Start values from the
+pseudo-linear regression (extended least squares): a long ARX model gives estimates
+of $e$, then one linear regression on $(-y, u, \\hat e)$ lags; then Gauss-Newton
+with Levenberg-Marquardt damping on the gradient
+$\\partial\\varepsilon/\\partial\\theta = -\\varphi(t, \\theta)/C(q)$. numpy/scipy, no JAX:
+the filters are recursions of a few coefficients.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+from scipy.signal import lfilter
+
+
+def _lags(x, lags, start):
+    """Columns x(t - l) for l in lags, rows t = start..N-1."""
+    return np.stack([x[start - l: x.size - l] for l in lags], axis=1) if lags else \
+        np.zeros((x.size - start, 0))
+
+
+@dataclasses.dataclass(frozen=True)
+class ARMAXResult:
+    """Result of `fit_armax`: polynomials `A` (leading 1), `B` (coefficient of
+    $u(t-n_k)$ first), `C` (leading 1) as arrays, the delay `nk`, the sample
+    interval `dt` [s] (or None), the innovation variance `noise_variance`
+    $\\hat\\lambda^2$, the covariance `covariance` of $\\theta = (a, b, c)$ (Gauss-Newton,
+    $\\hat\\lambda^2(J^TJ)^{-1}$), the loss `loss` (mean squared one-step error), the
+    number of iterations and whether the iteration `converged`."""
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    nk: int
+    dt: float | None
+    noise_variance: float
+    covariance: np.ndarray
+    loss: float
+    iterations: int
+    converged: bool
+
+    @property
+    def std(self) -> np.ndarray:
+        """Standard errors of (a_1.., b_0.., c_1..)."""
+        return np.sqrt(np.diag(self.covariance))
+
+    def residuals(self, y, u) -> np.ndarray:
+        """One-step prediction errors $\\varepsilon(t)$ (zero initial conditions)."""
+        return _residuals(np.asarray(y, float), np.asarray(u, float), self.A, self.B, self.C,
+                          self.nk)
+
+    def one_step(self, y, u) -> np.ndarray:
+        """One-step-ahead predictions $\\hat y(t|t-1) = y(t) - \\varepsilon(t)$."""
+        y = np.asarray(y, float)
+        return y - self.residuals(y, u)
+
+    def simulate(self, u) -> np.ndarray:
+        """The noise-free output $y = (B/A)\\,u(t - n_k)$ from rest."""
+        return lfilter(self.B, self.A, _delay(np.asarray(u, float), self.nk))
+
+    def nomoto(self) -> dict | None:
+        """The continuous model whose zero-order-hold sampling this is, where the orders
+        allow it (y = r, u = delta, nk = 1, needs `dt`): $n_a = n_b = 1$ gives Nomoto's
+        first-order `K` [1/s], `T` [s]; $n_a = n_b = 2$ the second-order `K`, `T1`,
+        `T2`, `T3` (and `T` = T1 + T2 - T3), as `fit_discrete_response`'s
+        `continuous_parameters`. None for other orders or without `dt`; NaN entries
+        where the poles have no real continuous counterpart."""
+        from ._discrete import continuous_parameters
+
+        if self.dt is None or self.nk != 1:
+            return None
+        na, nb = self.A.size - 1, self.B.size
+        if na == 1 and nb == 1:
+            c = {"a1": -self.A[1], "a2": self.B[0], "b0": 0.0}
+            p = continuous_parameters("linear1", c, self.dt)
+            return {"K": p["K"], "T": p["T"]}
+        if na == 2 and nb == 2:
+            c = {"a1": -self.A[1], "a2": -self.A[2], "b1": self.B[0], "b2": self.B[1],
+                 "c0": 0.0}
+            p = continuous_parameters("linear2", c, self.dt)
+            return {k: p[k] for k in ("K", "T1", "T2", "T3", "T")}
+        return None
+
+
+def _delay(u, nk):
+    return np.concatenate([np.zeros(nk), u[:u.size - nk]]) if nk else u
+
+
+def _residuals(y, u, A, B, C, nk):
+    w = lfilter(A, [1.0], y) - lfilter(B, [1.0], _delay(u, nk))
+    return lfilter([1.0], C, w)
+
+
+def _check(y, u, na, nb, nc, nk):
+    y = np.asarray(y, dtype=np.float64)
+    u = np.asarray(u, dtype=np.float64)
+    if y.ndim != 1 or u.shape != y.shape:
+        raise ValueError(f"`y` and `u` must be 1-D arrays of one length, got shapes {y.shape} "
+                         f"and {u.shape}.")
+    if not (np.all(np.isfinite(y)) and np.all(np.isfinite(u))):
+        raise ValueError("`y` and `u` must be finite.")
+    for name, v, low in (("na", na, 0), ("nb", nb, 1), ("nc", nc, 0), ("nk", nk, 0)):
+        if int(v) != v or v < low:
+            raise ValueError(f"`{name}` must be an integer >= {low}, got {v}.")
+    n0 = max(na, nk + nb - 1, nc)
+    if y.size < 5 * (na + nb + nc) + n0 + 10:
+        raise ValueError(f"{y.size} samples are too few for {na + nb + nc} parameters.")
+    if np.ptp(u) == 0:
+        raise ValueError("the input `u` is constant: it does not excite B.")
+    return y, u, n0
+
+
+def fit_armax(y, u, *, na: int = 2, nb: int = 2, nc: int = 2, nk: int = 1,
+              dt: float | None = None, max_iter: int = 100, tol: float = 1e-10,
+              arx_order: int | None = None) -> ARMAXResult:
+    """Fit an ARMAX model (Astrom & Kallstrom 1979, eq. 7) by prediction-error
+    minimisation.
+
+    **Arguments:** `y` output (e.g. yaw rate r [rad/s]) and `u` input (rudder
+    [rad]), 1-D arrays of one length (one uniformly sampled record); the orders `na`,
+    `nb`, `nc` and the delay `nk` (samples); `dt` [s], only for `nomoto()`;
+    `max_iter`, `tol` (relative decrease of the loss, and of the step) of the
+    Gauss-Newton/Levenberg-Marquardt iteration; `arx_order` of the long ARX model of
+    the start (default `max(20, 4 (na + nb + nc))`, capped by the data).
+
+    The loss uses the samples t >= max(na, nk + nb - 1, nc); errors before are
+    computed with zero initial conditions of $1/C$ and left out.
+
+    **Raises:** `ValueError` for bad orders or data.
+    """
+    y, u, n0 = _check(y, u, na, nb, nc, nk)
+    ud = _delay(u, nk)
+    a_lags, b_lags, c_lags = range(1, na + 1), range(0, nb), range(1, nc + 1)
+    # -- pseudo-linear regression start ---------------------------------------------
+    if nc:
+        m = int(arx_order or max(20, 4 * (na + nb + nc)))
+        m = min(m, (y.size - 10) // 3)
+        xa = np.hstack([-_lags(y, range(1, m + 1), m), _lags(ud, range(0, m), m)])
+        th = np.linalg.lstsq(xa, y[m:], rcond=None)[0]
+        e = np.zeros_like(y)
+        e[m:] = y[m:] - xa @ th
+    else:
+        e = np.zeros_like(y)
+    start = max(n0, 1)
+    phi = np.hstack([-_lags(y, a_lags, start), _lags(ud, b_lags, start),
+                     _lags(e, c_lags, start)])
+    theta = np.linalg.lstsq(phi, y[start:], rcond=None)[0]
+
+    def polys(th):
+        A = np.concatenate([[1.0], th[:na]])
+        B = th[na:na + nb]
+        C = np.concatenate([[1.0], th[na + nb:]])
+        return A, B, C
+
+    def evaluate(th):
+        A, B, C = polys(th)
+        if nc and np.any(np.abs(np.roots(C)) >= 1.0):
+            return np.inf, None
+        eps = _residuals(y, u, A, B, C, nk)
+        return float(np.mean(eps[start:] ** 2)), eps
+
+    def jacobian(th, eps):
+        A, B, C = polys(th)
+        # d eps / d theta = -phi / C with phi = (-y lags, u lags, eps lags)
+        cols = [lfilter([1.0], C, _delay(y, i)) for i in a_lags]
+        cols += [-lfilter([1.0], C, _delay(ud, j)) for j in b_lags]
+        cols += [-lfilter([1.0], C, _delay(eps, i)) for i in c_lags]
+        return np.stack(cols, axis=1)[start:]
+
+    if nc and np.any(np.abs(np.roots(polys(theta)[2])) >= 1.0):
+        theta[na + nb:] *= 0.0  # an unstable C from the start: begin from C = 1
+    loss, eps = evaluate(theta)
+    lam, converged, it = 1e-3, False, 0
+    for it in range(1, max_iter + 1):
+        J = jacobian(theta, eps)
+        g = J.T @ eps[start:]
+        H = J.T @ J
+        improved = False
+        for _ in range(30):
+            step = np.linalg.solve(H + lam * np.diag(np.diag(H) + 1e-300), -g)
+            new_loss, new_eps = evaluate(theta + step)
+            if new_loss <= loss:
+                improved = True
+                break
+            lam *= 10.0
+        if not improved:
+            converged = True  # no descent direction left at machine precision
+            break
+        small = (loss - new_loss <= tol * loss
+                 and np.linalg.norm(step) <= math.sqrt(tol) * (1 + np.linalg.norm(theta)))
+        theta, loss, eps = theta + step, new_loss, new_eps
+        lam = max(lam / 10.0, 1e-12)
+        if small or loss == 0.0:
+            converged = True
+            break
+    A, B, C = polys(theta)
+    J = jacobian(theta, eps)
+    n = y.size - start
+    sigma2 = float(np.sum(eps[start:] ** 2) / max(n - theta.size, 1))
+    try:
+        cov = sigma2 * np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        cov = np.full((theta.size, theta.size), np.nan)
+    return ARMAXResult(A, B, C, int(nk), None if dt is None else float(dt), sigma2, cov, loss,
+                       it, converged)

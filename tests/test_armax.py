@@ -1,0 +1,73 @@
+"""ARMAX (Astrom & Kallstrom 1979, eq. 7) by prediction-error minimisation."""
+
+import numpy as np
+import pytest
+from scipy.signal import lfilter
+
+from jaxship._estimate._armax import fit_armax
+from jaxship._estimate._discrete import discretise
+
+
+def _input(n=4000, seed=1):
+    rng = np.random.default_rng(seed)
+    return np.repeat(rng.choice([-0.1, 0.1], n // 20), 20)
+
+
+def test_exact_recovery_noise_free():
+    u = _input()
+    A, B = [1.0, -1.5, 0.7], [1.0, 0.5]
+    y = lfilter(B, A, np.r_[0.0, u[:-1]])
+    res = fit_armax(y, u, na=2, nb=2, nc=0)
+    np.testing.assert_allclose(res.A, A, rtol=1e-6)
+    np.testing.assert_allclose(res.B, B, rtol=1e-6)
+    np.testing.assert_allclose(res.simulate(u), y, rtol=1e-6, atol=1e-9)
+
+
+def test_noise_model_within_standard_errors():
+    rng = np.random.default_rng(2)
+    u = _input()
+    A, B, C = [1.0, -1.5, 0.7], [1.0, 0.5], [1.0, -0.6, 0.2]
+    e = 0.01 * rng.standard_normal(u.size)
+    y = lfilter(B, A, np.r_[0.0, u[:-1]]) + lfilter(C, A, e)
+    res = fit_armax(y, u, na=2, nb=2, nc=2)
+    assert res.converged
+    theta = np.r_[res.A[1:], res.B, res.C[1:]]
+    true = np.r_[A[1:], B, C[1:]]
+    assert np.all(np.abs(theta - true) < 4 * res.std)
+    assert res.noise_variance == pytest.approx(1e-4, rel=0.1)
+    # the one-step predictor beats the simulation on data with coloured noise
+    eps1 = y - res.one_step(y, u)
+    epss = y - res.simulate(u)
+    assert np.var(eps1) < np.var(epss)
+
+
+@pytest.mark.parametrize("structure,params,orders", [
+    ("linear1", dict(K=0.1, T=20.0), (1, 1)),
+    ("linear2", dict(K=0.1, T1=25.0, T2=3.0, T3=5.0), (2, 2)),
+])
+def test_nomoto_from_zoh_sampled_model(structure, params, orders):
+    h = 0.5
+    c = discretise(structure, params, h)
+    if structure == "linear1":
+        A, B = [1.0, -c["a1"]], [c["a2"]]
+    else:
+        A, B = [1.0, -c["a1"], -c["a2"]], [c["b1"], c["b2"]]
+    u = _input()
+    y = lfilter(B, A, np.r_[0.0, u[:-1]])
+    res = fit_armax(y, u, na=orders[0], nb=orders[1], nc=0, dt=h)
+    got = res.nomoto()
+    for k, v in params.items():
+        assert got[k] == pytest.approx(v, rel=1e-6)
+
+
+def test_bad_inputs():
+    u = _input(400)
+    with pytest.raises(ValueError, match="na"):
+        fit_armax(u, u, na=-1)
+    with pytest.raises(ValueError, match="one length"):
+        fit_armax(u, u[:-1])
+    with pytest.raises(ValueError, match="constant"):
+        fit_armax(u, np.ones_like(u))
+    with pytest.raises(ValueError, match="too few"):
+        fit_armax(u[:20], u[:20])
+    assert fit_armax(u, u, na=3, nb=1, nc=0).nomoto() is None

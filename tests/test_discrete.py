@@ -1,0 +1,114 @@
+"""Lu & Zhao (2008) discrete response models: exact recovery and conversion."""
+
+import numpy as np
+import pytest
+
+from jaxship._data import Experiment
+from jaxship._estimate._discrete import (
+    COEFFICIENTS,
+    DiscreteResponseFit,
+    continuous_parameters,
+    discretise,
+    fit_discrete_response,
+)
+from jaxship._steering import Nomoto1, Nomoto2, simulate_steering
+
+
+H = 0.2
+CASES = {
+    "linear1": dict(K=0.1, T=20.0, delta_r=0.01),
+    "nonlinear1": dict(alpha1=0.05, beta1=30.0, alpha2=0.005, delta_r=0.01),
+    "linear2": dict(K=0.1, T1=25.0, T2=3.0, T3=5.0, delta_r=0.01),
+    "nonlinear2": dict(K=0.1, T1=25.0, T2=3.0, T3=5.0, beta1=200.0, delta_r=0.01),
+}
+
+
+def _rudder(n=3000, seed=0):
+    rng = np.random.default_rng(seed)
+    return np.repeat(rng.choice([-0.2, 0.2], n // 50), 50)
+
+
+def _record(structure, how=None):
+    how = how or ("zoh" if structure.startswith("linear") else "euler")
+    c = discretise(structure, CASES[structure], H, discretisation=how)
+    model = DiscreteResponseFit(structure, "ls", how, H, c, {}, 0.0, 0)
+    d = _rudder()
+    return c, Experiment(np.arange(d.size) * H, d, r=model.simulate(d))
+
+
+@pytest.mark.parametrize("structure", list(CASES))
+def test_ls_exact_recovery(structure):
+    c, e = _record(structure)
+    f = fit_discrete_response(structure, e)
+    for k in COEFFICIENTS[structure]:
+        assert f.coefficients[k] == pytest.approx(c[k], rel=1e-6)
+    for k, v in CASES[structure].items():
+        assert f.parameters[k] == pytest.approx(v, rel=1e-6)
+
+
+@pytest.mark.parametrize("structure", ["linear1", "linear2"])
+def test_euler_linear_roundtrip(structure):
+    c, e = _record(structure, "euler")
+    f = fit_discrete_response(structure, e, discretisation="euler")
+    for k, v in CASES[structure].items():
+        assert f.parameters[k] == pytest.approx(v, rel=1e-6)
+
+
+def test_zoh_matches_continuous_models():
+    """ZOH coefficients reproduce the continuous Nomoto models they were sampled from
+    (reference: simulate_steering with fine RK4 substeps), and the fit recovers K, T."""
+    d = _rudder(1500)
+    for structure, model in (("linear1", Nomoto1(K=0.1, T=20.0, delta0=0.01)),
+                             ("linear2", Nomoto2(K=0.1, T1=25.0, T2=3.0, T3=5.0, delta0=0.01))):
+        r = np.asarray(simulate_steering(model, d, H, substeps=40).r)
+        e = Experiment(np.arange(d.size) * H, d, r=r)
+        f = fit_discrete_response(structure, e)
+        for k, v in CASES[structure].items():
+            assert f.parameters[k] == pytest.approx(v, rel=1e-6), k
+        assert isinstance(f.to_steering(), type(model))
+    # the difference equation from rest equals the continuous model from rest
+    for structure, model in (("linear1", Nomoto1(K=0.1, T=20.0)),
+                             ("linear2", Nomoto2(K=0.1, T1=25.0, T2=3.0, T3=5.0))):
+        params = {k: v for k, v in CASES[structure].items() if k != "delta_r"}
+        c = discretise(structure, params, H)
+        r = np.asarray(simulate_steering(model, d, H, substeps=40).r)
+        sim = DiscreteResponseFit(structure, "ls", "zoh", H, c, {}, 0.0, 0).simulate(d)
+        assert np.max(np.abs(sim - r)) < 1e-9 * np.max(np.abs(r))
+
+
+def test_to_steering_nonlinear1_matches_norrbin():
+    p = continuous_parameters("nonlinear1", discretise("nonlinear1", CASES["nonlinear1"], H), H)
+    f = DiscreteResponseFit("nonlinear1", "ls", "euler", H, {}, p, 0.0, 0)
+    m = f.to_steering()
+    assert m.K == pytest.approx(0.1) and m.T == pytest.approx(20.0)
+    assert m.n3 == pytest.approx(600.0) and m.n0 == pytest.approx(-0.001)
+
+
+@pytest.mark.parametrize("structure", list(CASES))
+def test_svr_recovers_noise_free(structure):
+    pytest.importorskip("sklearn")
+    c, e = _record(structure)
+    ls = fit_discrete_response(structure, e)
+    svr = fit_discrete_response(structure, e, method="svr")
+    assert svr.converged
+    # an iterative QP solver (liblinear, tol 1e-8): agreement to its tolerance
+    for k in COEFFICIENTS[structure]:
+        assert svr.coefficients[k] == pytest.approx(ls.coefficients[k], rel=1e-5, abs=1e-12)
+
+
+def test_bad_inputs():
+    _, e = _record("linear1")
+    with pytest.raises(ValueError, match="structure"):
+        fit_discrete_response("cubic", e)
+    with pytest.raises(ValueError, match="method"):
+        fit_discrete_response("linear1", e, method="svm")
+    with pytest.raises(ValueError, match="zero-order-hold"):
+        fit_discrete_response("nonlinear1", e, discretisation="zoh")
+    with pytest.raises(ValueError, match="Experiment"):
+        fit_discrete_response("linear1", np.zeros(10))
+    const = Experiment(e.t, np.zeros_like(e.t), r=np.zeros_like(e.t))
+    with pytest.raises(ValueError, match="excitation|zero"):
+        fit_discrete_response("linear1", const)
+    other = Experiment(e.t * 2, e.delta, r=e.r)
+    with pytest.raises(ValueError, match="sample intervals"):
+        fit_discrete_response("linear1", [e, other])
