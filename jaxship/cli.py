@@ -25,6 +25,32 @@ def main(argv=None) -> int:
     rep.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/reproduce"))
     rep.add_argument("--quick", action="store_true", help="fewer trials (for smoke tests)")
 
+    ident = sub.add_parser(
+        "identify", help="estimate a steering model from measured trials and validate it",
+        description="Estimate a steering model from training records (trial CSV files, "
+        "measurement files or folders of them) and validate it; writes result.json and "
+        "figures into --out.",
+    )
+    ident.add_argument("train", nargs="+", type=pathlib.Path,
+                       help="training records: trial CSV or measurement files, or folders")
+    ident.add_argument("--model", required=True,
+                       help="a registered model: nomoto1, nomoto2, nomoto1-nonlinear (an "
+                       "unknown name lists them all)")
+    ident.add_argument("--horizon", default=None,
+                       help="prediction horizon [s]; 'none' (default): output error, "
+                       "0: equation error")
+    ident.add_argument("--validate", nargs="+", type=pathlib.Path, default=None,
+                       metavar="TEST", help="held-out records to validate on")
+    ident.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
+    ident.add_argument("--rudder", default="delta", help="replayed rudder: delta or delta_c")
+    ident.add_argument("--channels", default="psi,r", help="fitted outputs, e.g. psi,r or r")
+    ident.add_argument("--initial", default="auto",
+                       help="window start states: measured, estimate or auto (default: "
+                       "estimate for output error, else measured)")
+    ident.add_argument("--max-steps", type=int, default=256, help="optimiser step limit")
+    ident.add_argument("--no-figures", action="store_true", help="write result.json only")
+    ident.add_argument("--quiet", action="store_true", help="no progress bar")
+
     args = parser.parse_args(argv)
     import jax
 
@@ -33,9 +59,9 @@ def main(argv=None) -> int:
 
     matplotlib.use("Agg")
     try:
-        return {"vessels": _vessels, "simulate": _simulate, "reproduce": _reproduce}[args.command](
-            args
-        )
+        commands = {"vessels": _vessels, "simulate": _simulate, "reproduce": _reproduce,
+                    "identify": _identify}
+        return commands[args.command](args)
     except ValueError as error:
         print(f"jaxship: error: {error}", file=sys.stderr)
         return 2
@@ -74,6 +100,78 @@ def _reproduce(args) -> int:
     from ._reproduce import reproduce
 
     reproduce(args.out, quick=args.quick, progress=True)
+    return 0
+
+
+def _horizon(text):
+    if text is None or text.strip().lower() in ("none", "oe", "output-error"):
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        raise ValueError(f"--horizon {text!r}: give seconds (e.g. 10), 0 (equation error) or "
+                         "'none' (output error).") from None
+
+
+class _ProgressBar:
+    """Turns `identify`'s `Progress` reports into tqdm bars on stderr."""
+
+    def __init__(self, enabled):
+        self.enabled, self.bar = enabled, None
+
+    def __call__(self, event):
+        if not self.enabled:
+            return
+        from tqdm.auto import tqdm
+
+        if event.stage != "fit":
+            if not event.done:
+                tqdm.write(f"jaxship: {event.message} ...", file=sys.stderr)
+            return
+        if self.bar is None:
+            self.bar = tqdm(total=event.total, desc=event.message, unit="step", leave=False,
+                            file=sys.stderr)
+        self.bar.n = min(int(event.step), event.total)
+        if event.cost is not None:
+            self.bar.set_postfix(cost=f"{event.cost:.5g}", refresh=False)
+        self.bar.refresh()
+        if event.done:
+            self.bar.close()
+            self.bar = None
+            tqdm.write(f"jaxship: {event.message}: {event.step} steps, cost {event.cost:.6g}",
+                       file=sys.stderr)
+
+
+def _identify(args) -> int:
+    import warnings
+
+    from ._identify import get_model_entry, identify, read_experiments
+
+    get_model_entry(args.model)  # unknown models fail before reading any file
+    horizon = _horizon(args.horizon)
+    train = read_experiments(args.train, role="training")
+    held_out = None if args.validate is None else read_experiments(args.validate,
+                                                                   role="validation")
+    bar = _ProgressBar(not args.quiet)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = identify(train, model=args.model, horizon=horizon, validate=held_out,
+                          rudder=args.rudder, channels=args.channels, initial=args.initial,
+                          max_steps=args.max_steps, progress=bar)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "result.json").write_text(result.to_json() + "\n")
+    written = ["result.json"]
+    if not args.no_figures:
+        from .plotting import save_identification_figures
+
+        paths = save_identification_figures(result, args.out / "figures")
+        written.append(f"figures/ ({len(paths)} figures)")
+    print(result.summary())
+    for note in result.notes:
+        print(f"note: {note}")
+    for message in dict.fromkeys(str(w.message) for w in caught):
+        print(f"jaxship: warning: {message}", file=sys.stderr)
+    print(f"wrote {args.out}/" + f", {args.out}/".join(written))
     return 0
 
 
