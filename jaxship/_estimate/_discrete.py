@@ -272,7 +272,7 @@ def _svr(x, y, C, epsilon, tol, max_iter):
     try:
         from sklearn.svm import LinearSVR
     except ImportError as err:  # pragma: no cover - depends on the environment
-        raise ImportError("method='svr' needs scikit-learn: `pip install "jaxship[svm]"`.") from err
+        raise ImportError("method='svr' needs scikit-learn: pip install 'jaxship[svm]'.") from err
     import warnings
 
     # Precondition: regress on orthonormal features q = x R^-1 (x = QR) scaled to unit
