@@ -212,7 +212,8 @@ def _estimators(settings: Settings):
 def _safe_fit(model, records, free, estimator):
     """`fit`, or None when the model diverges on the data (non-finite cost)."""
     try:
-        result = _quiet_fit(model, records, free=free, estimator=estimator)
+        with np.errstate(over="ignore", invalid="ignore"):  # residuals of a diverged model
+            result = _quiet_fit(model, records, free=free, estimator=estimator)
     except (ValueError, np.linalg.LinAlgError):  # NaN residuals of an unstable model
         return None
     return result if np.isfinite(result.cost) else None

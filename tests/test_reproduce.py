@@ -2,11 +2,14 @@
 
 import json
 
+import pytest
+
+from jaxship._reproduce import reproduce
 from jaxship.cli import main
 
 
-def test_quick_reproduce_writes_trials_and_matches_thesis_ranges(tmp_path, capsys):
-    assert main(["reproduce", "--quick", "--out", str(tmp_path)]) == 0
+def test_quick_reproduce_writes_trials_and_matches_thesis_ranges(tmp_path):
+    reproduce(tmp_path, quick=True, identification=False)
     summary = json.loads((tmp_path / "indices.json").read_text())
     assert set(summary) >= {"turn40_500rpm", "zigzag40-40_500rpm", "thesis_500rpm"}
     for name in summary:
@@ -25,3 +28,15 @@ def test_quick_reproduce_writes_trials_and_matches_thesis_ranges(tmp_path, capsy
     assert slow["max_yaw_rate_deg_s"] < 0.5 * fast["max_yaw_rate_deg_s"]
     assert abs(slow["tactical_diameter_m"] / fast["tactical_diameter_m"] - 1) < 0.2
     assert summary["zigzag40-40_500rpm"]["overshoot_1_deg"] > 0
+
+
+@pytest.mark.slow
+def test_quick_reproduce_command_identifies_the_steering_models(tmp_path, capsys):
+    assert main(["reproduce", "--quick", "--out", str(tmp_path)]) == 0
+    study = json.loads((tmp_path / "identification.json").read_text())
+    rows = {(r["case"], r["model"], r["family"]): r for r in study["table"]}
+    assert len(rows) == 18  # single / merged x three models x three families
+    # the Ross model explains the single 40 deg / 500 rpm records better than Nomoto
+    for family in ("turning", "zigzag", "thesis"):
+        assert rows["single", "ross", family]["fit"] > rows["single", "nomoto", family]["fit"]
+    assert "Steering models identified" in (tmp_path / "summary.md").read_text()
