@@ -13,7 +13,13 @@ from ._data import (
     shared_data_dir as shared_data_dir,
     write_trial_csv as write_trial_csv,
 )
+from ._design import (
+    excitation_order as excitation_order,
+    fisher_information as fisher_information,
+)
 from ._environment import Current as Current, Environment as Environment, Wind as Wind
+from ._estimate._armax import ARMAXResult as ARMAXResult, fit_armax as fit_armax
+from ._estimate._discrete import fit_discrete_response as fit_discrete_response
 from ._estimate._fit import (
     ConvergenceWarning as ConvergenceWarning,
     FitResult as FitResult,
@@ -23,6 +29,9 @@ from ._estimate._fit import (
 )
 from ._estimate._linear import initial_estimate as initial_estimate
 from ._estimate._params import Free as Free, param as param
+from ._estimate._predict import predict as predict
+from ._estimate._vessel_fit import default_free as default_free
+from ._identify import IdentificationResult as IdentificationResult, identify as identify
 from ._indices import (
     format_table as format_table,
     imo_criteria as imo_criteria,
@@ -61,12 +70,16 @@ from ._state import (
 from ._steering import (
     AbstractSteeringModel as AbstractSteeringModel,
     AuxInputs as AuxInputs,
+    LinearSwayYaw as LinearSwayYaw,
     Nomoto1 as Nomoto1,
     Nomoto2 as Nomoto2,
     NonlinearNomoto as NonlinearNomoto,
+    NorrbinCrossFlow as NorrbinCrossFlow,
+    RossAutopilot as RossAutopilot,
     SteeringTrajectory as SteeringTrajectory,
     simulate_steering as simulate_steering,
 )
+from ._steering.nonlinear_nomoto2 import NonlinearNomoto2 as NonlinearNomoto2
 from ._validate import (
     ValidationReport as ValidationReport,
     final_prediction_error as final_prediction_error,

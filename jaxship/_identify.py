@@ -12,8 +12,10 @@ in an `IdentificationResult` (JSON via `to_json`; figures via
 **The model registry.** `MODELS` maps a command-line name to a `ModelEntry`: a
 description and a function `start(train, context)` that builds the start model from
 the training data (a `Dataset`). Adding a model is adding one entry; see
-`ModelEntry`. Entries whose outputs or simulation differ from the yaw-rate response
-models (3-DOF vessel presets, ARMAX) override `channels` and `simulate`.
+`ModelEntry`. Entries whose outputs, data or simulation differ from the yaw-rate
+response models override `channels`, `requires`, `initial` and `simulate` (the
+3-DOF vessel presets, one entry per `jaxship.VESSELS` name), and `fit` (the
+discrete ARMAX model, estimated by `fit_armax` instead of `jaxship.fit`).
 
 The library stays quiet: progress goes to the `progress` callable (see `Progress`),
 which the `jaxship identify` command turns into a tqdm bar; identifiability and
@@ -34,19 +36,26 @@ import numpy as np
 import optimistix as optx
 
 from ._data import Dataset, Experiment, read_measured
+from ._estimate._armax import fit_armax
 from ._estimate._fit import (
     ConvergenceWarning,
     FitResult,
     IdentifiabilityWarning,
     PredictionError,
+    _excitation_flags,
+    _field_names,
     fit,
 )
 from ._estimate._linear import initial_estimate
-from ._estimate._params import as_arrays, parameter_fields
+from ._estimate._params import as_arrays, param, parameter_fields
+from ._estimate._predict import predict
 from ._estimate._windows import build_windows
 from ._steering._base import AbstractSteeringModel, propagate
 from ._steering.nomoto import Nomoto1, Nomoto2, NonlinearNomoto
-from ._validate import ValidationReport, _to_plain, validate
+from ._steering.ross import RossAutopilot, ross_initial_estimate
+from ._steering.sway_yaw import LinearSwayYaw, NorrbinCrossFlow
+from ._validate import ValidationReport, _to_plain, parameter_report, validate
+from ._vessel.catalogue import VESSELS, get_vessel
 
 
 CHANNEL_UNITS = {"psi": "rad", "r": "rad/s", "u": "m/s", "v": "m/s"}
@@ -135,10 +144,20 @@ class ModelEntry:
       in its flags).
     - `start_method`: how `start` gets its values, in words (for the report).
     - `channels`: the output channels the model predicts (and can be fitted to).
-    - `simulate(model, dataset, rudder, channels) -> (predictions, mask)`: the
-      output-error simulation of the model on records, starting from the measured
-      state: `{channel: (E, N) array}` and the (E, N) mask of simulated samples.
-      The default serves every `AbstractSteeringModel`.
+    - `default_channels`: the channels fitted when none are given.
+    - `requires`: channels every record must have measured (e.g. the surge and
+      sway velocities that drive `RossAutopilot`); a record without one is a
+      `ValueError` naming its file.
+    - `initial`: the window-start modes the fit supports (`PredictionError.initial`);
+      `"auto"` picks `"estimate"` for output error where it is supported.
+    - `simulate(model, dataset, rudder, channels, substeps=1) -> (predictions,
+      mask)`: the output-error simulation of the model on records, starting from
+      the measured state: `{channel: (E, N) array}` and the (E, N) mask of
+      simulated samples. The default (`simulate_steering_records`) serves every
+      `AbstractSteeringModel`.
+    - `fit(start, train, context) -> FitResult`: replaces the prediction-error fit
+      (`jaxship.fit` with `context.estimator`) for models it does not serve, e.g.
+      the discrete ARMAX model; None: `jaxship.fit`.
     """
 
     description: str
@@ -147,6 +166,10 @@ class ModelEntry:
     start_method: str = "linear least squares (initial_estimate)"
     channels: tuple[str, ...] = ("psi", "r")
     simulate: Callable | None = None
+    default_channels: tuple[str, ...] = ("psi", "r")
+    requires: tuple[str, ...] = ()
+    initial: tuple[str, ...] = ("measured", "estimate")
+    fit: Callable | None = None
 
 
 def _rms(a):
@@ -238,6 +261,239 @@ def _fallback_nonlinear(train: Dataset, context: StartContext) -> NonlinearNomot
     return NonlinearNomoto(K=first.K, T=first.T)
 
 
+# -- Ross autopilot -----------------------------------------------------------------------
+
+
+def _mean_valid(train: Dataset, name: str) -> float:
+    values = _valid(train, name)
+    return float(np.mean(values)) if values.size else 0.0
+
+
+def _ross_scales(train: Dataset) -> dict:
+    """Reference scales of `RossAutopilot` from the training records: $U_0$ the mean
+    measured surge speed, $n_0$ the mean propeller rate (1 rev/s when not measured)
+    and $L = 0.3\\,U_0/\\mathrm{rms}(r)$, which makes the scaled yaw rate $r' = rL/U_0$
+    of order 0.3 (the coefficients' conditioning; any $L$ gives the same model,
+    see `RossAutopilot.dimensional`)."""
+    speed = abs(_mean_valid(train, "u"))
+    speed = speed if math.isfinite(speed) and speed > 0 else 1.0
+    rate = abs(_mean_valid(train, "n")) if "n" in train.channels else 0.0
+    rate = rate if math.isfinite(rate) and rate > 0 else 1.0
+    spread = _rms(_valid(train, "r"))
+    length = 0.3 * speed / spread if spread > 0 else 1.0
+    return dict(length=float(length), speed=float(speed), rate=float(rate))
+
+
+def _start_ross(train: Dataset, context: StartContext) -> RossAutopilot:
+    scales = _ross_scales(train)
+    context.note("RossAutopilot reference scales (frozen): L = {length:.6g} m, U0 = {speed:.6g} "
+                 "m/s, n0 = {rate:.6g} rev/s; the estimates are the scaled coefficients a of "
+                 "these (RossAutopilot.dimensional() converts them).".format(**scales))
+    return ross_initial_estimate(RossAutopilot(**scales), train, rudder=context.rudder)
+
+
+def _fallback_ross(train: Dataset, context: StartContext) -> RossAutopilot:
+    """The neutral Nomoto1 in Ross form: $a_{ur}u'r'$ damping with time constant T and
+    the rudder term $a_\\delta u'^2\\delta$ with gain K at the reference speed."""
+    scales = _ross_scales(train)
+    first = _neutral_nomoto1(train, context.rudder)
+    length, speed = scales["length"], scales["speed"]
+    return RossAutopilot(**scales, n_ur=-length / (speed * float(first.T)),
+                         n_delta=float(first.K) * length**2 / (float(first.T) * speed**2))
+
+
+# -- sway-yaw models ------------------------------------------------------------------
+
+
+def _sway_yaw_start(model, train: Dataset, context: StartContext, preset: str):
+    speed = abs(_mean_valid(train, "u"))
+    if math.isfinite(speed) and speed > 0:
+        model = eqx.tree_at(lambda m: m.speed, model, speed)
+    context.note(f"{type(model).__name__} start: the {preset} derivatives (Astrom & Kallstrom "
+                 f"1979), with its length L = {float(model.length):.6g} m (the unit of the prime "
+                 "system) and its mass terms (frozen); speed = the mean measured u "
+                 f"{float(model.speed):.6g} m/s.")
+    return model
+
+
+def _start_linear_sway_yaw(train: Dataset, context: StartContext) -> LinearSwayYaw:
+    return _sway_yaw_start(LinearSwayYaw.from_vessel(get_vessel("sea_stratus_linear")), train,
+                           context, "sea_stratus_linear")
+
+
+def _start_norrbin(train: Dataset, context: StartContext) -> NorrbinCrossFlow:
+    return _sway_yaw_start(NorrbinCrossFlow.from_vessel(get_vessel("sea_stratus_nonlinear")),
+                           train, context, "sea_stratus_nonlinear")
+
+
+# -- ARMAX --------------------------------------------------------------------------------
+
+ARMAX_ORDERS = dict(na=2, nb=2, nc=2, nk=1)
+
+
+class ARMAXModel(eqx.Module):
+    """The ARMAX model of `jaxship identify --model armax` (Astrom & Kallstrom 1979,
+    eq. 7) with the fixed orders `ARMAX_ORDERS` ($n_a = n_b = n_c = 2$, delay
+    $n_k = 1$ sample) and $y = r$ [rad/s], $u = \\delta$ [rad]:
+
+    $$r(t) + a_1r(t-1) + a_2r(t-2) = b_0\\delta(t-1) + b_1\\delta(t-2)
+    + e(t) + c_1e(t-1) + c_2e(t-2).$$
+
+    A discrete model of the sample interval `dt` (frozen), estimated by
+    `fit_armax` (one-step prediction error)."""
+
+    a1: float = param(0.0, unit="-")  # a_1 [-] of A(q^-1)
+    a2: float = param(0.0, unit="-")  # a_2 [-]
+    b0: float = param(0.0, unit="1/s")  # b_0 [(rad/s)/rad] of B(q^-1), delta(t - 1)
+    b1: float = param(0.0, unit="1/s")  # b_1 [(rad/s)/rad], delta(t - 2)
+    c1: float = param(0.0, unit="-")  # c_1 [-] of C(q^-1)
+    c2: float = param(0.0, unit="-")  # c_2 [-]
+    nk: float = param(1.0, free=False, unit="samples")  # delay n_k (frozen)
+    dt: float = param(1.0, free=False, unit="s")  # sample interval [s] (frozen)
+
+    def polynomials(self):
+        """`(A, B, C)` coefficient arrays (leading 1 for A and C)."""
+        f = lambda *xs: np.array([float(x) for x in xs])
+        return f(1.0, self.a1, self.a2), f(self.b0, self.b1), f(1.0, self.c1, self.c2)
+
+
+_ARMAX_NAMES = ("a1", "a2", "b0", "b1", "c1", "c2")
+
+
+def _armax_record(train: Dataset, rudder: str):
+    """`(r, rudder, dt, source)` of the one training record `fit_armax` takes."""
+    if train.num_experiments != 1:
+        raise ValueError(f"armax is fitted to one record (fit_armax), got "
+                         f"{train.num_experiments} training records ({', '.join(train.names)}); "
+                         "give one and validate on the others with --validate.")
+    n = int(train.lengths[0])
+    y = np.asarray(train.r, dtype=np.float64)[0, :n]
+    u = np.asarray(getattr(train, rudder), dtype=np.float64)[0, :n]
+    return y, u, float(np.asarray(train.dt)[0]), str(dict(train.experiment_metadata[0]).get(
+        "file", train.names[0]))
+
+
+def _armax_fit_raw(train: Dataset, rudder: str, **kwargs):
+    y, u, dt, source = _armax_record(train, rudder)
+    try:
+        return fit_armax(y, u, dt=dt, **ARMAX_ORDERS, **kwargs), y, u, dt
+    except ValueError as error:
+        raise ValueError(f"{source}: armax: {error}") from None
+
+
+def _armax_model(res, dt) -> ARMAXModel:
+    values = np.concatenate([res.A[1:], res.B, res.C[1:]])
+    return ARMAXModel(**dict(zip(_ARMAX_NAMES, map(float, values))), nk=float(res.nk),
+                      dt=float(dt))
+
+
+def _start_armax(train: Dataset, context: StartContext) -> ARMAXModel:
+    """The pseudo-linear regression (extended least squares) start of `fit_armax`."""
+    res, _, _, dt = _armax_fit_raw(train, context.rudder, max_iter=0)
+    return _armax_model(res, dt)
+
+
+def _fit_armax_entry(start: ARMAXModel, train: Dataset, context: StartContext) -> FitResult:
+    """`fit_armax` on the training record as a `FitResult`: the one-step prediction
+    of r is the criterion (horizon one sample)."""
+    import optimistix as optx
+
+    if context.estimator.horizon is not None:
+        context.note(f"armax is fitted by its one-step prediction error (maximum likelihood); "
+                     f"--horizon {context.estimator.horizon:g} is not used.")
+    if tuple(context.channels) != ("r",):
+        raise ValueError("armax models the yaw rate: fit it with channels 'r'.")
+    res, y, u, dt = _armax_fit_raw(train, context.rudder)
+    model = _armax_model(res, dt)
+    values = np.array([float(getattr(model, n)) for n in _ARMAX_NAMES])
+    units = tuple(parameter_fields(model)[n].unit for n in _ARMAX_NAMES)
+    report = parameter_report(_ARMAX_NAMES, values, np.asarray(res.covariance), units=units,
+                              extra_flags=_excitation_flags(train, context.rudder))
+    first = max(ARMAX_ORDERS["na"], ARMAX_ORDERS["nk"] + ARMAX_ORDERS["nb"] - 1,
+                ARMAX_ORDERS["nc"], 1)  # the first sample of fit_armax's loss
+    eps = res.residuals(y, u)
+    shape = (1, train.num_samples)
+    line, mask = np.zeros(shape), np.zeros(shape, dtype=bool)
+    line[0, :y.size] = y - eps
+    mask[0, first:y.size] = True
+    rudder = np.asarray(getattr(train, context.rudder), dtype=np.float64)
+    metrics = {"r": validate(np.asarray(train.r, dtype=np.float64), line, mask,
+                             num_params=len(_ARMAX_NAMES), u=rudder,
+                             max_lag=context.estimator.max_lag, channel="r")}
+    result = FitResult(
+        model=model, parameters=report, metrics=metrics, predictions={"r": line},
+        predicted=mask,
+        result=optx.RESULTS.successful if res.converged
+        else optx.RESULTS.nonlinear_max_steps_reached,
+        num_steps=int(res.iterations), cost=0.5 * float(np.sum(eps[first:] ** 2)),
+        weights={"r": 1.0}, window_samples=(1,), horizon=dt,
+        experiment_names=tuple(train.names))
+    if report.flags:
+        warnings.warn("fit of ARMAX: " + " ".join(report.flags), IdentifiabilityWarning,
+                      stacklevel=2)
+    return result
+
+
+def simulate_armax_records(model: ARMAXModel, dataset: Dataset, rudder: str,
+                           channels=("psi", "r"), substeps: int = 1):
+    """Output-error simulation of an `ARMAXModel` on every record (the noise-free
+    part $A r = B\\delta(t - n_k)$): the recursion starts at the measured r of the
+    first sample, with r and the rudder before it held at their first values; psi
+    integrates the simulated r (trapezoid rule) from the measured first heading.
+    `substeps` is unused (a discrete model). Returns `(predictions, mask)` as
+    `simulate_steering_records`."""
+    A, B, _ = model.polynomials()
+    nk = int(round(float(model.nk)))
+    shape = (dataset.num_experiments, dataset.num_samples)
+    out = {"psi": np.zeros(shape), "r": np.zeros(shape)}
+    mask = np.zeros(shape, dtype=bool)
+    for i, n in enumerate(dataset.lengths):
+        r = np.asarray(dataset.r, dtype=np.float64)[i, :n]
+        d = np.asarray(getattr(dataset, rudder), dtype=np.float64)[i, :n]
+        pad = max(A.size - 1, nk + B.size - 1)
+        y = np.concatenate([np.full(pad, r[0]), np.zeros(n)])
+        x = np.concatenate([np.full(pad, d[0]), d])
+        y[pad] = r[0]
+        for k in range(pad + 1, pad + n):
+            y[k] = (B @ x[k - nk - np.arange(B.size)]
+                    - A[1:] @ y[k - 1 - np.arange(A.size - 1)])
+        sim = y[pad:]
+        dt = float(np.asarray(dataset.dt)[i])
+        psi0 = float(np.asarray(dataset.psi)[i, 0])
+        out["r"][i, :n] = sim
+        out["psi"][i, :n] = psi0 + np.concatenate([[0.0], np.cumsum(0.5 * dt * (sim[1:]
+                                                                               + sim[:-1]))])
+        mask[i, 1:n] = True
+    return {c: out[c] for c in channels}, mask
+
+
+# -- vessel presets -----------------------------------------------------------------------
+
+
+def simulate_vessel_records(vessel, dataset: Dataset, rudder: str,
+                            channels=("psi", "r", "u", "v"), substeps: int = 1):
+    """Output-error simulation of a 3-DOF vessel on every record from its measured
+    first state (`jaxship.predict` with horizon None), replaying the recorded
+    rudder and propeller rate. Returns `(predictions, mask)` as
+    `simulate_steering_records`."""
+    out = predict(vessel, dataset, estimator=PredictionError(
+        horizon=None, channels=tuple(channels), rudder=rudder, substeps=int(substeps)))
+    return out.predictions, np.asarray(out.predicted, dtype=bool)
+
+
+def _vessel_entry(name: str) -> ModelEntry:
+    def start(train, context):
+        return get_vessel(name)
+
+    return ModelEntry(
+        "vessel preset (3-DOF, default_free estimated): " + VESSELS[name].description,
+        start, start,
+        start_method=f"the preset's coefficients (get_vessel({name!r}))",
+        channels=("psi", "r", "u", "v"), default_channels=("psi", "r", "u", "v"),
+        requires=("u", "v"), initial=("measured",), simulate=simulate_vessel_records,
+    )
+
+
 MODELS: dict[str, ModelEntry] = {
     "nomoto1": ModelEntry(
         "first-order Nomoto model T r' + r = K (delta + delta0): K [1/s], T [s]",
@@ -255,15 +511,47 @@ MODELS: dict[str, ModelEntry] = {
         "T [s], n3 [s^2/rad^2]",
         _start_nonlinear, _fallback_nonlinear,
     ),
+    "ross-autopilot": ModelEntry(
+        "Ross (2008) autopilot model without roll, driven by the measured u, v (thesis eq. "
+        "3.6-3.7): 12 hull terms and the rudder term, scaled coefficients [-]",
+        _start_ross, _fallback_ross, requires=("u", "v"),
+        start_method="equation-error linear least squares (ross_initial_estimate)",
+    ),
+    "linear-sway-yaw": ModelEntry(
+        "linear sway-yaw model in prime derivatives driven by the measured u (Astrom & "
+        "Kallstrom 1979, eq. 3): Y'v, Y'r, N'v, N'r, Y'delta, N'delta [-]",
+        _start_linear_sway_yaw, _start_linear_sway_yaw, channels=("psi", "r", "v"),
+        requires=("u",), start_method="the sea_stratus_linear preset (LinearSwayYaw.from_vessel)",
+    ),
+    "norrbin-crossflow": ModelEntry(
+        "Norrbin's cross-flow model: the linear sway-yaw model plus cross-flow drag C [-] "
+        "(Astrom & Kallstrom 1979, sec. 2)",
+        _start_norrbin, _start_norrbin, channels=("psi", "r", "v"), requires=("u",),
+        start_method="the sea_stratus_nonlinear preset (NorrbinCrossFlow.from_vessel)",
+    ),
+    "armax": ModelEntry(
+        "ARMAX(2,2,2), delay 1 sample, of the yaw rate (Astrom & Kallstrom 1979, eq. 7): "
+        "a1, a2 [-], b0, b1 [1/s], c1, c2 [-]; one training record",
+        _start_armax, _start_armax, channels=("psi", "r"), default_channels=("r",),
+        initial=("measured",), simulate=simulate_armax_records, fit=_fit_armax_entry,
+        start_method="pseudo-linear regression (extended least squares) of fit_armax",
+    ),
+    **{name: _vessel_entry(name) for name in VESSELS},
 }
 
 
 def get_model_entry(name: str) -> ModelEntry:
     """The registry entry of `name`; `ValueError` listing the known names otherwise."""
+    return MODELS[model_key(name)]
+
+
+def model_key(name: str) -> str:
+    """The registry name of `name` (case-insensitive; `-` and `_` interchangeable)."""
     key = str(name).strip().lower()
-    if key not in MODELS:
-        raise ValueError(f"unknown model {name!r}; choose from {', '.join(MODELS)}.")
-    return MODELS[key]
+    for candidate in (key, key.replace("-", "_"), key.replace("_", "-")):
+        if candidate in MODELS:
+            return candidate
+    raise ValueError(f"unknown model {name!r}; choose from {', '.join(MODELS)}.")
 
 
 # ---------------------------------------------------------------------------------------
@@ -346,14 +634,23 @@ def _as_experiments(data, role: str) -> list[Experiment]:
                      f"Dataset or file paths, got {type(data).__name__}.")
 
 
-def _check_experiments(experiments, rudder: str, role: str) -> None:
-    """Errors naming the file, before any fitting."""
+def _check_experiments(experiments, rudder: str, role: str, model: str = "",
+                       requires=()) -> None:
+    """Errors naming the file, before any fitting: the replayed rudder and the
+    channels the `model` `requires` must be measured."""
     for e in experiments:
         where = f"{_source(e)} ({role} record {e.name!r})"
+        have = ", ".join(c for c in e.channels) or "none"
         if not e.has(rudder):
-            have = ", ".join(c for c in e.channels) or "none"
             raise ValueError(f"{where}: no column {rudder!r} (the replayed rudder); measured "
                              f"channels: {have}. Choose --rudder delta or delta_c.")
+        missing = [c for c in requires if not e.has(c)]
+        if missing:
+            raise ValueError(
+                f"{where}: model {model} needs the measured {' and '.join(map(repr, requires))}"
+                f" (the surge/sway velocities it is driven by or restarted from), but the record "
+                f"has no column {missing[0]!r}; measured channels: {have}. Use records with "
+                "them or a Nomoto model.")
         if e.num_samples < 3:
             raise ValueError(f"{where}: needs at least 3 samples, has {e.num_samples}.")
         if not e.is_uniform():
@@ -498,7 +795,12 @@ def _metrics_dict(m: ValidationReport, names) -> dict:
 
 
 def _values_text(model) -> str:
-    return ", ".join(f"{n} = {float(getattr(model, n)):.4g}" for n in parameter_fields(model))
+    names = tuple(parameter_fields(model))
+    if not names:  # a vessel: its default free coefficients
+        from ._estimate._vessel_fit import default_free
+
+        names = default_free(model)
+    return ", ".join(f"{n} = {float(getattr(model, n)):.4g}" for n in names)
 
 
 def _assess(kind, horizon, ds, rudder, predictions, mask, num_params, max_lag, notes=None,
@@ -655,7 +957,7 @@ def _parse_channels(channels, allowed) -> tuple[str, ...]:
 
 
 def identify(train, *, model: str, horizon: float | None = None, validate=None,
-             rudder: str = "delta", channels=("psi", "r"), initial: str = "auto",
+             rudder: str = "delta", channels=None, initial: str = "auto",
              max_steps: int = 256, substeps: int = 1,
              progress: Callable[[Progress], None] | None = None) -> IdentificationResult:
     """Estimate a registered steering model from training records and validate it.
@@ -664,7 +966,10 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
 
     - `train`: the training records: an `Experiment`, a list of them, a `Dataset`,
       or file/folder paths (see `read_experiments`).
-    - `model`: a name in `MODELS` (`nomoto1`, `nomoto2`, `nomoto1-nonlinear`).
+    - `model`: a name in `MODELS`: `nomoto1`, `nomoto2`, `nomoto1-nonlinear`,
+      `ross-autopilot`, `linear-sway-yaw`, `norrbin-crossflow`, `armax` or a vessel
+      preset of `jaxship.VESSELS` (its `default_free` coefficients are estimated
+      from the preset's values; records need u and v).
     - `horizon`: prediction horizon of the fit [s] (`PredictionError.horizon`):
       None (default) output error, 0 equation error, else windows of `horizon`
       seconds from the measured state.
@@ -672,13 +977,15 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
       model is simulated on them from each record's measured first state (output
       error) and assessed with the same figures.
     - `rudder`: the replayed rudder channel, `"delta"` or `"delta_c"`.
-    - `channels`: fitted outputs, a subset of `("psi", "r")` (or `"psi,r"`).
+    - `channels`: fitted outputs, a subset of the entry's `channels` (or a text
+      such as `"psi,r"`); None: the entry's `default_channels` (`psi, r`; `psi, r,
+      u, v` for vessel presets; `r` for armax).
     - `initial`: start of each fitted window (`PredictionError.initial`):
       `"measured"` (the measured r and psi), `"estimate"` (corrections of them are
       estimated with the parameters, which removes the bias a noisy start sample
       gives output error) or `"auto"` (default): `"estimate"` for output error
-      (`horizon=None`), `"measured"` otherwise. Validation simulations always start
-      from the measured state.
+      (`horizon=None`) where the entry supports it, `"measured"` otherwise. Validation
+      simulations always start from the measured state.
     - `max_steps`: optimiser step limit; `substeps`: RK4 steps per sample interval.
     - `progress`: a callable receiving `Progress` reports, or None (quiet).
 
@@ -691,26 +998,29 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     `parameters` (`{name: {value, std, unit, relative_std, start}}`, SI), `frozen`,
     `fit` (optimiser result), `train` (the fit criterion), `train_simulation` and
     `validation` (output error; None without held-out data), each with
-    `channels: {psi|r: {loss, fpe, aic, bic, fit_percent,
+    `channels: {psi|r|u|v: {loss, fpe, aic, bic, fit_percent,
     fit_percent_per_experiment, whiteness, input_independence, ...}}`,
     `correlation` (`names`, `matrix`), `identifiability` (`identifiable`,
     `condition_number`, plain-language `flags`), `data`, `start`, `options`,
     `notes`, `warnings`.
 
     **Raises:** `ValueError` naming the file/record and column for unknown models
-    or channels, missing files, a missing rudder column, non-finite values or
-    non-uniform sampling.
+    or channels, missing files, a missing rudder column, a missing u or v the model
+    needs (`ross-autopilot`, vessel presets; u for the sway-yaw models), non-finite
+    values or non-uniform sampling; for `armax`, more than one training record.
 
     **Warns:** `IdentifiabilityWarning` when the estimates are flagged (e.g. no
     excitation: the fit still returns, with infinite standard errors), and
     `ConvergenceWarning` when the optimiser did not converge.
     """
-    entry = get_model_entry(model)
-    name = str(model).strip().lower()
+    name = model_key(model)
+    entry = MODELS[name]
     if rudder not in ("delta", "delta_c"):
         raise ValueError(f"unknown rudder channel {rudder!r}; choose 'delta' (measured angle) "
                          "or 'delta_c' (command).")
-    channels = _parse_channels(channels, entry.channels)
+    default_channels = channels is None
+    channels = _parse_channels(entry.default_channels if default_channels else channels,
+                               entry.channels)
     if horizon is not None:
         horizon = float(horizon)
         if not (math.isfinite(horizon) and horizon >= 0):
@@ -720,26 +1030,35 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
         raise ValueError(f"unknown initial state {initial!r}; choose 'auto', 'measured' or "
                          "'estimate'.")
     if initial == "auto":
-        initial = "estimate" if horizon is None else "measured"
+        initial = "estimate" if horizon is None and "estimate" in entry.initial else "measured"
+    if initial not in entry.initial:
+        raise ValueError(f"model {name} supports initial {' or '.join(entry.initial)}, not "
+                         f"{initial!r}.")
     if int(max_steps) < 1:
         raise ValueError(f"`max_steps` must be a positive integer, got {max_steps}.")
     train_exps = _as_experiments(train, "training")
-    _check_experiments(train_exps, rudder, "training")
+    _check_experiments(train_exps, rudder, "training", name, entry.requires)
     held_out = None
     if validate is not None:
         held_out = _as_experiments(validate, "validation")
-        _check_experiments(held_out, rudder, "validation")
+        _check_experiments(held_out, rudder, "validation", name, entry.requires)
     train_ds = Dataset.from_experiments(train_exps)
     valid_ds = None if held_out is None else Dataset.from_experiments(held_out)
+    notes, caught = [], []
+    if default_channels:  # a default u or v that never varies (e.g. no surge dynamics)
+        constant = [c for c in channels if c in ("u", "v") and np.ptp(_valid(train_ds, c)) == 0]
+        if constant and len(constant) < len(channels):
+            channels = tuple(c for c in channels if c not in constant)
+            notes.append(f"the measured {', '.join(constant)} is constant in the training "
+                         f"records: not fitted (channels {', '.join(channels)}).")
 
     report = progress if progress is not None else (lambda event: None)
     solver = optx.LevenbergMarquardt(rtol=1e-9, atol=1e-9, verbose=_verbose_hook)
     estimator = PredictionError(horizon=horizon, channels=channels, rudder=rudder,
                                 substeps=int(substeps), solver=solver,
                                 max_steps=int(max_steps), initial=initial)
-    notes, caught = [], []
 
-    def run_fit(start_model, *, free=None, stage="fitting"):
+    def run_fit(start_model, *, free=None, stage="fitting", custom=None):
         total = int(max_steps)
         report(Progress("fit", stage, step=0, total=total))
         _RECEIVERS.append(lambda step, cost: report(Progress("fit", stage, step=step,
@@ -747,7 +1066,10 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
         try:
             with warnings.catch_warnings(record=True) as got:
                 warnings.simplefilter("always")
-                result = fit(start_model, train_ds, estimator=estimator, free=free)
+                if custom is None:
+                    result = fit(start_model, train_ds, estimator=estimator, free=free)
+                else:  # an entry's own estimator (e.g. ARMAX)
+                    result = custom(start_model, train_ds, context)
         finally:
             _RECEIVERS.pop()
         report(Progress("fit", stage, step=int(result.num_steps), total=total,
@@ -776,7 +1098,7 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
 
     def attempt(start_model):
         try:
-            outcome = run_fit(start_model, stage=f"fitting {name}")
+            outcome = run_fit(start_model, stage=f"fitting {name}", custom=entry.fit)
         except np.linalg.LinAlgError as error:  # NaN residuals: the simulation blew up
             return None, str(error)
         if not math.isfinite(outcome[0].cost):
@@ -804,10 +1126,11 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
     d = len(result.names)
-    simulate = entry.simulate or (lambda m, ds, rud, chans: simulate_steering_records(
-        m, ds, rud, chans, substeps=int(substeps)))
+    simulate = entry.simulate or simulate_steering_records
     max_lag = int(estimator.max_lag)
-    train_block = _assess("prediction" if horizon is not None else "simulation", horizon,
+    # the criterion's horizon: the estimator's, or the entry's own (ARMAX: one sample)
+    criterion = result.horizon
+    train_block = _assess("prediction" if criterion is not None else "simulation", criterion,
                           train_ds, rudder, result.predictions, result.predicted,
                           int(result.metrics[channels[0]].num_params), max_lag,
                           start="estimated" if initial == "estimate" else "measured")
@@ -815,19 +1138,24 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     def measured(ds):  # psi and r always exist (derived if need be); other outputs if measured
         return tuple(c for c in entry.channels if c in ("psi", "r") or c in ds.channels)
 
-    predictions, mask = simulate(result.model, train_ds, rudder, measured(train_ds))
+    predictions, mask = simulate(result.model, train_ds, rudder, measured(train_ds),
+                                 substeps=int(substeps))
     train_sim = _assess("simulation", None, train_ds, rudder, predictions, mask, d, max_lag,
                         notes)
     valid_block = None
     if valid_ds is not None:
         report(Progress("validate", "simulating the validation records"))
-        predictions, mask = simulate(result.model, valid_ds, rudder, measured(valid_ds))
+        predictions, mask = simulate(result.model, valid_ds, rudder, measured(valid_ds),
+                                     substeps=int(substeps))
         valid_block = _assess("simulation", None, valid_ds, rudder, predictions, mask, d,
                               max_lag, notes)
     report(Progress("validate", "validation", done=True))
 
-    frozen = [n for n in parameter_fields(result.model) if n not in result.names]
-    if frozen:
+    frozen = [n for n in _field_names(result.model) if n not in result.names]
+    if len(frozen) > 12:  # a vessel preset: listed in the report's "frozen"
+        notes.append(f"{len(frozen)} coefficients of the preset are frozen (not estimated); "
+                     "see `frozen`.")
+    elif frozen:
         notes.append("frozen parameters (not estimated): "
                      + ", ".join(f"{n} = {float(getattr(result.model, n)):.6g}" for n in frozen)
                      + ".")

@@ -25,17 +25,22 @@ def main(argv=None) -> int:
     rep.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/reproduce"))
     rep.add_argument("--quick", action="store_true", help="fewer trials (for smoke tests)")
 
+    from ._identify import MODELS
+
     ident = sub.add_parser(
         "identify", help="estimate a steering model from measured trials and validate it",
         description="Estimate a steering model from training records (trial CSV files, "
         "measurement files or folders of them) and validate it; writes result.json and "
         "figures into --out.",
+        epilog="models (--model):\n" + "\n".join(
+            f"  {name:<24} {entry.description}" for name, entry in MODELS.items()),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     ident.add_argument("train", nargs="+", type=pathlib.Path,
                        help="training records: trial CSV or measurement files, or folders")
     ident.add_argument("--model", required=True,
-                       help="a registered model: nomoto1, nomoto2, nomoto1-nonlinear (an "
-                       "unknown name lists them all)")
+                       help="a registered model (listed below): a steering model, armax or a "
+                       "vessel preset name")
     ident.add_argument("--horizon", default=None,
                        help="prediction horizon [s]; 'none' (default): output error, "
                        "0: equation error")
@@ -43,7 +48,9 @@ def main(argv=None) -> int:
                        metavar="TEST", help="held-out records to validate on")
     ident.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
     ident.add_argument("--rudder", default="delta", help="replayed rudder: delta or delta_c")
-    ident.add_argument("--channels", default="psi,r", help="fitted outputs, e.g. psi,r or r")
+    ident.add_argument("--channels", default=None,
+                       help="fitted outputs, e.g. psi,r or r (default: psi,r; psi,r,u,v for "
+                       "vessel presets; r for armax)")
     ident.add_argument("--initial", default="auto",
                        help="window start states: measured, estimate or auto (default: "
                        "estimate for output error, else measured)")

@@ -1,18 +1,29 @@
 """`jaxship identify` and `jaxship._identify.identify`: recovery of known steering
-models from trial CSV files written from simulations, the report's schema, figures,
-validation on held-out records, progress reporting and clear errors on bad input."""
+models from trial CSV files written from simulations (every registered kind: Nomoto,
+Ross, sway-yaw, ARMAX and a vessel preset), the report's schema, figures, validation on
+held-out records, progress reporting and clear errors on bad input."""
 
 import json
 import math
 import warnings
 
+import equinox as eqx
 import numpy as np
 import pytest
 
 import jaxship as js
 from jaxship._estimate._fit import IdentifiabilityWarning
 from jaxship._identify import MODELS, IdentificationResult, Progress, identify, read_experiments
-from jaxship._steering import Nomoto1, Nomoto2, NonlinearNomoto, simulate_steering
+from jaxship._steering import (
+    AuxInputs,
+    LinearSwayYaw,
+    Nomoto1,
+    Nomoto2,
+    NonlinearNomoto,
+    NorrbinCrossFlow,
+    RossAutopilot,
+    simulate_steering,
+)
 from jaxship.cli import main
 
 
@@ -20,6 +31,8 @@ DEG = np.pi / 180
 DT = 0.5
 NUM = 600
 TRUTH = Nomoto1(K=0.06, T=25.0)  # K [1/s], T [s]
+STEERING_MODELS = ("nomoto1", "nomoto2", "nomoto1-nonlinear", "ross-autopilot",
+                   "linear-sway-yaw", "norrbin-crossflow", "armax")
 
 
 def rudder_sequence(seed, amplitudes=(10.0,), hold=(16, 48)):
@@ -174,10 +187,10 @@ def test_folder_delta_c_horizon_and_channels(tmp_path, capsys):
                  marks=pytest.mark.slow),  # the fast tier has it in the folder test
 ])
 def test_every_registered_model_recovers_quietly(name, truth, capsys):
-    """Each registry entry recovers its own noise-free truth from its start values
+    """Each Nomoto entry recovers its own noise-free truth from its start values
     (the course-unstable nonlinear model included); the library prints nothing and
     reports progress through the callable, with increasing optimiser steps."""
-    assert set(MODELS) == {"nomoto1", "nomoto2", "nomoto1-nonlinear"}
+    assert set(MODELS) == set(STEERING_MODELS) | set(js.VESSELS)
     train = record(truth, rudder_sequence(5, amplitudes=(5.0, 15.0, 30.0)), name="a")
     test = record(truth, rudder_sequence(6, amplitudes=(5.0, 15.0, 30.0)), name="b")
     events = []
@@ -278,3 +291,180 @@ def test_measured_esso_osaka_zigzags(tmp_path, capsys):
     assert result["parameters"]["K"]["value"] > 0 and result["parameters"]["T"]["value"] > 0
     assert result["validation"]["channels"]["r"]["fit_percent"] > 0
     assert len(list((out / "figures").glob("fit_validation_*.png"))) == 2
+
+
+# -- the other registered models: fit-then-recover on their own noise-free records ---------
+
+
+def steps(num, seed, hold=(10, 40), lead=0):
+    """Rudder steps of random sign and size 5-30 deg [rad], after `lead` samples at 0."""
+    rng = np.random.default_rng(seed)
+    out, sign = [0.0] * lead, 1.0
+    while len(out) < num:
+        sign = -sign if rng.random() < 0.8 else sign
+        out.extend([sign * rng.choice([5.0, 15.0, 30.0]) * DEG] * int(rng.integers(*hold)))
+    return np.array(out[:num])
+
+
+def steering_csvs(folder, truth, dt, num, aux_of_t, seed=0):
+    """Two noise-free trial CSVs (train, test) of the steering model `truth` driven by
+    rudder steps and the measured u, v, n of `aux_of_t(t)` (v: the model's state
+    where it has one)."""
+    paths = []
+    for k in range(2):
+        t = dt * np.arange(num)
+        delta, aux = steps(num, seed + k), aux_of_t(t)
+        tr = simulate_steering(truth, delta, dt, aux=aux, psi0=0.2)
+        v = np.asarray(tr.state[:, 1]) if "v" in truth.state_names else aux.v
+        e = js.Experiment(t, delta, psi=np.asarray(tr.psi), r=np.asarray(tr.r), u=aux.u, v=v,
+                          n=aux.n, name=("train", "test")[k])
+        paths.append(write(folder / f"{e.name}.csv", e))
+    return paths
+
+
+ROSS_TRUTH = RossAutopilot(  # a course-stable Ross model (tests/test_ross_autopilot.py)
+    length=4.0, speed=1.5, rate=8.0, n_uv=-1.2, n_uuv=0.4, n_vvv=-3.0, n_rrv=-0.8,
+    n_absv_v=0.3, n_absr_v=-0.5, n_ur=-4.0, n_uur=0.8, n_rrr=-0.6, n_vvr=-1.5, n_absv_r=-1.0,
+    n_absr_r=-0.7, n_delta=2.5)
+
+
+def ross_aux(t):
+    """Measured u, v, n that vary independently of the rudder (every term excited)."""
+    return AuxInputs(u=1.5 * (1 - 0.15 * np.sin(2 * np.pi * t / 37) ** 2),
+                     v=0.12 * (np.sin(2 * np.pi * t / 23) + 0.6 * np.sin(2 * np.pi * t / 9.1 + 1)),
+                     n=np.full(t.shape, 8.0))
+
+
+def quiet_identify(*args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", IdentifiabilityWarning)  # correlated, still exact
+        return identify(*args, **kwargs)
+
+
+def test_ross_autopilot_recovers_from_trial_csvs(tmp_path):
+    """Ross' 13 coefficients from one 60 s record: the start is the least-squares
+    estimate, the reference scales come from the data (so the scaled coefficients
+    differ from the truth's), and Ross' dimensional ratios are recovered to 1e-6."""
+    train, test = steering_csvs(tmp_path, ROSS_TRUTH, 0.2, 300, ross_aux)
+    res = quiet_identify([train], model="ross-autopilot", validate=[test])
+    assert res.fit.success and isinstance(res.model, RossAutopilot)
+    assert res.start_method.startswith("equation-error linear least squares")
+    got, truth = res.model.dimensional(), ROSS_TRUTH.dimensional()
+    np.testing.assert_allclose([got[n] for n in res.fit.names],
+                               [truth[n] for n in res.fit.names], rtol=1e-6)
+    assert len(res.fit.names) == 13
+    assert res.validation.metrics["r"].fit_percent > 99.999
+    assert any("reference scales" in n for n in res.notes)
+
+
+@pytest.mark.parametrize("name, cls, preset", [
+    ("linear-sway-yaw", LinearSwayYaw, "sea_stratus_linear"),
+    pytest.param("norrbin-crossflow", NorrbinCrossFlow, "sea_stratus_nonlinear",
+                 marks=pytest.mark.slow),  # the same code path with one more parameter
+])
+def test_sway_yaw_models_recover_from_trial_csvs(tmp_path, name, cls, preset):
+    """The sway-yaw models start from the Sea Stratus derivatives and recover a
+    truth 15 % away (cross-flow C 0.8 instead of 0.63) from psi, r and the
+    measured v, with the measured (varying) surge speed as V, to 1e-6."""
+    truth = cls.from_vessel(js.get_vessel(preset))
+    changed = ("y_v", "n_r", "n_delta")
+    truth = eqx.tree_at(lambda m: tuple(getattr(m, k) for k in changed), truth,
+                        tuple(1.15 * float(getattr(truth, k)) for k in changed))
+    if cls is NorrbinCrossFlow:
+        truth = eqx.tree_at(lambda m: m.cross_flow, truth, 0.8)
+    aux = lambda t: AuxInputs(u=8 + 0.8 * np.sin(2 * np.pi * t / 300), v=0.0 * t,
+                              n=0.0 * t)
+    train, test = steering_csvs(tmp_path, truth, 2.0, 200, aux)
+    res = quiet_identify([train], model=name, validate=[test], channels="psi,r,v")
+    assert res.fit.success and isinstance(res.model, cls)
+    expected = [float(getattr(truth, n)) for n in res.fit.names]
+    np.testing.assert_allclose(res.fit.values, expected, rtol=1e-6)
+    assert set(res.validation.metrics) == {"psi", "r", "v"}
+    assert res.validation.metrics["v"].fit_percent > 99.999
+
+
+def test_armax_recovers_its_polynomials(tmp_path, capsys):
+    """ARMAX(2,2,2) on a noise-free record of its own difference equation: A and B to
+    1e-6 (C is not determined without noise), the one-step criterion as the train
+    block, the simulation of r and psi on a held-out record, result.json via the CLI."""
+    a, b = np.array([1.0, -1.6, 0.63]), np.array([0.004, 0.0035])
+    paths = []
+    for k in range(2):
+        delta = steps(300, k, lead=5)
+        r = np.zeros(300)
+        for i in range(2, 300):  # r(t) - 1.6 r(t-1) + 0.63 r(t-2) = b0 d(t-1) + b1 d(t-2)
+            r[i] = -a[1] * r[i - 1] - a[2] * r[i - 2] + b[0] * delta[i - 1] + b[1] * delta[i - 2]
+        psi = 0.1 + np.concatenate([[0.0], np.cumsum(0.5 * DT * (r[1:] + r[:-1]))])
+        e = js.Experiment(DT * np.arange(300), delta, psi=psi, r=r, name=f"arx{k}")
+        paths.append(write(tmp_path / f"arx{k}.csv", e))
+    out = tmp_path / "id"
+    code, _, err = run([paths[0], "--model", "armax", "--validate", paths[1], "--out", str(out),
+                        "--no-figures"], capsys)
+    assert code == 0, err
+    result = json.loads((out / "result.json").read_text())
+    assert result["model"] == "armax" and result["model_class"] == "ARMAXModel"
+    values = {k: v["value"] for k, v in result["parameters"].items()}
+    assert list(values) == ["a1", "a2", "b0", "b1", "c1", "c2"]
+    np.testing.assert_allclose([values[k] for k in ("a1", "a2", "b0", "b1")],
+                               [a[1], a[2], b[0], b[1]], rtol=1e-6)
+    assert result["parameters"]["b0"]["unit"] == "1/s"
+    assert result["frozen"] == {"nk": 1.0, "dt": DT}
+    assert result["options"]["channels"] == ["r"]
+    assert result["train"]["kind"] == "prediction" and result["train"]["horizon_s"] == DT
+    for block in ("train_simulation", "validation"):
+        for channel in ("psi", "r"):
+            m = result[block]["channels"][channel]
+            assert m["fit_percent"] > 99.999 and math.isfinite(m["fpe"])
+    assert result["correlation"]["names"] == list(values)
+    assert isinstance(result["identifiability"]["flags"], list)
+    # one training record only
+    code, _, err = run([*paths, "--model", "armax", "--out", str(tmp_path / "two")], capsys)
+    assert code == 2 and "armax is fitted to one record" in err
+
+
+@pytest.mark.slow
+def test_vessel_preset_recovers_its_default_free_coefficients(tmp_path, capsys):
+    """`--model mariner`: the seven default free coefficients of the preset, started
+    from the preset's values, recovered to 1e-6 from a zig-zag of a Mariner whose
+    first three differ by 10 % (the command replayed through the servo), fitted to
+    psi, r, u and v and validated by simulation."""
+    ship = js.get_vessel("mariner")
+    names = js.default_free(ship)
+    truth = ship
+    for n in names[:3]:
+        truth = eqx.tree_at(lambda m: getattr(m, n), truth, 1.1 * getattr(truth, n))
+    trial = js.simulate(truth, js.ZigZag(20 * DEG, 20 * DEG, duration=200.0, dt=1.0),
+                        js.straight_run(truth))
+    path = write(tmp_path / "zz.csv", js.Experiment.from_trajectory(trial, name="zz"))
+    out = tmp_path / "id"
+    code, _, err = run([path, "--model", "mariner", "--rudder", "delta_c", "--validate", path,
+                        "--out", str(out), "--no-figures"], capsys)
+    assert code == 0, err
+    result = json.loads((out / "result.json").read_text())
+    assert result["model"] == "mariner" and result["model_class"] == "Mariner"
+    assert list(result["parameters"]) == list(names)
+    np.testing.assert_allclose([result["parameters"][n]["value"] for n in names],
+                               [float(getattr(truth, n)) for n in names], rtol=1e-6)
+    assert result["options"]["channels"] == ["psi", "r", "u", "v"]
+    assert result["options"]["initial"] == "measured"
+    assert result["validation"]["channels"]["v"]["fit_percent"] > 99.999
+    assert "x_u" not in result["frozen"] and "m" in result["frozen"]
+
+
+@pytest.mark.parametrize("model", ["ross-autopilot", "mariner", "esso-osaka",
+                                   "linear-sway-yaw"])
+def test_models_driven_by_measured_speeds_need_them(files, tmp_path, capsys, model):
+    """Records without u (and v): a clear error naming the file, before any fit."""
+    code, _, err = run([files["train"], "--model", model, "--out", str(tmp_path / "o")], capsys)
+    assert code == 2
+    assert f"{files['train']} (training record 'train'): model " in err
+    assert "no column 'u'" in err and not (tmp_path / "o").exists()
+
+
+def test_help_lists_every_model(capsys):
+    with pytest.raises(SystemExit):
+        main(["identify", "--help"])
+    out = capsys.readouterr().out
+    listed = [line.split()[0] for line in out.split("models (--model):")[1].splitlines()
+              if line.strip()]
+    assert listed == [*STEERING_MODELS, *js.VESSELS]
