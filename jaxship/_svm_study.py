@@ -36,8 +36,13 @@ def _run(vessel, manoeuvre, x0):
 
 
 def _overshoots(t, psi, delta, switch):
-    zz = zigzag_indices(t=np.asarray(t), psi=np.asarray(psi), delta=np.asarray(delta),
-                        heading_switch=switch)
+    """First and second overshoot [rad]; NaN where the model never completes them
+    (e.g. a fitted gain too small to reach the switch heading)."""
+    try:
+        zz = zigzag_indices(t=np.asarray(t), psi=np.asarray(psi), delta=np.asarray(delta),
+                            heading_switch=switch)
+    except ValueError:
+        return np.nan, np.nan
     o = list(zz.overshoots) + [np.nan, np.nan]
     return float(o[0]), float(o[1])
 
