@@ -27,6 +27,15 @@ from ._estimate._fit import (
     PredictionError as PredictionError,
     fit as fit,
 )
+from ._estimate._kalman import (
+    KalmanFitResult as KalmanFitResult,
+    KalmanOutput as KalmanOutput,
+    SmoothedStates as SmoothedStates,
+    ekf as ekf,
+    fit_ml as fit_ml,
+    rts_smoother as rts_smoother,
+    smooth_states as smooth_states,
+)
 from ._estimate._linear import initial_estimate as initial_estimate
 from ._estimate._params import Free as Free, param as param
 from ._estimate._predict import predict as predict

@@ -72,7 +72,10 @@ class PredictionError(eqx.Module):
       window to the estimated parameters (nuisance parameters, reported in no table
       but counted in the FPE), which removes the errors-in-variables bias of a noisy
       start sample: use it for output error on noisy data (MATLAB's
-      `InitialState='estimate'`). Costs two parameters per window.
+      `InitialState='estimate'`). Costs two parameters per window. A list of
+      `SmoothedStates` (one per experiment, from `jaxship.smooth_states`) starts
+      the windows from the EKF + RTS smoothed r and psi instead (the targets stay
+      the measurements).
     - `wind`: vessels only: replay the measured true wind (`wind_speed`,
       `wind_dir`, held over each interval) as loads of `jaxship.Wind` on the
       vessel's wind areas. Default False: calm water.
@@ -86,7 +89,7 @@ class PredictionError(eqx.Module):
     solver: optx.AbstractLeastSquaresSolver = optx.LevenbergMarquardt(rtol=1e-9, atol=1e-9)
     max_steps: int = 256
     max_lag: int = 25
-    initial: str = "measured"
+    initial: str | list = "measured"
     wind: bool = False
 
 
@@ -398,11 +401,14 @@ def fit(model: AbstractSteeringModel, dataset, *, estimator: PredictionError = P
         raise ValueError(f"`substeps` must be a positive integer, got {estimator.substeps}.")
     specs = resolve_free(model, free)
     transform = Transform.from_specs(specs)
+    smoothed = not isinstance(estimator.initial, str)
+    starts = _smoothed_starts(ds, estimator.initial) if smoothed else None
+    if not smoothed and estimator.initial not in ("measured", "estimate"):
+        raise ValueError(f"`initial` must be 'measured', 'estimate' or a list of smoothed "
+                         f"states, got {estimator.initial!r}.")
     windows, layout = build_windows(ds, horizon=estimator.horizon, channels=channels,
                                     weights=estimator.weights, rudder=estimator.rudder,
-                                    substeps=int(estimator.substeps))
-    if estimator.initial not in ("measured", "estimate"):
-        raise ValueError(f"`initial` must be 'measured' or 'estimate', got {estimator.initial!r}.")
+                                    substeps=int(estimator.substeps), starts=starts)
     estimate_starts = estimator.initial == "estimate"
     if estimate_starts and min(layout["lengths"]) < 2:
         raise ValueError("`initial='estimate'` needs windows of at least 2 samples (with one "
@@ -426,6 +432,25 @@ def fit(model: AbstractSteeringModel, dataset, *, estimator: PredictionError = P
     return _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
                    result, num_steps, estimate_starts=estimate_starts, verbose=verbose,
                    stacklevel=3)
+
+
+def _smoothed_starts(ds, smoothed) -> dict:
+    """`{"r": (E, N), "psi": (E, N)}` window starts from `SmoothedStates` (one per
+    experiment of `ds`, e.g. from `jaxship.smooth_states`)."""
+    smoothed = list(smoothed)
+    if len(smoothed) != ds.num_experiments or not all(hasattr(s, "state") for s in smoothed):
+        raise ValueError(f"`initial` as smoothed states needs one SmoothedStates per "
+                         f"experiment ({ds.num_experiments}), got {len(smoothed)} items.")
+    out = {}
+    for name in ("r", "psi"):
+        a = np.array(getattr(ds, name), dtype=np.float64)
+        for i, s in enumerate(smoothed):
+            if s.mean.shape[0] != ds.lengths[i]:
+                raise ValueError(f"smoothed states {i} have {s.mean.shape[0]} samples, "
+                                 f"experiment {ds.names[i]!r} has {ds.lengths[i]}.")
+            a[i, :ds.lengths[i]] = s.state(name)
+        out[name] = a
+    return out
 
 
 def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac, result,

@@ -153,9 +153,11 @@ def channel_weights(ds: Dataset, channels, weights) -> np.ndarray:
 
 
 def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "delta",
-                  substeps: int = 1):
+                  substeps: int = 1, starts: dict | None = None):
     """`(Windows, layout)`; `layout` holds the NumPy index arrays to map window
-    predictions back onto the samples: `target` (E, W, L) sample index, `mask`."""
+    predictions back onto the samples: `target` (E, W, L) sample index, `mask`.
+    `starts`: optional `{"r": (E, N), "psi": (E, N)}` start values of the windows in
+    place of the measured ones (e.g. smoothed states); targets stay measured."""
     lengths = window_lengths(ds, horizon)
     num_exp, num = ds.num_experiments, ds.num_samples
     counts = [len(range(0, n - 1, L)) for n, L in zip(ds.lengths, lengths)]
@@ -176,6 +178,11 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
     def at(name, index, r):
         return np.asarray(getattr(ds, name), dtype=np.float64)[r, index]
 
+    def start_at(name, index, r):
+        if starts is not None and name in starts:
+            return np.asarray(starts[name], dtype=np.float64)[r, index]
+        return at(name, index, r)
+
     weights = channel_weights(ds, channels, weights)
     dt_e = np.asarray(ds.dt, dtype=np.float64)
     dt = np.broadcast_to(dt_e[:, None], (num_exp, num_w))
@@ -184,11 +191,12 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
     integral = np.concatenate([np.zeros((num_exp, 1)), np.cumsum(rud[:, :-1], axis=1)], axis=1)
     integral = integral * dt_e[:, None]
     first = lambda name: np.broadcast_to(
-        np.asarray(getattr(ds, name), dtype=np.float64)[:, :1], (num_exp, num_w))
+        start_at(name, np.zeros((1, 1), dtype=int), np.arange(num_exp)[:, None]),
+        (num_exp, num_w))
     f = lambda a: jnp.asarray(a, dtype=float)
     start_values = WindowStart(
-        r=f(at("r", start_index, rows2)),
-        psi=f(at("psi", start_index, rows2)),
+        r=f(start_at("r", start_index, rows2)),
+        psi=f(start_at("psi", start_index, rows2)),
         delta=f(rud[rows2, start_index]),
         r_first=f(first("r")),
         psi_first=f(first("psi")),

@@ -1,0 +1,769 @@
+"""State estimation and the likelihood of steering models: extended Kalman filter,
+Rauch-Tung-Striebel smoother, and innovations-form (PEM) and maximum-likelihood fits.
+
+**Model.** The filter works on the augmented state $z = (x, \\psi)$ of a steering model
+(`AbstractSteeringModel.state_names` followed by the heading). Over one sample
+interval the rudder $\\delta_k$ and the auxiliary inputs are held and the interval map
+$F$ is the RK4 integration of `_steering._base._rk4_interval` (the same numerics as
+`simulate_steering` and `fit`):
+
+$$z_{k+1} = F(z_k, \\delta_k + w_k) + v_k, \\qquad y_k = h(z_k) + e_k,$$
+
+with $w_k \\sim N(0, q_\\delta)$ a rudder-equivalent disturbance held over the interval
+(any yaw moment acting like the rudder: waves, wind), $v_k \\sim N(0, Q)$ a disturbance
+on the states, and $e_k \\sim N(0, R)$ the measurement noise of the channels
+$y = (\\psi, r)$ (unwrapped heading and yaw rate). Linearised, the process noise of an
+interval is $Q_k = Q + q_\\delta B_kB_k^T$, $B_k = \\partial F/\\partial\\delta$.
+
+**Filter** (Simon 2006, sec. 13.2; Sarkka 2013, alg. 5.4), with
+$A_k = \\partial F/\\partial z$ by `jax.jacfwd` of the interval map:
+
+$$\\hat z_{k|k-1} = F(\\hat z_{k-1|k-1}, \\delta_{k-1}), \\quad
+P_{k|k-1} = A P_{k-1|k-1} A^T + Q_k,$$
+$$\\varepsilon_k = y_k - h(\\hat z_{k|k-1}), \\quad S_k = H P_{k|k-1} H^T + R, \\quad
+K_k = P_{k|k-1} H^T S_k^{-1},$$
+$$\\hat z_{k|k} = \\hat z_{k|k-1} + K_k\\varepsilon_k, \\quad
+P_{k|k} = (I - K_kH)P_{k|k-1}(I - K_kH)^T + K_kRK_k^T \\;\\text{(Joseph form)}.$$
+
+The innovations $\\varepsilon_k$ are the one-step-ahead prediction errors of the
+innovations-form predictor (Ljung 1999, sec. 4.3, eq. 4.84-4.87); for a linear model
+with stationary noise the gain $K_k$ converges to the stationary Kalman gain. Sample 0
+is the prior: the model's `window_state` of the first record sample (as `fit` starts),
+with covariance $P_0$; samples 1..N-1 are predicted and updated; masked (padded)
+samples are predicted without update and add nothing to the likelihood.
+
+**Likelihood** (Ljung 1999, eq. 7.86-7.88; Astrom & Kallstrom 1979 fitted ship steering
+models by this approximate maximum likelihood with the Kalman filter):
+
+$$-\\log L = \\tfrac12\\sum_k \\left(\\log\\det S_k + \\varepsilon_k^TS_k^{-1}\\varepsilon_k
++ C\\log 2\\pi\\right).$$
+
+**Smoother** (Rauch, Tung & Striebel 1965; Sarkka 2013, alg. 9.3 for the extended form):
+$G_k = P_{k|k}A_{k+1}^TP_{k+1|k}^{-1}$,
+$\\hat z_{k|N} = \\hat z_{k|k} + G_k(\\hat z_{k+1|N} - \\hat z_{k+1|k})$,
+$P_{k|N} = P_{k|k} + G_k(P_{k+1|N} - P_{k+1|k})G_k^T$.
+"""
+
+import dataclasses
+import math
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optimistix as optx
+
+from .._steering._base import AbstractSteeringModel, AuxInputs, WindowStart, _rk4_interval
+from .._validate import ParameterReport, least_squares_covariance, parameter_report
+from ._params import Transform, as_arrays, rebuild, resolve_free
+from ._windows import as_dataset, channel_weights, check_data
+
+
+KALMAN_CHANNELS = ("psi", "r")
+_LOG_2PI = math.log(2.0 * math.pi)
+
+
+# -- noise specifications (host side) -------------------------------------------------
+
+
+def _augmented_names(model) -> tuple[str, ...]:
+    return tuple(model.state_names) + ("psi",)
+
+
+def _check_channels(channels) -> tuple[str, ...]:
+    if isinstance(channels, str):
+        channels = (channels,)
+    channels = tuple(channels)
+    if not channels:
+        raise ValueError(f"`channels` is empty; choose from {KALMAN_CHANNELS}.")
+    for c in channels:
+        if c not in KALMAN_CHANNELS:
+            raise ValueError(f"unknown channel {c!r} for the Kalman filter; choose from "
+                             f"{KALMAN_CHANNELS} (unwrapped heading and yaw rate).")
+    if len(set(channels)) != len(channels):
+        raise ValueError(f"`channels` repeats a channel: {channels}.")
+    return channels
+
+
+def _variance(name, value, what) -> float:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}[{name!r}] must be a number (a variance), got {value!r}.") \
+            from None
+    if not math.isfinite(value):
+        raise ValueError(f"{what}[{name!r}] is {value}; variances must be finite.")
+    if value < 0:
+        raise ValueError(f"{what}[{name!r}] is {value}; a variance cannot be negative.")
+    return value
+
+
+def _matrix(value, size, what, *, definite) -> np.ndarray:
+    a = np.asarray(value, dtype=np.float64)
+    if a.ndim == 1 and a.shape[0] == size:
+        a = np.diag(a)
+    if a.shape != (size, size):
+        raise ValueError(f"`{what}` must be a dict, {size} variances or a ({size}, {size}) "
+                         f"covariance matrix, got shape {a.shape}.")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"`{what}` contains non-finite entries (NaN or inf): {a.tolist()}.")
+    if not np.allclose(a, a.T, rtol=1e-12, atol=0.0):
+        raise ValueError(f"`{what}` must be symmetric.")
+    eig = np.linalg.eigvalsh(a) if size else np.zeros(0)
+    if np.any(np.diag(a) < 0) or (size and eig[0] < -1e-12 * max(eig[-1], 1e-300)):
+        raise ValueError(f"`{what}` has a negative variance or is not positive semi-definite "
+                         f"(eigenvalues {eig.tolist()}).")
+    if definite and size and eig[0] <= 0:
+        raise ValueError(f"`{what}` must be positive definite (every measured channel needs "
+                         f"a positive noise variance), eigenvalues {eig.tolist()}.")
+    return a
+
+
+def process_matrices(model, process_noise) -> tuple[np.ndarray, float]:
+    """`(Q, q_rudder)` from a process-noise spec: a dict `{name: variance}` with names of
+    the augmented state (`model.state_names` and `"psi"`; per sample, in the state's
+    units squared) and/or `"rudder"` (variance of the held rudder-equivalent disturbance
+    [rad^2]), or a covariance matrix over the augmented state."""
+    names = _augmented_names(model)
+    if isinstance(process_noise, dict):
+        q = np.zeros((len(names), len(names)))
+        rudder = 0.0
+        for key, value in process_noise.items():
+            v = _variance(key, value, "process_noise")
+            if key == "rudder":
+                rudder = v
+            elif key in names:
+                q[names.index(key), names.index(key)] = v
+            else:
+                raise ValueError(f"`process_noise` names {key!r}, which is neither a state of "
+                                 f"{type(model).__name__} ({', '.join(names)}) nor 'rudder'.")
+        return q, rudder
+    return _matrix(process_noise, len(names), "process_noise", definite=False), 0.0
+
+
+def measurement_matrix(channels, measurement_noise) -> np.ndarray:
+    """`R` (C, C) from a dict `{channel: variance}` (rad^2, (rad/s)^2), a sequence of
+    variances in channel order or a covariance matrix; positive definite."""
+    if isinstance(measurement_noise, dict):
+        unknown = [k for k in measurement_noise if k not in channels]
+        if unknown:
+            raise ValueError(f"`measurement_noise` names {unknown[0]!r}, which is not a "
+                             f"filtered channel ({', '.join(channels)}).")
+        missing = [c for c in channels if c not in measurement_noise]
+        if missing:
+            raise ValueError(f"`measurement_noise` has no variance for channel {missing[0]!r}.")
+        var = [_variance(c, measurement_noise[c], "measurement_noise") for c in channels]
+        measurement_noise = np.array(var)
+    return _matrix(measurement_noise, len(channels), "measurement_noise", definite=True)
+
+
+def _check_measured(ds, channels):
+    """The filter treats each channel as an independent measurement: a channel derived
+    from another (r from psi) would count the same noise twice."""
+    for i, name in enumerate(ds.names):
+        for c in channels:
+            if c not in ds.experiment_channels[i]:
+                raise ValueError(f"experiment {name!r} (dataset entry {i}): channel {c!r} was "
+                                 f"not measured (derived from the other channel); the Kalman "
+                                 f"filter needs independent measurements: pass "
+                                 f"channels={tuple(k for k in channels if k != c)}.")
+
+
+# -- the filter and the smoother (traced) ---------------------------------------------
+
+
+class KalmanOutput(eqx.Module):
+    """Output of `ekf` for one record of N samples; the state is the augmented
+    $z = (x, \\psi)$ (`names`).
+
+    - `predicted`, `predicted_cov`: $\\hat z_{k|k-1}$ (N, n), $P_{k|k-1}$ (N, n, n)
+      (sample 0: the prior);
+    - `filtered`, `filtered_cov`: $\\hat z_{k|k}$, $P_{k|k}$;
+    - `innovations` (N, C): $\\varepsilon_k$ (0 at sample 0 and at masked samples);
+      `innovation_cov` (N, C, C): $S_k$;
+    - `transition` (N, n, n): $A_k$, the Jacobian of the map from sample k-1 to k
+      (identity at sample 0);
+    - `neg_log_likelihood`: $-\\log L$ of the record (module docstring).
+    """
+
+    predicted: jax.Array
+    predicted_cov: jax.Array
+    filtered: jax.Array
+    filtered_cov: jax.Array
+    innovations: jax.Array
+    innovation_cov: jax.Array
+    transition: jax.Array
+    neg_log_likelihood: jax.Array
+    names: tuple[str, ...] = eqx.field(static=True)
+
+
+def _interval_map(model, substeps):
+    def f(z, delta, aux, dt):
+        x, psi = _rk4_interval(model, z[:-1], z[-1], delta, aux, dt, substeps)
+        return jnp.concatenate([x, psi[None]])
+
+    return f
+
+
+def _measure(model, channels):
+    def h(z):
+        out = {"psi": z[-1], "r": model.output(z[:-1])}
+        return jnp.stack([out[c] for c in channels])
+
+    return h
+
+
+def _filter(model, delta, aux, y, mask, dt, z0, P0, Q, q_rudder, R, channels, substeps):
+    """The EKF over one record (module docstring); `delta`, `aux` leaves, `mask`: (N,);
+    `y`: (N, C). Returns a `KalmanOutput`."""
+    F = _interval_map(model, substeps)
+    h = _measure(model, channels)
+    jac = jax.jacfwd(F, argnums=(0, 1))
+    n = z0.shape[0]
+    eye = jnp.eye(n, dtype=z0.dtype)
+
+    def step(carry, inputs):
+        z, P = carry
+        d, a, yk, mk = inputs
+        A, B = jac(z, d, a, dt)
+        z_pred = F(z, d, a, dt)
+        P_pred = A @ P @ A.T + Q + q_rudder * jnp.outer(B, B)
+        P_pred = 0.5 * (P_pred + P_pred.T)
+        H = jax.jacfwd(h)(z_pred)
+        e = yk - h(z_pred)
+        S = H @ P_pred @ H.T + R
+        S = 0.5 * (S + S.T)
+        chol = jnp.linalg.cholesky(S)
+        # K = P H^T S^-1 via the Cholesky factor of S
+        gain = jax.scipy.linalg.cho_solve((chol, True), H @ P_pred).T
+        z_upd = z_pred + gain @ e
+        IKH = eye - gain @ H
+        P_upd = IKH @ P_pred @ IKH.T + gain @ R @ gain.T
+        white = jax.scipy.linalg.solve_triangular(chol, e, lower=True)
+        nll = jnp.sum(jnp.log(jnp.diag(chol))) + 0.5 * (white @ white + e.shape[0] * _LOG_2PI)
+        z_new = jnp.where(mk, z_upd, z_pred)
+        P_new = jnp.where(mk, P_upd, P_pred)
+        out = (z_pred, P_pred, z_new, P_new, jnp.where(mk, e, 0.0), S, A, jnp.where(mk, nll, 0.0))
+        return (z_new, P_new), out
+
+    inputs = (delta[:-1], jax.tree.map(lambda v: v[:-1], aux), y[1:], mask[1:])
+    _, (zp, Pp, zf, Pf, e, S, A, nll) = jax.lax.scan(step, (z0, P0), inputs)
+    first = lambda a0, a: jnp.concatenate([a0[None], a])
+    c = y.shape[1]
+    S0 = _measure_cov0(model, channels, z0, P0, R)
+    return KalmanOutput(
+        predicted=first(z0, zp), predicted_cov=first(P0, Pp), filtered=first(z0, zf),
+        filtered_cov=first(P0, Pf), innovations=first(jnp.zeros(c, z0.dtype), e),
+        innovation_cov=first(S0, S), transition=first(eye, A),
+        neg_log_likelihood=jnp.sum(nll), names=(),
+    )
+
+
+def _measure_cov0(model, channels, z0, P0, R):
+    H = jax.jacfwd(_measure(model, channels))(z0)
+    return H @ P0 @ H.T + R
+
+
+def _smooth(out: KalmanOutput):
+    """RTS smoother over a `KalmanOutput` (module docstring); returns (means, covs)."""
+
+    def step(carry, inputs):
+        zs, Ps = carry
+        zf, Pf, zp_next, Pp_next, A_next = inputs
+        # G = P_f A^T P_p^-1 (pseudo-inverse: P_p may be singular without process noise)
+        G = Pf @ A_next.T @ jnp.linalg.pinv(Pp_next, hermitian=True)
+        z = zf + G @ (zs - zp_next)
+        P = Pf + G @ (Ps - Pp_next) @ G.T
+        P = 0.5 * (P + P.T)
+        return (z, P), (z, P)
+
+    inputs = (out.filtered[:-1], out.filtered_cov[:-1], out.predicted[1:],
+              out.predicted_cov[1:], out.transition[1:])
+    last = (out.filtered[-1], out.filtered_cov[-1])
+    _, (zs, Ps) = jax.lax.scan(step, last, inputs, reverse=True)
+    return (jnp.concatenate([zs, last[0][None]]), jnp.concatenate([Ps, last[1][None]]))
+
+
+# -- data as arrays -----------------------------------------------------------------
+
+
+class _Records(eqx.Module):
+    """A dataset as arrays for the filter: `delta`, `aux` leaves, `mask`: (E, N);
+    `y`: (E, N, C); `dt`: (E,); `start`: `WindowStart` of sample 0, leaves (E,)."""
+
+    delta: jax.Array
+    aux: AuxInputs
+    y: jax.Array
+    mask: jax.Array
+    dt: jax.Array
+    start: WindowStart
+    channels: tuple[str, ...] = eqx.field(static=True)
+    substeps: int = eqx.field(static=True)
+
+
+def _records(ds, channels, rudder, substeps) -> _Records:
+    f = lambda a: jnp.asarray(np.asarray(a, dtype=np.float64))
+    first = lambda name: f(np.asarray(getattr(ds, name), dtype=np.float64)[:, 0])
+    zero = jnp.zeros(ds.num_experiments)
+    start = WindowStart(r=first("r"), psi=first("psi"), delta=first(rudder), r_first=first("r"),
+                        psi_first=first("psi"), delta_integral=zero, elapsed=zero,
+                        aux=AuxInputs(u=first("u"), v=first("v"), n=first("n")))
+    return _Records(
+        delta=f(getattr(ds, rudder)),
+        aux=AuxInputs(u=f(ds.u), v=f(ds.v), n=f(ds.n)),
+        y=f(np.stack([np.asarray(getattr(ds, c)) for c in channels], axis=-1)),
+        mask=jnp.asarray(np.asarray(ds.mask, dtype=bool)),
+        dt=f(ds.dt), start=start, channels=tuple(channels), substeps=int(substeps),
+    )
+
+
+def _prior(model, start, channels, R, P0):
+    """Prior of sample 0: the model's window state at the first sample and the measured
+    heading; covariance `P0`, or by default R on the measured entries (psi, and the
+    first state, r) and 0 on hidden states."""
+    z0 = jnp.concatenate([model.window_state(start), jnp.asarray(start.psi)[None]])
+    if P0 is not None:
+        return z0, P0
+    n = z0.shape[0]
+    diag = jnp.zeros(n, dtype=z0.dtype)
+    for i, c in enumerate(channels):
+        diag = diag.at[n - 1 if c == "psi" else 0].set(R[i, i])
+    return z0, jnp.diag(diag)
+
+
+def _batch_filter(model, rec: _Records, Q, q_rudder, R, P0=None):
+    """The EKF of every record (vmapped): a `KalmanOutput` with a leading axis E."""
+
+    def one(delta, aux, y, mask, dt, start):
+        z0, p0 = _prior(model, start, rec.channels, R, P0)
+        return _filter(model, delta, aux, y, mask, dt, z0, p0, Q, q_rudder, R, rec.channels,
+                       rec.substeps)
+
+    return jax.vmap(one)(rec.delta, rec.aux, rec.y, rec.mask, rec.dt, rec.start)
+
+
+@eqx.filter_jit
+def _filter_jit(model, rec, Q, q_rudder, R, P0):
+    return _batch_filter(model, rec, Q, q_rudder, R, P0)
+
+
+@eqx.filter_jit
+def _smooth_jit(model, rec, Q, q_rudder, R, P0):
+    out = _batch_filter(model, rec, Q, q_rudder, R, P0)
+    zs, Ps = jax.vmap(_smooth)(out)
+    return out, zs, Ps
+
+
+def _prepare(model, data, channels, rudder, substeps, process_noise, measurement_noise,
+             initial_covariance):
+    if not isinstance(model, AbstractSteeringModel):
+        raise ValueError(f"`model` must be a jaxship AbstractSteeringModel, got "
+                         f"{type(model).__name__}.")
+    channels = _check_channels(channels)
+    if int(substeps) < 1:
+        raise ValueError(f"`substeps` must be a positive integer, got {substeps}.")
+    ds = as_dataset(data)
+    check_data(ds, rudder, channels)
+    _check_measured(ds, channels)
+    Q, q_rudder = process_matrices(model, process_noise)
+    R = measurement_matrix(channels, measurement_noise)
+    P0 = None
+    if initial_covariance is not None:
+        P0 = jnp.asarray(_matrix(initial_covariance, Q.shape[0], "initial_covariance",
+                                 definite=False))
+    rec = _records(ds, channels, rudder, substeps)
+    return ds, rec, jnp.asarray(Q), jnp.asarray(q_rudder), jnp.asarray(R), P0
+
+
+def ekf(model: AbstractSteeringModel, experiment, *, process_noise, measurement_noise,
+        channels=KALMAN_CHANNELS, rudder: str = "delta", initial_covariance=None,
+        substeps: int = 1) -> KalmanOutput:
+    """Extended Kalman filter of a steering model over one measured record (module
+    docstring for the equations).
+
+    **Arguments:**
+
+    - `model`: any `AbstractSteeringModel` (parameter values as they are).
+    - `experiment`: a `jaxship.Experiment` (replayed rudder, measured psi and/or r).
+    - `process_noise`: dict `{name: variance}` over the augmented state
+      (`model.state_names` and `"psi"`, per sample interval) and `"rudder"` (variance
+      [rad^2] of a rudder-equivalent disturbance held over each interval), or an
+      (n, n) covariance matrix over the augmented state.
+    - `measurement_noise`: dict `{channel: variance}`, variances in channel order, or a
+      (C, C) covariance; positive definite.
+    - `channels`: measured outputs, `"psi"` [rad] and/or `"r"` [rad/s], unwrapped.
+    - `rudder`: `"delta"` or `"delta_c"`.
+    - `initial_covariance`: $P_0$ (n, n) of the prior at sample 0 (default: R on psi and
+      r, 0 on hidden states).
+    - `substeps`: RK4 steps per sample interval.
+
+    **Returns:** a `KalmanOutput` (arrays of the record's length).
+    """
+    from .._data import Experiment
+
+    if not isinstance(experiment, Experiment):
+        raise ValueError(f"`experiment` must be a jaxship Experiment, got "
+                         f"{type(experiment).__name__}; use smooth_states for a Dataset.")
+    _, rec, Q, q, R, P0 = _prepare(model, experiment, channels, rudder, substeps,
+                                   process_noise, measurement_noise, initial_covariance)
+    out = _filter_jit(as_arrays(model), rec, Q, q, R, P0)
+    out = jax.tree.map(lambda a: a[0], out)
+    return dataclasses.replace(out, names=_augmented_names(model))
+
+
+def rts_smoother(filtered: KalmanOutput) -> tuple[jax.Array, jax.Array]:
+    """Rauch-Tung-Striebel smoother over the output of `ekf` (module docstring):
+    `(means (N, n), covariances (N, n, n))` of the augmented state given all samples."""
+    return jax.jit(_smooth)(filtered)
+
+
+class SmoothedStates(eqx.Module):
+    """Smoothed states of one record: time `t` (N,), `names` of the augmented state,
+    `mean` (N, n), `covariance` (N, n, n); `state(name)` is one column."""
+
+    t: np.ndarray
+    mean: np.ndarray
+    covariance: np.ndarray
+    names: tuple[str, ...] = eqx.field(static=True)
+    name: str = eqx.field(static=True)
+
+    def state(self, name: str) -> np.ndarray:
+        if name not in self.names:
+            raise ValueError(f"no state {name!r}; the states are {', '.join(self.names)}.")
+        return self.mean[:, self.names.index(name)]
+
+    def std(self, name: str) -> np.ndarray:
+        i = self.names.index(name)
+        return np.sqrt(np.maximum(self.covariance[:, i, i], 0.0))
+
+
+def smooth_states(model: AbstractSteeringModel, data, *, process_noise, measurement_noise,
+                  channels=KALMAN_CHANNELS, rudder: str = "delta", initial_covariance=None,
+                  substeps: int = 1) -> list[SmoothedStates]:
+    """Smoothed states (EKF + RTS smoother) of every experiment of `data` (an
+    `Experiment`, a list of them or a `Dataset`), e.g. for the start states of
+    prediction windows or for residual forces. Arguments as `ekf`; the noise is
+    typically that estimated by `fit_ml` (`result.noise`).
+
+    **Returns:** a list of `SmoothedStates`, one per experiment, cut to its length.
+    """
+    ds, rec, Q, q, R, P0 = _prepare(model, data, channels, rudder, substeps, process_noise,
+                                    measurement_noise, initial_covariance)
+    _, zs, Ps = _smooth_jit(as_arrays(model), rec, Q, q, R, P0)
+    zs, Ps = np.asarray(zs), np.asarray(Ps)
+    names = _augmented_names(model)
+    return [SmoothedStates(t=np.asarray(ds.t)[i, :n], mean=zs[i, :n], covariance=Ps[i, :n],
+                           names=names, name=ds.names[i]) for i, n in enumerate(ds.lengths)]
+
+
+# -- estimation ---------------------------------------------------------------------
+
+
+class _Noise(eqx.Module):
+    """Layout of the noise parameters: the process entries (`"rudder"` or augmented
+    state names) and the channels; `estimated` flags, fixed log-variances `fixed`."""
+
+    names: tuple[str, ...] = eqx.field(static=True)  # process names, then channels
+    estimated: tuple[bool, ...] = eqx.field(static=True)
+    fixed: jax.Array  # log variances of all entries (used where not estimated)
+    state_index: tuple[int, ...] = eqx.field(static=True)  # -1: rudder, -2: channel
+    num_states: int = eqx.field(static=True)
+
+    def matrices(self, log_var):
+        """(Q, q_rudder, R) from the estimated log variances."""
+        full, j = [], 0
+        for i, est in enumerate(self.estimated):
+            if est:
+                full.append(log_var[j])
+                j += 1
+            else:
+                full.append(self.fixed[i])
+        var = jnp.exp(jnp.stack(full))
+        Q = jnp.zeros((self.num_states, self.num_states), var.dtype)
+        q_rudder = jnp.zeros((), var.dtype)
+        r_diag = []
+        for i, k in enumerate(self.state_index):
+            if k == -1:
+                q_rudder = var[i]
+            elif k == -2:
+                r_diag.append(var[i])
+            else:
+                Q = Q.at[k, k].set(var[i])
+        return Q, q_rudder, jnp.diag(jnp.stack(r_diag))
+
+
+def _split(z, d, transform, model):
+    p = transform.to_physical(z[:d])
+    return rebuild(model, transform.names, p), z[d:]
+
+
+def _nll(z, args):
+    model, transform, noise, rec = args
+    m, log_var = _split(z, len(transform.names), transform, model)
+    Q, q, R = noise.matrices(log_var)
+    return jnp.sum(_batch_filter(m, rec, Q, q, R).neg_log_likelihood)
+
+
+def _pem_residuals(z, args):
+    model, transform, noise, rec, weights = args
+    m, log_var = _split(z, len(transform.names), transform, model)
+    Q, q, R = noise.matrices(log_var)
+    e = _batch_filter(m, rec, Q, q, R).innovations  # (E, N, C), 0 where masked
+    return e * weights
+
+
+@eqx.filter_jit
+def _ml_solve(z0, model, transform, noise, rec, solver, max_steps):
+    # the loss per sample keeps the tolerances independent of the record length
+    count = jnp.sum(rec.mask[:, 1:])
+    fn = lambda z, args: _nll(z, args) / count
+    sol = optx.minimise(fn, solver, z0, args=(model, transform, noise, rec),
+                        max_steps=max_steps, throw=False)
+    return sol.value, sol.result, sol.stats["num_steps"]
+
+
+@eqx.filter_jit
+def _pem_solve(z0, model, transform, noise, rec, weights, solver, max_steps):
+    sol = optx.least_squares(_pem_residuals, solver, z0,
+                             args=(model, transform, noise, rec, weights),
+                             options=dict(jac="fwd"), max_steps=max_steps, throw=False)
+    return sol.value, sol.result, sol.stats["num_steps"]
+
+
+def _physical(z, d, transform):
+    """Model parameters in physical units and log variances as one vector."""
+    return jnp.concatenate([transform.to_physical(z[:d]), z[d:]])
+
+
+@eqx.filter_jit
+def _ml_hessian(z, model, transform, noise, rec):
+    """NLL and its Hessian with respect to (physical parameters, log variances)."""
+    d = len(transform.names)
+    q = _physical(z, d, transform)
+
+    def f(q):
+        m = rebuild(model, transform.names, q[:d])
+        Q, qr, R = noise.matrices(q[d:])
+        return jnp.sum(_batch_filter(m, rec, Q, qr, R).neg_log_likelihood)
+
+    return f(q), jax.hessian(f)(q)
+
+
+@eqx.filter_jit
+def _pem_jacobian(z, model, transform, noise, rec, weights):
+    d = len(transform.names)
+    q = _physical(z, d, transform)
+
+    def f(q):
+        m = rebuild(model, transform.names, q[:d])
+        Q, qr, R = noise.matrices(q[d:])
+        return _batch_filter(m, rec, Q, qr, R).innovations * weights
+
+    return f(q), jax.jacfwd(f)(q)
+
+
+class KalmanFitResult(eqx.Module):
+    """Result of `fit_ml`.
+
+    - `model`: the model with the estimates (frozen parameters unchanged);
+    - `parameters`: `ParameterReport` of the free model parameters (values, standard
+      errors, covariance, correlation, flags);
+    - `noise`: `{name: variance}` of the noise at the optimum (process entries:
+      `"rudder"` [rad^2] or state names; channels `"psi"` [rad^2], `"r"`
+      [(rad/s)^2]); `noise_std`: their standard errors (0 when fixed);
+    - `criterion`: `"ml"` or `"pem"`; `loss`: the negative log likelihood (`"ml"`) or
+      half the sum of squared weighted innovations (`"pem"`);
+    - `result` (optimistix code), `success`, `message`, `num_steps`;
+    - `names`, `values`, `std`, `covariance`, `correlation`: shortcuts.
+    """
+
+    model: AbstractSteeringModel
+    parameters: ParameterReport
+    noise: dict
+    noise_std: dict
+    criterion: str
+    loss: float
+    result: optx.RESULTS
+    num_steps: int
+    experiment_names: tuple[str, ...]
+
+    names = property(lambda self: self.parameters.names)
+    values = property(lambda self: self.parameters.values)
+    std = property(lambda self: self.parameters.std)
+    covariance = property(lambda self: self.parameters.covariance)
+    correlation = property(lambda self: self.parameters.correlation)
+
+    @property
+    def success(self) -> bool:
+        return bool(self.result == optx.RESULTS.successful)
+
+    @property
+    def message(self) -> str:
+        return "successful" if self.success else optx.RESULTS[self.result]
+
+    def summary(self) -> str:
+        noise = ", ".join(f"{k} {v:.4g} +- {self.noise_std[k]:.2g}" for k, v in self.noise.items())
+        return (f"{type(self.model).__name__} by {self.criterion}: {self.message}, "
+                f"{self.num_steps} steps, loss {self.loss:.6g}\n{self.parameters.table()}\n"
+                f"noise variances: {noise}")
+
+
+def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
+    """The `_Noise` layout and the start log variances of the estimated entries.
+    Entry names: `"rudder"`, `"Q_<state>"` for process noise on a state, and the
+    channels `"psi"`, `"r"` for the measurement noise."""
+    names = _augmented_names(model)
+    if isinstance(process, str):
+        process = (process,)
+    process = tuple(process)
+    if not process:
+        raise ValueError("`process` is empty: name 'rudder' or states of the model.")
+    for p in process:
+        if p != "rudder" and p not in names:
+            raise ValueError(f"`process` names {p!r}, which is neither 'rudder' nor a state "
+                             f"of {type(model).__name__} ({', '.join(names)}).")
+    entries = tuple(p if p == "rudder" else f"Q_{p}" for p in process) + channels
+    index = tuple(-1 if p == "rudder" else names.index(p) for p in process)
+    index = index + (-2,) * len(channels)
+    # default start values: 10 % of the spread of each channel, 0.5 deg of rudder,
+    # 1 % of the spread of the yaw rate (heading for psi) per sample on a state
+    mask = np.asarray(ds.mask)
+    spread = {}
+    for c in ("psi", "r"):
+        y = np.asarray(getattr(ds, c), dtype=np.float64)
+        mean = np.sum(np.where(mask, y, 0.0), 1, keepdims=True) / mask.sum(1, keepdims=True)
+        spread[c] = float(np.sqrt(np.sum(np.where(mask, y - mean, 0.0) ** 2) / mask.sum())) or 1.0
+    default = {"rudder": math.radians(0.5) ** 2}
+    default.update({c: (0.1 * spread[c]) ** 2 for c in channels})
+    default.update({f"Q_{p}": (0.01 * spread["psi" if p == "psi" else "r"]) ** 2
+                    for p in process if p != "rudder"})
+    if isinstance(noise, str) and noise == "estimate":
+        fixed_values = {}
+    elif isinstance(noise, dict):
+        fixed_values = dict(noise)
+    else:
+        raise ValueError(f"`noise` must be 'estimate' or a dict of fixed variances, got "
+                         f"{noise!r}.")
+    starts = dict(noise_start or {})
+    for what, given in (("noise", fixed_values), ("noise_start", starts)):
+        for k in given:
+            if k not in entries:
+                raise ValueError(f"`{what}` names {k!r}, which is not a noise term of this fit "
+                                 f"({', '.join(entries)}).")
+    values, estimated = [], []
+    for e in entries:
+        if e in fixed_values:
+            v = _variance(e, fixed_values[e], "noise")
+        else:
+            v = _variance(e, starts.get(e, default[e]), "noise_start")
+        if v <= 0:
+            raise ValueError(f"noise variance of {e!r} must be positive, got {v}.")
+        values.append(math.log(v))
+        estimated.append(e not in fixed_values)
+    if criterion == "pem":
+        # the innovations do not fix the overall noise scale (scaling Q, R and P0 by one
+        # number leaves the gains unchanged): hold the first channel's variance
+        estimated[len(process)] = False
+    layout = _Noise(names=entries, estimated=tuple(estimated),
+                    fixed=jnp.asarray(values), state_index=index, num_states=len(names))
+    z = np.array([v for v, est in zip(values, estimated) if est])
+    return layout, z
+
+
+def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_CHANNELS,
+           criterion: str = "ml", process="rudder", noise="estimate", noise_start=None,
+           rudder: str = "delta", substeps: int = 1, max_steps: int = 512,
+           solver=None) -> KalmanFitResult:
+    """Estimate a steering model with its noise by the Kalman filter's innovations.
+
+    **Arguments:**
+
+    - `model`, `dataset`, `free`: as `jaxship.fit` (start values in the model; `free`
+      names or `Free` specs).
+    - `channels`: measured outputs, `"psi"` and/or `"r"`.
+    - `criterion`: `"ml"` (default): minimise the negative log likelihood
+      $\\tfrac12\\sum_k(\\log\\det S_k + \\varepsilon_k^TS_k^{-1}\\varepsilon_k)$ over the
+      model parameters and the log noise variances with `optimistix.BFGS`; standard
+      errors from the inverse Hessian (`jax.hessian`) of $-\\log L$ (Ljung 1999,
+      sec. 7.4 and eq. 9.29). `"pem"`: prediction-error method with the innovations
+      predictor (Ljung 1999, sec. 4.3 and 7.2): minimise
+      $\\tfrac12\\sum_k\\|W\\varepsilon_k\\|^2$ ($W$ = 1/std of each channel) with
+      Levenberg-Marquardt and forward-mode Jacobians; the noise variances set the
+      filter gain and are estimated as well, except the first channel's, which fixes
+      the scale (the innovations are invariant to it); standard errors as `fit`.
+    - `process`: where the process noise enters: `"rudder"` (default; a rudder-equivalent
+      disturbance held over each interval) and/or names of the model's states or
+      `"psi"` (a diagonal $Q$ entry each, named `"Q_<state>"` in `noise`).
+    - `noise`: `"estimate"` (default) or a dict `{name: variance}` of values to hold
+      fixed (names `"rudder"`, `"Q_<state>"` and the channels; the others are estimated).
+    - `noise_start`: dict of start variances (default: 10 % of each channel's spread
+      for R, (0.5 deg)^2 for the rudder, 1 % of the spread on states).
+    - `rudder`, `substeps`: as `PredictionError`.
+    - `max_steps`, `solver`: optimiser step limit and an optimistix solver (default
+      `BFGS(rtol=1e-8, atol=1e-8)` for ML, `LevenbergMarquardt(rtol=1e-9, atol=1e-9)`
+      for PEM).
+
+    **Returns:** a `KalmanFitResult`.
+    """
+    if not isinstance(model, AbstractSteeringModel):
+        raise ValueError(f"`model` must be a jaxship AbstractSteeringModel, got "
+                         f"{type(model).__name__}.")
+    if criterion not in ("ml", "pem"):
+        raise ValueError(f"`criterion` must be 'ml' or 'pem', got {criterion!r}.")
+    channels = _check_channels(channels)
+    if int(substeps) < 1:
+        raise ValueError(f"`substeps` must be a positive integer, got {substeps}.")
+    ds = as_dataset(dataset)
+    check_data(ds, rudder, channels)
+    _check_measured(ds, channels)
+    specs = resolve_free(model, free)
+    transform = Transform.from_specs(specs)
+    layout, z_noise = _noise_layout(model, ds, channels, process, noise, noise_start, criterion)
+    rec = _records(ds, channels, rudder, substeps)
+    z0 = jnp.asarray(np.concatenate([transform.to_unconstrained([s.start for s in specs]),
+                                     z_noise]), dtype=float)
+    base = as_arrays(model)
+    d = len(specs)
+    if criterion == "ml":
+        solver = optx.BFGS(rtol=1e-8, atol=1e-8) if solver is None else solver
+        z, result, steps = _ml_solve(z0, base, transform, layout, rec, solver, int(max_steps))
+        loss, hess = _ml_hessian(z, base, transform, layout, rec)
+        hess = np.asarray(hess, dtype=np.float64)
+        try:
+            cov = np.linalg.inv(hess)
+        except np.linalg.LinAlgError:
+            cov = np.full_like(hess, np.inf)
+        if not np.all(np.isfinite(cov)) or np.any(np.diag(cov) <= 0):
+            cov = np.where(np.eye(hess.shape[0], dtype=bool), np.inf, 0.0)
+        loss = float(loss)
+    else:
+        solver = optx.LevenbergMarquardt(rtol=1e-9, atol=1e-9) if solver is None else solver
+        weights = jnp.asarray(channel_weights(ds, channels, None), dtype=float)
+        z, result, steps = _pem_solve(z0, base, transform, layout, rec, weights, solver,
+                                      int(max_steps))
+        res, jac = _pem_jacobian(z, base, transform, layout, rec, weights)
+        mask = np.asarray(ds.mask).copy()
+        mask[:, 0] = False  # sample 0 is the prior, never predicted
+        res, jac = np.asarray(res), np.asarray(jac)
+        rows = np.concatenate([res[..., c][mask] for c in range(len(channels))])
+        jrows = np.concatenate([jac[..., c, :][mask] for c in range(len(channels))])
+        groups = np.repeat(np.arange(len(channels)), int(mask.sum()))
+        cov, _ = least_squares_covariance(jrows, rows, groups)
+        loss = 0.5 * float(np.sum(rows**2))
+    q = np.asarray(_physical(z, d, transform), dtype=np.float64)
+    values = q[:d]
+    fitted = rebuild(model, transform.names, [float(v) for v in values])
+    report = parameter_report(transform.names, values, cov[:d, :d],
+                              units=tuple(s.unit for s in specs))
+    log_var = np.asarray(layout.fixed, dtype=np.float64).copy()
+    log_std = np.zeros_like(log_var)
+    est_index = [i for i, e in enumerate(layout.estimated) if e]
+    log_var[est_index] = q[d:]
+    with np.errstate(invalid="ignore"):
+        log_std[est_index] = np.sqrt(np.diag(cov)[d:])
+    var = np.exp(log_var)
+    noise_out = {n: float(v) for n, v in zip(layout.names, var)}
+    noise_std = {n: float(v * s) for n, v, s in zip(layout.names, var, log_std)}
+    return KalmanFitResult(model=fitted, parameters=report, noise=noise_out, noise_std=noise_std,
+                           criterion=criterion, loss=loss, result=result, num_steps=int(steps),
+                           experiment_names=tuple(ds.names))
