@@ -10,13 +10,27 @@ and compiles, the second and third pass *new parameter values* of the same shape
   (`/jax/core/compile/backend_compile_duration`; every jitted call that compiles emits one).
 
 Cases: `simulate` of a 600 s 20/20 zig-zag of the Mariner (0.1 s samples, RK4), the same
-for the thesis vessel, and `simulate_batch` of 64 Mariner zig-zags. Prints the wall time
-of each call and the counts; float64.
+for the thesis vessel, and `simulate_batch` of 64 Mariner zig-zags.
 
-Run: `python benchmarks/compile.py`.
+Then one fit, twice over, with `jaxship.fit`: (a) a first-order Nomoto model (K, T free)
+on two simulated 20/20 zig-zags of the Mariner, and (b) the thesis vessel with 4 free
+coefficients (Y_uv, N_uv, N_ur, rudder area) on a simulated 20/20 zig-zag and a PRBS at
+500 rpm, prediction error with a 10 s horizon. Every call of a fit case passes *new data
+values* (other rudder angles, other measurement noise, same lengths) and *new start values*;
+the data are simulated before the clock starts. The traces counted are those of the fit's
+jitted core (`jaxship._estimate._fit._solve` for response models,
+`jaxship._estimate._vessel_fit._solve` for vessels); the XLA compilations are all those
+of the call (the core, the Jacobian for the covariance, and any small eager operation).
+The second and third calls must show 0 new traces and 0 new compilations.
+
+Prints the wall time of each call and the counts; float64.
+
+Run: `python benchmarks/compile.py` (`--skip-simulate` for the fit cases only).
 """
 
+import sys
 import time
+import warnings
 
 import jax
 
@@ -29,6 +43,8 @@ import numpy as np  # noqa: E402
 
 import jaxship as js  # noqa: E402
 import jaxship._batch as jb  # noqa: E402
+import jaxship._estimate._fit as jfit  # noqa: E402
+import jaxship._estimate._vessel_fit as jvfit  # noqa: E402
 import jaxship._simulate as jsim  # noqa: E402
 from jaxship._vessel.catalogue import get_vessel  # noqa: E402
 
@@ -45,7 +61,8 @@ def _listen(event, duration, **_):
 jax.monitoring.register_event_duration_secs_listener(_listen)
 
 
-ORIGINAL = {(jsim, "_simulate"): jsim._simulate, (jb, "_batched"): jb._batched}
+ORIGINAL = {(jsim, "_simulate"): jsim._simulate, (jb, "_batched"): jb._batched,
+            (jfit, "_solve"): jfit._solve, (jvfit, "_solve"): jvfit._solve}
 
 
 def count_traces(module, name):
@@ -55,22 +72,121 @@ def count_traces(module, name):
     return lambda: eqx.debug.get_num_traces(counted)
 
 
-def calls(label, run, values, traces):
+def calls(label, run, values, traces, prepare=None):
+    """Time `run(value)` for each value; `prepare(value)` (untimed) builds its inputs."""
     print(f"\n{label}")
     print("| call | new values | wall time [s] | traces so far | XLA compilations (time [s]) |")
     print("| ---: | --- | ---: | ---: | --- |")
+    out = []
     for k, value in enumerate(values, start=1):
+        if prepare is not None:
+            value = dict(value, inputs=prepare(value))
         before = len(COMPILES)
         start = time.perf_counter()
-        jax.block_until_ready(run(value))
+        result = jax.block_until_ready(run(value))
         wall = time.perf_counter() - start
         new = COMPILES[before:]
         what = f"{len(new)} ({sum(new):.2f})" if new else "0"
         print(f"| {k} | {value['note']} | {wall:.3f} | {traces()} | {what} |")
+        out.append(result)
+    return out
 
 
-def main():
+def noisy(experiment, rng, noise):
+    """The experiment with white noise of standard deviation `noise[c]` on channel c."""
+    channels = {c: getattr(experiment, c) + s * rng.standard_normal(experiment.num_samples)
+                for c, s in noise.items()}
+    return js.Experiment(experiment.t, experiment.delta, delta_c=experiment.delta_c,
+                         n=experiment.n, name=experiment.name, **channels)
+
+
+def fit_cases():
+    """One fit of a response model and one of a vessel, each called three times with new
+    data values and new start values."""
+    for (module, name), original in ORIGINAL.items():  # data simulation is not counted
+        setattr(module, name, original)
+    # (a) Nomoto 1 (K, T) on two Mariner zig-zags: the core is jaxship._estimate._fit._solve
+    solve_traces = count_traces(jfit, "_solve")
+    mariner = get_vessel("mariner")
+
+    def nomoto_data(value):
+        rng = np.random.default_rng(value["seed"])
+        out = []
+        for sign in (1, -1):
+            angle = sign * value["angle"] * DEG
+            tr = js.simulate(mariner, js.ZigZag(angle, abs(angle), duration=300.0, dt=0.5),
+                             js.straight_run(mariner))
+            e = js.Experiment.from_trajectory(tr, name=f"zigzag{sign * value['angle']:g}")
+            out.append(noisy(e, rng, {"psi": 0.05 * DEG, "r": 0.01 * DEG}))
+        return out
+
+    def nomoto_fit(value):
+        start = js.Nomoto1(K=value["K"], T=value["T"])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = js.fit(start, value["inputs"], estimator=js.PredictionError(horizon=20.0))
+        return res.values
+
+    results = calls("fit, Nomoto1 (K, T) on two 300 s Mariner zig-zags (0.5 s samples)",
+                    nomoto_fit, [
+                        dict(seed=0, angle=20.0, K=0.05, T=20.0, note="first call"),
+                        dict(seed=1, angle=15.0, K=0.08, T=40.0,
+                             note="15/15 zig-zags, new noise, K0 0.08, T0 40"),
+                        dict(seed=2, angle=25.0, K=0.03, T=10.0,
+                             note="25/25 zig-zags, new noise, K0 0.03, T0 10"),
+                    ], solve_traces, prepare=nomoto_data)
+    print("estimates (K [1/s], T [s]): " + "; ".join(
+        ", ".join(f"{x:.4g}" for x in np.asarray(r)) for r in results))
+
+    # (b) the thesis vessel, 4 coefficients: the core is jaxship._estimate._vessel_fit._solve
+    solve_traces = count_traces(jvfit, "_solve")
+    thesis = get_vessel("thesis")
+    free = ("y_uv", "n_uv", "n_ur", "rudder_area")
+    truth = np.array([getattr(thesis, k) for k in free])
+    n = 500 / 60
+
+    def vessel_data(value):
+        rng = np.random.default_rng(value["seed"])
+        angle = value["angle"] * DEG
+        out = []
+        for name, man in (("zigzag", js.ZigZag(angle, angle, duration=60.0, dt=0.1, n=n)),
+                          ("prbs", js.prbs(angle, 5.0, 60.0, n=n))):
+            tr = js.simulate(thesis, man, js.straight_run(thesis, n=n))
+            e = js.Experiment.from_trajectory(tr, name=name)
+            out.append(noisy(e, rng, {"psi": 0.02 * DEG, "r": 0.01 * DEG, "u": 0.001,
+                                      "v": 0.001}))
+        return out
+
+    def vessel_fit(value):
+        start = eqx.tree_at(lambda m: [getattr(m, k) for k in free], thesis,
+                            [float(x) for x in truth * value["factor"]])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = js.fit(start, value["inputs"], estimator=js.PredictionError(
+                horizon=10.0, rudder="delta_c"), free=free)
+        return res.values
+
+    results = calls("fit, thesis vessel (Y_uv, N_uv, N_ur, rudder area) on a 60 s zig-zag and "
+                    "a 60 s PRBS at 500 rpm (0.1 s samples)", vessel_fit, [
+                        dict(seed=0, angle=20.0, factor=np.array([1.2, 0.8, 1.2, 0.8]),
+                             note="first call"),
+                        dict(seed=1, angle=15.0, factor=np.array([0.8, 1.2, 0.9, 1.1]),
+                             note="15 deg, new noise, new start values"),
+                        dict(seed=2, angle=25.0, factor=np.array([1.1, 0.9, 0.8, 1.2]),
+                             note="25 deg, new noise, new start values"),
+                    ], solve_traces, prepare=vessel_data)
+    print("estimate / truth - 1: " + "; ".join(
+        ", ".join(f"{x:+.1e}" for x in np.asarray(r) / truth - 1) for r in results))
+
+
+def main(skip_simulate=False):
     print(f"jax {jax.__version__}, {jax.default_backend()}, float64")
+    if not skip_simulate:
+        simulate_cases()
+    fit_cases()
+
+
+def simulate_cases():
     for name in ("mariner", "thesis"):
         simulate_traces = count_traces(jsim, "_simulate")
         base = get_vessel(name)
@@ -108,4 +224,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    main(skip_simulate="--skip-simulate" in sys.argv[1:])

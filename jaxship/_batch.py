@@ -2,7 +2,7 @@
 
 `simulate_batch` vmaps `simulate` over a leading batch axis of any of its inputs and
 splits that axis across the devices of a `jax.sharding.Mesh` with `jax.shard_map`
-(one device: plain vmap). Multi-host runs use the same code after
+(`_sharding`; one device: plain vmap). Multi-host runs use the same code after
 `jax.distributed.initialize()`; see `benchmarks/README.md`.
 """
 
@@ -12,15 +12,13 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
-from jax.sharding import Mesh, PartitionSpec as P
+from jax.sharding import PartitionSpec as P
 
 from ._environment import Environment
+from ._sharding import AXIS, batch_mesh, pad_batch
 from ._simulate import Simulator, _as_arrays, _is_static_zero, _simulate
 from ._state import Trajectory, straight_state
 from ._vessel._base import surge_force
-
-
-_AXIS = "batch"  # name of the mesh axis the batch is split over
 
 
 def stack(modules: Sequence) -> eqx.Module:
@@ -117,8 +115,7 @@ def simulate_batch(
         }
         raise ValueError(f"batched inputs disagree on the batch size: {detail}.")
     size = sizes.pop()
-    devices = tuple(jax.devices() if devices is None else devices)
-    mesh = Mesh(np.array(devices), (_AXIS,)) if len(devices) > 1 else None
+    mesh = batch_mesh(devices)
     b_dyn, b_static = eqx.partition(batched, eqx.is_array)
     s_dyn, s_static = eqx.partition(shared, eqx.is_array)
     return _batched(
@@ -157,13 +154,9 @@ def _batched(b_dyn, s_dyn, b_static, s_static, simulator, output, wind, size, me
         return local(b_dyn, s_dyn)
     count = mesh.devices.size
     padded = -(-size // count) * count
-    if padded != size:  # repeat the last run: padding that is a valid, finite run
-        b_dyn = jax.tree.map(
-            lambda a: jnp.concatenate([a, jnp.repeat(a[-1:], padded - size, axis=0)]), b_dyn
-        )
     out = jax.shard_map(
-        local, mesh=mesh, in_specs=(P(_AXIS), P()), out_specs=P(_AXIS), check_vma=False
-    )(b_dyn, s_dyn)
+        local, mesh=mesh, in_specs=(P(AXIS), P()), out_specs=P(AXIS), check_vma=False
+    )(pad_batch(b_dyn, size, padded), s_dyn)
     # trimming the padding gathers the result (XLA shards only evenly): choose batch
     # sizes divisible by the device count to keep large outputs split over the devices
     return out if padded == size else jax.tree.map(lambda a: a[:size], out)

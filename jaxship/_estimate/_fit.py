@@ -18,6 +18,7 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
+from .._sharding import sharded_vmap
 from .._steering._base import AbstractSteeringModel, propagate
 from .._validate import (
     ParameterReport,
@@ -110,7 +111,7 @@ def _predict(model, w: Windows, offsets=None):
                 out[c] = states[:, model.state_names.index(c)]
         return out
 
-    out = jax.vmap(jax.vmap(one))(w.start, w.delta, w.aux, w.dt, offsets)
+    out = sharded_vmap(one, w.start, w.delta, w.aux, w.dt, offsets, batch_dims=2)
     return jnp.stack([out[c] for c in w.channels])
 
 

@@ -339,6 +339,8 @@ def _batch_filter(model, rec: _Records, Q, q_rudder, R, P0=None):
         return _filter(model, delta, aux, y, mask, dt, z0, p0, Q, q_rudder, R, rec.channels,
                        rec.substeps)
 
+    # plain vmap: reverse mode (the ML Hessian) of a scan inside shard_map fails in
+    # jax 0.10 ("context mesh ... should match"); records are few, windows are many
     return jax.vmap(one)(rec.delta, rec.aux, rec.y, rec.mask, rec.dt, rec.start)
 
 

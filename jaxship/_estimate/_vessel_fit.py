@@ -36,6 +36,7 @@ import numpy as np
 import optimistix as optx
 
 from .._environment import Wind
+from .._sharding import sharded_vmap
 from .._simulate import Simulator
 from .._vessel._base import AbstractVessel, inverse3
 from ._params import Free, ParameterSpec, Transform, as_arrays, rebuild
@@ -201,7 +202,7 @@ def _predict(vessel, w: Windows, x: VesselInputs):
         _, ys = jax.lax.scan(step, y0, (delta, n, wind))
         return ys  # (L, 4)
 
-    ys = jax.vmap(jax.vmap(one))(x.start, w.delta, x.n, x.wind, w.dt)
+    ys = sharded_vmap(one, x.start, w.delta, x.n, x.wind, w.dt, batch_dims=2)
     return jnp.stack([ys[..., _INDEX[c]] for c in w.channels])
 
 
