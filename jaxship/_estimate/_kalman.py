@@ -356,8 +356,8 @@ def _smooth_jit(model, rec, Q, q_rudder, R, P0):
     return out, zs, Ps
 
 
-def _prepare(model, data, channels, rudder, substeps, process_noise, measurement_noise,
-             initial_covariance):
+def _check_inputs(model, data, channels, rudder, substeps):
+    """`(dataset, channels)` after checking the model, the channels and the data."""
     if not isinstance(model, AbstractSteeringModel):
         raise ValueError(f"`model` must be a jaxship AbstractSteeringModel, got "
                          f"{type(model).__name__}.")
@@ -367,6 +367,12 @@ def _prepare(model, data, channels, rudder, substeps, process_noise, measurement
     ds = as_dataset(data)
     check_data(ds, rudder, channels)
     _check_measured(ds, channels)
+    return ds, channels
+
+
+def _prepare(model, data, channels, rudder, substeps, process_noise, measurement_noise,
+             initial_covariance):
+    ds, channels = _check_inputs(model, data, channels, rudder, substeps)
     Q, q_rudder = process_matrices(model, process_noise)
     R = measurement_matrix(channels, measurement_noise)
     P0 = None
@@ -707,17 +713,9 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
 
     **Returns:** a `KalmanFitResult`.
     """
-    if not isinstance(model, AbstractSteeringModel):
-        raise ValueError(f"`model` must be a jaxship AbstractSteeringModel, got "
-                         f"{type(model).__name__}.")
     if criterion not in ("ml", "pem"):
         raise ValueError(f"`criterion` must be 'ml' or 'pem', got {criterion!r}.")
-    channels = _check_channels(channels)
-    if int(substeps) < 1:
-        raise ValueError(f"`substeps` must be a positive integer, got {substeps}.")
-    ds = as_dataset(dataset)
-    check_data(ds, rudder, channels)
-    _check_measured(ds, channels)
+    ds, channels = _check_inputs(model, dataset, channels, rudder, substeps)
     specs = resolve_free(model, free)
     transform = Transform.from_specs(specs)
     layout, z_noise = _noise_layout(model, ds, channels, process, noise, noise_start, criterion)
