@@ -37,6 +37,7 @@ from ._estimate._kalman import (
     smooth_states as smooth_states,
 )
 from ._estimate._linear import initial_estimate as initial_estimate
+from ._estimate._lm import LevenbergMarquardt as LevenbergMarquardt
 from ._estimate._params import Free as Free, param as param
 from ._estimate._predict import predict as predict
 from ._estimate._vessel_fit import default_free as default_free

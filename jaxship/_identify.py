@@ -47,6 +47,7 @@ from ._estimate._fit import (
     fit,
 )
 from ._estimate._linear import initial_estimate
+from ._estimate._lm import LevenbergMarquardt
 from ._estimate._params import as_arrays, param, parameter_fields
 from ._estimate._predict import predict
 from ._estimate._windows import build_windows
@@ -396,7 +397,6 @@ def _start_armax(train: Dataset, context: StartContext) -> ARMAXModel:
 def _fit_armax_entry(start: ARMAXModel, train: Dataset, context: StartContext) -> FitResult:
     """`fit_armax` on the training record as a `FitResult`: the one-step prediction
     of r is the criterion (horizon one sample)."""
-    import optimistix as optx
 
     if context.estimator.horizon is not None:
         context.note(f"armax is fitted by its one-step prediction error (maximum likelihood); "
@@ -1053,7 +1053,7 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
                          f"records: not fitted (channels {', '.join(channels)}).")
 
     report = progress if progress is not None else (lambda event: None)
-    solver = optx.LevenbergMarquardt(rtol=1e-9, atol=1e-9, verbose=_verbose_hook)
+    solver = LevenbergMarquardt(rtol=1e-9, atol=1e-9, verbose=_verbose_hook)
     estimator = PredictionError(horizon=horizon, channels=channels, rudder=rudder,
                                 substeps=int(substeps), solver=solver,
                                 max_steps=int(max_steps), initial=initial)

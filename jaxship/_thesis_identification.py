@@ -31,12 +31,12 @@ import math
 import warnings
 
 import numpy as np
-import optimistix as optx
 
 from . import _manoeuvres as man
 from ._data import Experiment
 from ._estimate._fit import ConvergenceWarning, IdentifiabilityWarning, PredictionError, fit
 from ._estimate._linear import initial_estimate
+from ._estimate._lm import LevenbergMarquardt
 from ._simulate import Simulator, simulate
 from ._steering._base import AuxInputs, simulate_steering
 from ._steering.nomoto import Nomoto1
@@ -202,7 +202,7 @@ def _quiet_fit(*args, **kwargs):
 
 
 def _estimators(settings: Settings):
-    solver = optx.LevenbergMarquardt(rtol=settings.tolerance, atol=settings.tolerance)
+    solver = LevenbergMarquardt(rtol=settings.tolerance, atol=settings.tolerance)
     common = dict(channels=("r",), substeps=settings.substeps, solver=solver,
                   max_steps=settings.max_steps)
     return (PredictionError(horizon=settings.horizon, **common),

@@ -5,8 +5,9 @@ and sums the squared, weighted output errors of all windows of all experiments
 (vmapped; padding masked): Astrom & Kallstrom (1979) found a finite horizon of
 6-60 s essential on full-scale data; `horizon=None` is output error and a horizon
 of one sample equation error. The optimiser is `optimistix.LevenbergMarquardt` in
-the scaled, unconstrained parameter space of `_params.Transform`, with the Jacobian
-by forward-mode autodiff (`options=dict(jac="fwd")`) through the RK4 scan.
+the scaled, unconstrained parameter space of `_params.Transform` (with MINPACK's
+cost-based stopping rule added, `_lm.py`), the Jacobian by forward-mode autodiff
+through the RK4 scan, computed once per evaluation (`_lm.stored_jacobian`).
 """
 
 import math
@@ -26,6 +27,7 @@ from .._validate import (
     parameter_report,
     validate,
 )
+from ._lm import LevenbergMarquardt, solve_least_squares
 from ._params import Transform, as_arrays, rebuild, resolve_free
 from ._windows import Windows, as_dataset, build_windows, check_data, to_timeline
 
@@ -64,8 +66,10 @@ class PredictionError(eqx.Module):
     - `rudder`: the replayed rudder channel, `"delta"` (measured angle) or
       `"delta_c"` (command).
     - `substeps`: RK4 steps per sample interval.
-    - `solver`: an `optimistix` least-squares solver; Levenberg-Marquardt with
-      `rtol = atol = 1e-9` by default.
+    - `solver`: an `optimistix` least-squares solver; by default jaxship's
+      `LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-10)`: optimistix's solver that
+      also stops, like MINPACK, once an accepted step lowers the cost by at most
+      `ftol` relative (`jaxship/_estimate/_lm.py`).
     - `max_steps`: optimiser step limit.
     - `max_lag`: largest lag of the residual correlation tests [samples].
     - `initial`: `"measured"` (default) starts each window from the measured r and
@@ -87,7 +91,7 @@ class PredictionError(eqx.Module):
     weights: dict | tuple | None = None
     rudder: str = "delta"
     substeps: int = 1
-    solver: optx.AbstractLeastSquaresSolver = optx.LevenbergMarquardt(rtol=1e-9, atol=1e-9)
+    solver: optx.AbstractLeastSquaresSolver = LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-10)
     max_steps: int = 256
     max_lag: int = 25
     initial: str | list = "measured"
@@ -138,11 +142,19 @@ def _residual_fn(z, args):
 
 @eqx.filter_jit
 def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
-    sol = optx.least_squares(
-        _residual_fn, solver, z0, args=(model, transform, windows, offset_scale),
-        options=dict(jac="fwd"), max_steps=max_steps, throw=False,
-    )
-    return sol.value, sol.result, sol.stats["num_steps"]
+    """LM from z0; the estimate z, result, steps, the physical parameters and start
+    offsets q, the predictions (C, E, W, L) and the Jacobian with respect to q."""
+
+    def physical(z):
+        p, offsets = _split(z, transform, windows, offset_scale)
+        p = transform.to_physical(p)
+        return p if offsets is None else jnp.concatenate([p, jnp.reshape(offsets, (-1,))])
+
+    z, result, steps, q, residual, jac = solve_least_squares(
+        _residual_fn, solver, z0, (model, transform, windows, offset_scale), max_steps,
+        physical)
+    pred = windows.targets - residual / windows.weights[:, None, None, None]
+    return z, result, steps, q[: len(transform.names)], pred, jac
 
 
 @eqx.filter_jit
@@ -427,9 +439,8 @@ def fit(model: AbstractSteeringModel, dataset, *, estimator: PredictionError = P
         solver = eqx.tree_at(lambda s: s.verbose, solver, verbose if callable(verbose)
                              else _progress)
     base = as_arrays(model)
-    z, result, num_steps = _solve(z0, base, transform, windows, offset_scale, solver,
-                                  int(estimator.max_steps))
-    p, pred, jac = _evaluate(z, base, transform, windows, offset_scale)
+    _, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows, offset_scale,
+                                                solver, int(estimator.max_steps))
     return _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
                    result, num_steps, estimate_starts=estimate_starts, verbose=verbose,
                    stacklevel=3)

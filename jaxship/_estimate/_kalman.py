@@ -55,6 +55,7 @@ import optimistix as optx
 
 from .._steering._base import AbstractSteeringModel, AuxInputs, WindowStart, _rk4_interval
 from .._validate import ParameterReport, least_squares_covariance, parameter_report
+from ._lm import LevenbergMarquardt, solve_least_squares
 from ._params import Transform, as_arrays, rebuild, resolve_free
 from ._windows import as_dataset, channel_weights, check_data
 
@@ -532,10 +533,13 @@ def _ml_solve(z0, model, transform, noise, rec, solver, max_steps):
 
 @eqx.filter_jit
 def _pem_solve(z0, model, transform, noise, rec, weights, solver, max_steps):
-    sol = optx.least_squares(_pem_residuals, solver, z0,
-                             args=(model, transform, noise, rec, weights),
-                             options=dict(jac="fwd"), max_steps=max_steps, throw=False)
-    return sol.value, sol.result, sol.stats["num_steps"]
+    """LM on the weighted innovations; z, result, steps, the innovations and their
+    Jacobian with respect to the physical parameters and log variances."""
+    d = len(transform.names)
+    z, result, steps, _, res, jac = solve_least_squares(
+        _pem_residuals, solver, z0, (model, transform, noise, rec, weights), max_steps,
+        lambda z: _physical(z, d, transform))
+    return z, result, steps, res, jac
 
 
 def _physical(z, d, transform):
@@ -555,19 +559,6 @@ def _ml_hessian(z, model, transform, noise, rec):
         return jnp.sum(_batch_filter(m, rec, Q, qr, R).neg_log_likelihood)
 
     return f(q), jax.hessian(f)(q)
-
-
-@eqx.filter_jit
-def _pem_jacobian(z, model, transform, noise, rec, weights):
-    d = len(transform.names)
-    q = _physical(z, d, transform)
-
-    def f(q):
-        m = rebuild(model, transform.names, q[:d])
-        Q, qr, R = noise.matrices(q[d:])
-        return _batch_filter(m, rec, Q, qr, R).innovations * weights
-
-    return f(q), jax.jacfwd(f)(q)
 
 
 class KalmanFitResult(eqx.Module):
@@ -708,8 +699,8 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
       for R, (0.5 deg)^2 for the rudder, 1 % of the spread on states).
     - `rudder`, `substeps`: as `PredictionError`.
     - `max_steps`, `solver`: optimiser step limit and an optimistix solver (default
-      `BFGS(rtol=1e-8, atol=1e-8)` for ML, `LevenbergMarquardt(rtol=1e-9, atol=1e-9)`
-      for PEM).
+      `BFGS(rtol=1e-8, atol=1e-8)` for ML, jaxship's `LevenbergMarquardt(rtol=1e-9,
+      atol=1e-9)` with MINPACK's cost test for PEM).
 
     **Returns:** a `KalmanFitResult`.
     """
@@ -737,11 +728,10 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
             cov = np.where(np.eye(hess.shape[0], dtype=bool), np.inf, 0.0)
         loss = float(loss)
     else:
-        solver = optx.LevenbergMarquardt(rtol=1e-9, atol=1e-9) if solver is None else solver
+        solver = LevenbergMarquardt(rtol=1e-9, atol=1e-9) if solver is None else solver
         weights = jnp.asarray(channel_weights(ds, channels, None), dtype=float)
-        z, result, steps = _pem_solve(z0, base, transform, layout, rec, weights, solver,
-                                      int(max_steps))
-        res, jac = _pem_jacobian(z, base, transform, layout, rec, weights)
+        z, result, steps, res, jac = _pem_solve(z0, base, transform, layout, rec, weights,
+                                                solver, int(max_steps))
         mask = np.asarray(ds.mask).copy()
         mask[:, 0] = False  # sample 0 is the prior, never predicted
         res, jac = np.asarray(res), np.asarray(jac)

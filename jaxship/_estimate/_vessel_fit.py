@@ -33,12 +33,12 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
-import optimistix as optx
 
 from .._environment import Wind
 from .._sharding import sharded_vmap
 from .._simulate import Simulator
 from .._vessel._base import AbstractVessel, inverse3
+from ._lm import solve_least_squares
 from ._params import Free, ParameterSpec, Transform, as_arrays, rebuild
 from ._windows import Windows, as_dataset, build_windows, check_data
 
@@ -218,21 +218,21 @@ def _residual_fn(z, args):
 
 @eqx.filter_jit
 def _solve(z0, vessel, transform, windows, inputs, solver, max_steps):
-    sol = optx.least_squares(
-        _residual_fn, solver, z0, args=(vessel, transform, windows, inputs),
-        options=dict(jac="fwd"), max_steps=max_steps, throw=False,
-    )
-    return sol.value, sol.result, sol.stats["num_steps"]
+    """LM from z0; the estimate z, result, steps, physical parameters, predictions
+    (C, E, W, L) and the Jacobian with respect to the physical parameters."""
+    z, result, steps, p, residual, jac = solve_least_squares(
+        _residual_fn, solver, z0, (vessel, transform, windows, inputs), max_steps,
+        transform.to_physical)
+    pred = windows.targets - residual / windows.weights[:, None, None, None]
+    return z, result, steps, p, pred, jac
 
 
 @eqx.filter_jit
-def _evaluate(z, vessel, transform, windows, inputs):
-    """Physical parameters, predictions (C, E, W, L) and the forward-mode Jacobian of
-    the weighted residuals with respect to the physical parameters (C, E, W, L, d)."""
-    p = transform.to_physical(z)
+def _jacobian(p, vessel, transform, windows, inputs):
+    """Forward-mode Jacobian (C, E, W, L, d) of the weighted residuals with respect to
+    the physical parameters p."""
     f = lambda q: _residuals(rebuild(vessel, transform.names, q), windows, inputs)
-    pred = _predict(rebuild(vessel, transform.names, p), windows, inputs)
-    return p, pred, jax.jacfwd(f)(p)
+    return jax.jacfwd(f)(p)
 
 
 # ------------------------------------------------------------------------------- data
@@ -305,8 +305,7 @@ def fit_vessel(vessel: AbstractVessel, dataset, *, estimator, free=None, verbose
     if zero.any():
         provisional = [dataclasses.replace(s, scale=s.scale or 1.0) for s in specs]
         transform = Transform.from_specs(provisional)
-        z0 = jnp.asarray(transform.to_unconstrained(start), dtype=float)
-        _, _, jac = _evaluate(z0, base, transform, windows, inputs)
+        jac = _jacobian(jnp.asarray(start, dtype=float), base, transform, windows, inputs)
         norms = np.sqrt(np.sum(np.asarray(jac, dtype=np.float64).reshape(-1, len(specs)) ** 2,
                                axis=0))
         scaled = norms * np.array([s.scale for s in provisional])
@@ -321,8 +320,7 @@ def fit_vessel(vessel: AbstractVessel, dataset, *, estimator, free=None, verbose
     if verbose and hasattr(solver, "verbose"):
         solver = eqx.tree_at(lambda s: s.verbose, solver, verbose if callable(verbose)
                              else _progress)
-    z, result, num_steps = _solve(z0, base, transform, windows, inputs, solver,
-                                  int(estimator.max_steps))
-    p, pred, jac = _evaluate(z, base, transform, windows, inputs)
+    _, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows, inputs, solver,
+                                                int(estimator.max_steps))
     return _report(vessel, ds, estimator, specs, transform, windows, layout, p, pred, jac,
                    result, num_steps, verbose=verbose, stacklevel=4)

@@ -1,0 +1,87 @@
+"""jaxship's Levenberg-Marquardt (MINPACK's cost test on top of optimistix's) and the
+stored-Jacobian residuals of `jaxship/_estimate/_lm.py`."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optimistix as optx
+import pytest
+
+from jaxship import LevenbergMarquardt
+from jaxship._estimate._lm import solve_least_squares, stored_jacobian
+
+
+T = jnp.linspace(0.0, 10.0, 200)
+# two decaying exponentials with noise: a nonzero-residual problem whose last
+# parameter digits settle slowly (an ill-conditioned sum of exponentials)
+DATA = (2.0 * jnp.exp(-0.3 * T) + 0.5 * jnp.exp(-1.7 * T)
+        + 0.01 * np.random.default_rng(0).standard_normal(200))
+Z0 = jnp.array([1.0, 0.5, 1.0, 1.0])
+
+
+def residuals(z, args):
+    a, b, c, d = z
+    return a * jnp.exp(-b * T) + c * jnp.exp(-d * T) - DATA
+
+
+def solve(solver):
+    sol = optx.least_squares(residuals, solver, Z0, max_steps=1000, throw=False)
+    r = residuals(sol.value, None)
+    return sol, 0.5 * float(r @ r)
+
+
+def test_ftol_zero_is_optimistix_levenberg_marquardt():
+    ref, cost_ref = solve(optx.LevenbergMarquardt(rtol=1e-12, atol=1e-12))
+    sol, cost = solve(LevenbergMarquardt(rtol=1e-12, atol=1e-12, ftol=0.0))
+    assert int(sol.stats["num_steps"]) == int(ref.stats["num_steps"])
+    np.testing.assert_array_equal(sol.value, ref.value)
+    assert cost == cost_ref
+
+
+def test_cost_test_stops_earlier_at_the_same_cost():
+    """With tight parameter tolerances optimistix keeps stepping after the cost has
+    settled; the cost test stops sooner, at a cost equal to 1e-9 relative."""
+    ref, cost_ref = solve(optx.LevenbergMarquardt(rtol=1e-12, atol=1e-12))
+    sol, cost = solve(LevenbergMarquardt(rtol=1e-12, atol=1e-12, ftol=1e-10))
+    assert sol.result == optx.RESULTS.successful
+    assert int(sol.stats["num_steps"]) < int(ref.stats["num_steps"])
+    assert abs(cost - cost_ref) <= 1e-9 * cost_ref
+    # a loose ftol stops earlier still, and the cost shows it
+    loose, cost_loose = solve(LevenbergMarquardt(rtol=1e-12, atol=1e-12, ftol=1e-3))
+    assert int(loose.stats["num_steps"]) < int(sol.stats["num_steps"])
+    assert cost_loose > cost_ref * (1 + 1e-9)
+
+
+def test_negative_ftol_raises():
+    with pytest.raises(ValueError, match="ftol"):
+        LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=-1.0)
+
+
+def test_stored_jacobian_values_and_linearisation():
+    f = stored_jacobian(residuals)
+    z = jnp.array([1.7, 0.4, 0.3, 2.0])
+    value, jac = f(z, None)
+    np.testing.assert_array_equal(value, residuals(z, None))
+    np.testing.assert_allclose(jac, jax.jacfwd(residuals)(z, None), rtol=1e-13, atol=1e-15)
+    # the JVP through the custom rule equals the JVP of the plain function
+    dz = jnp.array([0.3, -1.0, 2.0, 0.5])
+    _, lin = jax.linearize(lambda q: f(q, None)[0], z)
+    _, ref = jax.jvp(lambda q: residuals(q, None), (z,), (dz,))
+    np.testing.assert_allclose(lin(dz), ref, rtol=1e-12, atol=1e-14)
+
+
+@pytest.mark.parametrize("solver", [LevenbergMarquardt(rtol=1e-10, atol=1e-10),
+                                    optx.BFGS(rtol=1e-10, atol=1e-10)],
+                         ids=["gauss-newton", "minimiser"])
+def test_solve_least_squares_returns_physical_jacobian(solver):
+    """Residuals and Jacobian at the solution: the Gauss-Newton solver's stored ones
+    and, for another solver, a fresh evaluation; both with respect to q = 2 z."""
+    scaled = lambda z, args: residuals(2.0 * z, args)
+    out = jax.jit(lambda z: solve_least_squares(scaled, solver, z, None, 1000,
+                                                lambda z: 2.0 * z))(Z0 / 2.0)
+    z, result, _, q, res, jac = out
+    assert result == optx.RESULTS.successful
+    np.testing.assert_allclose(q, 2.0 * z)
+    np.testing.assert_allclose(q, [2.02014445, 0.30187279, 0.48552742, 1.83116784], rtol=1e-6)
+    np.testing.assert_allclose(res, residuals(q, None), rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(jac, jax.jacfwd(residuals)(q, None), rtol=1e-12, atol=1e-15)
