@@ -105,6 +105,27 @@ class ParameterSpec:
         return BOX if lo and hi else LOWER if lo else UPPER if hi else UNBOUNDED
 
 
+def select_free(free, default, fields, kind: str, noun: str) -> dict:
+    """`{name: Free or None}` chosen by `free` (None: the names `default`; a sequence
+    of names; a dict), checked against `fields`, the valid names of `kind`'s `noun`s."""
+    if free is None:
+        chosen = {name: None for name in default}
+    elif isinstance(free, str):
+        raise ValueError(f"`free` must be a sequence of field names or a dict, got the "
+                         f"string {free!r}; write free=({free!r},).")
+    elif isinstance(free, dict):
+        chosen = dict(free)
+    else:
+        chosen = {name: None for name in free}
+    unknown = [name for name in chosen if name not in fields]
+    if unknown:
+        raise ValueError(f"`free` names {unknown[0]!r}, which is not a {noun} of {kind}; its "
+                         f"{noun}s are {', '.join(fields)}.")
+    if not chosen:
+        raise ValueError(f"`free` selects no {noun} of {kind}; choose from {', '.join(fields)}.")
+    return chosen
+
+
 def resolve_free(model, free=None) -> tuple[ParameterSpec, ...]:
     """The free parameters of `model` for `fit(..., free=free)`.
 
@@ -115,23 +136,8 @@ def resolve_free(model, free=None) -> tuple[ParameterSpec, ...]:
     """
     fields = parameter_fields(model)
     kind = type(model).__name__
-    if free is None:
-        chosen = {name: None for name, info in fields.items() if info.free}
-    elif isinstance(free, str):
-        raise ValueError(f"`free` must be a sequence of field names or a dict, got the "
-                         f"string {free!r}; write free=({free!r},).")
-    elif isinstance(free, dict):
-        chosen = dict(free)
-    else:
-        chosen = {name: None for name in free}
-    unknown = [name for name in chosen if name not in fields]
-    if unknown:
-        raise ValueError(
-            f"`free` names {unknown[0]!r}, which is not a parameter of {kind}; its parameters "
-            f"are {', '.join(fields)}."
-        )
-    if not chosen:
-        raise ValueError(f"`free` selects no parameter of {kind}; choose from {', '.join(fields)}.")
+    chosen = select_free(free, [n for n, info in fields.items() if info.free], fields, kind,
+                         "parameter")
     specs = []
     for name in fields:  # field order, whatever the order of `free`
         if name not in chosen:

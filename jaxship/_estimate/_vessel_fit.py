@@ -39,7 +39,7 @@ from .._sharding import sharded_vmap
 from .._simulate import Simulator
 from .._vessel._base import AbstractVessel, inverse3
 from ._lm import solve_least_squares
-from ._params import Free, ParameterSpec, Transform, as_arrays, rebuild
+from ._params import Free, ParameterSpec, Transform, as_arrays, rebuild, select_free
 from ._windows import Windows, as_dataset, build_windows, check_data
 
 
@@ -101,22 +101,8 @@ def resolve_vessel_free(vessel: AbstractVessel, free=None) -> tuple[ParameterSpe
     `{name: Free(...) or None}`. A spec's scale of 0 marks "from the Jacobian"."""
     fields = vessel_coefficients(vessel)
     kind = type(vessel).__name__
-    if free is None:
-        chosen = {n: None for n in default_free(vessel)}
-    elif isinstance(free, str):
-        raise ValueError(f"`free` must be a sequence of field names or a dict, got the "
-                         f"string {free!r}; write free=({free!r},).")
-    elif isinstance(free, dict):
-        chosen = dict(free)
-    else:
-        chosen = {n: None for n in free}
-    unknown = [n for n in chosen if n not in fields]
-    if unknown:
-        raise ValueError(f"`free` names {unknown[0]!r}, which is not a scalar coefficient of "
-                         f"{kind}; its coefficients are {', '.join(fields)}.")
-    if not chosen:
-        raise ValueError(f"`free` selects no coefficient of {kind}; choose from "
-                         f"{', '.join(fields)}.")
+    default = default_free(vessel) if free is None else ()
+    chosen = select_free(free, default, fields, kind, "scalar coefficient")
     specs = []
     for name in fields:  # field order
         if name not in chosen:
