@@ -27,7 +27,7 @@ from .._validate import (
     parameter_report,
     validate,
 )
-from ._lm import LevenbergMarquardt, solve_least_squares
+from ._lm import LevenbergMarquardt, SolverOutcome, solve_least_squares
 from ._params import Transform, as_arrays, rebuild, resolve_free
 from ._windows import Windows, as_dataset, build_windows, check_data, to_timeline
 
@@ -181,7 +181,7 @@ def _progress(**kwargs):
                     kwargs["loss_this_step"][1], kwargs["loss_last_accepted_step"][1])
 
 
-class FitResult(eqx.Module):
+class FitResult(SolverOutcome):
     """Result of `fit`.
 
     - `model`: the model with the estimates (frozen parameters unchanged);
@@ -237,14 +237,6 @@ class FitResult(eqx.Module):
     @property
     def flags(self) -> tuple[str, ...]:
         return self.parameters.flags
-
-    @property
-    def success(self) -> bool:
-        return bool(self.result == optx.RESULTS.successful)
-
-    @property
-    def message(self) -> str:
-        return "successful" if self.success else optx.RESULTS[self.result]
 
     def interval(self, level: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
         """Normal confidence intervals `(lower, upper)` of the estimates at `level`

@@ -55,7 +55,7 @@ import optimistix as optx
 
 from .._steering._base import AbstractSteeringModel, AuxInputs, WindowStart, _rk4_interval
 from .._validate import ParameterReport, least_squares_covariance, parameter_report
-from ._lm import LevenbergMarquardt, solve_least_squares
+from ._lm import LevenbergMarquardt, SolverOutcome, solve_least_squares
 from ._params import Transform, as_arrays, rebuild, resolve_free
 from ._windows import as_dataset, channel_weights, check_data
 
@@ -561,7 +561,7 @@ def _ml_hessian(z, model, transform, noise, rec):
     return f(q), jax.hessian(f)(q)
 
 
-class KalmanFitResult(eqx.Module):
+class KalmanFitResult(SolverOutcome):
     """Result of `fit_ml`.
 
     - `model`: the model with the estimates (frozen parameters unchanged);
@@ -591,14 +591,6 @@ class KalmanFitResult(eqx.Module):
     std = property(lambda self: self.parameters.std)
     covariance = property(lambda self: self.parameters.covariance)
     correlation = property(lambda self: self.parameters.correlation)
-
-    @property
-    def success(self) -> bool:
-        return bool(self.result == optx.RESULTS.successful)
-
-    @property
-    def message(self) -> str:
-        return "successful" if self.success else optx.RESULTS[self.result]
 
     def summary(self) -> str:
         noise = ", ".join(f"{k} {v:.4g} +- {self.noise_std[k]:.2g}" for k, v in self.noise.items())

@@ -61,6 +61,20 @@ class LevenbergMarquardt(optx.AbstractGaussNewton):
         return y, new, aux
 
 
+class SolverOutcome(eqx.Module):
+    """Base of fit results: `success` and `message` from the optimistix `result`."""
+
+    result: eqx.AbstractVar[optx.RESULTS]
+
+    @property
+    def success(self) -> bool:
+        return bool(self.result == optx.RESULTS.successful)
+
+    @property
+    def message(self) -> str:
+        return "successful" if self.success else optx.RESULTS[self.result]
+
+
 def value_and_jacfwd(f, z):
     """`(f(z), J)` with $J_{...,i} = \\partial f / \\partial z_i$ by forward mode, one
     batched JVP over the unit vectors (the primal is computed once)."""
