@@ -4,10 +4,13 @@ For each case the script calls the same entry point three times: the first call 
 and compiles, the second and third pass *new parameter values* of the same shapes
 (vessel coefficients, rudder angle, initial speed). Counted for every call:
 
-- traces of the jitted body (`eqx.debug.assert_max_traces` around it, which also raises
-  if it is traced more than once);
-- XLA compilations and their time, from JAX's own monitoring events
+- new traces of jitted functions (the entry point's core and anything else the call
+  traces), from JAX's own monitoring events (`/jax/core/compile/jaxpr_trace_duration`);
+- XLA compilations and their time, from JAX's monitoring events as well
   (`/jax/core/compile/backend_compile_duration`; every jitted call that compiles emits one).
+
+Both are counted through the public API only, so the counts do not depend on how
+jaxship names its internal jitted functions.
 
 Cases: `simulate` of a 600 s 20/20 zig-zag of the Mariner (0.1 s samples, RK4), the same
 for the thesis vessel, and `simulate_batch` of 64 Mariner zig-zags.
@@ -17,11 +20,9 @@ on two simulated 20/20 zig-zags of the Mariner, and (b) the thesis vessel with 4
 coefficients (Y_uv, N_uv, N_ur, rudder area) on a simulated 20/20 zig-zag and a PRBS at
 500 rpm, prediction error with a 10 s horizon. Every call of a fit case passes *new data
 values* (other rudder angles, other measurement noise, same lengths) and *new start values*;
-the data are simulated before the clock starts. The traces counted are those of the fit's
-jitted core (`jaxship._estimate._fit._solve` for response models,
-`jaxship._estimate._vessel_fit._solve` for vessels); the XLA compilations are all those
-of the call (the core, the Jacobian for the covariance, and any small eager operation).
-The second and third calls must show 0 new traces and 0 new compilations.
+the data are simulated before the clock starts. The traces and XLA compilations are all
+those of the call (the fit's core, the Jacobian for the covariance, and any small eager
+operation). The second and third calls must show 0 new traces and 0 new compilations.
 
 Prints the wall time of each call and the counts; float64.
 
@@ -42,52 +43,42 @@ import jax.monitoring  # noqa: E402
 import numpy as np  # noqa: E402
 
 import jaxship as js  # noqa: E402
-import jaxship._batch as jb  # noqa: E402
-import jaxship._estimate._fit as jfit  # noqa: E402
-import jaxship._estimate._vessel_fit as jvfit  # noqa: E402
-import jaxship._simulate as jsim  # noqa: E402
-from jaxship._vessel.catalogue import get_vessel  # noqa: E402
 
 
 DEG = np.pi / 180
 COMPILES = []  # durations of the XLA compilations seen so far [s]
+TRACES = []  # durations of the traces of jitted functions seen so far [s]
 
 
 def _listen(event, duration, **_):
     if event == "/jax/core/compile/backend_compile_duration":
         COMPILES.append(duration)
+    elif event == "/jax/core/compile/jaxpr_trace_duration":
+        TRACES.append(duration)
 
 
 jax.monitoring.register_event_duration_secs_listener(_listen)
 
 
-ORIGINAL = {(jsim, "_simulate"): jsim._simulate, (jb, "_batched"): jb._batched,
-            (jfit, "_solve"): jfit._solve, (jvfit, "_solve"): jvfit._solve}
-
-
-def count_traces(module, name):
-    """Replace the jitted `module.name` by a fresh copy that counts (and limits) its traces."""
-    counted = eqx.debug.assert_max_traces(ORIGINAL[module, name].__wrapped__, max_traces=1)
-    setattr(module, name, eqx.filter_jit(counted))
-    return lambda: eqx.debug.get_num_traces(counted)
-
-
-def calls(label, run, values, traces, prepare=None):
-    """Time `run(value)` for each value; `prepare(value)` (untimed) builds its inputs."""
+def calls(label, run, values, prepare=None):
+    """Time `run(value)` for each value; `prepare(value)` (untimed) builds its inputs.
+    Raises when a call after the first traces or compiles anything."""
     print(f"\n{label}")
-    print("| call | new values | wall time [s] | traces so far | XLA compilations (time [s]) |")
+    print("| call | new values | wall time [s] | new traces | XLA compilations (time [s]) |")
     print("| ---: | --- | ---: | ---: | --- |")
     out = []
     for k, value in enumerate(values, start=1):
         if prepare is not None:
             value = dict(value, inputs=prepare(value))
-        before = len(COMPILES)
+        traces, compiles = len(TRACES), len(COMPILES)
         start = time.perf_counter()
         result = jax.block_until_ready(run(value))
         wall = time.perf_counter() - start
-        new = COMPILES[before:]
+        new, traced = COMPILES[compiles:], len(TRACES) - traces
         what = f"{len(new)} ({sum(new):.2f})" if new else "0"
-        print(f"| {k} | {value['note']} | {wall:.3f} | {traces()} | {what} |")
+        print(f"| {k} | {value['note']} | {wall:.3f} | {traced} | {what} |")
+        if k > 1 and (traced or new):
+            raise RuntimeError(f"{label}: call {k} with new values retraced or recompiled.")
         out.append(result)
     return out
 
@@ -103,11 +94,8 @@ def noisy(experiment, rng, noise):
 def fit_cases():
     """One fit of a response model and one of a vessel, each called three times with new
     data values and new start values."""
-    for (module, name), original in ORIGINAL.items():  # data simulation is not counted
-        setattr(module, name, original)
-    # (a) Nomoto 1 (K, T) on two Mariner zig-zags: the core is jaxship._estimate._fit._solve
-    solve_traces = count_traces(jfit, "_solve")
-    mariner = get_vessel("mariner")
+    # (a) Nomoto 1 (K, T) on two Mariner zig-zags
+    mariner = js.vessel("mariner")
 
     def nomoto_data(value):
         rng = np.random.default_rng(value["seed"])
@@ -134,13 +122,12 @@ def fit_cases():
                              note="15/15 zig-zags, new noise, K0 0.08, T0 40"),
                         dict(seed=2, angle=25.0, K=0.03, T=10.0,
                              note="25/25 zig-zags, new noise, K0 0.03, T0 10"),
-                    ], solve_traces, prepare=nomoto_data)
+                    ], prepare=nomoto_data)
     print("estimates (K [1/s], T [s]): " + "; ".join(
         ", ".join(f"{x:.4g}" for x in np.asarray(r)) for r in results))
 
-    # (b) the thesis vessel, 4 coefficients: the core is jaxship._estimate._vessel_fit._solve
-    solve_traces = count_traces(jvfit, "_solve")
-    thesis = get_vessel("thesis")
+    # (b) the thesis vessel, 4 coefficients
+    thesis = js.vessel("thesis")
     free = ("y_uv", "n_uv", "n_ur", "rudder_area")
     truth = np.array([getattr(thesis, k) for k in free])
     n = 500 / 60
@@ -174,7 +161,7 @@ def fit_cases():
                              note="15 deg, new noise, new start values"),
                         dict(seed=2, angle=25.0, factor=np.array([1.1, 0.9, 0.8, 1.2]),
                              note="25 deg, new noise, new start values"),
-                    ], solve_traces, prepare=vessel_data)
+                    ], prepare=vessel_data)
     print("estimate / truth - 1: " + "; ".join(
         ", ".join(f"{x:+.1e}" for x in np.asarray(r) / truth - 1) for r in results))
 
@@ -188,8 +175,7 @@ def main(skip_simulate=False):
 
 def simulate_cases():
     for name in ("mariner", "thesis"):
-        simulate_traces = count_traces(jsim, "_simulate")
-        base = get_vessel(name)
+        base = js.vessel(name)
         coef = "n_r" if name == "mariner" else "n_ur"
 
         def run(value, base=base, coef=coef):
@@ -205,22 +191,21 @@ def simulate_cases():
             dict(f=1.1, angle=15.0, u=0.9, note=f"{coef} x1.1, 15 deg, 0.9 U0"),
             dict(f=0.8, angle=25.0, u=1.1, note=f"{coef} x0.8, 25 deg, 1.1 U0"),
         ]
-        calls(f"simulate, {name}: 600 s a/a zig-zag at 0.1 s", run, values, simulate_traces)
+        calls(f"simulate, {name}: 600 s a/a zig-zag at 0.1 s", run, values)
 
-    batch_traces = count_traces(jb, "_batched")
-    base = get_vessel("mariner")
+    base = js.vessel("mariner")
 
     def run_batch(value):
         vessel = eqx.tree_at(lambda v: v.n_r, base, base.n_r * value["f"])
         angles = np.linspace(10, 30, 64) * DEG * value["f"]
         man = js.ZigZag(angles, angles, duration=600.0, dt=0.1)
-        return jb.simulate_batch(vessel, man, js.straight_state(np.full(64, 7.0 * value["f"])))
+        return js.simulate_batch(vessel, man, js.straight_state(np.full(64, 7.0 * value["f"])))
 
     calls("simulate_batch, 64 Mariner zig-zags", run_batch, [
         dict(f=1.0, note="first call"),
         dict(f=1.1, note="n_r, angles, speeds x1.1"),
         dict(f=0.9, note="n_r, angles, speeds x0.9"),
-    ], batch_traces)
+    ])
 
 
 if __name__ == "__main__":

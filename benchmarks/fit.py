@@ -14,11 +14,14 @@ errors-in-variables bias, the same for both fits).
 Both fits minimise the same residuals from the same start (every coefficient 10-30 %
 off): prediction error with a 10 s horizon (each window restarts from the measured
 u, v, r, psi and rudder angle), the recorded rudder command replayed through the
-rudder servo and the measured propeller rate held, channels psi, r, u, v weighted by
-1/std of the measured channel; parameters scaled by their start magnitudes.
+rudder servo (held over each interval) and the measured propeller rate interpolated
+linearly between samples (jaxship's default holds; the rate is constant within each
+experiment here), channels psi, r, u, v weighted by 1/std of the measured channel
+(within-experiment mean removed, pooled); parameters scaled by their start magnitudes.
+The SciPy side rebuilds these windows and weights in plain NumPy (`ScipyProblem`).
 
 - jaxship: `jaxship.fit(vessel, data, estimator=PredictionError(horizon=10.0,
-  rudder="delta_c"), free=FREE)`: its default solver, optimistix's LM with MINPACK's
+  rudder="delta_c", max_steps=500), free=FREE)`: its default solver, optimistix's LM with MINPACK's
   cost test added (`jaxship.LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-10)`: it
   stops once an accepted step lowers the cost by at most 1e-10 relative, SciPy's
   `ftol` below), forward-mode Jacobian through the fixed-step RK4 scan, vmapped over
@@ -29,8 +32,9 @@ rudder servo and the measured propeller rate held, channels psi, r, u, v weighte
   rtol 1e-9, atol 1e-12) on a right-hand side written in NumPy (checked against
   `jaxship.state_derivative` at random states below). To be fair to SciPy, each
   call of `solve_ivp` integrates *all windows at once* (one vectorised state of
-  5 x windows) over one sample interval, the input held (zero-order hold
-  without discontinuities inside a call): 100 calls per residual evaluation.
+  5 x windows) over one sample interval, the rudder command held and the
+  propeller rate linear in time (no discontinuities inside a call): 100 calls per
+  residual evaluation.
   SciPy gets a wall-clock budget (`--budget`, default 1800 s); if it runs out, the best
   point so far is reported as such.
 
@@ -55,8 +59,6 @@ from scipy.integrate import solve_ivp  # noqa: E402
 from scipy.optimize import least_squares  # noqa: E402
 
 import jaxship as js  # noqa: E402
-from jaxship._estimate._fit import IdentifiabilityWarning  # noqa: E402
-from jaxship._estimate._windows import build_windows, to_timeline  # noqa: E402
 
 
 DEG = np.pi / 180
@@ -186,38 +188,75 @@ def check_rhs(vessel, rng, count=200):
     return worst
 
 
+def channel_weights(data, channels):
+    """1/std of each measured channel: the deviations from each experiment's own mean,
+    pooled over all samples of all experiments (jaxship's default weights)."""
+    out = []
+    for c in channels:
+        dev = np.concatenate([getattr(e, c) - np.mean(getattr(e, c)) for e in data])
+        var = float(np.mean(dev**2))
+        out.append(1.0 / np.sqrt(var) if var > 0 else 1.0)
+    return np.array(out)
+
+
 class ScipyProblem:
     """The prediction-error residuals of the fit, with solve_ivp on the NumPy model.
-    Windows and weights come from the same layout as jaxship's (`build_windows`)."""
+
+    The windows are jaxship's definition, rebuilt here in NumPy: per experiment of N
+    samples at interval dt, L = round(HORIZON / dt) clipped to [1, N - 1]; windows
+    start at samples 0, L, 2L, ... while the start is < N - 1; each starts from the
+    measured u, v, r, psi and rudder angle delta at its start sample and predicts
+    samples start + 1 .. start + L that exist (every sample but the first is predicted
+    once). Windows of all experiments are stacked to (B, L_max) with a mask.
+    Inputs: the commanded rudder `delta_c` is held over each interval (zero-order
+    hold, jaxship's default for a command) and drives the servo; the measured
+    propeller rate `n` is interpolated linearly between samples (first-order hold,
+    jaxship's default for measured signals) -- constant within each experiment here,
+    so the hold makes no difference."""
+
+    CHANNELS = ("psi", "r", "u", "v")
+    STATE = ("u", "v", "r", "psi", "delta")  # the NumPy model's state order
 
     def __init__(self, vessel, data, names, scale):
-        ds = js.Dataset.from_experiments(data)
-        w, layout = build_windows(ds, horizon=HORIZON, channels=("psi", "r", "u", "v"),
-                                  weights=None, rudder="delta_c")
         self.vessel, self.names, self.scale = vessel, names, np.asarray(scale)
-        self.mask = np.asarray(w.mask).reshape(-1, w.mask.shape[-1])  # (B, L)
-        self.targets = np.asarray(w.targets).reshape(4, *self.mask.shape)
-        self.weights = np.asarray(w.weights)
-        self.delta_c = np.asarray(w.delta).reshape(self.mask.shape)
-        self.n = np.asarray(w.aux.n).reshape(self.mask.shape)
-        step = np.clip(layout["target"] - 1, 0, ds.num_samples - 1)[..., 0]
-        rows = np.arange(ds.num_experiments)[:, None]
-        self.y0 = np.stack([np.asarray(getattr(ds, c))[rows, step].reshape(-1)
-                            for c in ("u", "v", "r", "psi", "delta")])
-        self.layout, self.shape = layout, (ds.num_experiments, ds.num_samples)
-        self.dt = float(np.asarray(ds.dt)[0])
-        assert np.allclose(np.asarray(ds.dt), self.dt)
+        self.dt = float(data[0].dt)
+        assert all(np.isclose(e.dt, self.dt) for e in data), "one sample interval"
+        lengths = [min(max(int(round(HORIZON / e.dt)), 1), e.num_samples - 1) for e in data]
+        num_l = max(lengths)
+        k = np.arange(num_l)
+        y0, delta_c, n, targets, mask, where = [], [], [], [], [], []
+        for i, (e, length) in enumerate(zip(data, lengths)):
+            last = e.num_samples - 1
+            for s in range(0, last, length):
+                y0.append([getattr(e, c)[s] for c in self.STATE])
+                valid = (k < length) & (s + 1 + k <= last)
+                target = np.minimum(s + 1 + k, last)  # beyond the end the last sample holds
+                delta_c.append(e.delta_c[np.minimum(s + k, last)])  # interval starts
+                n.append(e.n[np.minimum(s + np.arange(num_l + 1), last)])  # and its end
+                targets.append([getattr(e, c)[target] for c in self.CHANNELS])
+                mask.append(valid)
+                where.append((i, target))
+        self.y0 = np.array(y0).T  # (5, B)
+        self.delta_c = np.array(delta_c)  # (B, L)
+        self.n = np.array(n)  # (B, L + 1)
+        self.targets = np.moveaxis(np.array(targets), 1, 0)  # (4, B, L)
+        self.mask = np.array(mask)  # (B, L)
+        self.where = where
+        self.lengths = [e.num_samples for e in data]
+        self.weights = channel_weights(data, self.CHANNELS)
         self.nfev = 0
 
     def predict(self, values):
+        """(5, B, L) predicted states at the window samples."""
         model = NumpyRoss(self.vessel, self.names, values)
         y = self.y0.copy()
         out = np.empty((y.shape[0],) + self.mask.shape)
-        size = y.size
+        size, dt = y.size, self.dt
         for k in range(self.mask.shape[1]):
-            dc, n = self.delta_c[:, k], self.n[:, k]
-            sol = solve_ivp(lambda t, z: model.rhs(z.reshape(5, -1), dc, n).reshape(-1),
-                            (0.0, self.dt), y.reshape(size), method="RK45", rtol=1e-9,
+            dc, n0, n1 = self.delta_c[:, k], self.n[:, k], self.n[:, k + 1]
+            sol = solve_ivp(lambda t, z: model.rhs(z.reshape(5, -1), dc,
+                                                   n0 + (n1 - n0) * (t / dt)).reshape(-1),
+                            (0.0, dt), y.reshape(size), method="RK45", rtol=1e-9,
                             atol=1e-12)
             y = sol.y[:, -1].reshape(5, -1)
             out[:, :, k] = y
@@ -226,16 +265,19 @@ class ScipyProblem:
     def timeline(self, values):
         """{channel: (E, N) predictions} on the samples, as jaxship's FitResult."""
         pred = self.predict(values)
-        e, w, ln = self.layout["mask"].shape
-        return {c: to_timeline(pred[i].reshape(e, w, ln), self.layout, self.shape)[0]
-                for c, i in (("psi", 3), ("r", 2), ("u", 0), ("v", 1))}
+        out = {c: np.zeros((len(self.lengths), max(self.lengths))) for c in self.CHANNELS}
+        for b, (i, target) in enumerate(self.where):
+            m = self.mask[b]
+            for c in self.CHANNELS:
+                out[c][i, target[m]] = pred[self.STATE.index(c), b, m]
+        return out
 
     def residuals(self, z):
         self.nfev += 1
         pred = self.predict(z * self.scale)
-        order = (3, 2, 0, 1)  # psi, r, u, v of (u, v, r, psi, delta)
-        res = self.weights[:, None, None] * (self.targets - pred[list(order)])
-        return np.where(self.mask[None], res, 0.0)[:, self.mask].reshape(-1)
+        order = [self.STATE.index(c) for c in self.CHANNELS]
+        res = self.weights[:, None, None] * (self.targets - pred[order])
+        return res[:, self.mask].reshape(-1)
 
 
 class Budget(Exception):
@@ -281,7 +323,7 @@ def main(args):
 
     def jax_fit():
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore", IdentifiabilityWarning)
+            warnings.simplefilter("ignore", js.IdentifiabilityWarning)
             t = time.perf_counter()
             res = js.fit(start_vessel, data, estimator=est, free=names)
             return res, time.perf_counter() - t

@@ -29,8 +29,6 @@ import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
 
 import jaxship as js  # noqa: E402
-from jaxship._batch import simulate_batch  # noqa: E402
-from jaxship._vessel.mariner import mariner  # noqa: E402
 
 
 DEG = np.pi / 180
@@ -47,7 +45,7 @@ def with_params(vessel, theta):
 
 
 def main(args):
-    vessel = mariner()
+    vessel = js.vessel("mariner")
     theta0 = jnp.array([getattr(vessel, k) for k in PARAMS])
     man = js.ZigZag(20 * DEG, 20 * DEG, duration=600.0, dt=0.1)
     x0 = js.straight_run(vessel)
@@ -67,7 +65,7 @@ def main(args):
     batched = with_params(vessel, jnp.asarray(thetas).T)  # 0-d leaves stay shared
 
     def fd_batch():
-        return simulate_batch(batched, man, x0, in_axes=(0, None, None, None))
+        return js.simulate_batch(batched, man, x0, in_axes=(0, None, None, None))
 
     functions = {
         "one simulation": lambda: sim(theta0),

@@ -8,11 +8,11 @@ about 10.3 rps at model scale), as in the tests, and (b) at the MMG model's own
 self-propulsion rate for that speed (11.85 rps: the MMG parameter set has a 0.216 m
 propeller, the tests used the 0.204 m INSEAN stock propeller).
 
-Definitions (both sides alike, `jaxship._indices`): overshoot k = largest heading
-excursion beyond the switch heading after rudder execute k + 1, relative to the
-heading at the first execute; advance, transfer and tactical diameter from the midship
-track rotated into the initial-course frame at the rudder execute, interpolated at 90
-and 180 deg heading change, in units of L_pp.
+Definitions (both sides alike, `jaxship.zigzag_indices` and `jaxship.turning_indices`):
+overshoot k = largest heading excursion beyond the switch heading after rudder execute
+k + 1, relative to the heading at the first execute; advance, transfer and tactical
+diameter from the midship track rotated into the initial-course frame at the rudder
+execute, interpolated at 90 and 180 deg heading change, in units of L_pp.
 
 Run: `python benchmarks/kvlcc2_simman.py [--data DIR]`; prints a markdown table.
 """
@@ -29,9 +29,6 @@ jax.config.update("jax_enable_x64", True)
 import numpy as np  # noqa: E402
 
 import jaxship as js  # noqa: E402
-from jaxship._data import read_hsva_kvlcc2, read_marin_kvlcc2, shared_data_dir  # noqa: E402
-from jaxship._indices import turning_indices, zigzag_indices  # noqa: E402
-from jaxship._vessel.mmg import kvlcc2  # noqa: E402
 
 
 LENGTH = 7.0  # L_pp of the model [m]
@@ -65,7 +62,7 @@ def measured_zigzag(exp, switch_deg):
     # no rudder history given: with a neutral-helm offset (MARIN: about 0.8 deg) the
     # rudder still has the approach sign at the execute; the side is then taken from the
     # heading, which first passes the switch angle on the side the rudder turns to
-    z = zigzag_indices(t=exp.t, psi=exp.psi, heading_switch=np.deg2rad(switch_deg),
+    z = js.zigzag_indices(t=exp.t, psi=exp.psi, heading_switch=np.deg2rad(switch_deg),
                        execute_times=[float(exp.t[k])])
     if z.side != side:
         raise ValueError(f"{exp.name}: heading and rudder disagree about the first side")
@@ -78,7 +75,7 @@ def simulate_zigzag(vessel, angle_deg, switch_deg, side, speed, n, duration=ZIGZ
     manoeuvre = js.ZigZag(side * np.deg2rad(angle_deg), np.deg2rad(switch_deg),
                           duration=duration, dt=DT, n=n)
     traj = js.simulate(vessel, manoeuvre, x0, simulator=js.Simulator(substeps=1))
-    z = zigzag_indices(traj, np.deg2rad(switch_deg))
+    z = js.zigzag_indices(traj, np.deg2rad(switch_deg))
     return np.rad2deg(z.overshoots)
 
 
@@ -91,7 +88,7 @@ def measured_turn(exp):
     track 2-4 % smaller than the printed positions during the turn, so they are not
     used.)"""
     k = execute_index(exp.delta)
-    ti = turning_indices(t=exp.t, x=exp.x, y=exp.y, psi=exp.psi, u=exp.u, v=exp.v, r=exp.r,
+    ti = js.turning_indices(t=exp.t, x=exp.x, y=exp.y, psi=exp.psi, u=exp.u, v=exp.v, r=exp.r,
                          execute_time=float(exp.t[k]))
     indices = np.array([ti.advance, ti.transfer, ti.tactical_diameter]) / LENGTH
     return indices, ti.side, float(np.hypot(exp.u[k], exp.v[k])), float(exp.n[k])
@@ -102,7 +99,7 @@ def simulate_turn(vessel, side, speed, n, angle_deg=35.0, duration=TURN_DURATION
     x0 = js.straight_state(speed, n)
     traj = js.simulate(vessel, js.Turn(side * np.deg2rad(angle_deg), duration=duration, dt=DT, n=n),
                        x0, simulator=js.Simulator(substeps=1))
-    ti = turning_indices(traj)
+    ti = js.turning_indices(traj)
     return np.array([ti.advance, ti.transfer, ti.tactical_diameter]) / LENGTH
 
 
@@ -112,7 +109,7 @@ def self_propulsion_n(vessel, speed):
 
 def compare_hsva(path, vessel, *, self_propulsion=True):
     """Rows (run, quantity, measured, simulated at measured n, simulated at self-propulsion n)."""
-    exp = read_hsva_kvlcc2(path)
+    exp = js.read_hsva_kvlcc2(path)
     angle, switch = zigzag_parameters(exp.name)
     measured, side, speed, n = measured_zigzag(exp, switch)
     sim = simulate_zigzag(vessel, angle, switch, side, speed, n)
@@ -127,7 +124,7 @@ def compare_hsva(path, vessel, *, self_propulsion=True):
 
 
 def compare_marin_turn(path, vessel, *, self_propulsion=True):
-    exp = read_marin_kvlcc2(path, model_scale=True)
+    exp = js.read_marin_kvlcc2(path, model_scale=True)
     measured, side, speed, n = measured_turn(exp)
     sim = simulate_turn(vessel, side, speed, n)
     sim_sp = (simulate_turn(vessel, side, speed, self_propulsion_n(vessel, speed))
@@ -139,7 +136,7 @@ def compare_marin_turn(path, vessel, *, self_propulsion=True):
 
 
 def compare_marin_zigzag(path, vessel, *, self_propulsion=True):
-    exp = read_marin_kvlcc2(path, model_scale=True)
+    exp = js.read_marin_kvlcc2(path, model_scale=True)
     angle = abs(float(path.stem.split("_")[-2]))
     measured, side, speed, n = measured_zigzag(exp, angle)
     sim = simulate_zigzag(vessel, angle, angle, side, speed, n)
@@ -175,10 +172,10 @@ def main():
     parser.add_argument("--data", type=Path, default=None,
                         help="measured-data folder (default: jaxship's shared data folder)")
     args = parser.parse_args()
-    data = args.data or shared_data_dir()
+    data = args.data or js.shared_data_dir()
     if data is None or not (data / "kvlcc2_simman2008_hsva").is_dir():
         raise SystemExit("measured data not found: give --data DIR (the shared/data folder)")
-    vessel = kvlcc2()
+    vessel = js.vessel("kvlcc2")
     rows = []
     for path in sorted((data / "kvlcc2_simman2008_hsva").glob("*.dat")):
         rows += compare_hsva(path, vessel)

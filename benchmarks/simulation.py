@@ -67,8 +67,6 @@ from jax.sharding import Mesh, PartitionSpec as P  # noqa: E402
 from scipy.integrate import solve_ivp  # noqa: E402
 
 import jaxship as js  # noqa: E402
-from jaxship._batch import simulate_batch, straight_run_batch  # noqa: E402
-from jaxship._vessel.catalogue import get_vessel  # noqa: E402
 
 
 DEG = math.pi / 180
@@ -166,7 +164,7 @@ def ross_params(vessel) -> dict:
 
 
 def ross_rhs(xp, p, y, dc, nc):
-    """Thesis vessel (Ross-type model of `jaxship._vessel.ross`): state u v r x y psi delta n."""
+    """Thesis vessel (Ross-type model of `jaxship.RossVessel`): state u v r x y psi delta n."""
     u, v, r, psi, d, n = y[0], y[1], y[2], y[5], y[6], y[7]
     m, xg = p["mass"], p["xg"]
     au, av, ar = xp.abs(u), xp.abs(v), xp.abs(r)
@@ -213,7 +211,7 @@ class Case:
 
     def __init__(self, name, duration):
         self.name = name
-        self.vessel = get_vessel(name)
+        self.vessel = js.vessel(name)
         self.duration = duration
         self.num = int(round(duration / DT)) + 1
         if name == "mariner":
@@ -238,7 +236,7 @@ class Case:
         """Initial straight runs: speeds and rates (numpy arrays)."""
         if self.name == "mariner":
             return np.asarray(second, float), np.zeros_like(second)
-        x = straight_run_batch(self.vessel, n=np.asarray(second, float))
+        x = js.straight_run_batch(self.vessel, n=np.asarray(second, float))
         return np.asarray(x.u), np.asarray(x.n)
 
     def jaxship_args(self, angles, second):
@@ -458,12 +456,12 @@ def run_case(case, args, devices, rows):
         hp, axes, hy0, ha, hn = case.hand_args(angles, second)
         hand_b = hand_batch_fn(case, axes, devices)
         fs = {
-            "jaxship": lambda: simulate_batch(*jargs, in_axes=in_axes, devices=devices),
+            "jaxship": lambda: js.simulate_batch(*jargs, in_axes=in_axes, devices=devices),
             "hand": lambda: hand_b(hp, hy0, ha, hn),
         }
         tb = best_of(fs, max(2, args.repeats // (2 if size > 64 else 1)))
         # check: the batch equals the hand scan run by run
-        traj = simulate_batch(*jargs, in_axes=in_axes, devices=devices)
+        traj = js.simulate_batch(*jargs, in_axes=in_axes, devices=devices)
         hand_psi = np.asarray(hand_b(hp, hy0, ha, hn)[5])
         diff = np.max(np.abs(np.asarray(traj.state.psi) - hand_psi))
         # SciPy: a subset spread over the batch, per-run time extrapolated

@@ -61,8 +61,6 @@ import equinox as eqx  # noqa: E402
 import numpy as np  # noqa: E402
 
 import jaxship as js  # noqa: E402
-from jaxship._batch import batch_turning_indices, simulate_batch, straight_run_batch  # noqa: E402
-from jaxship._vessel.catalogue import get_vessel  # noqa: E402
 
 
 DEG = np.pi / 180
@@ -82,7 +80,7 @@ def peak_rss_mb() -> float:
 def build(args, dt):
     """The batched vessel, manoeuvre and initial state of the whole grid."""
     setup = SETUP[args.vessel]
-    vessel = get_vessel(args.vessel)
+    vessel = js.vessel(args.vessel)
     angles = np.linspace(10, 35, args.angles) * DEG
     rng = np.random.default_rng(0)
     factors = rng.uniform(0.8, 1.2, (args.perturbations, len(setup["fields"])))
@@ -92,7 +90,7 @@ def build(args, dt):
     a, k, j = a.ravel(), k.ravel(), j.ravel()
     if args.vessel == "thesis":
         rates = np.linspace(400, 600, args.rates) / 60  # [rev/s]
-        starts = straight_run_batch(vessel, n=rates)
+        starts = js.straight_run_batch(vessel, n=rates)
         u0, n0 = np.asarray(starts.u)[k], rates[k]
         second = rates[k] * 60
     else:
@@ -127,9 +125,9 @@ def main(args):
     print(f"peak memory before the sweep: {peak_rss_mb():.0f} MiB")
 
     def sweep():
-        return simulate_batch(
+        return js.simulate_batch(
             vessel, manoeuvre, x0, simulator=simulator, in_axes=(0, 0, 0, None),
-            output=batch_turning_indices, chunk_size=args.chunk_size,
+            output=js.batch_turning_indices, chunk_size=args.chunk_size,
         )
 
     start = time.perf_counter()
@@ -148,7 +146,7 @@ def main(args):
           f"({runs * (manoeuvre.num_samples - 1) * args.substeps / best / 1e6:.2f} M RK4 "
           f"steps/s); peak memory (maxrss): {peak_rss_mb():.0f} MiB")
     print(f"runs that did not reach 180 deg: {missing} of {runs}")
-    length = float(get_vessel(args.vessel).length)
+    length = float(js.vessel(args.vessel).length)
     for name in ("advance", "transfer", "tactical_diameter"):
         v = out[name] / length
         print(f"  {name} / L: min {np.nanmin(v):.2f}, median {np.nanmedian(v):.2f}, "
@@ -158,12 +156,12 @@ def main(args):
     # samples and RK4 steps 10x finer (the indices interpolate between samples)
     pick = np.unique(np.linspace(0, runs - 1, 8).astype(int))
     take = lambda tree: jax.tree.map(lambda a: a[pick] if np.ndim(a) else a, tree)
-    coarse = simulate_batch(take(vessel), take(manoeuvre), take(x0), simulator=simulator,
-                            in_axes=(0, 0, 0, None), output=batch_turning_indices)
+    coarse = js.simulate_batch(take(vessel), take(manoeuvre), take(x0), simulator=simulator,
+                            in_axes=(0, 0, 0, None), output=js.batch_turning_indices)
     fine_dt = args.dt / 10
     v_f, m_f, x_f, _ = build(args, fine_dt)
-    fine = simulate_batch(take(v_f), take(m_f), take(x_f), simulator=js.Simulator(substeps=1),
-                          in_axes=(0, 0, 0, None), output=batch_turning_indices)
+    fine = js.simulate_batch(take(v_f), take(m_f), take(x_f), simulator=js.Simulator(substeps=1),
+                          in_axes=(0, 0, 0, None), output=js.batch_turning_indices)
     print(f"\naccuracy on {pick.size} runs of the grid against dt = {fine_dt:g} s "
           f"(one RK4 step per sample), max relative difference:")
     for name in ("advance", "transfer", "tactical_diameter", "time_to_180"):

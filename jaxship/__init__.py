@@ -2,20 +2,23 @@
 
 from ._actuators import RudderServo as RudderServo, Shaft as Shaft
 from ._batch import simulate_batch as simulate_batch, stack as stack
-from ._data import (
-    Dataset as Dataset,
-    Experiment as Experiment,
-    read_esso_osaka as read_esso_osaka,
-    read_hsva_kvlcc2 as read_hsva_kvlcc2,
-    read_marin_kvlcc2 as read_marin_kvlcc2,
-    read_measured as read_measured,
-    read_trial_csv as read_trial_csv,
-    shared_data_dir as shared_data_dir,
-    write_trial_csv as write_trial_csv,
-)
+from ._covariance import parameter_report as parameter_report
+from ._data import Dataset as Dataset, Experiment as Experiment
 from ._design import (
     excitation_order as excitation_order,
     fisher_information as fisher_information,
+)
+from ._effects import (
+    AbstractEffect as AbstractEffect,
+    AugmentedSteering as AugmentedSteering,
+    AugmentedVessel as AugmentedVessel,
+    HeadingSensorBias as HeadingSensorBias,
+    RecordedDisturbance as RecordedDisturbance,
+    RudderOffset as RudderOffset,
+    SwayForceBias as SwayForceBias,
+    YawMomentBias as YawMomentBias,
+    YawRateSensorBias as YawRateSensorBias,
+    augment as augment,
 )
 from ._environment import Current as Current, Environment as Environment, Wind as Wind
 from ._estimate._armax import ARMAXResult as ARMAXResult, fit_armax as fit_armax
@@ -28,20 +31,19 @@ from ._estimate._fit import (
     fit as fit,
 )
 from ._estimate._kalman import (
-    KalmanFitResult as KalmanFitResult,
     KalmanOutput as KalmanOutput,
     SmoothedStates as SmoothedStates,
     ekf as ekf,
-    fit_ml as fit_ml,
     rts_smoother as rts_smoother,
     smooth_states as smooth_states,
 )
-from ._estimate._linear import initial_estimate as initial_estimate
+from ._estimate._likelihood import KalmanFitResult as KalmanFitResult, fit_ml as fit_ml
+from ._estimate._linear import (
+    initial_estimate as initial_estimate,
+    ross_initial_estimate as ross_initial_estimate,
+)
 from ._estimate._lm import LevenbergMarquardt as LevenbergMarquardt
-from ._estimate._params import Free as Free, param as param
 from ._estimate._predict import predict as predict
-from ._estimate._vessel_fit import default_free as default_free
-from ._identify import IdentificationResult as IdentificationResult, identify as identify
 from ._indices import (
     format_table as format_table,
     imo_criteria as imo_criteria,
@@ -70,7 +72,21 @@ from ._manoeuvres import (
     spiral as spiral,
     thesis_manoeuvre as thesis_manoeuvre,
 )
-from ._simulate import Simulator as Simulator, simulate as simulate
+from ._params import Free as Free, default_free as default_free, param as param
+from ._readers import (
+    read_esso_osaka as read_esso_osaka,
+    read_hsva_kvlcc2 as read_hsva_kvlcc2,
+    read_marin_kvlcc2 as read_marin_kvlcc2,
+    read_measured as read_measured,
+    read_trial_csv as read_trial_csv,
+    shared_data_dir as shared_data_dir,
+    write_trial_csv as write_trial_csv,
+)
+from ._simulate import RK4 as RK4, Simulator as Simulator, simulate as simulate
+from ._simulate_steering import (
+    SteeringTrajectory as SteeringTrajectory,
+    simulate_steering as simulate_steering,
+)
 from ._state import (
     Command as Command,
     ShipState as ShipState,
@@ -86,15 +102,12 @@ from ._steering import (
     NonlinearNomoto as NonlinearNomoto,
     NorrbinCrossFlow as NorrbinCrossFlow,
     RossAutopilot as RossAutopilot,
-    SteeringTrajectory as SteeringTrajectory,
-    simulate_steering as simulate_steering,
 )
 from ._steering.nonlinear_nomoto2 import NonlinearNomoto2 as NonlinearNomoto2
 from ._validate import (
     ValidationReport as ValidationReport,
     final_prediction_error as final_prediction_error,
     fit_percent as fit_percent,
-    parameter_report as parameter_report,
     validate as validate,
 )
 from ._vessel._base import (
@@ -112,3 +125,29 @@ from ._vessel.sway_yaw import SwayYawVessel as SwayYawVessel
 
 
 __version__ = "0.1.0"
+
+# study and application helpers, added for jaxship.studies and the notebooks
+from ._armax_model import ARMAXModel as ARMAXModel
+from ._batch import (
+    batch_turning_indices as batch_turning_indices,
+    straight_run_batch as straight_run_batch,
+)
+from ._simulate_steering import steer_manoeuvre as steer_manoeuvre
+from ._steering.ross import (
+    ROSS_FREE as ROSS_FREE,
+    SPEED_RUDDER as SPEED_RUDDER,
+)
+from ._trials import (
+    initial_state as initial_state,
+    run_trial as run_trial,
+    trial_indices as trial_indices,
+)
+
+# (the application layer, .identification, imports jaxship itself: keep it last)
+from .identification import (
+    IdentificationResult as IdentificationResult,
+    identify as identify,
+)
+
+
+vessel = get_vessel  # js.vessel("mariner"): a fresh instance of a preset (VESSELS)

@@ -118,8 +118,9 @@ def simulate_batch(
     mesh = batch_mesh(devices)
     b_dyn, b_static = eqx.partition(batched, eqx.is_array)
     s_dyn, s_static = eqx.partition(shared, eqx.is_array)
+    steps = simulator.steps_per_sample(manoeuvre.dt)
     return _batched(
-        b_dyn, s_dyn, b_static, s_static, simulator, output, wind, size, mesh, chunk_size
+        b_dyn, s_dyn, b_static, s_static, simulator, steps, output, wind, size, mesh, chunk_size
     )
 
 
@@ -137,11 +138,12 @@ def _resolve_axes(prefix, tree, name):
 
 
 @eqx.filter_jit
-def _batched(b_dyn, s_dyn, b_static, s_static, simulator, output, wind, size, mesh, chunk_size):
+def _batched(b_dyn, s_dyn, b_static, s_static, simulator, steps, output, wind, size, mesh,
+             chunk_size):
     def one(b, s):
         vessel, manoeuvre, x0, environment = eqx.combine(b, b_static, s, s_static)
         traj = _simulate.__wrapped__(
-            vessel, manoeuvre, x0, environment, simulator, wind=wind, per_field=True
+            vessel, manoeuvre, x0, environment, simulator, steps, wind=wind, per_field=True
         )
         return traj if output is None else output(traj)
 

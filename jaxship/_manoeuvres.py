@@ -1,9 +1,12 @@
 """Standard trials as rudder/propeller command generators.
 
-A manoeuvre is evaluated at the sample times: `command(t, state, memory)` sees the
-sampled state (closed-loop logic such as zig-zag switching or an autopilot) and
-returns the command held until the next sample. Angles are radians and propeller
-rates rev/s; degrees and rpm belong to the CLI and the file formats.
+A manoeuvre is a controller (its `init` and `command`) plus a duration and an output
+sampling. The simulator calls `command(t, state, memory, h)` at the start of every
+control step of `h` seconds (at most `Simulator.max_step`, 0.1 s by default, whatever
+the output interval `dt`): closed-loop logic such as zig-zag switching or a heading
+controller sees the state there and returns the command for the step; its memory
+(an integrator, the zig-zag side) travels in the simulated state. Angles are radians
+and propeller rates rev/s; degrees and rpm belong to the CLI and the file formats.
 """
 
 import abc
@@ -42,9 +45,10 @@ class AbstractManoeuvre(eqx.Module):
         """Controller memory at the first sample: initial rpm, initial heading, own state."""
         return (x0.n, x0.psi, self.init_memory(x0))
 
-    def command(self, t, state, memory):
+    def command(self, t, state, memory, h):
+        """The command for the control step `[t, t + h]` and the new memory."""
         n0, psi0, own = memory
-        delta, own = self.rudder(t - self.start, state, psi0, own)
+        delta, own = self.rudder(t - self.start, state, psi0, own, h)
         n = n0 if self.n is None else self.n
         return Command(delta, self.propeller(t - self.start, n)), (n0, psi0, own)
 
@@ -58,8 +62,9 @@ class AbstractManoeuvre(eqx.Module):
         """Initial controller memory (a pytree; `None` for open-loop manoeuvres)."""
 
     @abc.abstractmethod
-    def rudder(self, tau, state, psi0, memory):
-        """Rudder command [rad] at `tau` seconds after the start, and the new memory."""
+    def rudder(self, tau, state, psi0, memory, h):
+        """Rudder command [rad] at `tau` seconds after the start, held for the control
+        step of `h` seconds, and the new memory."""
 
 
 def _step(tau, execute):
@@ -80,7 +85,7 @@ class Turn(AbstractManoeuvre):
     def init_memory(self, x0):
         return None
 
-    def rudder(self, tau, state, psi0, memory):
+    def rudder(self, tau, state, psi0, memory, h):
         return self.angle * _step(tau, self.execute), memory
 
 
@@ -89,7 +94,10 @@ class ZigZag(AbstractManoeuvre):
 
     The rudder goes to `angle` at `execute` (negative `angle`: port first) and is
     reversed whenever the heading change from the initial heading passes
-    `heading` on the side the rudder is turning the ship to.
+    `heading` on the side the rudder is turning the ship to: at the control step
+    nearest to the crossing (`switch_at="nearest"`, within half a step, 0.05 s by
+    default) or at the first control step after it (`"after"`, as MSS `zigzag.m` and
+    sampled-logic implementations do, late by up to one step).
     """
 
     angle: ArrayLike  # delta_0 [rad], sign gives the first side
@@ -100,12 +108,19 @@ class ZigZag(AbstractManoeuvre):
     start: ArrayLike = 0.0
     n: ArrayLike | None = None
     num_samples: int | None = eqx.field(static=True, default=None)
+    switch_at: str = eqx.field(static=True, default="nearest")
+
+    def __check_init__(self):
+        if self.switch_at not in ("nearest", "after"):
+            raise ValueError(f"`switch_at` must be 'nearest' or 'after', got {self.switch_at!r}.")
 
     def init_memory(self, x0):
         return jnp.sign(jnp.asarray(self.angle, dtype=float))
 
-    def rudder(self, tau, state, psi0, side):
+    def rudder(self, tau, state, psi0, side, h):
         change = state.psi - psi0
+        if self.switch_at == "nearest":  # the heading change half a control step ahead
+            change = change + 0.5 * h * state.r
         side = jnp.where((side > 0) & (change >= self.heading), -1.0, side)
         side = jnp.where((side < 0) & (change <= -self.heading), 1.0, side)
         side = jnp.where(tau >= self.execute, side, jnp.sign(self.angle))
@@ -131,7 +146,7 @@ class Schedule(AbstractManoeuvre):
     def init_memory(self, x0):
         return None
 
-    def rudder(self, tau, state, psi0, memory):
+    def rudder(self, tau, state, psi0, memory, h):
         times, angles = jnp.asarray(self.times), jnp.asarray(self.angles)
         # right-continuous interpolation so that a step at t_k is already taken at t_k
         k = jnp.clip(jnp.searchsorted(times, tau, side="right") - 1, 0, times.shape[0] - 2)
@@ -242,7 +257,7 @@ class Stop(AbstractManoeuvre):
     def init_memory(self, x0):
         return None
 
-    def rudder(self, tau, state, psi0, memory):
+    def rudder(self, tau, state, psi0, memory, h):
         return jnp.zeros_like(tau), memory
 
     def propeller(self, tau, n):
@@ -275,10 +290,10 @@ class ReverseSpiral(AbstractManoeuvre):
     def init_memory(self, x0):
         return jnp.zeros_like(jnp.asarray(x0.r, dtype=float))
 
-    def rudder(self, tau, state, psi0, integral):
+    def rudder(self, tau, state, psi0, integral, h):
         error = self.reference(tau) - state.r
         limit = self.max_angle / jnp.maximum(self.ki, 1e-12)
-        integral = jnp.clip(integral + error * self.dt, -limit, limit)
+        integral = jnp.clip(integral + error * h, -limit, limit)
         delta = jnp.clip(self.kp * error + self.ki * integral, -self.max_angle, self.max_angle)
         return delta, integral
 
@@ -310,19 +325,22 @@ class HeadingAutopilot(AbstractManoeuvre):
         phase = jnp.floor(2 * tau / self.period) % 2
         return psi0 + self.amplitude * (1 - 2 * phase)
 
-    def rudder(self, tau, state, psi0, integral):
+    def rudder(self, tau, state, psi0, integral, h):
         error = ssa(self.reference(tau, psi0) - state.psi)
         limit = self.max_angle / jnp.maximum(self.ki, 1e-12)
-        integral = jnp.clip(integral + error * self.dt, -limit, limit)
+        integral = jnp.clip(integral + error * h, -limit, limit)
         delta = self.kp * error + self.ki * integral - self.kd * state.r
         return jnp.clip(delta, -self.max_angle, self.max_angle), integral
 
 
 class Replay(AbstractManoeuvre):
-    """Open-loop replay of recorded rudder and propeller commands (zero-order hold).
+    """Open-loop replay of recorded rudder and propeller commands.
 
-    Used to drive a model with measured inputs (estimation replays inputs even for
-    zig-zags). `delta` [rad] and `n` [rev/s] are sampled every `dt` from `start`.
+    `delta_record` [rad] and `n_record` [rev/s] are sampled every `dt` from `start`.
+    Between samples each channel is held (`"zoh"`, zero-order hold: right for a
+    commanded, piecewise-constant signal) or interpolated linearly (`"foh"`,
+    first-order hold: right for a measured, continuous signal such as a logged rudder
+    angle or shaft speed), as MATLAB's `InterSample`. Commands default to `"zoh"`.
     """
 
     delta_record: ArrayLike
@@ -332,11 +350,17 @@ class Replay(AbstractManoeuvre):
     duration: ArrayLike | None = None
     n: None = None
     num_samples: int | None = eqx.field(static=True, default=None)
+    delta_hold: str = eqx.field(static=True, default="zoh")
+    n_hold: str = eqx.field(static=True, default="zoh")
 
     def __post_init__(self):
         length = np.shape(self.delta_record)[0]
         if np.shape(self.n_record)[0] != length:
             raise ValueError("`delta_record` and `n_record` must have the same length.")
+        for name in ("delta_hold", "n_hold"):
+            if getattr(self, name) not in HOLDS:
+                raise ValueError(f"`{name}` must be one of {HOLDS}, got "
+                                 f"{getattr(self, name)!r}.")
         if self.duration is None:
             self.duration = (length - 1) * float(self.dt)
         if self.num_samples is None:
@@ -345,12 +369,29 @@ class Replay(AbstractManoeuvre):
     def init_memory(self, x0):
         return None
 
-    def _index(self, tau):
-        last = np.shape(self.delta_record)[0] - 1
-        return jnp.clip(jnp.round(tau / self.dt).astype(int), 0, last)
+    def rudder(self, tau, state, psi0, memory, h):
+        return interpolate(self.delta_record, self.dt, tau, self.delta_hold)[0], memory
 
-    def rudder(self, tau, state, psi0, memory):
-        return jnp.asarray(self.delta_record)[self._index(tau)], memory
+    def command(self, t, state, memory, h):
+        tau = t - self.start
+        delta, delta_rate = interpolate(self.delta_record, self.dt, tau, self.delta_hold)
+        n, n_rate = interpolate(self.n_record, self.dt, tau, self.n_hold)
+        return Command(delta, n, delta_rate, n_rate), memory
 
-    def propeller(self, tau, n):
-        return jnp.asarray(self.n_record)[self._index(tau)]
+
+HOLDS = ("zoh", "foh")
+
+
+def interpolate(record, dt, tau, hold: str):
+    """Value and slope of a record sampled every `dt` at `tau` seconds after its first
+    sample, held (`"zoh"`) or linearly interpolated (`"foh"`) between samples; the
+    last sample holds beyond the end."""
+    record = jnp.asarray(record)
+    last = record.shape[0] - 1
+    position = tau / dt
+    k = jnp.clip(jnp.floor(position + 1e-9).astype(int), 0, last)
+    if hold == "zoh":
+        return record[k], jnp.zeros_like(record[k])
+    k1 = jnp.minimum(k + 1, last)
+    slope = (record[k1] - record[k]) / dt
+    return record[k] + slope * jnp.clip(tau - k * dt, 0.0, None), slope

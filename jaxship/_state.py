@@ -5,6 +5,8 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
+from ._frames import trajectory_to_dataframe
+
 
 class ShipState(eqx.Module):
     """Horizontal-plane state of a vessel, Fossen (2021) notation.
@@ -24,6 +26,22 @@ class ShipState(eqx.Module):
     n: ArrayLike  # actual propeller rate [rev/s]
 
 
+# The order of `ShipState.to_vector`: the state travels through the integrator as one
+# vector, far fewer (and larger) XLA operations per step than a pytree of eight scalars,
+# which is what makes the fast path fast on CPU (see benchmarks/README.md).
+STATE_FIELDS = ("u", "v", "r", "x", "y", "psi", "delta", "n")
+
+
+def to_vector(state: "ShipState"):
+    """The state as one vector in the order of `STATE_FIELDS`."""
+    return jnp.stack([jnp.asarray(getattr(state, k), dtype=float) for k in STATE_FIELDS])
+
+
+def from_vector(y) -> "ShipState":
+    """The inverse of `to_vector` (also for arrays with the fields on the last axis)."""
+    return ShipState(*(y[..., i] for i in range(len(STATE_FIELDS))))
+
+
 def straight_state(u: ArrayLike, n: ArrayLike = 0.0, psi: ArrayLike = 0.0) -> ShipState:
     """Steady straight-ahead state at surge speed `u` [m/s] and propeller rate `n` [rev/s]."""
     zero = jnp.zeros_like(jnp.asarray(u, dtype=float))
@@ -40,10 +58,21 @@ def straight_state(u: ArrayLike, n: ArrayLike = 0.0, psi: ArrayLike = 0.0) -> Sh
 
 
 class Command(eqx.Module):
-    """What the helm and engine are asked for, held constant over one sample interval."""
+    """What the helm and engine are asked for over one control step, from its start:
+    $\\delta_c(t_k + \\tau) = \\delta + \\dot\\delta\\,\\tau$, likewise $n_c$. The slopes are
+    zero for a held command (zero-order hold) and the record's slope for a replayed
+    signal interpolated between samples (first-order hold)."""
 
     delta: ArrayLike  # commanded rudder angle [rad]
     n: ArrayLike  # commanded propeller rate [rev/s]
+    delta_rate: ArrayLike | None = None  # slope of the rudder command [rad/s]; None: 0
+    n_rate: ArrayLike | None = None  # slope of the propeller command [rev/s^2]; None: 0
+
+    def at(self, tau: ArrayLike) -> "Command":
+        """The command `tau` seconds after the start of the step (slopes kept)."""
+        ramp = lambda value, rate: value if rate is None else value + rate * tau
+        return Command(ramp(self.delta, self.delta_rate), ramp(self.n, self.n_rate),
+                       self.delta_rate, self.n_rate)
 
 
 def tree_axpy(a: ArrayLike, x, y):
@@ -65,6 +94,11 @@ class Trajectory(eqx.Module):
     command: Command
     valid: Array
     success: Array
+
+    def to_dataframe(self):
+        """One row per valid sample (pandas, an optional dependency): t, the state, and
+        the commands `delta_c`, `n_c`. Index one run of a batch first."""
+        return trajectory_to_dataframe(self)
 
     @property
     def speed(self) -> Array:

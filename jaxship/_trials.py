@@ -6,12 +6,18 @@ spec suits a 4 m model and a 160 m ship.
 """
 
 import dataclasses
+import json
+import pathlib
 
+import matplotlib.pyplot as plt
 import numpy as np
 
-from . import _manoeuvres as man
+from . import _indices as ix, _manoeuvres as man
+from ._readers import write_trial_csv
 from ._simulate import Simulator, simulate
+from ._state import straight_state
 from ._vessel._base import straight_run, surge_force
+from .plotting import plot_trajectory
 
 
 SPEC_HELP = (
@@ -124,8 +130,6 @@ def initial_state(vessel, *, speed=None, rpm=None):
     """Straight-run approach at `speed` [m/s] and/or `rpm`; nominal if neither is given."""
     n = None if rpm is None else rpm / 60.0
     if speed is not None and n is not None:
-        from ._state import straight_state
-
         return straight_state(speed, n)
     return straight_run(vessel, speed=speed, n=n)
 
@@ -154,8 +158,6 @@ def run_trial(vessel, spec, *, speed=None, rpm=None, duration=None, dt=None, sub
 
 def trial_indices(spec, manoeuvre, traj) -> dict:
     """The indices of the trial `spec` as a JSON-ready dict (display units in the names)."""
-    from . import _indices as ix
-
     spec = TrialSpec.parse(spec) if isinstance(spec, str) else spec
     base = {
         "max_yaw_rate_deg_s": float(np.rad2deg(np.max(np.abs(traj.state.r)))),
@@ -184,14 +186,6 @@ def simulate_to_folder(
     vessel, spec, out, *, speed=None, rpm=None, duration=None, dt=None, title=""
 ) -> dict:
     """Run `spec` on `vessel` and write `trial.csv`, `indices.json` and `trial.png` to `out`."""
-    import json
-    import pathlib
-
-    import matplotlib.pyplot as plt
-
-    from ._data import write_trial_csv
-    from .plotting import plot_trajectory
-
     manoeuvre, traj = run_trial(vessel, spec, speed=speed, rpm=rpm, duration=duration, dt=dt)
     if not bool(traj.success):
         raise ValueError(

@@ -4,6 +4,20 @@ import argparse
 import json
 import pathlib
 import sys
+import warnings
+
+import jax
+import matplotlib
+from tqdm.auto import tqdm
+
+
+matplotlib.use("Agg")  # the command writes files; it never opens a window
+
+from ._trials import simulate_to_folder  # noqa: E402
+from ._vessel.catalogue import VESSELS, get_vessel  # noqa: E402
+from .identification import MODELS, get_model_entry, identify, read_experiments  # noqa: E402
+from .plotting import save_identification_figures  # noqa: E402
+from .studies.reproduce import reproduce  # noqa: E402
 
 
 def main(argv=None) -> int:
@@ -24,8 +38,6 @@ def main(argv=None) -> int:
     rep = sub.add_parser("reproduce", help="the thesis pipeline on the built-in thesis vessel")
     rep.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/reproduce"))
     rep.add_argument("--quick", action="store_true", help="fewer trials (for smoke tests)")
-
-    from ._identify import MODELS
 
     ident = sub.add_parser(
         "identify", help="estimate a steering model from measured trials and validate it",
@@ -59,12 +71,7 @@ def main(argv=None) -> int:
     ident.add_argument("--quiet", action="store_true", help="no progress bar")
 
     args = parser.parse_args(argv)
-    import jax
-
     jax.config.update("jax_enable_x64", True)
-    import matplotlib
-
-    matplotlib.use("Agg")
     try:
         commands = {"vessels": _vessels, "simulate": _simulate, "reproduce": _reproduce,
                     "identify": _identify}
@@ -75,8 +82,6 @@ def main(argv=None) -> int:
 
 
 def _vessels(args) -> int:
-    from ._vessel.catalogue import VESSELS
-
     width = max(map(len, VESSELS))
     for name, entry in VESSELS.items():
         print(f"{name:<{width}}  {entry.description}")
@@ -84,9 +89,6 @@ def _vessels(args) -> int:
 
 
 def _simulate(args) -> int:
-    from ._trials import simulate_to_folder
-    from ._vessel.catalogue import get_vessel
-
     vessel = get_vessel(args.vessel)
     indices = simulate_to_folder(
         vessel,
@@ -104,8 +106,6 @@ def _simulate(args) -> int:
 
 
 def _reproduce(args) -> int:
-    from ._reproduce import reproduce
-
     reproduce(args.out, quick=args.quick, progress=True)
     return 0
 
@@ -129,8 +129,6 @@ class _ProgressBar:
     def __call__(self, event):
         if not self.enabled:
             return
-        from tqdm.auto import tqdm
-
         if event.stage != "fit":
             if not event.done:
                 tqdm.write(f"jaxship: {event.message} ...", file=sys.stderr)
@@ -150,10 +148,6 @@ class _ProgressBar:
 
 
 def _identify(args) -> int:
-    import warnings
-
-    from ._identify import get_model_entry, identify, read_experiments
-
     get_model_entry(args.model)  # unknown models fail before reading any file
     horizon = _horizon(args.horizon)
     train = read_experiments(args.train, role="training")
@@ -169,8 +163,6 @@ def _identify(args) -> int:
     (args.out / "result.json").write_text(result.to_json() + "\n")
     written = ["result.json"]
     if not args.no_figures:
-        from .plotting import save_identification_figures
-
         paths = save_identification_figures(result, args.out / "figures")
         written.append(f"figures/ ({len(paths)} figures)")
     print(result.summary())

@@ -1,5 +1,7 @@
 """Matplotlib figures of simulated and measured trials (degrees and rpm on the axes)."""
 
+from pathlib import Path
+
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -68,7 +70,7 @@ def plot_comparison(assessment, index: int = 0, *, title: str = ""):
 
     **Arguments:**
 
-    - `assessment`: a `jaxship._identify.Assessment` (or anything with `data`
+    - `assessment`: a `jaxship.identification.Assessment` (or anything with `data`
       (a `Dataset`), `rudder`, `predictions` {channel: (E, N)}, `mask` (E, N) and
       `metrics` {channel: `ValidationReport`}).
     - `index`: which record (experiment) of the assessment.
@@ -180,7 +182,7 @@ def _file_part(name: str) -> str:
 
 
 def save_identification_figures(result, folder, *, dpi: int = 100) -> list:
-    """Write the figures of a `jaxship._identify.IdentificationResult` into `folder`
+    """Write the figures of a `jaxship.IdentificationResult` into `folder`
     and return their paths:
 
     - `fit_train_NN_NAME.png`, `fit_validation_NN_NAME.png`: measured vs simulated
@@ -190,8 +192,6 @@ def save_identification_figures(result, folder, *, dpi: int = 100) -> list:
       the same for the simulation errors on the held-out records;
     - `correlation.png`: the parameter correlation heat map.
     """
-    from pathlib import Path
-
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     written = []

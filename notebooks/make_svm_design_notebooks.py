@@ -13,10 +13,10 @@ svm.cells = [
     nbf.v4.new_markdown_cell(
         "# Lu & Zhao (2008): four discrete response models, LS and SVR\n\n"
         "The four models of their eqs. 7-10 (continuous eqs. 1-4) fitted to a simulated "
-        "20/20 zig-zag of the Mariner (`jaxship._svm_study.svm_response_study`); overshoots "
+        "20/20 zig-zag of the Mariner (`jaxship.studies.svm.svm_response_study`); overshoots "
         "in the form of their Table 1, indices in the form of Tables 2-4, and prediction of "
         "an untrained 10/10 zig-zag and a 20 deg turning circle (sec. 3.2)."),
-    nbf.v4.new_code_cell(SETUP + "from jaxship._svm_study import svm_response_study\n"
+    nbf.v4.new_code_cell(SETUP + "from jaxship.studies.svm import svm_response_study\n"
                          "study = svm_response_study('mariner', dt=0.5)"),
     nbf.v4.new_markdown_cell("## Table 1: first and second overshoot [deg]"),
     nbf.v4.new_code_cell("for name, o1, o2 in study['table1']:\n"
@@ -43,9 +43,9 @@ design.cells = [
         "Nomoto 1 and 2 models of the thesis vessel at 500 rpm (least-squares fits to a "
         "noise-free simulation), a rate gyro with 0.05 deg/s white noise, every manoeuvre "
         "run for the same duration as the thesis manoeuvre (thesis sec. 3.3.2). "
-        "`jaxship._svm_study.design_study`, `jaxship._design.fisher_information`."),
-    nbf.v4.new_code_cell(SETUP + "from jaxship._svm_study import design_study\n"
-                         "from jaxship._design import excitation_order\n"
+        "`jaxship.studies.svm.design_study`, `jaxship.fisher_information`."),
+    nbf.v4.new_code_cell(SETUP + "from jaxship.studies.svm import design_study\n"
+                         "from jaxship import excitation_order\n"
                          "d = design_study('thesis', rpm=500.0)\nprint(d['nominal'])\n"
                          "print('duration', d['duration'], 's')"),
     nbf.v4.new_code_cell(

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter
 
+from jaxship._armax_model import ARMAXModel, simulate_armax
 from jaxship._estimate._armax import fit_armax
 from jaxship._estimate._discrete import discretise
 
@@ -71,3 +72,21 @@ def test_bad_inputs():
     with pytest.raises(ValueError, match="too few"):
         fit_armax(u[:20], u[:20])
     assert fit_armax(u, u, na=3, nb=1, nc=0).nomoto() is None
+
+
+def test_armax_model_simulation_equals_the_recursion():
+    """`simulate_armax` (one lfilter call for a batch of records) equals the explicit
+    recursion r(k) = b0 d(k-1) + b1 d(k-2) - a1 r(k-1) - a2 r(k-2), started at r0 with
+    r and the rudder before the first sample held at r0 and d(0)."""
+    model = ARMAXModel(a1=-1.6, a2=0.65, b0=0.02, b1=0.015, dt=0.5)
+    rng = np.random.default_rng(3)
+    delta = np.stack([_input(200, seed) for seed in (4, 5)])
+    r0 = rng.normal(0.0, 0.01, 2)
+    got = simulate_armax(model, delta, r0)
+    for d, start, row in zip(delta, r0, got):
+        r = np.full(d.size + 2, start)  # two samples of history before sample 0
+        x = np.r_[d[0], d[0], d]
+        for k in range(3, d.size + 2):
+            r[k] = 0.02 * x[k - 1] + 0.015 * x[k - 2] + 1.6 * r[k - 1] - 0.65 * r[k - 2]
+        np.testing.assert_allclose(row, r[2:], rtol=1e-12, atol=1e-15)
+    np.testing.assert_array_equal(simulate_armax(model, delta[1], r0[1]), got[1])

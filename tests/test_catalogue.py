@@ -4,13 +4,12 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._vessel.catalogue import VESSELS, get_vessel
 
 
-@pytest.mark.parametrize("name", list(VESSELS))
+@pytest.mark.parametrize("name", list(js.VESSELS))
 def test_preset_turns_to_starboard_with_positive_rudder(name):
-    vessel = get_vessel(name)
-    assert VESSELS[name].description, "the factory docstring must name the model and source"
+    vessel = js.vessel(name)
+    assert js.VESSELS[name].description, "the factory docstring must name the model and source"
     x0 = js.straight_run(vessel)
     assert np.isfinite(float(x0.u)) and float(x0.u) > 0
     tau = float(vessel.length) / float(x0.u)
@@ -27,4 +26,10 @@ def test_preset_turns_to_starboard_with_positive_rudder(name):
 
 def test_unknown_vessel_names_the_choices():
     with pytest.raises(ValueError, match="mariner"):
-        get_vessel("titanic")
+        js.vessel("titanic")
+
+
+def test_vessel_and_get_vessel_give_fresh_equal_presets():
+    a, b = js.vessel("Mariner"), js.get_vessel("mariner")
+    assert a is not b and type(a) is type(b) is js.Mariner
+    assert float(a.length) == float(b.length)

@@ -6,14 +6,13 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._vessel.catalogue import VESSELS
 from jaxship.cli import main
 
 
 def test_vessels_lists_every_preset_with_source(capsys):
     assert main(["vessels"]) == 0
     out = capsys.readouterr().out
-    for name in VESSELS:
+    for name in js.VESSELS:
         assert name in out
     assert "Chislett" in out and "Yasukawa" in out
 

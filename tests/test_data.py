@@ -6,8 +6,7 @@ import pytest
 from helpers import linear_test_vessel
 
 import jaxship as js
-from jaxship._data import (
-    CHANNELS,
+from jaxship import (
     Dataset,
     Experiment,
     read_esso_osaka,
@@ -18,6 +17,7 @@ from jaxship._data import (
     shared_data_dir,
     write_trial_csv,
 )
+from jaxship._data import CHANNELS
 
 
 def synthetic_experiment(num=201, dt=0.1, t0=5.0):
@@ -290,9 +290,7 @@ def test_dataset_vmap_replay_matches_original(turn):
     first, later = full.segment(stop=120.0), full.segment(start=110.0)
     data = Dataset.from_experiments([first, later])
     assert data.lengths == (41, 101)
-    batch = jax.vmap(lambda m, x0: js.simulate(vessel, m, x0))(
-        data.replays(rudder="delta_c"), data.initial_states()
-    )
+    batch = js.simulate_batch(vessel, data.replays(rudder="delta_c"), data.initial_states())
     np.testing.assert_array_equal(np.asarray(batch.valid), data.mask)
     np.testing.assert_allclose(np.asarray(batch.t), data.t, rtol=1e-14)
     for key in ("psi", "r", "u", "v", "x", "y"):

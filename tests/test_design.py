@@ -5,10 +5,15 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._design import excitation_order, fisher_information
-from jaxship._manoeuvres import prbs
-from jaxship._steering import Nomoto1, Nomoto2, simulate_steering
-from jaxship._steering.manoeuvre import steer_manoeuvre
+from jaxship import (
+    Nomoto1,
+    Nomoto2,
+    excitation_order,
+    fisher_information,
+    prbs,
+    simulate_steering,
+    steer_manoeuvre,
+)
 
 
 def test_excitation_order_known_signals():

@@ -3,15 +3,13 @@
 import numpy as np
 import pytest
 
-from jaxship._data import Experiment
+from jaxship import Experiment, Nomoto1, Nomoto2, fit_discrete_response, simulate_steering
 from jaxship._estimate._discrete import (
     COEFFICIENTS,
     DiscreteResponseFit,
     continuous_parameters,
     discretise,
-    fit_discrete_response,
 )
-from jaxship._steering import Nomoto1, Nomoto2, simulate_steering
 
 
 H = 0.2
@@ -60,7 +58,7 @@ def test_zoh_matches_continuous_models():
     d = _rudder(1500)
     for structure, model in (("linear1", Nomoto1(K=0.1, T=20.0, delta0=0.01)),
                              ("linear2", Nomoto2(K=0.1, T1=25.0, T2=3.0, T3=5.0, delta0=0.01))):
-        r = np.asarray(simulate_steering(model, d, H, substeps=40).r)
+        r = np.asarray(simulate_steering(model, d, H, substeps=40, hold="zoh").r)
         e = Experiment(np.arange(d.size) * H, d, r=r)
         f = fit_discrete_response(structure, e)
         for k, v in CASES[structure].items():
@@ -71,7 +69,7 @@ def test_zoh_matches_continuous_models():
                              ("linear2", Nomoto2(K=0.1, T1=25.0, T2=3.0, T3=5.0))):
         params = {k: v for k, v in CASES[structure].items() if k != "delta_r"}
         c = discretise(structure, params, H)
-        r = np.asarray(simulate_steering(model, d, H, substeps=40).r)
+        r = np.asarray(simulate_steering(model, d, H, substeps=40, hold="zoh").r)
         sim = DiscreteResponseFit(structure, "ls", "zoh", H, c, {}, 0.0, 0).simulate(d)
         assert np.max(np.abs(sim - r)) < 1e-9 * np.max(np.abs(r))
 

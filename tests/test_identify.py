@@ -1,4 +1,4 @@
-"""`jaxship identify` and `jaxship._identify.identify`: recovery of known steering
+"""`jaxship identify` and `jaxship.identify`: recovery of known steering
 models from trial CSV files written from simulations (every registered kind: Nomoto,
 Ross, sway-yaw, ARMAX and a vessel preset), the report's schema, figures, validation on
 held-out records, progress reporting and clear errors on bad input."""
@@ -12,19 +12,21 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._estimate._fit import IdentifiabilityWarning
-from jaxship._identify import MODELS, IdentificationResult, Progress, identify, read_experiments
-from jaxship._steering import (
+from jaxship import (
     AuxInputs,
+    IdentifiabilityWarning,
+    IdentificationResult,
     LinearSwayYaw,
     Nomoto1,
     Nomoto2,
     NonlinearNomoto,
     NorrbinCrossFlow,
     RossAutopilot,
+    identify,
     simulate_steering,
 )
 from jaxship.cli import main
+from jaxship.identification import MODELS, Progress, read_experiments
 
 
 DEG = np.pi / 180
@@ -48,8 +50,9 @@ def rudder_sequence(seed, amplitudes=(10.0,), hold=(16, 48)):
 def record(model, delta, *, name, noise=0.0, seed=0, command=None):
     """A record of `model` driven by `delta` from rest, heading 0.1 rad, with white
     measurement noise of `noise` deg on psi and `noise / 10` deg/s on r. `command`:
-    an optional commanded rudder written as `delta_c`."""
-    tr = simulate_steering(model, delta, DT, psi0=0.1)
+    an optional commanded rudder written as `delta_c`, which then drives the model held
+    over each interval (as `identify --rudder delta_c` replays a command)."""
+    tr = simulate_steering(model, delta, DT, psi0=0.1, hold="foh" if command is None else "zoh")
     rng = np.random.default_rng(seed)
     psi = np.asarray(tr.psi) + noise * DEG * rng.standard_normal(NUM)
     r = np.asarray(tr.r) + 0.1 * noise * DEG * rng.standard_normal(NUM)

@@ -6,16 +6,9 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._indices import (
-    CriterionRow,
-    InitialTurningIndices,
-    SpiralCurve,
-    StoppingIndices,
-    TurningIndices,
-    ZigZagIndices,
+from jaxship import (
     format_table,
     imo_criteria,
-    imo_overshoot_limits_deg,
     initial_turning_indices,
     loop_width,
     pull_out_indices,
@@ -24,6 +17,15 @@ from jaxship._indices import (
     stopping_indices,
     turning_indices,
     zigzag_indices,
+)
+from jaxship._indices import (
+    CriterionRow,
+    InitialTurningIndices,
+    SpiralCurve,
+    StoppingIndices,
+    TurningIndices,
+    ZigZagIndices,
+    imo_overshoot_limits_deg,
 )
 
 
@@ -466,10 +468,12 @@ def test_zigzag_overshoot_decreases_with_yaw_damping(toy):
                                                        dt=0.2, execute=5.0), x0)
         ind = zigzag_indices(traj, 10 * DEG)
         firsts.append(ind.overshoots[0])
-        # simulated executes: first sample after each switch crossing
+        # simulated executes: the first sample after the reversal, which is ordered at
+        # the 0.1 s control step nearest to the crossing
         executes, switches = np.array(ind.execute_times[1:]), np.array(ind.switch_times)
         n = min(executes.size, switches.size)
-        assert np.all((executes[:n] >= switches[:n]) & (executes[:n] < switches[:n] + 0.2 + 1e-9))
+        assert np.all((executes[:n] >= switches[:n] - 0.05)
+                      & (executes[:n] < switches[:n] + 0.2 + 1e-9))
         assert ind.execute_times[0] == 5.0 and ind.rudder_angle == pytest.approx(10 * DEG)
     assert firsts[0] > firsts[1] > firsts[2] > 0
     port = js.simulate(toy, js.ZigZag(-10 * DEG, 10 * DEG, duration=400.0, dt=0.2, execute=5.0),
@@ -514,8 +518,7 @@ def test_mariner_cross_check_numbers():
     """Indices of the Mariner against the independent numpy/RK4 re-implementation in
     shared/reference/vessel-models.md sec. 6 (mariner.m equations, h = 0.05 s, order at
     t = 0 from a steady approach; its "internal delta = +35 deg" turn is a port turn here)."""
-    mariner = pytest.importorskip("jaxship._vessel.mariner").mariner
-    vessel = mariner()
+    vessel = js.vessel("mariner")
     x0 = js.straight_run(vessel)
     turn = turning_indices(js.simulate(vessel, js.Turn(-35 * DEG, duration=700.0, dt=0.1), x0,
                                        simulator=js.Simulator(substeps=2)))
@@ -523,8 +526,10 @@ def test_mariner_cross_check_numbers():
         [turn.advance, turn.transfer, turn.tactical_diameter], [596.7, 439.6, 1070.3], atol=0.1)
     np.testing.assert_allclose(turn.steady_turning_diameter / 2, 576.0, atol=1.0)
     for angle, overshoots in ((10, [4.95, 4.47, 6.18, 4.46]), (20, [7.78, 6.32, 7.21, 6.22])):
-        traj = js.simulate(vessel, js.ZigZag(angle * DEG, angle * DEG, duration=500.0, dt=0.05),
-                           x0)
+        # the reference's convention: the rudder reversed at its first 0.05 s step after
+        # the crossing
+        zigzag = js.ZigZag(angle * DEG, angle * DEG, duration=500.0, dt=0.05, switch_at="after")
+        traj = js.simulate(vessel, zigzag, x0, simulator=js.Simulator(max_step=0.05))
         ind = zigzag_indices(traj, angle * DEG)
         np.testing.assert_allclose(np.array(ind.overshoots[:4]) / DEG, overshoots, atol=0.006)
     initial = initial_turning_indices(js.simulate(vessel, js.Turn(10 * DEG, duration=60.0,

@@ -10,8 +10,8 @@ import pytest
 from test_estimate import zigzag_like
 
 import jaxship as js
-from jaxship._estimate import _kalman
-from jaxship._steering import Nomoto1, NonlinearNomoto, simulate_steering
+from jaxship import Nomoto1, NonlinearNomoto, simulate_steering
+from jaxship._estimate import _likelihood
 
 
 DEG = np.pi / 180
@@ -73,8 +73,9 @@ def numpy_kalman(K, T, delta, y, dt, q, R):
 
 def test_ekf_of_a_linear_model_is_the_linear_kalman_filter():
     exp, _, _ = noisy_record(TRUTH, 300, 1)
+    # the reference discretises the rudder held over each interval (zero-order hold)
     out = js.ekf(TRUTH, exp, process_noise={"rudder": Q_RUDDER},
-                 measurement_noise={"psi": R_PSI, "r": R_R})
+                 measurement_noise={"psi": R_PSI, "r": R_R}, hold="zoh")
     zs, Ps = js.rts_smoother(out)
     y = np.stack([exp.psi, exp.r], axis=-1)
     zf, innov, nll, zs_ref, Ps_ref = numpy_kalman(0.06, 25.0, exp.delta, y, DT, Q_RUDDER,
@@ -162,7 +163,7 @@ def test_ml_intervals_cover_the_truth_at_about_the_nominal_rate():
         lower = res.values - 1.96 * res.std
         upper = res.values + 1.96 * res.std
         covered.extend((lower <= [0.06, 25.0]) & ([0.06, 25.0] <= upper))
-        sizes.add(_kalman._ml_solve._cached._cache_size())
+        sizes.add(_likelihood._ml_solve._cached._cache_size())
     assert np.mean(covered) >= 0.8, np.mean(covered)
     assert len(sizes) == 1  # one trace for every data set and start
 

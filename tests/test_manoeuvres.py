@@ -1,5 +1,7 @@
 """Manoeuvre generators: the command histories they produce, open and closed loop."""
 
+import math
+
 import jax
 import numpy as np
 import pytest
@@ -9,6 +11,7 @@ import jaxship as js
 from jaxship._indices import reverse_spiral_curve
 
 
+AT_SAMPLES = js.Simulator(max_step=math.inf)  # controllers act at the output samples
 DEG = np.pi / 180
 
 
@@ -26,7 +29,7 @@ def open_loop(manoeuvre, tau):
     """Rudder and propeller orders of an open-loop manoeuvre at `tau` s after its start."""
     state = js.straight_state(5.0, n=1.25)
     memory = manoeuvre.init(state)
-    command = jax.vmap(lambda s: manoeuvre.command(manoeuvre.start + s, state, memory)[0])
+    command = jax.vmap(lambda s: manoeuvre.command(manoeuvre.start + s, state, memory, 0.1)[0])
     out = command(np.asarray(tau, dtype=float))
     return np.asarray(out.delta), np.asarray(out.n)
 
@@ -145,11 +148,14 @@ def test_stop_orders_astern_at_execute(vessel, x0):
 
 
 def test_replay_reproduces_a_closed_loop_run_and_pads(vessel, x0):
-    zigzag = js.simulate(vessel, js.ZigZag(15 * DEG, 5 * DEG, duration=150.0, dt=0.5), x0)
+    # the zig-zag logic acting at the samples (one control step per sample), so that the
+    # sampled commands are all it ordered
+    zigzag = js.simulate(vessel, js.ZigZag(15 * DEG, 5 * DEG, duration=150.0, dt=0.5), x0,
+                         simulator=AT_SAMPLES)
     rec_delta, rec_n = np.asarray(zigzag.command.delta), np.asarray(zigzag.command.n)
     replay = js.Replay(rec_delta, rec_n, dt=0.5)
     assert replay.duration == 150.0 and replay.num_samples == rec_delta.size
-    again = js.simulate(vessel, replay, x0)
+    again = js.simulate(vessel, replay, x0, simulator=AT_SAMPLES)
     for name in ("u", "v", "r", "x", "y", "psi", "delta", "n"):
         np.testing.assert_allclose(getattr(again.state, name), getattr(zigzag.state, name),
                                    rtol=1e-12, atol=1e-12, err_msg=name)
@@ -221,7 +227,7 @@ def test_heading_autopilot_tracks_the_square_wave(vessel, x0):
     # the rudder law, recomputed from the sampled states (PID with anti-windup clip)
     kp, ki, kd = 2.0, 0.005, 60.0
     pid = js.HeadingAutopilot(A, period, kp=kp, ki=ki, kd=kd, duration=600.0, dt=dt)
-    traj = js.simulate(vessel, pid, x0)
+    traj = js.simulate(vessel, pid, x0, simulator=AT_SAMPLES)
     t, psi = np.asarray(traj.t), np.asarray(traj.state.psi)
     r, order = np.asarray(traj.state.r), np.asarray(traj.command.delta)
     reference = np.where(np.floor(2 * t / period) % 2 == 0, A, -A)

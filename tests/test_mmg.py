@@ -17,8 +17,8 @@ import pytest
 from helpers import central_difference
 
 import jaxship as js
-from jaxship._data import read_esso_osaka, shared_data_dir
 from jaxship._indices import turning_indices, zigzag_indices
+from jaxship._readers import read_esso_osaka, shared_data_dir
 from jaxship._vessel.esso_osaka import LowSpeedMMGVessel, cross_flow_integrals, esso_osaka
 from jaxship._vessel.mmg import MMGVessel, kvlcc2
 

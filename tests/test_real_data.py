@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._real_data import (
+from jaxship.studies.real_data import (
     ESSO_TEST,
     decimate,
     esso_osaka_split,

@@ -4,8 +4,8 @@ import json
 
 import pytest
 
-from jaxship._reproduce import reproduce
 from jaxship.cli import main
+from jaxship.studies.reproduce import reproduce
 
 
 def test_quick_reproduce_writes_trials_and_matches_thesis_ranges(tmp_path):

@@ -12,17 +12,20 @@ import pytest
 from helpers import central_difference
 
 import jaxship as js
-from jaxship import _thesis_identification as ti
-from jaxship._estimate._fit import IdentifiabilityWarning, PredictionError, fit
-from jaxship._estimate._params import parameter_fields
-from jaxship._steering import AuxInputs, simulate_steering
-from jaxship._steering.ross import (
-    HULL_TERMS,
+from jaxship import (
     ROSS_FREE,
     SPEED_RUDDER,
+    AuxInputs,
+    IdentifiabilityWarning,
+    PredictionError,
     RossAutopilot,
+    fit,
     ross_initial_estimate,
+    simulate_steering,
 )
+from jaxship._params import parameter_fields
+from jaxship._steering.ross import HULL_TERMS
+from jaxship.studies import thesis as ti
 
 
 DEG = np.pi / 180
@@ -53,8 +56,10 @@ def synthetic_inputs(num, seed, rpm):
 
 
 def record(model, num, seed, rpm, *, name="synthetic"):
+    """Noise-free record of rudder steps held over each interval (a commanded,
+    piecewise-constant rudder; fitted with `hold="zoh"`)."""
     delta, aux = synthetic_inputs(num, seed, rpm)
-    tr = simulate_steering(model, delta, DT, aux=aux, psi0=0.2)
+    tr = simulate_steering(model, delta, DT, aux=aux, psi0=0.2, hold="zoh")
     return js.Experiment(np.asarray(tr.t), delta, psi=np.asarray(tr.psi), r=np.asarray(tr.r),
                          u=aux.u, v=aux.v, n=aux.n, name=name)
 
@@ -117,14 +122,14 @@ def test_least_squares_start_is_close_and_fit_recovers_to_1e6():
     so v'^3 and v'^2 r' are small signals; the error is the trapezoid/midpoint
     discretisation of the regression), and the prediction-error fit of all 16
     coefficients recovers them to 1e-6 relative."""
-    start = ross_initial_estimate(RossAutopilot(**SCALES), DATA, free=SPEED_RUDDER)
+    start = ross_initial_estimate(RossAutopilot(**SCALES), DATA, free=SPEED_RUDDER, hold="zoh")
     truth = np.array([getattr(TRUTH, n) for n in SPEED_RUDDER])
     got = np.array([getattr(start, n) for n in SPEED_RUDDER])
     weak = np.isin(SPEED_RUDDER, ("n_vvv", "n_vvr"))
     np.testing.assert_allclose(got[~weak], truth[~weak], rtol=2e-2, atol=2e-2)
     np.testing.assert_allclose(got[weak], truth[weak], rtol=0.1)
     res = quiet_fit(start, DATA, free=SPEED_RUDDER,
-                    estimator=PredictionError(horizon=2.0, channels=("psi", "r")))
+                    estimator=PredictionError(horizon=2.0, channels=("psi", "r"), hold="zoh"))
     assert res.success and res.names == SPEED_RUDDER
     np.testing.assert_allclose(res.values, truth, rtol=1e-6)
     assert res.metrics["r"].fit_percent > 100 - 1e-6
@@ -132,7 +137,7 @@ def test_least_squares_start_is_close_and_fit_recovers_to_1e6():
 
 def test_frozen_terms_enter_the_start_as_known():
     start = ross_initial_estimate(RossAutopilot(**SCALES, n_delta_nn=0.9, n_delta3=-0.8,
-                                                n_delta3_nn=-0.3), DATA)
+                                                n_delta3_nn=-0.3), DATA, hold="zoh")
     assert (start.n_delta_nn, start.n_delta3, start.n_delta3_nn) == (0.9, -0.8, -0.3)
     np.testing.assert_allclose([start.n_ur, start.n_delta], [-4.0, 2.5], rtol=2e-2)
     with pytest.raises(ValueError, match="span"):

@@ -1,5 +1,7 @@
 """Core simulator: invariants, numerics, batching, gradients and tracing."""
 
+import math
+
 import diffrax as dfx
 import equinox as eqx
 import jax
@@ -11,6 +13,8 @@ from helpers import central_difference, linear_test_vessel, tree_allclose
 import jaxship as js
 
 
+AT_SAMPLES = js.Simulator(max_step=math.inf)  # one step per output sample
+ADAPTIVE = js.Simulator(dfx.Tsit5(), stepsize_controller=dfx.PIDController(rtol=1e-8, atol=1e-8))
 DEG = np.pi / 180
 
 
@@ -73,12 +77,13 @@ def test_kinetic_energy_decays_without_thrust(vessel):
 
 
 def test_fixed_step_converges_to_adaptive(vessel, x0):
-    man = js.ZigZag(20 * DEG, 20 * DEG, duration=300.0, dt=1.0)
-    exact = js.simulate(vessel, man, x0, simulator=js.Simulator(dfx.Tsit5()))
+    man = js.Turn(20 * DEG, duration=300.0, dt=1.0)  # open loop: the same input for all
+    exact = js.simulate(vessel, man, x0, simulator=ADAPTIVE)
     assert exact.success
     errors = []
     for substeps in (1, 2, 4):
-        fixed = js.simulate(vessel, man, x0, simulator=js.Simulator(substeps=substeps))
+        fixed = js.simulate(vessel, man, x0,
+                            simulator=js.Simulator(max_step=math.inf, substeps=substeps))
         errors.append(float(jnp.max(jnp.abs(fixed.state.psi - exact.state.psi))))
     assert errors[-1] < 1e-6
     # fourth order: halving the step cuts the error by about 16
@@ -128,10 +133,14 @@ def test_padded_batch_marks_valid_samples(vessel, x0):
     short = js.Turn(10 * DEG, duration=50.0, num_samples=1001)
     long = js.Turn(10 * DEG, duration=100.0)
     assert short.num_samples == long.num_samples == 1001
-    both = eqx.filter_vmap(lambda m: js.simulate(vessel, m, x0))(
-        jax.tree.map(lambda a, b: jnp.stack([a, b]), short, long)
-    )
+    stacked = jax.tree.map(lambda a, b: jnp.stack([a, b]), short, long)
+    # under vmap the sample interval is traced: one step per sample, or say so
+    both = eqx.filter_vmap(lambda m: js.simulate(vessel, m, x0, simulator=AT_SAMPLES))(stacked)
     assert int(both.valid[0].sum()) == 501 and bool(both.valid[1].all())
+    with pytest.raises(ValueError, match="simulate_batch"):
+        eqx.filter_vmap(lambda m: js.simulate(vessel, m, x0))(stacked)
+    batch = js.simulate_batch(vessel, stacked, x0, in_axes=(None, 0, None, None))
+    np.testing.assert_array_equal(batch.valid, both.valid)
 
 
 def _final_heading(vessel, x0, simulator):
@@ -146,7 +155,9 @@ def _final_heading(vessel, x0, simulator):
 
 @pytest.mark.parametrize(
     "simulator",
-    [js.Simulator(substeps=2), js.Simulator(dfx.Tsit5(), adjoint=dfx.ForwardMode())],
+    [js.Simulator(substeps=2),
+     js.Simulator(dfx.Tsit5(), stepsize_controller=dfx.PIDController(rtol=1e-8, atol=1e-8),
+                  adjoint=dfx.ForwardMode())],
     ids=["rk4-scan", "diffrax-forward"],
 )
 def test_forward_gradient_matches_finite_difference(vessel, x0, simulator):
@@ -158,7 +169,7 @@ def test_forward_gradient_matches_finite_difference(vessel, x0, simulator):
 
 
 @pytest.mark.parametrize(
-    "simulator", [js.Simulator(substeps=2), js.Simulator(dfx.Tsit5())], ids=["rk4-scan", "diffrax"]
+    "simulator", [js.Simulator(substeps=2), ADAPTIVE], ids=["rk4-scan", "diffrax"]
 )
 def test_reverse_gradient_matches_finite_difference(vessel, x0, simulator):
     f = _final_heading(vessel, x0, simulator)
@@ -176,7 +187,7 @@ def test_new_parameter_values_do_not_retrace(vessel, x0):
     for nr, angle in [(-0.0016, 10.0), (-0.0020, 25.0), (-0.0030, -5.0)]:
         v = eqx.tree_at(lambda s: s.nr, vessel, nr)
         m = eqx.tree_at(lambda s: s.angle, man, angle * DEG)
-        jitted(*js._simulate._as_arrays((v, m, x0, js.Environment())), js.Simulator())
+        jitted(*js._simulate._as_arrays((v, m, x0, js.Environment())), js.Simulator(), 1)
 
 
 def test_python_floats_do_not_retrace(vessel, x0):

@@ -1,19 +1,16 @@
 """Response models (Nomoto 1/2, nonlinear Nomoto) and their RK4 simulation."""
 
+import math
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxship._steering import (
-    AuxInputs,
-    Nomoto1,
-    Nomoto2,
-    NonlinearNomoto,
-    WindowStart,
-    simulate_steering,
-)
+import jaxship as js
+from jaxship import AuxInputs, Nomoto1, Nomoto2, NonlinearNomoto, simulate_steering
+from jaxship._steering import WindowStart
 
 
 DEG = np.pi / 180
@@ -88,7 +85,8 @@ def test_nomoto2_window_state_reconstructs_the_hidden_state():
     rng = np.random.default_rng(1)
     delta = np.repeat(rng.uniform(-20, 20, 25) * DEG, 16)
     dt, r_first = 0.5, 0.004
-    tr = simulate_steering(m, delta, dt, state0=m.initial_state(r_first), psi0=0.2)
+    tr = simulate_steering(m, delta, dt, state0=m.initial_state(r_first), psi0=0.2,
+                           hold="zoh")
     integral = np.concatenate([[0.0], np.cumsum(delta[:-1]) * dt])
     k = np.arange(delta.shape[0])
     start = WindowStart(r=tr.r, psi=tr.psi, delta=delta, r_first=r_first, psi_first=0.2,
@@ -116,7 +114,7 @@ def test_forward_mode_derivatives_match_finite_differences():
 
 
 def test_vmap_over_parameters_equals_loop_and_no_retrace():
-    from jaxship._steering._base import _simulate_steering
+    from jaxship._simulate_steering import _simulate_steering
 
     delta = np.repeat(np.array([10, -10, 20]) * DEG, 30)
     gains = jnp.array([0.03, 0.05, 0.08])
@@ -132,9 +130,10 @@ def test_vmap_over_parameters_equals_loop_and_no_retrace():
     jitted = eqx.filter_jit(counted)
     for K in (0.02, 0.04):
         m = Nomoto1(K=jnp.asarray(K), T=jnp.asarray(10.0), delta0=jnp.asarray(0.0))
-        jitted(m, jnp.asarray(delta), jnp.asarray(0.5), None, jnp.asarray(0.0),
-               jax.tree.map(lambda a: jnp.zeros(delta.shape), AuxInputs()),
-               jnp.asarray(0.0), 1)
+        zero = jnp.zeros(delta.shape)
+        records = {"delta": jnp.asarray(delta), "u": zero, "v": zero, "n": zero}
+        jitted(m, records, jnp.asarray(0.5), None, jnp.asarray(0.0), jnp.asarray(0.0),
+               dict.fromkeys(records, "zoh"), js.Simulator(max_step=math.inf), 1)
 
 
 def test_simulate_rejects_bad_arguments():

@@ -12,24 +12,19 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._astrom import (
-    FREE,
-    TABLE3_START,
-    NoiseLevels,
-    simulate_disturbed,
-    window_robust_std,
-    zigzag_trial,
-)
-from jaxship._estimate._fit import IdentifiabilityWarning, PredictionError, fit
-from jaxship._steering import (
+from jaxship import (
     AuxInputs,
+    IdentifiabilityWarning,
     LinearSwayYaw,
     NorrbinCrossFlow,
-    WindowStart,
+    PredictionError,
+    fit,
     simulate_steering,
 )
+from jaxship._steering import WindowStart
 from jaxship._vessel._base import state_derivative
 from jaxship._vessel.sway_yaw import sea_stratus_linear, sea_stratus_nonlinear
+from jaxship.studies.astrom import FREE, TABLE3_START, NoiseLevels, simulate_disturbed, zigzag_trial
 
 
 DEG = np.pi / 180
@@ -91,17 +86,15 @@ def test_rhs_equals_the_vessel_sway_and_yaw_accelerations():
 def test_matches_the_3dof_simulation_of_sea_stratus():
     """What agrees: r, v and psi of a 20/20 zig-zag of the 3-DOF `sea_stratus_nonlinear`
     (rudder servo, RK4 at 0.1 s; u stays 8 m/s as X = 0) and of `NorrbinCrossFlow`
-    replaying the vessel's rudder at 0.1 s (interval means of the servo angle, zero-order
-    hold) with the measured u, to 1e-5 of each signal's range; at 1 s samples the
-    hold of a ramping rudder costs 2e-4. `zigzag_trial` without noise is `simulate`."""
+    replaying the vessel's rudder angle sampled at 0.1 s (linear between samples, the
+    default hold) with the measured u, to 2e-6 of each signal's range; sampled at 1 s,
+    where the servo's ramps start and end between samples, to 2e-4. `zigzag_trial`
+    without noise is `simulate`."""
     man = js.ZigZag(angle=20 * DEG, heading=20 * DEG, duration=600.0, dt=0.1)
     tr = js.simulate(VESSEL, man, js.straight_run(VESSEL))
     d = np.asarray(tr.state.delta)
-    for over, tol in ((1, 1e-5), (10, 2e-4)):
-        n = (d.shape[0] - 1) // over
-        blocks = d[: n * over].reshape(n, over)
-        mean = (blocks.sum(1) - 0.5 * blocks[:, 0] + 0.5 * d[over::over][:n]) / over
-        st = simulate_steering(TRUTH, np.append(mean, d[-1]), 0.1 * over,
+    for over, tol in ((1, 2e-6), (10, 2e-4)):
+        st = simulate_steering(TRUTH, d[::over], 0.1 * over,
                                aux=AuxInputs(u=np.asarray(tr.state.u)[::over]))
         for name, got in (("r", st.r), ("v", st.state[:, 1]), ("psi", st.psi)):
             ref = np.asarray(getattr(tr.state, name))[::over]
@@ -197,10 +190,11 @@ def test_disturbed_simulation_adds_the_yaw_moment():
     man = js.Turn(angle=0.0, duration=2.0, dt=1.0)
     moment = 0.5 * VESSEL.rho * VESSEL.length**3 * 64.0 * VESSEL.n_delta * DEG
     x0 = js.straight_run(VESSEL)
-    t, states, command = simulate_disturbed(VESSEL, man, x0, jnp.full(3, moment))
+    traj = simulate_disturbed(VESSEL, man, x0, jnp.full(3, moment))
     deriv = state_derivative(VESSEL, x0, js.Command(0.0, 0.0), js.Environment())
-    assert float(deriv.r) == 0.0 and float(states[-1, 2]) > 0.0
-    assert np.all(np.asarray(command) == 0.0) and np.all(np.asarray(states[:, 6]) == 0.0)
+    assert float(deriv.r) == 0.0 and float(traj.state.r[-1]) > 0.0
+    assert np.all(np.asarray(traj.command.delta) == 0.0)
+    assert np.all(np.asarray(traj.state.delta) == 0.0)
 
 
 # -- noise: coverage and prediction error against output error ------------------------------
@@ -212,13 +206,13 @@ def _noisy_fit(seed, horizon, angle=20.0):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", IdentifiabilityWarning)
         res = fit(table3_start(), exp, estimator=est, free=FREE)
-    return res, window_robust_std(res, exp, est)
+    return res, res.parameters.std_robust
 
 
 @pytest.mark.slow
-def test_window_robust_intervals_cover_the_truth_under_noise():
+def test_robust_intervals_cover_the_truth_under_noise():
     """20/20 zig-zags with the default random yaw moment and sensor noise, 12 seeds,
-    T_p = 60 s: the 95 % intervals from the window-robust standard errors cover the
+    T_p = 60 s: the 95 % intervals from the HAC (Newey-West) standard errors cover the
     truth for at least 85 % of the 84 (parameter, seed) pairs; the white-residual
     standard errors of `fit` are too small under process noise (coverage below 70 %)."""
     truth = np.array([getattr(TRUTH, k) for k in FREE])
@@ -241,8 +235,7 @@ def test_prediction_error_beats_output_error_under_process_noise():
     truth = np.array([getattr(TRUTH, k) for k in FREE])
     for seed in range(4):
         pe, _ = _noisy_fit(200 + seed, 60.0)
-        oe, rstd = _noisy_fit(200 + seed, None)
-        assert np.all(np.isnan(rstd))  # one window: no robust standard errors
+        oe, _ = _noisy_fit(200 + seed, None)
         rel = lambda r: np.sqrt(np.mean(((r.values - truth) / truth) ** 2))
         assert rel(pe) < rel(oe), (seed, rel(pe), rel(oe))
         assert abs(pe.values[-1] - 0.63) < abs(oe.values[-1] - 0.63)

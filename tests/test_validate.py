@@ -6,13 +6,18 @@ import math
 import numpy as np
 import pytest
 
+from jaxship._covariance import (
+    bartlett_long_run,
+    hac_covariance,
+    hac_from_windows,
+    least_squares_covariance,
+    parameter_report,
+)
 from jaxship._validate import (
     Z99,
     chi2_quantile_99,
     final_prediction_error,
     fit_percent,
-    least_squares_covariance,
-    parameter_report,
     residual_autocorrelation,
     residual_input_correlation,
     validate,
@@ -156,3 +161,196 @@ def test_reports_serialise_to_json():
     prep = parameter_report(["K"], [1.0], np.array([[np.inf]]))
     assert json.loads(json.dumps(prep.to_dict()))["std"] == ["inf"]
     assert "condition number" in prep.table()
+
+
+# ---------------------------------------------------------------------------------------
+# robust (Newey-West HAC) standard errors
+
+
+def _ar1(rng, n, phi, burn=200):
+    w = rng.standard_normal(n + burn)
+    e = np.zeros_like(w)
+    for k in range(1, w.size):
+        e[k] = phi * e[k - 1] + w[k]
+    return e[burn:]
+
+
+def _monte_carlo(phi_e, *, n=1000, seeds=200, lags=None):
+    """y = b0 + b1 x + e with x AR(1) (phi 0.9) and e AR(1) (phi_e): empirical std of the
+    LS estimates over the seeds against the root-mean-square reported std."""
+    est, var_ls, var_hac, used = [], [], [], []
+    for seed in range(seeds):
+        rng = np.random.default_rng(seed)
+        x = np.stack([np.ones(n), _ar1(rng, n, 0.9)], axis=1)
+        y = x @ np.array([1.0, 2.0]) + _ar1(rng, n, phi_e)
+        b = np.linalg.lstsq(x, y, rcond=None)[0]
+        res = y - x @ b
+        var_ls.append(np.diag(least_squares_covariance(x, res)[0]))
+        hac, lag = hac_covariance(x, res, lags=lags)
+        var_hac.append(np.diag(hac))
+        est.append(b)
+        used.append(lag)
+    empirical = np.std(est, axis=0, ddof=1)
+    return (np.sqrt(np.mean(var_ls, axis=0)) / empirical,
+            np.sqrt(np.mean(var_hac, axis=0)) / empirical, np.mean(used))
+
+
+def test_hac_std_matches_the_spread_of_estimates_with_ar1_errors():
+    """AR(1) errors (phi 0.9) and a correlated regressor: the white-noise std is 3-4
+    times too small, the HAC std (automatic bandwidth) within 25 % of the truth; the
+    fixed rule floor(4 (N/100)^(2/9)) = 6 lags is not enough."""
+    ls, hac, lags = _monte_carlo(0.9)
+    assert np.all(ls < 0.4), ls  # measured 0.24, 0.30
+    assert np.all(np.abs(hac - 1) < 0.25), hac  # measured 0.90, 0.81
+    assert 30 < lags < 70  # Andrews' AR(1) rule, measured 47
+    _, fixed, _ = _monte_carlo(0.9, lags=int(4 * (1000 / 100) ** (2 / 9)))
+    assert np.all(fixed < 0.75), fixed
+
+
+def test_hac_std_equals_plain_std_with_white_errors():
+    ls, hac, lags = _monte_carlo(0.0)
+    np.testing.assert_allclose(hac, ls, rtol=0.15)
+    assert np.all(np.abs(hac - 1) < 0.15), hac
+    assert lags < 5
+    # lag 0 alone on homoscedastic white residuals: White's estimator, close to plain
+    rng = np.random.default_rng(7)
+    x = np.stack([np.ones(2000), rng.standard_normal(2000)], axis=1)
+    res = rng.standard_normal(2000)
+    plain = np.diag(least_squares_covariance(x, res)[0])
+    white = np.diag(hac_covariance(x, res, lags=0)[0])
+    np.testing.assert_allclose(white, plain, rtol=0.15)
+
+
+def _naive_hac(jac, res, mask, lags):
+    """The textbook formula, lag by lag, per experiment: jac (C, E, N, d)."""
+    jac = np.where(mask[..., None], jac, 0.0)
+    g = np.einsum("cenp,cen->enp", jac, np.where(mask, res, 0.0))
+    s = np.zeros((jac.shape[-1],) * 2)
+    for ge in g:
+        s += ge.T @ ge
+        for lag in range(1, lags + 1):
+            gamma = ge[lag:].T @ ge[:-lag]
+            s += (1 - lag / (lags + 1)) * (gamma + gamma.T)
+    rows = np.concatenate([jac[c][mask[c]] for c in range(jac.shape[0])])
+    bread = np.linalg.inv(rows.T @ rows)
+    return bread @ s @ bread * rows.shape[0] / (rows.shape[0] - jac.shape[-1])
+
+
+def test_hac_equals_the_lag_by_lag_formula():
+    rng = np.random.default_rng(8)
+    jac = rng.standard_normal((2, 3, 60, 3)) * np.array([1.0, 1e3, 1e-2])
+    res = rng.standard_normal((2, 3, 60)).cumsum(axis=-1)
+    mask = np.ones((2, 3, 60), dtype=bool)
+    mask[:, 1, 45:] = False  # a shorter experiment
+    mask[1, 2, 10:20] = False  # a channel missing for a while
+    for lags in (0, 1, 7, 80):
+        got, used = hac_covariance(jac, res, mask, lags=lags)
+        assert used == lags
+        np.testing.assert_allclose(got, _naive_hac(jac, res, mask, lags), rtol=1e-9)
+    g = rng.standard_normal((2, 50, 2))
+    naive = sum(x.T @ x + sum((1 - k / 6) * (x[k:].T @ x[:-k] + x[:-k].T @ x[k:])
+                              for k in range(1, 6)) for x in g)
+    np.testing.assert_allclose(bartlett_long_run(g, 5), naive, rtol=1e-10)
+
+
+def test_hac_experiments_are_independent_and_padding_is_ignored():
+    """Two experiments padded to a common length give the same covariance as one
+    timeline with the second experiment after a masked gap longer than the lags, and
+    differ from the two glued together (lagged products would straddle them)."""
+    rng = np.random.default_rng(9)
+    n1, n2, lags = 80, 50, 6
+    j1, j2 = rng.standard_normal((n1, 2)), rng.standard_normal((n2, 2))
+    e1, e2 = _ar1(rng, n1, 0.8), _ar1(rng, n2, 0.8)
+    jac = np.zeros((2, n1, 2)) + 1e6  # padding holds garbage
+    res = np.full((2, n1), -1e6)
+    jac[0], jac[1, :n2], res[0], res[1, :n2] = j1, j2, e1, e2
+    mask = np.arange(n1)[None] < np.array([[n1], [n2]])
+    got, _ = hac_covariance(jac, res, mask, lags=lags)
+    gap = np.zeros((lags + 1, 2))
+    glued_gap = np.concatenate([j1, gap, j2]), np.concatenate([e1, gap[:, 0], e2])
+    gap_mask = np.concatenate([np.ones(n1), np.zeros(lags + 1), np.ones(n2)]).astype(bool)
+    np.testing.assert_allclose(hac_covariance(*glued_gap, gap_mask, lags=lags)[0], got,
+                               rtol=1e-10)
+    glued = hac_covariance(np.concatenate([j1, j2]), np.concatenate([e1, e2]), lags=lags)[0]
+    assert not np.allclose(glued, got, rtol=1e-6)
+    # (E, N) and (N,) layouts and the automatic bandwidth on padded data
+    auto, used = hac_covariance(jac, res, mask)
+    assert 0 < used < n1 and np.all(np.isfinite(auto))
+    with pytest.raises(ValueError, match="non-finite"):
+        hac_covariance(np.where(mask[..., None], jac, np.nan), res)
+
+
+def test_hac_undetermined_parameter_is_infinite():
+    rng = np.random.default_rng(10)
+    a = rng.standard_normal(200)
+    jac = np.stack([a, 2 * a, rng.standard_normal(200)], axis=1)
+    cov, _ = hac_covariance(jac, rng.standard_normal(200), lags=3)
+    assert np.isinf(np.diag(cov)[:2]).all() and np.isfinite(cov[2, 2])
+
+
+def _window_layout(lengths, horizon_samples, num):
+    """The index arrays of `_estimate._windows.build_windows`: window w of experiment
+    e starts at sample w L and predicts samples wL + 1 .. wL + L."""
+    counts = [len(range(0, n - 1, L)) for n, L in zip(lengths, horizon_samples)]
+    w_idx = np.arange(max(counts))[None, :, None]
+    l_idx = np.arange(max(horizon_samples))[None, None, :]
+    size = np.array(horizon_samples)[:, None, None]
+    target = w_idx * size + l_idx + 1
+    mask = ((l_idx < size) & (target <= np.array(lengths)[:, None, None] - 1)
+            & (w_idx < np.array(counts)[:, None, None]))
+    return {"target": np.clip(target, 0, num - 1), "mask": mask}
+
+
+def test_hac_from_windows_equals_the_timeline_computation():
+    rng = np.random.default_rng(11)
+    lengths, num, d = (40, 27), 40, 3
+    layout = _window_layout(lengths, (4, 5), num)
+    jac_t = rng.standard_normal((2, 2, num, d))  # (C, E, N, d) in time order
+    res_t = rng.standard_normal((2, 2, num)).cumsum(axis=-1)
+    e_idx = np.arange(2)[:, None, None]
+    jac_w = jac_t[:, e_idx, layout["target"]]  # (C, E, W, L, d)
+    res_w = res_t[:, e_idx, layout["target"]]
+    jac_w[:, ~layout["mask"]] = np.nan  # never read
+    hit = np.zeros((2, num), dtype=bool)
+    hit[np.broadcast_to(e_idx, layout["mask"].shape)[layout["mask"]],
+        layout["target"][layout["mask"]]] = True
+    assert hit.sum() == sum(lengths) - 2  # every sample but the first of each experiment
+    for lags in (0, 5, None):
+        want, want_lags = hac_covariance(jac_t, res_t, hit, lags=lags)
+        got, got_lags = hac_from_windows(jac_w, res_w, layout, lags=lags)
+        assert got_lags == want_lags
+        np.testing.assert_allclose(got, want, rtol=1e-10)
+    # one channel given without the channel axis
+    got, _ = hac_from_windows(jac_w[0], res_w[0], layout, lags=5)
+    np.testing.assert_allclose(got, hac_covariance(jac_t[0], res_t[0], hit, lags=5)[0],
+                               rtol=1e-10)
+
+
+def test_not_white_flag_and_robust_std_in_the_report():
+    cov = np.diag([1e-6, 1e-2])
+    robust = np.diag([1.44e-4, 4e-2])  # 12x and 2x the plain std
+    for white in (None, True):
+        rep = parameter_report(["K", "T"], [0.05, 10.0], cov, robust_covariance=robust,
+                               white=white)
+        assert rep.flags == () and rep.identifiable and rep.residuals_white is white
+        np.testing.assert_allclose(rep.std_robust, [0.012, 0.2])
+    plain = parameter_report(["K", "T"], [0.05, 10.0], cov)
+    assert np.isnan(plain.std_robust).all() and "std robust" not in plain.table()
+    assert plain.residuals_white is None and plain.hac_lags is None
+    rep = parameter_report(["K", "T"], [0.05, 10.0], cov, robust_covariance=robust,
+                           white=False, hac_lags=25)
+    assert len(rep.flags) == 1 and rep.uncertainty_flags == rep.flags
+    flag = rep.flags[0]
+    assert "not white" in flag and "too small by up to 12x (K)" in flag and "25 lags" in flag
+    assert rep.identifiable  # correlated residuals are not an identifiability problem
+    assert "std robust" in rep.table() and rep.residuals_white is False
+    data = json.loads(json.dumps(rep.to_dict()))
+    assert data["std_robust"] == pytest.approx([0.012, 0.2]) and data["hac_lags"] == 25
+    # the relative-error check uses the robust std when the residuals are not white
+    rep = parameter_report(["K", "T"], [0.02, 10.0], cov, robust_covariance=robust,
+                           white=False)
+    assert any("K = 0.02 is poorly determined: robust" in f for f in rep.flags)
+    assert not rep.identifiable
+    # not white without robust errors: still flagged
+    rep = parameter_report(["K", "T"], [0.05, 10.0], cov, white=False)
+    assert len(rep.flags) == 1 and "no robust standard errors" in rep.flags[0]

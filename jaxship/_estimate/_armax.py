@@ -24,6 +24,8 @@ import math
 import numpy as np
 from scipy.signal import lfilter
 
+from ._discrete import continuous_parameters
+
 
 def _lags(x, lags, start):
     """Columns x(t - l) for l in lags, rows t = start..N-1."""
@@ -77,8 +79,6 @@ class ARMAXResult:
         `T2`, `T3` (and `T` = T1 + T2 - T3), as `fit_discrete_response`'s
         `continuous_parameters`. None for other orders or without `dt`; NaN entries
         where the poles have no real continuous counterpart."""
-        from ._discrete import continuous_parameters
-
         if self.dt is None or self.nk != 1:
             return None
         na, nb = self.A.size - 1, self.B.size

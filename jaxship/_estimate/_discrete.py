@@ -41,11 +41,15 @@ start values and quick looks, `fit` (prediction error) gives the final estimates
 import cmath
 import dataclasses
 import math
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
+from scipy.linalg import expm
 
 from .._data import Experiment
+from .._steering.nomoto import Nomoto1, Nomoto2, NonlinearNomoto
+from .._steering.nonlinear_nomoto2 import NonlinearNomoto2
 
 
 STRUCTURES = ("linear1", "nonlinear1", "linear2", "nonlinear2")
@@ -105,8 +109,6 @@ def _zoh2_ps(K, P, S, T3, h):
     $K(1 + T_3s)/(Ps^2 + Ss + 1)$ at interval h, by the matrix exponential of the
     controllable realisation $\\dot x_1 = x_2$, $P\\dot x_2 = -x_1 - Sx_2 + \\delta$,
     $r = K(x_1 + T_3x_2)$ (Astrom & Wittenmark, Computer-Controlled Systems, ch. 2)."""
-    from scipy.linalg import expm
-
     m = np.zeros((3, 3))
     m[0, 1] = 1.0
     m[1, :] = [-1.0 / P, -S / P, 1.0 / P]
@@ -273,8 +275,6 @@ def _svr(x, y, C, epsilon, tol, max_iter):
         from sklearn.svm import LinearSVR
     except ImportError as err:  # pragma: no cover - depends on the environment
         raise ImportError("method='svr' needs scikit-learn: pip install 'jaxship[svm]'.") from err
-    import warnings
-
     # Precondition: regress on orthonormal features q = x R^-1 (x = QR) scaled to unit
     # RMS, then map back w = R^-1 w_q. The epsilon-insensitive loss depends on x w
     # only, so this changes nothing but the regulariser, ||w_q||^2 instead of ||w||^2,
@@ -341,9 +341,6 @@ class DiscreteResponseFit:
         $n_3 = \\beta_1/|\\alpha_1|$, $n_0 = -K\\delta_r$), `Nomoto2` or
         `NonlinearNomoto2`; the offset is `delta0`. Raises `ValueError` when the
         second-order time constants are complex or not positive."""
-        from .._steering.nomoto import Nomoto1, Nomoto2, NonlinearNomoto
-        from .._steering.nonlinear_nomoto2 import NonlinearNomoto2
-
         p = self.parameters
         if self.structure == "linear1":
             return Nomoto1(K=p["K"], T=p["T"], delta0=p["delta_r"])

@@ -10,6 +10,7 @@ cost-based stopping rule added, `_lm.py`), the Jacobian by forward-mode autodiff
 through the RK4 scan, computed once per evaluation (`_lm.stored_jacobian`).
 """
 
+import dataclasses
 import math
 import warnings
 
@@ -19,17 +20,19 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
-from .._sharding import sharded_vmap
-from .._steering._base import AbstractSteeringModel, propagate
-from .._validate import (
+from .._covariance import (
     ParameterReport,
+    hac_from_windows,
     least_squares_covariance,
     parameter_report,
-    validate,
 )
+from .._frames import fit_to_dataframe
+from .._params import Transform, as_arrays, get_path, parameter_fields, rebuild, resolve_free
+from .._sharding import sharded_vmap
+from .._simulate import Simulator, integrate, replay_policy
+from .._validate import _to_plain, validate
 from ._lm import LevenbergMarquardt, SolverOutcome, solve_least_squares
-from ._params import Transform, as_arrays, rebuild, resolve_free
-from ._windows import Windows, as_dataset, build_windows, check_data, to_timeline
+from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_data, to_timeline
 
 
 class IdentifiabilityWarning(UserWarning):
@@ -82,8 +85,13 @@ class PredictionError(eqx.Module):
       the windows from the EKF + RTS smoothed r and psi instead (the targets stay
       the measurements).
     - `wind`: vessels only: replay the measured true wind (`wind_speed`,
-      `wind_dir`, held over each interval) as loads of `jaxship.Wind` on the
-      vessel's wind areas. Default False: calm water.
+      `wind_dir`) as loads of `jaxship.Wind` on the vessel's wind areas. Default
+      False: calm water.
+    - `hold`: how the replayed signals are interpolated between samples (MATLAB's
+      `InterSample`): `None` (default) linearly for measured, continuous signals
+      (the rudder angle `delta`, `n`, `u`, `v`, the wind speed: first-order hold) and
+      held for commands (`delta_c`) and the wind direction (zero-order hold); `"zoh"`
+      or `"foh"` for all; or a dict by channel name overriding some.
     """
 
     horizon: float | None = None
@@ -96,27 +104,33 @@ class PredictionError(eqx.Module):
     max_lag: int = 25
     initial: str | list = "measured"
     wind: bool = False
+    hold: str | dict | None = None
 
 
 def _predict(model, w: Windows, offsets=None):
     """Model outputs at the window samples, shape (C, E, W, L). `offsets` (E, W, 2):
-    estimated corrections of the measured r and psi at the window starts, or None."""
+    estimated corrections of the measured r and psi at the window starts, or None.
+    Any model of the shared contract (`replay_state`, `replay_field`, `channel_index`)."""
+    field = model.replay_field(w.servo)  # built once per evaluation (e.g. M^-1)
+    index = [model.channel_index(c) for c in w.channels]
+    corrected = jnp.array([model.channel_index("r"), model.channel_index("psi")])
+    simulator = Simulator(max_step=math.inf, substeps=w.substeps)
+    holds = dict(w.holds)
 
-    def one(start, delta, aux, dt, offset):
-        x0 = model.window_state(start)
-        psi0 = start.psi
+    def one(start, records, dt, offset):
+        y0 = model.replay_state(start, w.servo)
         if offset is not None:
-            x0 = x0.at[0].add(offset[0])
-            psi0 = psi0 + offset[1]
-        psi, r, states = propagate(model, x0, psi0, delta, aux, dt, w.substeps)
-        out = {"psi": psi, "r": r}
-        for c in w.channels:  # "u", "v": the model state of that name
-            if c not in out:
-                out[c] = states[:, model.state_names.index(c)]
-        return out
+            y0 = y0.at[corrected].add(offset)
+        num = records["delta"].shape[0] - 1
+        observe = lambda y, _: jnp.stack([model.measure(c, y[i]) for c, i in
+                                          zip(w.channels, index)])
+        out, _ = integrate(lambda t, y, a: field(t, y, a[0].at(t - a[1])), y0,
+                           replay_policy(records, dt, holds), None, 0.0, dt, num, simulator,
+                           w.substeps, observe, emit="end")
+        return out  # (L, C)
 
-    out = sharded_vmap(one, w.start, w.delta, w.aux, w.dt, offsets, batch_dims=2)
-    return jnp.stack([out[c] for c in w.channels])
+    out = sharded_vmap(one, w.start, w.records, w.dt, offsets, batch_dims=2)
+    return jnp.moveaxis(out, -1, 0)
 
 
 def _residuals(model, w: Windows, offsets=None):
@@ -155,25 +169,6 @@ def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
         physical)
     pred = windows.targets - residual / windows.weights[:, None, None, None]
     return z, result, steps, q[: len(transform.names)], pred, jac
-
-
-@eqx.filter_jit
-def _evaluate(z, model, transform, windows, offset_scale):
-    """Physical parameters, predictions (C, E, W, L) and the Jacobian of the
-    weighted residuals with respect to the physical parameters and the physical
-    start offsets (C, E, W, L, d + 2 E W), by forward mode."""
-    p, offsets = _split(z, transform, windows, offset_scale)
-    p = transform.to_physical(p)
-    q = p if offsets is None else jnp.concatenate([p, jnp.reshape(offsets, (-1,))])
-
-    def f(q):
-        pp, oo = q[: p.shape[0]], None
-        if offsets is not None:
-            oo = jnp.reshape(q[p.shape[0]:], offsets.shape)
-        return _residuals(rebuild(model, transform.names, pp), windows, oo)
-
-    pred = _predict(rebuild(model, transform.names, p), windows, offsets)
-    return p, pred, jax.jacfwd(f)(q)
 
 
 def _progress(**kwargs):
@@ -238,6 +233,11 @@ class FitResult(SolverOutcome):
     def flags(self) -> tuple[str, ...]:
         return self.parameters.flags
 
+    def to_dataframe(self):
+        """One row per free parameter: name, value, std, std_robust, unit and the 95 %
+        interval (pandas, an optional dependency)."""
+        return fit_to_dataframe(self)
+
     def interval(self, level: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
         """Normal confidence intervals `(lower, upper)` of the estimates at `level`
         (two-sided), from the standard errors."""
@@ -258,9 +258,7 @@ class FitResult(SolverOutcome):
     def to_dict(self) -> dict:
         """JSON-ready summary: model name, parameters (value, std, unit), frozen
         values, metrics per channel, correlation, condition number, flags, result."""
-        from .._validate import _to_plain
-
-        fields = {n: getattr(self.model, n) for n in _field_names(self.model)}
+        fields = {n: get_path(self.model, n) for n in _field_names(self.model)}
         params = {
             n: {"value": float(v), "std": _to_plain(float(s)), "unit": u}
             for n, v, s, u in zip(self.names, self.values, self.std, self.parameters.units)
@@ -285,13 +283,6 @@ class FitResult(SolverOutcome):
 
 
 def _field_names(model):
-    from .._vessel._base import AbstractVessel
-    from ._params import parameter_fields
-
-    if isinstance(model, AbstractVessel):
-        from ._vessel_fit import vessel_coefficients
-
-        return tuple(vessel_coefficients(model))
     return tuple(parameter_fields(model))
 
 
@@ -350,77 +341,53 @@ def _excitation_flags(ds, rudder) -> list[str]:
     return flags
 
 
-def fit(model: AbstractSteeringModel, dataset, *, estimator: PredictionError = PredictionError(),
-        free=None, verbose=False) -> FitResult:
-    """Estimate the free parameters of a response model from measured data.
+def fit(model, dataset, *, estimator: PredictionError = PredictionError(), free=None,
+        verbose=False) -> FitResult:
+    """Estimate the free parameters of a steering model or a vessel from measured data.
 
     **Arguments:**
 
-    - `model`: an `AbstractSteeringModel` whose field values are the start values
-      (e.g. from `initial_estimate`) and the values of frozen parameters.
+    - `model`: any model of the shared contract, a steering model
+      (`AbstractSteeringModel`) or a 3-DOF vessel (`AbstractVessel`), whose field
+      values are the start values (e.g. from `initial_estimate`) and the values of
+      frozen parameters.
     - `dataset`: a `Dataset`, an `Experiment` or a list of experiments (merged:
       different lengths, sample intervals and propeller rates are fine). Each needs
-      a measured rudder and uniform sampling; r and psi are measured or derived.
-    - `estimator`: a `PredictionError` (horizon, channels, weights, solver).
-    - `free`: which parameters to estimate: `None` (the model's defaults, see its
-      `param` fields), a sequence of field names, or `{name: Free(value, lower=,
-      upper=, scale=) or None}`.
+      a measured rudder and uniform sampling; r and psi are measured or derived; a
+      vessel's windows start from the measured u and v too.
+    - `estimator`: a `PredictionError` (horizon, channels, weights, holds, solver).
+    - `free`: which parameters to estimate: `None` (the model's defaults: its `param`
+      fields declared free, or a vessel's `free_by_default`), a sequence of field
+      names, or `{name: Free(value, lower=, upper=, scale=) or None}`.
     - `verbose`: print the optimiser's progress (True, or a callable taking the
       optimistix verbose keyword arguments).
 
     **Returns:** a `FitResult`. The covariance is $\\hat\\sigma^2(J^TJ)^{-1}$ in the
     physical parameters (per-channel noise variances: see
-    `jaxship._validate.least_squares_covariance`), which is right for white
+    `jaxship._covariance.least_squares_covariance`), which is right for white
     residuals: output error with measurement noise only, or a horizon that makes the
     residuals white. Check `metrics[c].white`.
 
     **Raises:** `ValueError` for bad data (non-finite values, naming the experiment,
-    channel and sample; no rudder record; non-uniform sampling), unknown parameter
-    names or start values outside the bounds.
+    channel and sample; no rudder record; non-uniform sampling; a channel the model
+    needs but the record lacks), unknown parameter names or start values outside the
+    bounds.
 
     **Warns:** `IdentifiabilityWarning` when the parameter report has flags (strong
     correlations, large relative errors, undetermined combinations, no excitation);
     `ConvergenceWarning` when the optimiser did not converge.
     """
-    from .._vessel._base import AbstractVessel
-
-    if not isinstance(estimator, PredictionError):
-        raise ValueError(f"`estimator` must be a PredictionError, got {type(estimator).__name__}.")
-    if isinstance(model, AbstractVessel):
-        from ._vessel_fit import fit_vessel
-
-        return fit_vessel(model, dataset, estimator=estimator, free=free, verbose=verbose)
-    if not isinstance(model, AbstractSteeringModel):
-        raise ValueError(f"`model` must be a jaxship steering model (AbstractSteeringModel) "
-                         f"or vessel (AbstractVessel), got {type(model).__name__}.")
-    if estimator.wind:
-        raise ValueError("`wind=True` is for vessels; steering models have no wind loads.")
-    ds = as_dataset(dataset)
-    channels = ("psi", "r") if estimator.channels is None else tuple(estimator.channels)
-    for c in channels:
-        if c in ("u", "v") and c not in model.state_names:
-            raise ValueError(f"unknown output channel {c!r} for {type(model).__name__}, whose "
-                             f"outputs are psi, r and its states {model.state_names}.")
-    check_data(ds, estimator.rudder, channels)
-    if int(estimator.substeps) < 1:
-        raise ValueError(f"`substeps` must be a positive integer, got {estimator.substeps}.")
+    ds, windows, layout = _prepare(model, dataset, estimator)
     specs = resolve_free(model, free)
-    transform = Transform.from_specs(specs)
-    smoothed = not isinstance(estimator.initial, str)
-    starts = _smoothed_starts(ds, estimator.initial) if smoothed else None
-    if not smoothed and estimator.initial not in ("measured", "estimate"):
-        raise ValueError(f"`initial` must be 'measured', 'estimate' or a list of smoothed "
-                         f"states, got {estimator.initial!r}.")
-    windows, layout = build_windows(ds, horizon=estimator.horizon, channels=channels,
-                                    weights=estimator.weights, rudder=estimator.rudder,
-                                    substeps=int(estimator.substeps), starts=starts)
     estimate_starts = estimator.initial == "estimate"
     if estimate_starts and min(layout["lengths"]) < 2:
         raise ValueError("`initial='estimate'` needs windows of at least 2 samples (with one "
                          "sample the estimated start explains every residual); use a longer "
                          "`horizon` or initial='measured'.")
-    start = np.array([s.start for s in specs])
-    z0 = transform.to_unconstrained(start)
+    base = as_arrays(model)
+    specs = _jacobian_scales(specs, base, windows)
+    transform = Transform.from_specs(specs)
+    z0 = transform.to_unconstrained(np.array([s.start for s in specs]))
     offset_scale = None
     if estimate_starts:
         offset_scale = jnp.asarray(_offset_scales(ds), dtype=float)
@@ -430,12 +397,85 @@ def fit(model: AbstractSteeringModel, dataset, *, estimator: PredictionError = P
     if verbose and hasattr(solver, "verbose"):
         solver = eqx.tree_at(lambda s: s.verbose, solver, verbose if callable(verbose)
                              else _progress)
-    base = as_arrays(model)
     _, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows, offset_scale,
                                                 solver, int(estimator.max_steps))
     return _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
                    result, num_steps, estimate_starts=estimate_starts, verbose=verbose,
                    stacklevel=3)
+
+
+def _prepare(model, dataset, estimator):
+    """Check the model, data and estimator and build the windows: `(ds, windows,
+    layout)`, shared by `fit` and `predict`."""
+    if not isinstance(estimator, PredictionError):
+        raise ValueError(f"`estimator` must be a PredictionError, got {type(estimator).__name__}.")
+    if not all(hasattr(model, m) for m in ("replay_field", "replay_state", "channel_index")):
+        raise ValueError(f"`model` must be a jaxship steering model (AbstractSteeringModel) "
+                         f"or vessel (AbstractVessel), got {type(model).__name__}.")
+    ds = as_dataset(dataset)
+    channels = model.default_channels if estimator.channels is None else tuple(
+        estimator.channels)
+    for c in channels:
+        if c not in CHANNEL_NAMES:
+            raise ValueError(f"unknown output channel {c!r}; choose from {CHANNEL_NAMES}.")
+        try:
+            model.channel_index(c)
+        except ValueError:
+            raise ValueError(f"unknown output channel {c!r} for {type(model).__name__}, whose "
+                             f"outputs are psi, r and its states.") from None
+    check_data(ds, estimator.rudder, channels)
+    if estimator.wind and not model.wind_loads:
+        raise ValueError(f"`wind=True` is for vessels; {type(model).__name__} has no wind "
+                         "loads.")
+    servo = estimator.rudder == "delta_c"
+    needed = list(model.start_channels) + (["delta"] if servo and model.has_servo else [])
+    needed += ["wind_speed", "wind_dir"] if estimator.wind else []
+    for i, name in enumerate(ds.names):
+        missing = [c for c in needed if c not in ds.experiment_channels[i]]
+        if missing:
+            raise ValueError(
+                f"experiment {name!r} (dataset entry {i}): no measured {missing[0]!r}; "
+                f"{type(model).__name__} restarts every window from the measured "
+                f"{', '.join(needed)} (and `wind=True` replays the measured wind), so these "
+                "must be measured (or fit a steering model instead).")
+    if int(estimator.substeps) < 1:
+        raise ValueError(f"`substeps` must be a positive integer, got {estimator.substeps}.")
+    smoothed = not isinstance(estimator.initial, str)
+    starts = _smoothed_starts(ds, estimator.initial) if smoothed else None
+    if not smoothed and estimator.initial not in ("measured", "estimate"):
+        raise ValueError(f"`initial` must be 'measured', 'estimate' or a list of smoothed "
+                         f"states, got {estimator.initial!r}.")
+    windows, layout = build_windows(ds, horizon=estimator.horizon, channels=channels,
+                                    weights=estimator.weights, rudder=estimator.rudder,
+                                    substeps=int(estimator.substeps), starts=starts,
+                                    hold=estimator.hold, wind=bool(estimator.wind))
+    return ds, windows, layout
+
+
+def _jacobian_scales(specs, model, windows):
+    """Specs whose scale is 0 (unbounded parameters starting at zero) get the scale
+    that gives their Jacobian column the median norm of the others (scaled)."""
+    zero = np.array([s.scale == 0.0 for s in specs])
+    if not zero.any():
+        return specs
+    provisional = [dataclasses.replace(s, scale=s.scale or 1.0) for s in specs]
+    transform = Transform.from_specs(provisional)
+    start = jnp.asarray([s.start for s in specs], dtype=float)
+    jac = _jacobian(start, model, transform, windows)
+    norms = np.sqrt(np.sum(np.asarray(jac, dtype=np.float64).reshape(-1, len(specs)) ** 2,
+                           axis=0))
+    scaled = norms * np.array([s.scale for s in provisional])
+    reference = np.median(scaled[~zero]) if (~zero).any() else 1.0
+    return tuple(
+        dataclasses.replace(s, scale=float(reference / norms[i]) if norms[i] > 0 else 1.0)
+        if zero[i] else s for i, s in enumerate(specs))
+
+
+@eqx.filter_jit
+def _jacobian(p, model, transform, windows):
+    """Forward-mode Jacobian (C, E, W, L, d) of the weighted residuals with respect to
+    the physical parameters p."""
+    return jax.jacfwd(lambda q: _residuals(rebuild(model, transform.names, q), windows))(p)
 
 
 def _smoothed_starts(ds, smoothed) -> dict:
@@ -485,9 +525,6 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
     covariance = full[:d, :d]
     null = [v[:d] / np.linalg.norm(v[:d]) for v in null if np.linalg.norm(v[:d]) > 1e-3]
     flags = _excitation_flags(ds, estimator.rudder)
-    report = parameter_report(transform.names, values, covariance,
-                              units=tuple(s.unit for s in specs), null_directions=null,
-                              extra_flags=flags)
     num_params = columns.shape[0]
 
     shape = (ds.num_experiments, ds.num_samples)
@@ -499,6 +536,15 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
         measured = np.asarray(getattr(ds, name), dtype=np.float64)
         metrics[name] = validate(measured, timeline, hit, num_params=num_params, u=u,
                                  max_lag=estimator.max_lag, channel=name)
+    # standard errors that do not assume white residuals (Newey-West HAC), reported and
+    # flagged when the residuals fail the whiteness test
+    white = all(m.white for m in metrics.values())
+    robust, lags = hac_from_windows(jac[..., columns], resid, layout, num_samples=shape[1],
+                                    focus=np.arange(d))
+    report = parameter_report(transform.names, values, covariance,
+                              units=tuple(s.unit for s in specs), null_directions=null,
+                              extra_flags=flags, robust_covariance=robust[:d, :d],
+                              white=white, hac_lags=lags)
     out = FitResult(
         model=fitted, parameters=report, metrics=metrics, predictions=predictions,
         predicted=hit, result=result, num_steps=int(num_steps), cost=cost,
@@ -511,7 +557,7 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
     if not out.success:
         warnings.warn(f"fit of {type(model).__name__}: the optimiser stopped without "
                       f"converging ({out.message}).", ConvergenceWarning, stacklevel=stacklevel)
-    if report.flags:
+    if not report.identifiable:
         warnings.warn(f"fit of {type(model).__name__}: " + " ".join(report.flags),
                       IdentifiabilityWarning, stacklevel=stacklevel)
     return out

@@ -1,11 +1,13 @@
-"""State estimation and the likelihood of steering models: extended Kalman filter,
-Rauch-Tung-Striebel smoother, and innovations-form (PEM) and maximum-likelihood fits.
+"""State estimation of steering models: extended Kalman filter and
+Rauch-Tung-Striebel smoother (the innovations-form (PEM) and maximum-likelihood
+fits on top of them are in `jaxship._estimate._likelihood`).
 
 **Model.** The filter works on the augmented state $z = (x, \\psi)$ of a steering model
 (`AbstractSteeringModel.state_names` followed by the heading). Over one sample
-interval the rudder $\\delta_k$ and the auxiliary inputs are held and the interval map
-$F$ is the RK4 integration of `_steering._base._rk4_interval` (the same numerics as
-`simulate_steering` and `fit`):
+interval the recorded rudder and auxiliary inputs are replayed as `fit` replays them
+(the measured angle linear between $\\delta_k$ and $\\delta_{k+1}$, a command held) and
+the interval map $F$ is the simulator's time loop over the interval
+(`jaxship._simulate.integrate`, the same numerics as `simulate_steering` and `fit`):
 
 $$z_{k+1} = F(z_k, \\delta_k + w_k) + v_k, \\qquad y_k = h(z_k) + e_k,$$
 
@@ -51,13 +53,13 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
-import optimistix as optx
 
-from .._steering._base import AbstractSteeringModel, AuxInputs, WindowStart, _rk4_interval
-from .._validate import ParameterReport, least_squares_covariance, parameter_report
-from ._lm import LevenbergMarquardt, SolverOutcome, solve_least_squares
-from ._params import Transform, as_arrays, rebuild, resolve_free
-from ._windows import as_dataset, channel_weights, check_data
+from .._data import Experiment
+from .._params import as_arrays
+from .._simulate import Held, Simulator, integrate
+from .._simulate_steering import steering_field
+from .._steering._base import AbstractSteeringModel, AuxInputs, WindowStart
+from ._windows import as_dataset, check_data, resolve_holds
 
 
 KALMAN_CHANNELS = ("psi", "r")
@@ -198,10 +200,22 @@ class KalmanOutput(eqx.Module):
     names: tuple[str, ...] = eqx.field(static=True)
 
 
-def _interval_map(model, substeps):
-    def f(z, delta, aux, dt):
-        x, psi = _rk4_interval(model, z[:-1], z[-1], delta, aux, dt, substeps)
-        return jnp.concatenate([x, psi[None]])
+def _interval_map(model, substeps, holds):
+    """$F(z, \\delta + w)$: one sample interval of the simulator's time loop, the
+    recorded inputs replayed from sample k to k + 1 with `holds` (as `fit` replays
+    them) and the disturbance $w$ held over the interval."""
+    simulator = Simulator(max_step=math.inf, substeps=substeps)
+    field = steering_field(model)
+
+    def f(z, w, delta, aux, dt):
+        start = {"delta": delta[0] + w, "u": aux.u[0], "v": aux.v[0], "n": aux.n[0]}
+        end = {"delta": delta[1] + w, "u": aux.u[1], "v": aux.v[1], "n": aux.n[1]}
+        slope = {k: (end[k] - start[k]) / dt if holds[k] == "foh" else 0.0 * start[k]
+                 for k in start}
+        held = Held(start, slope)
+        out, _ = integrate(field, z, lambda t, y, s, h: (held, s), None, 0.0, dt, 1,
+                           simulator, substeps, lambda y, _: y, emit="end")
+        return out[0]
 
     return f
 
@@ -214,10 +228,11 @@ def _measure(model, channels):
     return h
 
 
-def _filter(model, delta, aux, y, mask, dt, z0, P0, Q, q_rudder, R, channels, substeps):
+def _filter(model, delta, aux, y, mask, dt, z0, P0, Q, q_rudder, R, channels, substeps,
+            holds):
     """The EKF over one record (module docstring); `delta`, `aux` leaves, `mask`: (N,);
     `y`: (N, C). Returns a `KalmanOutput`."""
-    F = _interval_map(model, substeps)
+    F = _interval_map(model, substeps, dict(holds))
     h = _measure(model, channels)
     jac = jax.jacfwd(F, argnums=(0, 1))
     n = z0.shape[0]
@@ -226,8 +241,8 @@ def _filter(model, delta, aux, y, mask, dt, z0, P0, Q, q_rudder, R, channels, su
     def step(carry, inputs):
         z, P = carry
         d, a, yk, mk = inputs
-        A, B = jac(z, d, a, dt)
-        z_pred = F(z, d, a, dt)
+        A, B = jac(z, 0.0, d, a, dt)
+        z_pred = F(z, 0.0, d, a, dt)
         P_pred = A @ P @ A.T + Q + q_rudder * jnp.outer(B, B)
         P_pred = 0.5 * (P_pred + P_pred.T)
         H = jax.jacfwd(h)(z_pred)
@@ -247,7 +262,8 @@ def _filter(model, delta, aux, y, mask, dt, z0, P0, Q, q_rudder, R, channels, su
         out = (z_pred, P_pred, z_new, P_new, jnp.where(mk, e, 0.0), S, A, jnp.where(mk, nll, 0.0))
         return (z_new, P_new), out
 
-    inputs = (delta[:-1], jax.tree.map(lambda v: v[:-1], aux), y[1:], mask[1:])
+    pairs = lambda v: jnp.stack([v[:-1], v[1:]], axis=-1)  # (N - 1, 2): each interval's ends
+    inputs = (pairs(delta), jax.tree.map(pairs, aux), y[1:], mask[1:])
     _, (zp, Pp, zf, Pf, e, S, A, nll) = jax.lax.scan(step, (z0, P0), inputs)
     first = lambda a0, a: jnp.concatenate([a0[None], a])
     c = y.shape[1]
@@ -300,9 +316,10 @@ class _Records(eqx.Module):
     start: WindowStart
     channels: tuple[str, ...] = eqx.field(static=True)
     substeps: int = eqx.field(static=True)
+    holds: tuple = eqx.field(static=True, default=())
 
 
-def _records(ds, channels, rudder, substeps) -> _Records:
+def _records(ds, channels, rudder, substeps, hold=None) -> _Records:
     f = lambda a: jnp.asarray(np.asarray(a, dtype=np.float64))
     first = lambda name: f(np.asarray(getattr(ds, name), dtype=np.float64)[:, 0])
     zero = jnp.zeros(ds.num_experiments)
@@ -315,6 +332,7 @@ def _records(ds, channels, rudder, substeps) -> _Records:
         y=f(np.stack([np.asarray(getattr(ds, c)) for c in channels], axis=-1)),
         mask=jnp.asarray(np.asarray(ds.mask, dtype=bool)),
         dt=f(ds.dt), start=start, channels=tuple(channels), substeps=int(substeps),
+        holds=resolve_holds(rudder, hold, ("delta", "u", "v", "n")),
     )
 
 
@@ -338,7 +356,7 @@ def _batch_filter(model, rec: _Records, Q, q_rudder, R, P0=None):
     def one(delta, aux, y, mask, dt, start):
         z0, p0 = _prior(model, start, rec.channels, R, P0)
         return _filter(model, delta, aux, y, mask, dt, z0, p0, Q, q_rudder, R, rec.channels,
-                       rec.substeps)
+                       rec.substeps, rec.holds)
 
     # plain vmap: reverse mode (the ML Hessian) of a scan inside shard_map fails in
     # jax 0.10 ("context mesh ... should match"); records are few, windows are many
@@ -372,7 +390,7 @@ def _check_inputs(model, data, channels, rudder, substeps):
 
 
 def _prepare(model, data, channels, rudder, substeps, process_noise, measurement_noise,
-             initial_covariance):
+             initial_covariance, hold=None):
     ds, channels = _check_inputs(model, data, channels, rudder, substeps)
     Q, q_rudder = process_matrices(model, process_noise)
     R = measurement_matrix(channels, measurement_noise)
@@ -380,13 +398,13 @@ def _prepare(model, data, channels, rudder, substeps, process_noise, measurement
     if initial_covariance is not None:
         P0 = jnp.asarray(_matrix(initial_covariance, Q.shape[0], "initial_covariance",
                                  definite=False))
-    rec = _records(ds, channels, rudder, substeps)
+    rec = _records(ds, channels, rudder, substeps, hold)
     return ds, rec, jnp.asarray(Q), jnp.asarray(q_rudder), jnp.asarray(R), P0
 
 
 def ekf(model: AbstractSteeringModel, experiment, *, process_noise, measurement_noise,
         channels=KALMAN_CHANNELS, rudder: str = "delta", initial_covariance=None,
-        substeps: int = 1) -> KalmanOutput:
+        substeps: int = 1, hold=None) -> KalmanOutput:
     """Extended Kalman filter of a steering model over one measured record (module
     docstring for the equations).
 
@@ -405,16 +423,16 @@ def ekf(model: AbstractSteeringModel, experiment, *, process_noise, measurement_
     - `initial_covariance`: $P_0$ (n, n) of the prior at sample 0 (default: R on psi and
       r, 0 on hidden states).
     - `substeps`: RK4 steps per sample interval.
+    - `hold`: how the recorded inputs are replayed between samples, as
+      `PredictionError(hold=...)`.
 
     **Returns:** a `KalmanOutput` (arrays of the record's length).
     """
-    from .._data import Experiment
-
     if not isinstance(experiment, Experiment):
         raise ValueError(f"`experiment` must be a jaxship Experiment, got "
                          f"{type(experiment).__name__}; use smooth_states for a Dataset.")
     _, rec, Q, q, R, P0 = _prepare(model, experiment, channels, rudder, substeps,
-                                   process_noise, measurement_noise, initial_covariance)
+                                   process_noise, measurement_noise, initial_covariance, hold)
     out = _filter_jit(as_arrays(model), rec, Q, q, R, P0)
     out = jax.tree.map(lambda a: a[0], out)
     return dataclasses.replace(out, names=_augmented_names(model))
@@ -448,7 +466,7 @@ class SmoothedStates(eqx.Module):
 
 def smooth_states(model: AbstractSteeringModel, data, *, process_noise, measurement_noise,
                   channels=KALMAN_CHANNELS, rudder: str = "delta", initial_covariance=None,
-                  substeps: int = 1) -> list[SmoothedStates]:
+                  substeps: int = 1, hold=None) -> list[SmoothedStates]:
     """Smoothed states (EKF + RTS smoother) of every experiment of `data` (an
     `Experiment`, a list of them or a `Dataset`), e.g. for the start states of
     prediction windows or for residual forces. Arguments as `ekf`; the noise is
@@ -457,295 +475,9 @@ def smooth_states(model: AbstractSteeringModel, data, *, process_noise, measurem
     **Returns:** a list of `SmoothedStates`, one per experiment, cut to its length.
     """
     ds, rec, Q, q, R, P0 = _prepare(model, data, channels, rudder, substeps, process_noise,
-                                    measurement_noise, initial_covariance)
+                                    measurement_noise, initial_covariance, hold)
     _, zs, Ps = _smooth_jit(as_arrays(model), rec, Q, q, R, P0)
     zs, Ps = np.asarray(zs), np.asarray(Ps)
     names = _augmented_names(model)
     return [SmoothedStates(t=np.asarray(ds.t)[i, :n], mean=zs[i, :n], covariance=Ps[i, :n],
                            names=names, name=ds.names[i]) for i, n in enumerate(ds.lengths)]
-
-
-# -- estimation ---------------------------------------------------------------------
-
-
-class _Noise(eqx.Module):
-    """Layout of the noise parameters: the process entries (`"rudder"` or augmented
-    state names) and the channels; `estimated` flags, fixed log-variances `fixed`."""
-
-    names: tuple[str, ...] = eqx.field(static=True)  # process names, then channels
-    estimated: tuple[bool, ...] = eqx.field(static=True)
-    fixed: jax.Array  # log variances of all entries (used where not estimated)
-    state_index: tuple[int, ...] = eqx.field(static=True)  # -1: rudder, -2: channel
-    num_states: int = eqx.field(static=True)
-
-    def matrices(self, log_var):
-        """(Q, q_rudder, R) from the estimated log variances."""
-        full, j = [], 0
-        for i, est in enumerate(self.estimated):
-            if est:
-                full.append(log_var[j])
-                j += 1
-            else:
-                full.append(self.fixed[i])
-        var = jnp.exp(jnp.stack(full))
-        Q = jnp.zeros((self.num_states, self.num_states), var.dtype)
-        q_rudder = jnp.zeros((), var.dtype)
-        r_diag = []
-        for i, k in enumerate(self.state_index):
-            if k == -1:
-                q_rudder = var[i]
-            elif k == -2:
-                r_diag.append(var[i])
-            else:
-                Q = Q.at[k, k].set(var[i])
-        return Q, q_rudder, jnp.diag(jnp.stack(r_diag))
-
-
-def _split(z, d, transform, model):
-    p = transform.to_physical(z[:d])
-    return rebuild(model, transform.names, p), z[d:]
-
-
-def _nll(z, args):
-    model, transform, noise, rec = args
-    m, log_var = _split(z, len(transform.names), transform, model)
-    Q, q, R = noise.matrices(log_var)
-    return jnp.sum(_batch_filter(m, rec, Q, q, R).neg_log_likelihood)
-
-
-def _pem_residuals(z, args):
-    model, transform, noise, rec, weights = args
-    m, log_var = _split(z, len(transform.names), transform, model)
-    Q, q, R = noise.matrices(log_var)
-    e = _batch_filter(m, rec, Q, q, R).innovations  # (E, N, C), 0 where masked
-    return e * weights
-
-
-@eqx.filter_jit
-def _ml_solve(z0, model, transform, noise, rec, solver, max_steps):
-    # the loss per sample keeps the tolerances independent of the record length
-    count = jnp.sum(rec.mask[:, 1:])
-    fn = lambda z, args: _nll(z, args) / count
-    sol = optx.minimise(fn, solver, z0, args=(model, transform, noise, rec),
-                        max_steps=max_steps, throw=False)
-    return sol.value, sol.result, sol.stats["num_steps"]
-
-
-@eqx.filter_jit
-def _pem_solve(z0, model, transform, noise, rec, weights, solver, max_steps):
-    """LM on the weighted innovations; z, result, steps, the innovations and their
-    Jacobian with respect to the physical parameters and log variances."""
-    d = len(transform.names)
-    z, result, steps, _, res, jac = solve_least_squares(
-        _pem_residuals, solver, z0, (model, transform, noise, rec, weights), max_steps,
-        lambda z: _physical(z, d, transform))
-    return z, result, steps, res, jac
-
-
-def _physical(z, d, transform):
-    """Model parameters in physical units and log variances as one vector."""
-    return jnp.concatenate([transform.to_physical(z[:d]), z[d:]])
-
-
-@eqx.filter_jit
-def _ml_hessian(z, model, transform, noise, rec):
-    """NLL and its Hessian with respect to (physical parameters, log variances)."""
-    d = len(transform.names)
-    q = _physical(z, d, transform)
-
-    def f(q):
-        m = rebuild(model, transform.names, q[:d])
-        Q, qr, R = noise.matrices(q[d:])
-        return jnp.sum(_batch_filter(m, rec, Q, qr, R).neg_log_likelihood)
-
-    return f(q), jax.hessian(f)(q)
-
-
-class KalmanFitResult(SolverOutcome):
-    """Result of `fit_ml`.
-
-    - `model`: the model with the estimates (frozen parameters unchanged);
-    - `parameters`: `ParameterReport` of the free model parameters (values, standard
-      errors, covariance, correlation, flags);
-    - `noise`: `{name: variance}` of the noise at the optimum (process entries:
-      `"rudder"` [rad^2] or state names; channels `"psi"` [rad^2], `"r"`
-      [(rad/s)^2]); `noise_std`: their standard errors (0 when fixed);
-    - `criterion`: `"ml"` or `"pem"`; `loss`: the negative log likelihood (`"ml"`) or
-      half the sum of squared weighted innovations (`"pem"`);
-    - `result` (optimistix code), `success`, `message`, `num_steps`;
-    - `names`, `values`, `std`, `covariance`, `correlation`: shortcuts.
-    """
-
-    model: AbstractSteeringModel
-    parameters: ParameterReport
-    noise: dict
-    noise_std: dict
-    criterion: str
-    loss: float
-    result: optx.RESULTS
-    num_steps: int
-    experiment_names: tuple[str, ...]
-
-    names = property(lambda self: self.parameters.names)
-    values = property(lambda self: self.parameters.values)
-    std = property(lambda self: self.parameters.std)
-    covariance = property(lambda self: self.parameters.covariance)
-    correlation = property(lambda self: self.parameters.correlation)
-
-    def summary(self) -> str:
-        noise = ", ".join(f"{k} {v:.4g} +- {self.noise_std[k]:.2g}" for k, v in self.noise.items())
-        return (f"{type(self.model).__name__} by {self.criterion}: {self.message}, "
-                f"{self.num_steps} steps, loss {self.loss:.6g}\n{self.parameters.table()}\n"
-                f"noise variances: {noise}")
-
-
-def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
-    """The `_Noise` layout and the start log variances of the estimated entries.
-    Entry names: `"rudder"`, `"Q_<state>"` for process noise on a state, and the
-    channels `"psi"`, `"r"` for the measurement noise."""
-    names = _augmented_names(model)
-    if isinstance(process, str):
-        process = (process,)
-    process = tuple(process)
-    if not process:
-        raise ValueError("`process` is empty: name 'rudder' or states of the model.")
-    for p in process:
-        if p != "rudder" and p not in names:
-            raise ValueError(f"`process` names {p!r}, which is neither 'rudder' nor a state "
-                             f"of {type(model).__name__} ({', '.join(names)}).")
-    entries = tuple(p if p == "rudder" else f"Q_{p}" for p in process) + channels
-    index = tuple(-1 if p == "rudder" else names.index(p) for p in process)
-    index = index + (-2,) * len(channels)
-    # default start values: 10 % of the spread of each channel, 0.5 deg of rudder,
-    # 1 % of the spread of the yaw rate (heading for psi) per sample on a state
-    mask = np.asarray(ds.mask)
-    spread = {}
-    for c in ("psi", "r"):
-        y = np.asarray(getattr(ds, c), dtype=np.float64)
-        mean = np.sum(np.where(mask, y, 0.0), 1, keepdims=True) / mask.sum(1, keepdims=True)
-        spread[c] = float(np.sqrt(np.sum(np.where(mask, y - mean, 0.0) ** 2) / mask.sum())) or 1.0
-    default = {"rudder": math.radians(0.5) ** 2}
-    default.update({c: (0.1 * spread[c]) ** 2 for c in channels})
-    default.update({f"Q_{p}": (0.01 * spread["psi" if p == "psi" else "r"]) ** 2
-                    for p in process if p != "rudder"})
-    if isinstance(noise, str) and noise == "estimate":
-        fixed_values = {}
-    elif isinstance(noise, dict):
-        fixed_values = dict(noise)
-    else:
-        raise ValueError(f"`noise` must be 'estimate' or a dict of fixed variances, got "
-                         f"{noise!r}.")
-    starts = dict(noise_start or {})
-    for what, given in (("noise", fixed_values), ("noise_start", starts)):
-        for k in given:
-            if k not in entries:
-                raise ValueError(f"`{what}` names {k!r}, which is not a noise term of this fit "
-                                 f"({', '.join(entries)}).")
-    values, estimated = [], []
-    for e in entries:
-        if e in fixed_values:
-            v = _variance(e, fixed_values[e], "noise")
-        else:
-            v = _variance(e, starts.get(e, default[e]), "noise_start")
-        if v <= 0:
-            raise ValueError(f"noise variance of {e!r} must be positive, got {v}.")
-        values.append(math.log(v))
-        estimated.append(e not in fixed_values)
-    if criterion == "pem":
-        # the innovations do not fix the overall noise scale (scaling Q, R and P0 by one
-        # number leaves the gains unchanged): hold the first channel's variance
-        estimated[len(process)] = False
-    layout = _Noise(names=entries, estimated=tuple(estimated),
-                    fixed=jnp.asarray(values), state_index=index, num_states=len(names))
-    z = np.array([v for v, est in zip(values, estimated) if est])
-    return layout, z
-
-
-def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_CHANNELS,
-           criterion: str = "ml", process="rudder", noise="estimate", noise_start=None,
-           rudder: str = "delta", substeps: int = 1, max_steps: int = 512,
-           solver=None) -> KalmanFitResult:
-    """Estimate a steering model with its noise by the Kalman filter's innovations.
-
-    **Arguments:**
-
-    - `model`, `dataset`, `free`: as `jaxship.fit` (start values in the model; `free`
-      names or `Free` specs).
-    - `channels`: measured outputs, `"psi"` and/or `"r"`.
-    - `criterion`: `"ml"` (default): minimise the negative log likelihood
-      $\\tfrac12\\sum_k(\\log\\det S_k + \\varepsilon_k^TS_k^{-1}\\varepsilon_k)$ over the
-      model parameters and the log noise variances with `optimistix.BFGS`; standard
-      errors from the inverse Hessian (`jax.hessian`) of $-\\log L$ (Ljung 1999,
-      sec. 7.4 and eq. 9.29). `"pem"`: prediction-error method with the innovations
-      predictor (Ljung 1999, sec. 4.3 and 7.2): minimise
-      $\\tfrac12\\sum_k\\|W\\varepsilon_k\\|^2$ ($W$ = 1/std of each channel) with
-      Levenberg-Marquardt and forward-mode Jacobians; the noise variances set the
-      filter gain and are estimated as well, except the first channel's, which fixes
-      the scale (the innovations are invariant to it); standard errors as `fit`.
-    - `process`: where the process noise enters: `"rudder"` (default; a rudder-equivalent
-      disturbance held over each interval) and/or names of the model's states or
-      `"psi"` (a diagonal $Q$ entry each, named `"Q_<state>"` in `noise`).
-    - `noise`: `"estimate"` (default) or a dict `{name: variance}` of values to hold
-      fixed (names `"rudder"`, `"Q_<state>"` and the channels; the others are estimated).
-    - `noise_start`: dict of start variances (default: 10 % of each channel's spread
-      for R, (0.5 deg)^2 for the rudder, 1 % of the spread on states).
-    - `rudder`, `substeps`: as `PredictionError`.
-    - `max_steps`, `solver`: optimiser step limit and an optimistix solver (default
-      `BFGS(rtol=1e-8, atol=1e-8)` for ML, jaxship's `LevenbergMarquardt(rtol=1e-9,
-      atol=1e-9)` with MINPACK's cost test for PEM).
-
-    **Returns:** a `KalmanFitResult`.
-    """
-    if criterion not in ("ml", "pem"):
-        raise ValueError(f"`criterion` must be 'ml' or 'pem', got {criterion!r}.")
-    ds, channels = _check_inputs(model, dataset, channels, rudder, substeps)
-    specs = resolve_free(model, free)
-    transform = Transform.from_specs(specs)
-    layout, z_noise = _noise_layout(model, ds, channels, process, noise, noise_start, criterion)
-    rec = _records(ds, channels, rudder, substeps)
-    z0 = jnp.asarray(np.concatenate([transform.to_unconstrained([s.start for s in specs]),
-                                     z_noise]), dtype=float)
-    base = as_arrays(model)
-    d = len(specs)
-    if criterion == "ml":
-        solver = optx.BFGS(rtol=1e-8, atol=1e-8) if solver is None else solver
-        z, result, steps = _ml_solve(z0, base, transform, layout, rec, solver, int(max_steps))
-        loss, hess = _ml_hessian(z, base, transform, layout, rec)
-        hess = np.asarray(hess, dtype=np.float64)
-        try:
-            cov = np.linalg.inv(hess)
-        except np.linalg.LinAlgError:
-            cov = np.full_like(hess, np.inf)
-        if not np.all(np.isfinite(cov)) or np.any(np.diag(cov) <= 0):
-            cov = np.where(np.eye(hess.shape[0], dtype=bool), np.inf, 0.0)
-        loss = float(loss)
-    else:
-        solver = LevenbergMarquardt(rtol=1e-9, atol=1e-9) if solver is None else solver
-        weights = jnp.asarray(channel_weights(ds, channels, None), dtype=float)
-        z, result, steps, res, jac = _pem_solve(z0, base, transform, layout, rec, weights,
-                                                solver, int(max_steps))
-        mask = np.asarray(ds.mask).copy()
-        mask[:, 0] = False  # sample 0 is the prior, never predicted
-        res, jac = np.asarray(res), np.asarray(jac)
-        rows = np.concatenate([res[..., c][mask] for c in range(len(channels))])
-        jrows = np.concatenate([jac[..., c, :][mask] for c in range(len(channels))])
-        groups = np.repeat(np.arange(len(channels)), int(mask.sum()))
-        cov, _ = least_squares_covariance(jrows, rows, groups)
-        loss = 0.5 * float(np.sum(rows**2))
-    q = np.asarray(_physical(z, d, transform), dtype=np.float64)
-    values = q[:d]
-    fitted = rebuild(model, transform.names, [float(v) for v in values])
-    report = parameter_report(transform.names, values, cov[:d, :d],
-                              units=tuple(s.unit for s in specs))
-    log_var = np.asarray(layout.fixed, dtype=np.float64).copy()
-    log_std = np.zeros_like(log_var)
-    est_index = [i for i, e in enumerate(layout.estimated) if e]
-    log_var[est_index] = q[d:]
-    with np.errstate(invalid="ignore"):
-        log_std[est_index] = np.sqrt(np.diag(cov)[d:])
-    var = np.exp(log_var)
-    noise_out = {n: float(v) for n, v in zip(layout.names, var)}
-    noise_std = {n: float(v * s) for n, v, s in zip(layout.names, var, log_std)}
-    return KalmanFitResult(model=fitted, parameters=report, noise=noise_out, noise_std=noise_std,
-                           criterion=criterion, loss=loss, result=result, num_steps=int(steps),
-                           experiment_names=tuple(ds.names))

@@ -12,16 +12,13 @@ import dataclasses
 import equinox as eqx
 import numpy as np
 
+from .._params import as_arrays
 from .._validate import ValidationReport, validate
-from .._vessel._base import AbstractVessel
-from ._fit import PredictionError, _predict as _steering_predict
-from ._params import as_arrays
-from ._vessel_fit import _check_vessel_data, _predict as _vessel_predict, _vessel_inputs
-from ._windows import as_dataset, build_windows, check_data, to_timeline
+from ._fit import PredictionError, _predict, _prepare
+from ._windows import to_timeline
 
 
-_steering = eqx.filter_jit(lambda model, w: _steering_predict(model, w))
-_vessel = eqx.filter_jit(_vessel_predict)
+_predict_jit = eqx.filter_jit(lambda model, w: _predict(model, w))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -54,25 +51,9 @@ def predict(model, dataset, *, estimator: PredictionError = PredictionError()) -
 
     Raises `ValueError` for bad data as `fit` does.
     """
-    ds = as_dataset(dataset)
-    is_vessel = isinstance(model, AbstractVessel)
-    channels = estimator.channels
-    if channels is None:
-        channels = ("psi", "r", "u", "v") if is_vessel else ("psi", "r")
-    channels = tuple(channels)
-    check_data(ds, estimator.rudder, channels)
-    windows, layout = build_windows(ds, horizon=estimator.horizon, channels=channels,
-                                    weights=estimator.weights, rudder=estimator.rudder,
-                                    substeps=int(estimator.substeps))
-    if is_vessel:
-        _check_vessel_data(ds, estimator)
-        inputs = _vessel_inputs(ds, model, layout, bool(estimator.wind), estimator.rudder)
-        pred = _vessel(as_arrays(model), windows, inputs)
-    else:
-        for c in channels:
-            if c in ("u", "v") and c not in model.state_names:
-                raise ValueError(f"unknown output channel {c!r} for {type(model).__name__}.")
-        pred = _steering(as_arrays(model), windows)
+    ds, windows, layout = _prepare(model, dataset, estimator)
+    channels = windows.channels
+    pred = _predict_jit(as_arrays(model), windows)
     pred = np.asarray(pred, dtype=np.float64)
     shape = (ds.num_experiments, ds.num_samples)
     u = np.asarray(getattr(ds, estimator.rudder), dtype=np.float64)

@@ -88,16 +88,47 @@ def check_data(ds: Dataset, rudder: str, channels, *, rtol: float = 1e-6) -> Non
             )
 
 
+# how each replayed signal is interpolated between samples (MATLAB's `InterSample`):
+# measured continuous signals linearly (first-order hold), commands held (zero-order)
+DEFAULT_HOLDS = {"delta": "foh", "delta_c": "zoh", "u": "foh", "v": "foh", "n": "foh",
+                 "wind_speed": "foh", "wind_dir": "zoh"}
+
+
+def resolve_holds(rudder: str, hold, names) -> tuple[tuple[str, str], ...]:
+    """`(replayed name, hold)` pairs: `hold` None (the defaults by channel, the rudder
+    by the channel it is read from), one of "zoh"/"foh" for every signal, or a dict
+    overriding some channels (keys are channel names, e.g. "delta_c", "n")."""
+    source = {name: (rudder if name == "delta" else name) for name in names}
+    chosen = {src: DEFAULT_HOLDS[src] for src in source.values()}
+    if isinstance(hold, str):
+        chosen = dict.fromkeys(chosen, hold)
+    elif isinstance(hold, dict):
+        unknown = [k for k in hold if k not in chosen]
+        if unknown:
+            raise ValueError(f"`hold` names {unknown[0]!r}, which is not replayed here; the "
+                             f"replayed channels are {sorted(chosen)}.")
+        chosen.update(hold)
+    elif hold is not None:
+        raise ValueError(f"`hold` must be None, 'zoh', 'foh' or a dict, got {hold!r}.")
+    for k, v in chosen.items():
+        if v not in ("zoh", "foh"):
+            raise ValueError(f"hold of {k!r} must be 'zoh' or 'foh', got {v!r}.")
+    return tuple((name, chosen[src]) for name, src in source.items())
+
+
 class Windows(eqx.Module):
     """The prediction windows of a dataset, as arrays for the jitted fit.
 
-    `delta`, `aux` leaves, `mask`: shape (E, W, L); `start` (a `WindowStart` with
-    leaves (E, W)) and `dt`: (E, W); `targets`: (C, E, W, L) measured outputs at the
-    ends of the intervals; `weights`: (C,).
+    `records`: `{name: (E, W, L + 1)}` the replayed signals (`"delta"`: the rudder
+    channel replayed, `"u"`, `"v"`, `"n"`, and the wind when asked for) at the window
+    start and the L samples after it, interpolated between samples as `holds` says;
+    `mask`: (E, W, L); `start` (a `WindowStart` with leaves (E, W)) and `dt`: (E, W);
+    `targets`: (C, E, W, L) measured outputs at the ends of the intervals; `weights`:
+    (C,); `servo`: the replayed rudder is the command, which the vessel's servo turns
+    into the angle.
     """
 
-    delta: jax.Array
-    aux: AuxInputs
+    records: dict
     dt: jax.Array
     start: WindowStart
     targets: jax.Array
@@ -105,6 +136,18 @@ class Windows(eqx.Module):
     weights: jax.Array
     channels: tuple[str, ...] = eqx.field(static=True)
     substeps: int = eqx.field(static=True)
+    holds: tuple = eqx.field(static=True, default=())
+    servo: bool = eqx.field(static=True, default=False)
+
+    @property
+    def delta(self):
+        """The replayed rudder at the start of each interval (E, W, L)."""
+        return self.records["delta"][..., :-1]
+
+    @property
+    def aux(self) -> AuxInputs:
+        """The auxiliary inputs at the start of each interval (E, W, L)."""
+        return AuxInputs(*(self.records[k][..., :-1] for k in ("u", "v", "n")))
 
 
 def window_lengths(ds: Dataset, horizon) -> tuple[int, ...]:
@@ -153,11 +196,13 @@ def channel_weights(ds: Dataset, channels, weights) -> np.ndarray:
 
 
 def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "delta",
-                  substeps: int = 1, starts: dict | None = None):
+                  substeps: int = 1, starts: dict | None = None, hold=None,
+                  wind: bool = False):
     """`(Windows, layout)`; `layout` holds the NumPy index arrays to map window
     predictions back onto the samples: `target` (E, W, L) sample index, `mask`.
     `starts`: optional `{"r": (E, N), "psi": (E, N)}` start values of the windows in
-    place of the measured ones (e.g. smoothed states); targets stay measured."""
+    place of the measured ones (e.g. smoothed states); targets stay measured. `hold`:
+    see `resolve_holds`; `wind`: also replay the measured wind."""
     lengths = window_lengths(ds, horizon)
     num_exp, num = ds.num_experiments, ds.num_samples
     counts = [len(range(0, n - 1, L)) for n, L in zip(ds.lengths, lengths)]
@@ -169,7 +214,9 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
     target = start + l_idx + 1
     valid_len = np.array(ds.lengths)[:, None, None]
     mask = (l_idx < size) & (target <= valid_len - 1) & (w_idx < np.array(counts)[:, None, None])
-    step_index = np.clip(start + l_idx, 0, num - 1)
+    # the samples replayed in each window: its start and the L after it (clipped to the
+    # experiment: beyond its end the last sample holds)
+    record_index = np.minimum(start + np.arange(num_l + 1)[None, None, :], valid_len - 1)
     target_index = np.clip(target, 0, num - 1)
     start_index = np.clip(start[..., 0], 0, num - 1)  # (E, W)
     rows = np.arange(num_exp)[:, None, None]
@@ -187,8 +234,15 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
     dt_e = np.asarray(ds.dt, dtype=np.float64)
     dt = np.broadcast_to(dt_e[:, None], (num_exp, num_w))
     rud = np.asarray(getattr(ds, rudder), dtype=np.float64)
-    # integral of the held rudder from the first sample to sample k
-    integral = np.concatenate([np.zeros((num_exp, 1)), np.cumsum(rud[:, :-1], axis=1)], axis=1)
+    # integral of the replayed rudder from the first sample to sample k (trapezoidal for
+    # a first-order hold, rectangles for a zero-order hold: exact for either)
+    names = ("delta", "u", "v", "n") + (("wind_speed", "wind_dir") if wind else ())
+    holds = resolve_holds(rudder, hold, names)
+    if dict(holds)["delta"] == "foh":
+        pieces = 0.5 * (rud[:, 1:] + rud[:, :-1])
+    else:
+        pieces = rud[:, :-1]
+    integral = np.concatenate([np.zeros((num_exp, 1)), np.cumsum(pieces, axis=1)], axis=1)
     integral = integral * dt_e[:, None]
     first = lambda name: np.broadcast_to(
         start_at(name, np.zeros((1, 1), dtype=int), np.arange(num_exp)[:, None]),
@@ -204,11 +258,12 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
         elapsed=f(start_index * dt_e[:, None]),
         aux=AuxInputs(u=f(at("u", start_index, rows2)), v=f(at("v", start_index, rows2)),
                       n=f(at("n", start_index, rows2))),
+        rudder_angle=f(at("delta", start_index, rows2)),
     )
+    records = {name: f(rud[rows, record_index] if name == "delta" else
+                       at(name, record_index, rows)) for name in names}
     windows = Windows(
-        delta=f(at(rudder, step_index, rows)),
-        aux=AuxInputs(u=f(at("u", step_index, rows)), v=f(at("v", step_index, rows)),
-                      n=f(at("n", step_index, rows))),
+        records=records,
         dt=f(dt),
         start=start_values,
         targets=f(np.stack([at(c, target_index, rows) for c in channels])),
@@ -216,6 +271,8 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
         weights=f(weights),
         channels=tuple(channels),
         substeps=int(substeps),
+        holds=holds,
+        servo=rudder == "delta_c",
     )
     layout = {"target": target_index, "mask": mask, "lengths": lengths, "weights": weights}
     return windows, layout

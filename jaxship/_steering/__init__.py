@@ -3,16 +3,13 @@
 from ._base import (
     AbstractSteeringModel as AbstractSteeringModel,
     AuxInputs as AuxInputs,
-    SteeringTrajectory as SteeringTrajectory,
     WindowStart as WindowStart,
-    simulate_steering as simulate_steering,
 )
 from .nomoto import Nomoto1 as Nomoto1, Nomoto2 as Nomoto2, NonlinearNomoto as NonlinearNomoto
 from .ross import (
     ROSS_FREE as ROSS_FREE,
     SPEED_RUDDER as SPEED_RUDDER,
     RossAutopilot as RossAutopilot,
-    ross_initial_estimate as ross_initial_estimate,
 )
 from .sway_yaw import (
     AbstractSwayYaw as AbstractSwayYaw,

@@ -5,20 +5,16 @@ is the integral of the yaw rate. Unlike a vessel (`jaxship.AbstractVessel`) it h
 sway or surge dynamics of its own: measured speeds, when a model needs them, come in
 as the auxiliary inputs `AuxInputs(u, v, n)` of the current sample.
 
-Simulation replays sampled inputs with a zero-order hold (held over each sample
-interval, as recorded data are) and integrates the model and the heading with
-classic Runge-Kutta 4 in a `jax.lax.scan`: exact in forward and reverse mode, no
-adaptive stepping, so Levenberg-Marquardt's forward-mode Jacobians are cheap.
+The models never integrate themselves: `jaxship.simulate_steering`,
+`jaxship.steer_manoeuvre` and `fit` run them through the simulator's one time loop.
 """
 
 import abc
+from typing import ClassVar
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
-
-from .._estimate._params import as_arrays
 
 
 class AuxInputs(eqx.Module):
@@ -37,8 +33,10 @@ class WindowStart(eqx.Module):
     heading `psi` [rad] there, the rudder `delta` [rad] held over the next
     interval, the auxiliary inputs `aux` there, and, from the start $t_0$ of the
     experiment, `r_first`, `psi_first`, the rudder integral
-    `delta_integral` $= \\int_{t_0}^{t_s}\\delta\\,dt$ [rad s] (exact for the held
-    rudder) and `elapsed` $= t_s - t_0$ [s]."""
+    `delta_integral` $= \\int_{t_0}^{t_s}\\delta\\,dt$ [rad s] (exact for the
+    replayed rudder, held or interpolated) and `elapsed` $= t_s - t_0$ [s];
+    `rudder_angle`: the measured rudder angle at $t_s$ (where a servo replays the
+    command)."""
 
     r: ArrayLike
     psi: ArrayLike
@@ -48,6 +46,7 @@ class WindowStart(eqx.Module):
     delta_integral: ArrayLike
     elapsed: ArrayLike
     aux: AuxInputs
+    rudder_angle: ArrayLike | None = None  # the measured rudder angle there [rad]
 
 
 class AbstractSteeringModel(eqx.Module):
@@ -73,6 +72,12 @@ class AbstractSteeringModel(eqx.Module):
     """
 
     state_names: eqx.AbstractClassVar[tuple[str, ...]]
+    # the model contract shared with vessels (see `jaxship.fit`): fitted outputs by
+    # default, channels every window starts from, wind loads, a rudder servo
+    default_channels: ClassVar[tuple[str, ...]] = ("psi", "r")
+    start_channels: ClassVar[tuple[str, ...]] = ()
+    wind_loads: ClassVar[bool] = False
+    has_servo: ClassVar[bool] = False
 
     @abc.abstractmethod
     def rhs(self, state: Array, delta: ArrayLike, aux: AuxInputs) -> Array:
@@ -90,115 +95,36 @@ class AbstractSteeringModel(eqx.Module):
     def window_state(self, start: WindowStart) -> Array:
         """The state at a window start, reconstructed from the record."""
 
+    # -- the model contract shared with vessels: the simulated state is y = (x, psi) --
 
-def _rk4_interval(model, state, psi, delta, aux, dt, substeps):
-    """Integrate (state, psi) over one sample interval with the inputs held."""
-    h = dt / substeps
+    def channel_index(self, channel: str) -> int:
+        """Where an output channel sits in $y = (x, \\psi)$: r is the first state, psi
+        the last entry, `"u"`/`"v"` a state of that name."""
+        if channel == "psi":
+            return len(self.state_names)
+        if channel in self.state_names:
+            return self.state_names.index(channel)
+        raise ValueError(f"{type(self).__name__} has no output {channel!r}; its outputs are "
+                         f"psi and its states {self.state_names}.")
 
-    def f(y):
-        x, _ = y
-        return model.rhs(x, delta, aux), model.output(x)
+    def measure(self, channel: str, value):
+        """What the sensor of `channel` reports for the true `value` (exact here;
+        sensor effects change it)."""
+        return value
 
-    def step(y, _):
-        add = lambda a, k, c: jax.tree.map(lambda yi, ki: yi + c * ki, a, k)
-        k1 = f(y)
-        k2 = f(add(y, k1, h / 2))
-        k3 = f(add(y, k2, h / 2))
-        k4 = f(add(y, k3, h))
-        incr = jax.tree.map(lambda a, b, c, d: (a + 2 * b + 2 * c + d) / 6, k1, k2, k3, k4)
-        return add(y, incr, h), None
+    def replay_state(self, start: WindowStart, servo: bool = False) -> Array:
+        """$y = (x, \\psi)$ at a window start, `x` from `window_state`."""
+        return jnp.concatenate([self.window_state(start), jnp.reshape(start.psi, (1,))])
 
-    (state, psi), _ = jax.lax.scan(step, (state, psi), None, length=substeps,
-                                   unroll=substeps <= 8)
-    return state, psi
+    def replay_field(self, servo: bool = False):
+        """`f(t, y, inputs)` $= (f(x, \\delta, a), h(x))$ with the replayed rudder
+        `inputs["delta"]` (a command, with `servo`, is taken as the angle: a response
+        model has no servo) and the measured `inputs["u"]`, `["v"]`, `["n"]`."""
 
+        def field(t, y, inputs):
+            x = y[:-1]
+            aux = AuxInputs(inputs["u"], inputs["v"], inputs["n"])
+            return jnp.concatenate([self.rhs(x, inputs["delta"], aux),
+                                    jnp.reshape(self.output(x), (1,))])
 
-def propagate(model: AbstractSteeringModel, state0, psi0, delta, aux: AuxInputs, dt,
-              substeps: int = 1):
-    """Predict the `L` samples after a start: `delta` and the `aux` leaves have shape
-    `(L,)` (the inputs held over intervals 0..L-1); returns `(psi, r, states)` at the
-    ends of the intervals, shapes `(L,)`, `(L,)`, `(L, num_states)`."""
-
-    def step(carry, inputs):
-        state, psi = carry
-        d, a = inputs
-        state, psi = _rk4_interval(model, state, psi, d, a, dt, substeps)
-        return (state, psi), (psi, model.output(state), state)
-
-    _, (psi, r, states) = jax.lax.scan(step, (state0, psi0), (delta, aux))
-    return psi, r, states
-
-
-class SteeringTrajectory(eqx.Module):
-    """Result of `simulate_steering`: `t` [s], heading `psi` [rad], yaw rate `r`
-    [rad/s], the model `state` (shape `(N, num_states)`) and the rudder angle `delta`
-    [rad] at the N sample times (sample 0 is the initial state)."""
-
-    t: Array
-    psi: Array
-    r: Array
-    state: Array
-    delta: Array
-
-
-def simulate_steering(
-    model: AbstractSteeringModel,
-    delta: ArrayLike,
-    dt: ArrayLike,
-    *,
-    state0: ArrayLike | None = None,
-    psi0: ArrayLike = 0.0,
-    aux: AuxInputs | None = None,
-    start: ArrayLike = 0.0,
-    substeps: int = 1,
-) -> SteeringTrajectory:
-    """Simulate a response model driven by sampled rudder angles.
-
-    **Arguments:**
-
-    - `model`: any `AbstractSteeringModel`.
-    - `delta`: rudder angles [rad], shape `(N,)`; `delta[k]` is held over
-      $[t_k, t_{k+1})$ (zero-order hold).
-    - `dt`: sample interval [s].
-    - `state0`: initial model state (default `model.initial_state(0.0)`: at rest).
-    - `psi0`: initial heading [rad].
-    - `aux`: `AuxInputs` with leaves of shape `(N,)` (or scalars), for models that
-      use measured speeds; zeros by default.
-    - `start`: time of sample 0 [s].
-    - `substeps`: RK4 steps per sample interval (RK4 is stable for
-      `dt / substeps` below about 2.8 times the smallest time constant).
-
-    **Returns:** a `SteeringTrajectory` with N samples.
-
-    Parameter values are traced: changing them does not recompile.
-    """
-    delta = jnp.asarray(delta, dtype=float)
-    if delta.ndim != 1 or delta.shape[0] < 2:
-        raise ValueError(f"`delta` must be a 1-D array of at least 2 samples, got shape "
-                         f"{delta.shape}.")
-    if int(substeps) < 1:
-        raise ValueError(f"`substeps` must be a positive integer, got {substeps}.")
-    num = delta.shape[0]
-    aux = AuxInputs() if aux is None else aux
-    aux = jax.tree.map(lambda a: jnp.broadcast_to(jnp.asarray(a, dtype=float), (num,)), aux)
-    return _simulate_steering(as_arrays(model), delta, jnp.asarray(dt, float),
-                              None if state0 is None else jnp.asarray(state0, float),
-                              jnp.asarray(psi0, float), aux, jnp.asarray(start, float),
-                              int(substeps))
-
-
-@eqx.filter_jit
-def _simulate_steering(model, delta, dt, state0, psi0, aux, start, substeps):
-    if state0 is None:
-        state0 = model.initial_state(jnp.zeros_like(psi0))
-    head = lambda a: a[:-1]
-    psi, r, states = propagate(model, state0, psi0, delta[:-1], jax.tree.map(head, aux), dt,
-                               substeps)
-    first = lambda a0, a: jnp.concatenate([jnp.asarray(a0)[None], a])
-    return SteeringTrajectory(
-        t=start + dt * jnp.arange(delta.shape[0]),
-        psi=first(psi0, psi),
-        r=first(model.output(state0), r),
-        state=jnp.concatenate([state0[None], states]),
-        delta=delta,
-    )
+        return field

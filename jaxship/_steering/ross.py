@@ -17,10 +17,9 @@ terms), and $N_R$ is the rudder moment, the right-hand side "N" of eq. 3.6.
 """
 
 import jax.numpy as jnp
-import numpy as np
 from jaxtyping import Array, ArrayLike
 
-from .._estimate._params import param, resolve_free
+from .._params import param
 from ._base import AbstractSteeringModel, AuxInputs, WindowStart
 
 
@@ -174,65 +173,6 @@ class RossAutopilot(AbstractSteeringModel):
         return out
 
 
-def ross_initial_estimate(model: RossAutopilot, dataset, *, free=None, rudder: str = "delta",
-                          span: int = 1) -> RossAutopilot:
-    """Equation-error least-squares start values of `RossAutopilot` (`free` as in
-    `fit`; frozen parameters enter as known).
-
-    The model is linear in its coefficients, $\\dot r = (U_0/L)^2\\phi(r, \\delta, u, v,
-    n)\\cdot a$. Integrated over `span` sample intervals with the trapezoid rule for
-    r and the held inputs,
-
-    $$r_{k+m} - r_k = \\frac{U_0^2}{L^2}\\sum_{j=k}^{k+m-1} dt\\,
-    \\phi\\big(\\tfrac12(r_j + r_{j+1}), \\delta_j, u_j, v_j, n_j\\big)\\cdot a,$$
-
-    one linear regression over all (non-overlapping) spans of all experiments. A
-    longer span averages measurement noise on r (the regressand is a difference of
-    noisy samples) at the price of discretisation error. Like every equation-error
-    estimate it is biased by noise in the regressors; it gives start values for
-    `fit`, not final estimates.
-
-    **Raises:** `ValueError` for bad data (as `fit`) or data that do not excite the
-    free parameters (singular regression).
-    """
-    from .._estimate._linear import _lstsq, _replace
-    from .._estimate._windows import as_dataset, check_data
-
-    if not isinstance(model, RossAutopilot):
-        raise ValueError(f"`model` must be a RossAutopilot, got {type(model).__name__}.")
-    span = int(span)
-    if span < 1:
-        raise ValueError(f"`span` must be a positive number of samples, got {span}.")
-    ds = as_dataset(dataset)
-    check_data(ds, rudder, ("r",))
-    names = tuple(s.name for s in resolve_free(model, free))
-    order = tuple(h for h, _ in HULL_TERMS) + RUDDER_TERMS
-    gain = (float(model.speed) / float(model.length)) ** 2
-    rows, targets = [], []
-    for i, num in enumerate(ds.lengths):
-        get = lambda key: np.asarray(getattr(ds, key), dtype=np.float64)[i, :num]
-        r, d = get("r"), get(rudder)
-        dt = float(np.asarray(ds.dt)[i])
-        aux = AuxInputs(u=get("u")[:-1], v=get("v")[:-1], n=get("n")[:-1])
-        phi = np.asarray(model.regressors(0.5 * (r[:-1] + r[1:]), d[:-1], aux), np.float64)
-        count = (num - 1) // span
-        if count == 0:
-            continue
-        phi = phi[: count * span].reshape(count, span, -1).sum(axis=1) * dt * gain
-        rows.append(phi)
-        targets.append(r[span: count * span + 1: span] - r[: count * span: span])
-    if not rows:
-        raise ValueError(f"RossAutopilot start: no experiment has more than `span` = {span} "
-                         "samples.")
-    phi, y = np.concatenate(rows), np.concatenate(targets)
-    columns = [order.index(n) for n in names]
-    frozen = [k for k, n in enumerate(order) if n not in names]
-    a = np.asarray(model.coefficients(), dtype=np.float64)
-    known = phi[:, frozen] @ a[frozen] if frozen else 0.0
-    coef = _lstsq(phi[:, columns], y - known, names, "RossAutopilot start")
-    return _replace(model, dict(zip(names, coef)))
-
-
 def reference_scales(vessel) -> dict:
     """Reference scales `dict(length=, speed=, rate=)` of a vessel: $L_{pp}$, the
     nominal speed and the nominal propeller rate."""
@@ -240,5 +180,5 @@ def reference_scales(vessel) -> dict:
                 rate=float(vessel.nominal_n))
 
 
-__all__ = ["RossAutopilot", "ross_initial_estimate", "ROSS_FREE", "SPEED_RUDDER",
+__all__ = ["RossAutopilot", "ROSS_FREE", "SPEED_RUDDER",
            "HULL_TERMS", "RUDDER_TERMS", "reference_scales"]

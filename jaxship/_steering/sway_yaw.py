@@ -38,7 +38,7 @@ import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
 from .._actuators import RudderServo
-from .._estimate._params import param
+from .._params import param
 from .._vessel.sway_yaw import SwayYawVessel
 from ._base import AbstractSteeringModel, AuxInputs, WindowStart
 

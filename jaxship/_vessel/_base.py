@@ -1,6 +1,7 @@
 """The vessel interface: vessels return forces and a mass matrix, never integrate."""
 
 import abc
+from typing import ClassVar
 
 import equinox as eqx
 import jax
@@ -8,8 +9,8 @@ import jax.numpy as jnp
 from jaxtyping import Array
 
 from .._actuators import RudderServo, Shaft
-from .._environment import Environment
-from .._state import Command, ShipState
+from .._environment import Environment, Wind
+from .._state import STATE_FIELDS, Command, ShipState, from_vector, straight_state, to_vector
 
 
 class AbstractVessel(eqx.Module):
@@ -33,15 +34,74 @@ class AbstractVessel(eqx.Module):
     frontal_wind_area: eqx.AbstractVar[float]  # A_F [m^2], 0 for no windage
     lateral_wind_area: eqx.AbstractVar[float]  # A_L [m^2]
 
+    # coefficients `jaxship.fit` estimates with `free=None` (field names)
+    free_by_default: ClassVar[tuple[str, ...]] = ()
+    # the model contract shared with steering models (see `jaxship.fit`): fitted outputs
+    # by default, channels every window starts from, wind loads, a rudder servo
+    default_channels: ClassVar[tuple[str, ...]] = ("psi", "r", "u", "v")
+    start_channels: ClassVar[tuple[str, ...]] = ("u", "v")
+    wind_loads: ClassVar[bool] = True
+    has_servo: ClassVar[bool] = True
+
     @abc.abstractmethod
     def mass_matrix(self) -> Array:
         """The 3x3 matrix $M = M_{RB} + M_A$ in SI units [kg, kg m, kg m^2]."""
+
+    def loads(self, t, u, v, r, delta, n) -> Array:
+        """All loads at time `t` [s]: `forces` here; effects that vary in time add to
+        them (`jaxship.AugmentedVessel`)."""
+        return self.forces(u, v, r, delta, n)
 
     @abc.abstractmethod
     def forces(self, u, v, r, delta, n) -> Array:
         """Loads $\\tau = (X, Y, N)$ [N, N, N m] at velocities `u, v` [m/s], `r`
         [rad/s], rudder angle `delta` [rad] and propeller rate `n` [rev/s],
         including the Coriolis-centripetal terms, i.e. everything except $M\\dot\\nu$."""
+
+
+    # -- the model contract shared with steering models (replay of measured records) --
+
+    def channel_index(self, channel: str) -> int:
+        """Where an output channel (`"psi"`, `"r"`, `"u"`, `"v"`) sits in the state vector."""
+        return STATE_FIELDS.index(channel)
+
+    def measure(self, channel: str, value):
+        """What the sensor of `channel` reports for the true `value` (exact here;
+        sensor effects change it)."""
+        return value
+
+    def replay_state(self, start, servo: bool = False) -> Array:
+        """The state vector at a window start (`WindowStart`) of a measured record:
+        $(u, v, r, 0, 0, \\psi, \\delta, n)$ measured; the positions do not enter the
+        loads. The rudder is the replayed angle, or with `servo` the measured angle
+        the servo starts from."""
+        zero = jnp.zeros_like(start.r)
+        delta = start.rudder_angle if servo else start.delta
+        return jnp.stack([start.aux.u, start.aux.v, start.r, zero, zero, start.psi,
+                          delta + zero, start.aux.n + zero])
+
+    def replay_field(self, servo: bool = False):
+        """`f(t, y, inputs)`: the state derivative with the measured rudder angle and
+        propeller rate replayed (`inputs["delta"]`, `inputs["n"]`; their states do not
+        move) or, with `servo`, the rudder command `inputs["delta"]` through the
+        vessel's servo; with `inputs["wind_speed"]` and `["wind_dir"]` the wind loads
+        of `jaxship.Wind`. The same `state_derivative` as `jaxship.simulate`."""
+        mass_inverse = inverse3(self.mass_matrix())  # once per evaluation
+
+        def field(t, y, inputs):
+            state = from_vector(y)
+            delta = state.delta if servo else inputs["delta"]
+            state = eqx.tree_at(lambda s: (s.delta, s.n), state, (delta, inputs["n"]))
+            wind = "wind_speed" in inputs
+            environment = Environment(wind=Wind(inputs["wind_speed"], inputs["wind_dir"])
+                                      ) if wind else Environment()
+            d = _state_derivative(self, state, Command(inputs["delta"], inputs["n"]),
+                                  environment, mass_inverse, wind=wind, t=t)
+            still = jnp.zeros_like(d.n)
+            return to_vector(eqx.tree_at(lambda s: (s.delta, s.n), d,
+                                         (d.delta if servo else still, still)))
+
+        return field
 
 
 def state_derivative(
@@ -59,11 +119,13 @@ def _state_derivative(
     mass_inverse: Array,
     *,
     wind: bool = True,
+    t=0.0,
 ) -> ShipState:
     """`state_derivative` with $M^{-1}$ given (the simulator inverts $M$ once per run, not
     four times per step) and, with `wind=False`, without the wind loads (the simulator
-    passes it when the wind speed is a static zero, where the loads vanish identically)."""
-    tau = vessel.forces(state.u, state.v, state.r, state.delta, state.n)
+    passes it when the wind speed is a static zero, where the loads vanish identically);
+    `t` [s] for loads that vary in time."""
+    tau = vessel.loads(t, state.u, state.v, state.r, state.delta, state.n)
     xdot, ydot = environment.ground_velocity(state.u, state.v, state.psi)
     if wind:
         cn, ce = environment.current.velocity()
@@ -131,8 +193,6 @@ def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> Ship
     solve for the equilibrium speed; with neither, the vessel's nominal approach.
     Vessels without a propeller term keep `n` as given and `speed` as given.
     """
-    from .._state import straight_state
-
     if speed is None and n is None:
         speed, n = vessel.nominal_speed, vessel.nominal_n
     if n is None:

@@ -89,6 +89,11 @@ class LowSpeedMMGVessel(AbstractVessel):
     is left out too (wind loads come from `Environment`; the projected areas are given).
     """
 
+    # fitted by default: the hull's linear derivatives and cross-flow drag, the resistance
+    # ahead, and the rudder's inflow and flow-straightening factors
+    free_by_default = ("x_0f", "y_v", "y_r", "n_v", "n_r", "c_d", "c_ry", "c_rn", "epsilon",
+                       "gamma_n", "gamma_p")
+
     length: float  # L_pp [m]
     rudder: RudderServo
     shaft: Shaft

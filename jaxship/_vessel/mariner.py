@@ -42,6 +42,8 @@ class Mariner(AbstractVessel):
     differs (MSS `mariner.m` takes $u_i$ with $\\delta_c = -u_i$; here $\\delta = u_i$).
     """
 
+    free_by_default = ("x_u", "y_v", "y_r", "n_v", "n_r", "y_d", "n_d")  # fitted by default
+
     length: float = 160.93  # L_pp [m], MSS mariner.m
     rudder: RudderServo = RudderServo(
         max_angle=float(np.deg2rad(40.0)),  # delta_max 40 deg, MSS mariner.m (2003 revision)

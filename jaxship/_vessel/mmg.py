@@ -86,6 +86,9 @@ class MMGVessel(AbstractVessel):
     resistance $-R_0'U^2$ keeps its sign astern).
     """
 
+    # fitted by default: linear and cubic hull derivatives, resistance, rudder inflow factor
+    free_by_default = ("r_0", "y_v", "y_r", "n_v", "n_r", "y_vvv", "n_rrr", "epsilon")
+
     length: float  # L_pp [m]
     rudder: RudderServo
     shaft: Shaft

@@ -20,6 +20,8 @@ class NomotoVessel(AbstractVessel):
     with the speed of the simulated state.
     """
 
+    free_by_default = ("gain", "time_constant")  # fitted by default
+
     length: float  # L [m]
     rudder: RudderServo
     nominal_speed: float  # U [m/s], the constant surge speed the constants belong to

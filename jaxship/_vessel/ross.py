@@ -54,6 +54,12 @@ class RossVessel(AbstractVessel):
     model is port/starboard symmetric (no constant terms).
     """
 
+    # fitted by default (`jaxship.fit`, `jaxship identify`): linear and cross-flow hull
+    # damping in sway and yaw, the surge resistance and induced drag, and the rudder area
+    # (lift slope and area enter only as a product, so only one is free)
+    free_by_default = ("x_uu", "x_vv", "y_uv", "y_ur", "y_absv_v", "y_absr_v", "n_uv", "n_ur",
+                       "n_absv_r", "n_absr_r", "rudder_area")
+
     length: float  # L_pp [m], thesis Table 4.1
     rudder: RudderServo
     shaft: Shaft

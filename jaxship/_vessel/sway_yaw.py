@@ -62,6 +62,8 @@ class SwayYawVessel(AbstractVessel):
     starboard): they are minus the published $Y'_\\delta > 0$, $N'_\\delta < 0$.
     """
 
+    free_by_default = ("y_v", "y_r", "n_v", "n_r", "y_delta", "n_delta")  # fitted by default
+
     length: float  # L [m]
     draught: float  # T [m], constant along the hull (cross-flow drag only)
     rudder: RudderServo

@@ -80,12 +80,37 @@ class Free:
 
 
 def parameter_fields(model) -> dict[str, ParameterInfo]:
-    """The fields of `model` declared with `param`, with their metadata, in field order."""
-    return {
-        f.name: f.metadata[_KEY]
-        for f in dataclasses.fields(model)
-        if _KEY in f.metadata
-    }
+    """The estimable fields of `model` with their metadata, in field order: the fields
+    declared with `param`, or, for a vessel (whose coefficient tables are plain
+    floats), every scalar float field, free when named in its `free_by_default`; for a
+    model with effects, the base's and each effect's as `"<effect id>.<field>"`."""
+    if hasattr(model, "lookup"):  # a model with effects: the base's and "<id>.<field>"
+        out = dict(parameter_fields(model.base))
+        for effect in model.effects:
+            out.update({f"{effect.id}.{k}": v for k, v in parameter_fields(effect).items()})
+        return out
+    fields = {f.name: f.metadata[_KEY] for f in dataclasses.fields(model) if _KEY in f.metadata}
+    if fields or not hasattr(model, "free_by_default"):
+        return fields
+    default = model.free_by_default
+    out = {}
+    for f in dataclasses.fields(model):
+        value = getattr(model, f.name, None)
+        if isinstance(value, bool) or not (isinstance(value, (int, float, np.number)) or (
+                isinstance(value, (np.ndarray, jax.Array)) and np.ndim(value) == 0)):
+            continue
+        out[f.name] = ParameterInfo(free=f.name in default)
+    return out
+
+
+def default_free(model) -> tuple[str, ...]:
+    """The parameters `fit(model, data)` estimates with `free=None`, in field order."""
+    names = tuple(n for n, info in parameter_fields(model).items() if info.free)
+    if not names:
+        raise ValueError(f"no default set of free parameters for {type(model).__name__}; pass "
+                         f"`free=` with names of its coefficients: "
+                         f"{', '.join(parameter_fields(model))}.")
+    return names
 
 
 @dataclasses.dataclass(frozen=True)
@@ -129,14 +154,16 @@ def select_free(free, default, fields, kind: str, noun: str) -> dict:
 def resolve_free(model, free=None) -> tuple[ParameterSpec, ...]:
     """The free parameters of `model` for `fit(..., free=free)`.
 
-    `free` is `None` (the fields declared `param(free=True)`), a sequence of field
-    names, or a dict `{name: Free(...) or None}` (None: the field's defaults).
+    `free` is `None` (the fields declared `param(free=True)`, or a vessel's
+    `free_by_default`), a sequence of field names, or a dict `{name: Free(...) or
+    None}` (None: the field's defaults). A scale of 0 (an unbounded parameter that
+    starts at zero, with no scale given) means "from the Jacobian": `fit` sets it.
     Raises `ValueError` for unknown names, start values outside the bounds and
     empty selections.
     """
     fields = parameter_fields(model)
     kind = type(model).__name__
-    chosen = select_free(free, [n for n, info in fields.items() if info.free], fields, kind,
+    chosen = select_free(free, default_free(model) if free is None else (), fields, kind,
                          "parameter")
     specs = []
     for name in fields:  # field order, whatever the order of `free`
@@ -149,7 +176,7 @@ def resolve_free(model, free=None) -> tuple[ParameterSpec, ...]:
                 f"{type(override).__name__}."
             )
         override = override or Free()
-        start = override.value if override.value is not None else getattr(model, name)
+        start = override.value if override.value is not None else get_path(model, name)
         try:
             start = float(start)
         except (TypeError, ValueError):
@@ -168,14 +195,17 @@ def resolve_free(model, free=None) -> tuple[ParameterSpec, ...]:
             )
         scale = override.scale if override.scale is not None else info.scale
         if scale is None:
-            if math.isfinite(lower) and not math.isfinite(upper):
+            if math.isfinite(lower) and math.isfinite(upper):
+                scale = upper - lower
+            elif math.isfinite(lower):
                 scale = start - lower
-            elif math.isfinite(upper) and not math.isfinite(lower):
+            elif math.isfinite(upper):
                 scale = upper - start
             else:
-                scale = abs(start) or 1.0
+                scale = abs(start)  # 0: from the Jacobian (`fit`)
+        given = override.scale is not None or info.scale is not None
         scale = float(scale)
-        if not (scale > 0 and math.isfinite(scale)):
+        if not (math.isfinite(scale) and (scale > 0 or scale == 0 and not given)):
             raise ValueError(f"scale of {kind}.{name} must be positive and finite, got {scale}.")
         specs.append(ParameterSpec(name, start, lower, upper, scale, info.unit))
     return tuple(specs)
@@ -240,10 +270,17 @@ class Transform(eqx.Module):
         return z
 
 
+def get_path(model, name: str):
+    """The parameter `name` of `model`: a field, or `"<effect id>.<field>"`."""
+    for part in name.split("."):
+        model = model.lookup(part) if hasattr(model, "lookup") else getattr(model, part)
+    return model
+
+
 def rebuild(model, names, values):
-    """`model` with the fields `names` replaced by the entries of `values` (traced)."""
+    """`model` with the parameters `names` replaced by the entries of `values` (traced)."""
     return eqx.tree_at(
-        lambda m: tuple(getattr(m, n) for n in names), model,
+        lambda m: tuple(get_path(m, n) for n in names), model,
         tuple(values[i] for i in range(len(names))),
     )
 

@@ -23,24 +23,14 @@ error with a suitable horizon is superior to output error under disturbances.
 
 import dataclasses
 import math
+import warnings
 
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
-from jaxtyping import ArrayLike
 
-from ._data import Dataset, Experiment
-from ._environment import Environment
-from ._estimate._fit import PredictionError, _evaluate, fit
-from ._estimate._params import Transform, as_arrays, resolve_free
-from ._estimate._windows import as_dataset, build_windows
-from ._manoeuvres import ZigZag
-from ._simulate import Simulator, _flatten, _unflatten
-from ._state import Command
-from ._steering.sway_yaw import NorrbinCrossFlow
-from ._vessel._base import AbstractVessel, _state_derivative, inverse3, straight_run
-from ._vessel.sway_yaw import SwayYawVessel, sea_stratus_nonlinear
+import jaxship as js
 
 
 DEG = math.pi / 180.0
@@ -50,82 +40,17 @@ TABLE3_START = dict(y_v=-0.00687, y_r=-0.00724, n_v=-0.00254, n_r=-0.00161,
                     y_delta=-0.00201, n_delta=0.00100, cross_flow=0.7)
 
 
-class DisturbedVessel(AbstractVessel):
-    """A vessel with an added body-fixed sway force `sway_force` [N] and yaw moment
-    `yaw_moment` [N m] (constant; `simulate_disturbed` replaces them every sample)."""
-
-    base: AbstractVessel
-    sway_force: ArrayLike = 0.0  # Y_w [N]
-    yaw_moment: ArrayLike = 0.0  # N_w [N m]
-
-    @property
-    def length(self):
-        return self.base.length
-
-    @property
-    def rudder(self):
-        return self.base.rudder
-
-    @property
-    def shaft(self):
-        return self.base.shaft
-
-    @property
-    def nominal_speed(self):
-        return self.base.nominal_speed
-
-    @property
-    def nominal_n(self):
-        return self.base.nominal_n
-
-    @property
-    def frontal_wind_area(self):
-        return self.base.frontal_wind_area
-
-    @property
-    def lateral_wind_area(self):
-        return self.base.lateral_wind_area
-
-    def mass_matrix(self):
-        return self.base.mass_matrix()
-
-    def forces(self, u, v, r, delta, n):
-        tau = self.base.forces(u, v, r, delta, n)
-        return tau + jnp.stack([jnp.zeros_like(tau[0]), self.sway_force + 0 * tau[1],
-                                self.yaw_moment + 0 * tau[2]])
-
-
-@eqx.filter_jit
-def simulate_disturbed(vessel: AbstractVessel, manoeuvre, x0, yaw_moment, *,
-                       sway_force=None, simulator: Simulator = Simulator()):
-    """Like `jaxship.simulate` (same sampled closed-loop logic and integrator) with a
-    disturbance force `sway_force[k]` [N] and moment `yaw_moment[k]` [N m] held over
-    sample interval k (arrays of `manoeuvre.num_samples`). Returns `(t, states
-    (N, 8) in ShipState field order, rudder command (N,))`."""
-    num = manoeuvre.num_samples
+def simulate_disturbed(vessel, manoeuvre, x0, yaw_moment, *, sway_force=None,
+                       simulator=js.Simulator()):
+    """`jaxship.simulate` of `vessel` with a disturbance force `sway_force[k]` [N] and
+    moment `yaw_moment[k]` [N m] held over sample interval k (arrays of
+    `manoeuvre.num_samples`): the vessel with a `RecordedDisturbance` effect."""
     yaw_moment = jnp.asarray(yaw_moment, dtype=float)
-    sway_force = jnp.zeros(num) if sway_force is None else jnp.asarray(sway_force, float)
-    dt = jnp.asarray(manoeuvre.dt, dtype=float)
-    mass_inverse = inverse3(vessel.mass_matrix())
-    y0 = _flatten(x0)
-    memory = manoeuvre.init(x0)
-    environment = Environment()
-
-    def step(carry, inputs):
-        y, memory = carry
-        k, yw, nw = inputs
-        t = manoeuvre.start + k * dt
-        command, memory = manoeuvre.command(t, _unflatten(y), memory)
-        held = Command(jnp.asarray(command.delta, float), jnp.asarray(command.n, float))
-        disturbed = DisturbedVessel(vessel, yw, nw)
-        rhs = lambda z: _flatten(_state_derivative(disturbed, _unflatten(z), held, environment,
-                                                   mass_inverse, wind=False))
-        new_y, _ = simulator._integrate(rhs, y, t, dt)
-        return (new_y, memory), (y, held.delta)
-
-    _, (states, command) = jax.lax.scan(step, (y0, memory),
-                                        (jnp.arange(num), sway_force, yaw_moment))
-    return manoeuvre.start + jnp.arange(num) * dt, states, command
+    sway_force = jnp.zeros_like(yaw_moment) if sway_force is None else jnp.asarray(
+        sway_force, dtype=float)
+    disturbance = js.RecordedDisturbance(manoeuvre.dt, yaw_moment, sway_force,
+                                         start=manoeuvre.start)
+    return js.simulate(js.augment(vessel, disturbance), manoeuvre, x0, simulator=simulator)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -143,25 +68,23 @@ class NoiseLevels:
     v: float = 0.01
 
 
-def zigzag_trial(vessel: SwayYawVessel, angle: float, *, duration: float, dt: float = 1.0,
+def zigzag_trial(vessel, angle: float, *, duration: float, dt: float = 1.0,
                  noise: NoiseLevels = NoiseLevels(), seed: int = 0, name: str | None = None,
-                 oversample: int = 10) -> Experiment:
+                 oversample: int = 10) -> js.Experiment:
     """A `angle`/`angle` zig-zag [rad] of `vessel` from its straight run at the nominal
     speed, with the process and measurement noise of `noise` drawn from `seed`, sampled
     every `dt` [s].
 
     The ship is simulated (`simulate_disturbed`, RK4) at `dt / oversample` with the
     rudder servo of the vessel (rate-limited, so the rudder ramps); the yaw moment is
-    held over each record interval. The recorded rudder `delta[k]` is the mean of the
-    servo angle over $[t_k, t_{k+1})$ (trapezoidal rule on the fine grid): the input
-    whose zero-order hold reproduces the ramps, as an anti-aliased rudder record.
-    Sampling the ramping rudder instead (a half-sample delay) biases the fitted
-    derivatives by 5-15 % on the 20/20 zig-zag. `delta_c` is the command, the extra
-    signal `yaw_disturbance` the equivalent rudder angle $w$ [rad] of the moment.
+    held over each record interval. The recorded rudder `delta[k]` is the servo angle
+    at the sample times, as a logged angle is; `fit` replays it linearly between the
+    samples (first-order hold), which follows the ramps. `delta_c` is the command, the
+    extra signal `yaw_disturbance` the equivalent rudder angle $w$ [rad] of the moment.
     """
     rng = np.random.default_rng(seed)
     fine_dt = dt / oversample
-    man = ZigZag(angle=angle, heading=angle, duration=duration, dt=fine_dt)
+    man = js.ZigZag(angle=angle, heading=angle, duration=duration, dt=fine_dt)
     num = int(round(duration / dt)) + 1
     a = math.exp(-dt / noise.yaw_noise_time)
     e = rng.standard_normal(num)
@@ -172,55 +95,19 @@ def zigzag_trial(vessel: SwayYawVessel, angle: float, *, duration: float, dt: fl
     V, L = vessel.nominal_speed, vessel.length
     moment = 0.5 * vessel.rho * L**3 * V**2 * vessel.n_delta * w
     fine_moment = np.repeat(moment, oversample)[: man.num_samples]
-    x0 = straight_run(vessel)
-    t, states, command = simulate_disturbed(vessel, man, x0, jnp.asarray(fine_moment))
-    states = np.asarray(states)[: (num - 1) * oversample + 1]
-    s = _unflatten(states[::oversample])
-    fine_delta = states[:, 6]  # ShipState field order: u, v, r, x, y, psi, delta, n
-    blocks = fine_delta[: (num - 1) * oversample].reshape(num - 1, oversample)
-    ends = fine_delta[oversample::oversample]
-    mean = (blocks.sum(axis=1) - 0.5 * blocks[:, 0] + 0.5 * ends) / oversample
-    delta = np.append(mean, fine_delta[-1])
+    x0 = js.straight_run(vessel)
+    traj = simulate_disturbed(vessel, man, x0, jnp.asarray(fine_moment))
+    every = slice(0, (num - 1) * oversample + 1, oversample)
+    s = jax.tree.map(lambda a: np.asarray(a)[every], traj.state)
+    t, delta = np.asarray(traj.t)[every], s.delta
     noisy = lambda x, sd: np.asarray(x) + sd * rng.standard_normal(num)
-    return Experiment(
-        np.asarray(t)[::oversample][:num], delta, psi=noisy(s.psi, noise.psi),
+    return js.Experiment(
+        t, delta, psi=noisy(s.psi, noise.psi),
         r=noisy(s.r, noise.r), u=np.asarray(s.u), v=noisy(s.v, noise.v),
-        delta_c=np.asarray(command)[::oversample][:num],
+        delta_c=np.asarray(traj.command.delta)[every],
         name=name or f"zigzag {angle / DEG:g}/{angle / DEG:g}",
         metadata=dict(seed=seed), extra={"yaw_disturbance": w},
     )
-
-
-def window_robust_std(result, dataset, estimator: PredictionError) -> np.ndarray:
-    """Standard errors of a `fit` result that allow correlated residuals within each
-    prediction window (a cluster-robust sandwich, windows as clusters):
-    $(J^TJ)^{-1}(\\sum_w J_w^Te_we_w^TJ_w)(J^TJ)^{-1}$. Under process noise the
-    residuals of one window are correlated (a prediction error grows along the
-    window) while different windows restart from measurements; the usual
-    $\\hat\\sigma^2(J^TJ)^{-1}$ of `fit` assumes white residuals. NaN with fewer than
-    five windows (output error has one per experiment)."""
-    ds = as_dataset(dataset)
-    model = result.model
-    specs = resolve_free(model, result.names)
-    transform = Transform.from_specs(specs)
-    channels = tuple(estimator.channels or ("psi", "r"))
-    windows, layout = build_windows(ds, horizon=estimator.horizon, channels=channels,
-                                    weights=result.weights, rudder=estimator.rudder,
-                                    substeps=int(estimator.substeps))
-    mask = layout["mask"]
-    clusters = int(mask.any(axis=-1).sum())
-    if clusters < 5:
-        return np.full(len(specs), np.nan)
-    z = jnp.asarray(transform.to_unconstrained(result.values))
-    _, pred, jac = _evaluate(z, as_arrays(model), transform, windows, None)
-    w = np.asarray(windows.weights)[:, None, None, None]
-    e = np.where(mask[None], w * (np.asarray(windows.targets) - np.asarray(pred)), 0.0)
-    jac = np.where(mask[None, ..., None], np.asarray(jac), 0.0)
-    jtj = np.einsum("cewlp,cewlq->pq", jac, jac)
-    scores = np.einsum("cewlp,cewl->ewp", jac, e).reshape(-1, jac.shape[-1])
-    bread = np.linalg.inv(jtj)
-    meat = scores.T @ scores * clusters / (clusters - 1)
-    return np.sqrt(np.diag(bread @ meat @ bread))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -233,7 +120,7 @@ class AstromRow:
     success: bool
     values: np.ndarray
     std: np.ndarray  # from fit: white-residual covariance
-    robust_std: np.ndarray  # window-clustered sandwich (NaN for output error)
+    robust_std: np.ndarray  # from fit: Newey-West (HAC) standard errors
     z: np.ndarray  # (estimate - truth) / std
     z_robust: np.ndarray  # (estimate - truth) / robust_std
     simulation_fit: dict  # {channel: fit %} of the fitted model simulated from the start
@@ -242,17 +129,15 @@ class AstromRow:
     loss: dict  # {channel: V_N} of the estimator's own residuals
 
 
-def _simulate_fit(model, exp: Experiment) -> dict:
+def _simulate_fit(model, exp: js.Experiment) -> dict:
     """Fit % of the fitted model simulated over the whole record (replayed rudder and
     speed) against the noisy measurements, psi, r and v."""
-    from ._steering._base import AuxInputs, simulate_steering
-    from ._validate import fit_percent
-
-    tr = simulate_steering(model, exp.delta, exp.dt, state0=jnp.array([exp.r[0], exp.v[0]]),
-                           psi0=exp.psi[0], aux=AuxInputs(u=exp.u, v=exp.v, n=exp.n))
-    return {"psi": fit_percent(exp.psi, np.asarray(tr.psi)),
-            "r": fit_percent(exp.r, np.asarray(tr.r)),
-            "v": fit_percent(exp.v, np.asarray(tr.state[:, 1]))}
+    tr = js.simulate_steering(model, exp.delta, exp.dt,
+                              state0=jnp.array([exp.r[0], exp.v[0]]), psi0=exp.psi[0],
+                              aux=js.AuxInputs(u=exp.u, v=exp.v, n=exp.n), hold="foh")
+    return {"psi": js.fit_percent(exp.psi, np.asarray(tr.psi)),
+            "r": js.fit_percent(exp.r, np.asarray(tr.r)),
+            "v": js.fit_percent(exp.v, np.asarray(tr.state[:, 1]))}
 
 
 def astrom_kallstrom(*, noise: NoiseLevels = NoiseLevels(), seed: int = 0, dt: float = 1.0,
@@ -266,12 +151,8 @@ def astrom_kallstrom(*, noise: NoiseLevels = NoiseLevels(), seed: int = 0, dt: f
     error (`horizon` [s]), channels psi, r, v, from `start` (default: Table 3's initial
     estimates, `TABLE3_START`).
     """
-    import warnings
-
-    from ._estimate._fit import ConvergenceWarning, IdentifiabilityWarning
-
-    vessel = sea_stratus_nonlinear()
-    truth_model = NorrbinCrossFlow.from_vessel(vessel)
+    vessel = js.vessel("sea_stratus_nonlinear")
+    truth_model = js.NorrbinCrossFlow.from_vessel(vessel)
     truth = np.array([getattr(truth_model, k) for k in FREE])
     start_model = eqx.tree_at(lambda m: tuple(getattr(m, k) for k in FREE), truth_model,
                               tuple(float((start or TABLE3_START)[k]) for k in FREE))
@@ -285,14 +166,15 @@ def astrom_kallstrom(*, noise: NoiseLevels = NoiseLevels(), seed: int = 0, dt: f
     sets = {"5/5": [five], "20/20": [twenty], "both": [five, twenty]}
     rows = []
     for label, exps in sets.items():
-        ds = Dataset.from_experiments(exps)
+        ds = js.Dataset.from_experiments(exps)
         for method, h in (("output error", None), (f"PE T_p = {horizon:g} s", horizon)):
-            est = PredictionError(horizon=h, channels=("psi", "r", "v"), max_steps=max_steps)
+            est = js.PredictionError(horizon=h, channels=("psi", "r", "v"),
+                                     max_steps=max_steps)
             with warnings.catch_warnings():
-                warnings.simplefilter("ignore", IdentifiabilityWarning)
-                warnings.simplefilter("ignore", ConvergenceWarning)
-                res = fit(start_model, ds, estimator=est, free=FREE)
-            robust = window_robust_std(res, ds, est)
+                warnings.simplefilter("ignore", js.IdentifiabilityWarning)
+                warnings.simplefilter("ignore", js.ConvergenceWarning)
+                res = js.fit(start_model, ds, estimator=est, free=FREE)
+            robust = res.parameters.std_robust
             sim = [_simulate_fit(res.model, e) for e in exps]
             rows.append(AstromRow(
                 data=label, method=method, success=res.success, values=res.values,
@@ -309,8 +191,8 @@ def astrom_kallstrom(*, noise: NoiseLevels = NoiseLevels(), seed: int = 0, dt: f
 
 def table(result: dict) -> str:
     """The reproduction as a Markdown table: estimate ± standard error of `fit`
-    [window-robust standard error] per parameter; the largest |estimate - truth| in
-    robust standard errors (plain ones for output error); fit % of psi of the
+    [HAC standard error] per parameter; the largest |estimate - truth| in HAC
+    standard errors; fit % of psi of the
     estimator's own predictions, of the fitted model simulated over the training
     records and over the noise-free 10/10 validation zig-zag; and the loss of psi."""
     names = list(result["truth"])

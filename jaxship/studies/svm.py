@@ -12,34 +12,28 @@ and a turning circle (sec. 3.2).
 thesis manoeuvre for Nomoto 1 and 2 models of a vessel (thesis sec. 3.3.2).
 """
 
+import equinox as eqx
 import numpy as np
 
-from . import _manoeuvres as man
-from ._data import Experiment
-from ._design import fisher_information
-from ._estimate._discrete import STRUCTURES, fit_discrete_response
-from ._indices import zigzag_indices
-from ._simulate import Simulator, simulate
-from ._steering.manoeuvre import steer_manoeuvre
-from ._trials import initial_state
-from ._vessel.catalogue import get_vessel
+import jaxship as js
 
 
 DEG = np.pi / 180.0
+STRUCTURES = ("linear1", "nonlinear1", "linear2", "nonlinear2")  # Lu & Zhao eqs. 7-10
 
 
 def _run(vessel, manoeuvre, x0):
-    traj = simulate(vessel, manoeuvre, x0, simulator=Simulator(substeps=2))
+    traj = js.simulate(vessel, manoeuvre, x0, simulator=js.Simulator(substeps=2))
     if not bool(traj.success):
         raise RuntimeError("vessel simulation failed")
-    return Experiment.from_trajectory(traj)
+    return js.Experiment.from_trajectory(traj)
 
 
 def _overshoots(t, psi, delta, switch):
     """First and second overshoot [rad]; NaN where the model never completes them
     (e.g. a fitted gain too small to reach the switch heading)."""
     try:
-        zz = zigzag_indices(t=np.asarray(t), psi=np.asarray(psi), delta=np.asarray(delta),
+        zz = js.zigzag_indices(t=np.asarray(t), psi=np.asarray(psi), delta=np.asarray(delta),
                             heading_switch=switch)
     except ValueError:
         return np.nan, np.nan
@@ -77,10 +71,6 @@ def discrete_zigzag(fit, angle, switch, dt, num, *, rudder_rate=None):
     return dt * np.arange(num), psi, d[1:]
 
 
-def _fit_percent(y, yhat):
-    return float(100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y - np.mean(y))))
-
-
 def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=40.0,
                        noise_r=0.0, seed=0, methods=("ls", "svr"), svr_options=None) -> dict:
     """Fit the four response models of Lu & Zhao to a simulated 20/20 zig-zag and
@@ -99,28 +89,28 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
     `"consistency"` (the Tables 2-4 quantities per model),
     `"generalisation"` {(structure, method): {trial: fit % of r}} and the records.
     """
-    v = get_vessel(vessel) if isinstance(vessel, str) else vessel
-    x0 = initial_state(v, rpm=rpm)
+    v = js.vessel(vessel) if isinstance(vessel, str) else vessel
+    x0 = js.initial_state(v, rpm=rpm)
     tau = float(v.length) / float(x0.u)
     duration = duration_lengths * tau
     rate = float(v.rudder.max_rate)
     trials = {
-        "zigzag 20/20": man.ZigZag(20 * DEG, 20 * DEG, duration=duration, dt=dt),
-        "zigzag 10/10": man.ZigZag(10 * DEG, 10 * DEG, duration=duration, dt=dt),
-        "turn 20": man.Turn(20 * DEG, duration=duration, dt=dt),
+        "zigzag 20/20": js.ZigZag(20 * DEG, 20 * DEG, duration=duration, dt=dt),
+        "zigzag 10/10": js.ZigZag(10 * DEG, 10 * DEG, duration=duration, dt=dt),
+        "turn 20": js.Turn(20 * DEG, duration=duration, dt=dt),
     }
     records = {k: _run(v, m, x0) for k, m in trials.items()}
     train = records["zigzag 20/20"]
     if noise_r:
         rng = np.random.default_rng(seed)
-        train = Experiment(train.t, train.delta, psi=train.psi,
+        train = js.Experiment(train.t, train.delta, psi=train.psi,
                            r=train.r + noise_r * rng.standard_normal(train.r.shape),
                            name="zigzag 20/20 noisy")
     fits = {}
     for method in methods:
         opts = dict(svr_options or {}) if method == "svr" else {}
         for s in STRUCTURES:
-            fits[(s, method)] = fit_discrete_response(s, train, method=method, **opts)
+            fits[(s, method)] = js.fit_discrete_response(s, train, method=method, **opts)
     test = records["zigzag 20/20"]
     table1 = [("test",) + _overshoots(test.t, test.psi, test.delta, 20 * DEG)]
     table1_discrete = []
@@ -133,15 +123,13 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
         except ValueError:
             table1.append((f"{key[0]} ({key[1]})", np.nan, np.nan))
             continue
-        tr = steer_manoeuvre(model, trials["zigzag 20/20"], rudder_rate=rate, substeps=2)
+        tr = js.steer_manoeuvre(model, trials["zigzag 20/20"], rudder_rate=rate, substeps=2)
         o1, o2 = _overshoots(tr.t, tr.psi, tr.delta, 20 * DEG)
         table1.append((f"{key[0]} ({key[1]})", o1, o2))
-        from ._steering._base import simulate_steering
-
         general[key] = {}
         for name, rec in records.items():
-            sim = simulate_steering(model, rec.delta, rec.dt, substeps=2)
-            general[key][name] = _fit_percent(rec.r, np.asarray(sim.r))
+            sim = js.simulate_steering(model, rec.delta, rec.dt, substeps=2)
+            general[key][name] = js.fit_percent(rec.r, np.asarray(sim.r))
     table1 = [(n, o1 / DEG, o2 / DEG) for n, o1, o2 in table1]
     table1_discrete = [(n, o1 / DEG, o2 / DEG) for n, o1, o2 in table1_discrete]
     consistency = {key: f.parameters for key, f in fits.items()}
@@ -165,33 +153,31 @@ def design_study(vessel="thesis", *, rpm=500.0, dt=0.5, noise_r=0.05 * DEG, dura
 
     **Returns** `{"nominal": {...}, "reports": {(model, manoeuvre): DesignReport}}`.
     """
-    v = get_vessel(vessel) if isinstance(vessel, str) else vessel
-    x0 = initial_state(v, rpm=rpm)
-    thesis = man.thesis_manoeuvre(dt=dt)
+    v = js.vessel(vessel) if isinstance(vessel, str) else vessel
+    x0 = js.initial_state(v, rpm=rpm)
+    thesis = js.thesis_manoeuvre(dt=dt)
     duration = float(thesis.duration) if duration is None else float(duration)
     rate = float(v.rudder.max_rate)
-    rec = [_run(v, man.ZigZag(20 * DEG, 20 * DEG, duration=600.0, dt=dt), x0),
+    rec = [_run(v, js.ZigZag(20 * DEG, 20 * DEG, duration=600.0, dt=dt), x0),
            _run(v, thesis, x0)]
-    n1 = fit_discrete_response("linear1", rec).to_steering()
-    n2 = fit_discrete_response("linear2", rec).to_steering()
-    import equinox as eqx
-
+    n1 = js.fit_discrete_response("linear1", rec).to_steering()
+    n2 = js.fit_discrete_response("linear2", rec).to_steering()
     n1 = eqx.tree_at(lambda m: m.delta0, n1, 0.0)
     n2 = eqx.tree_at(lambda m: m.delta0, n2, 0.0)
     manoeuvres = {
-        "turn 20": man.Turn(20 * DEG, duration=duration, dt=dt),
-        "zigzag 20/20": man.ZigZag(20 * DEG, 20 * DEG, duration=duration, dt=dt),
-        "zigzag 10/10": man.ZigZag(10 * DEG, 10 * DEG, duration=duration, dt=dt),
-        "PRBS 10": man.prbs(10 * DEG, bit_time=10.0, duration=duration, dt=dt),
-        "3211 10": man.multi_step_3211(10 * DEG, unit=10.0, settle=duration - 70.0, dt=dt),
-        "thesis": man.thesis_manoeuvre(dt=dt, end_hold=300.0 + duration - float(
+        "turn 20": js.Turn(20 * DEG, duration=duration, dt=dt),
+        "zigzag 20/20": js.ZigZag(20 * DEG, 20 * DEG, duration=duration, dt=dt),
+        "zigzag 10/10": js.ZigZag(10 * DEG, 10 * DEG, duration=duration, dt=dt),
+        "PRBS 10": js.prbs(10 * DEG, bit_time=10.0, duration=duration, dt=dt),
+        "3211 10": js.multi_step_3211(10 * DEG, unit=10.0, settle=duration - 70.0, dt=dt),
+        "thesis": js.thesis_manoeuvre(dt=dt, end_hold=300.0 + duration - float(
             thesis.duration)),
     }
     reports = {}
     for mname, model, free in (("Nomoto1", n1, ("K", "T")),
                                ("Nomoto2", n2, ("K", "T1", "T2", "T3"))):
         for name, m in manoeuvres.items():
-            reports[(mname, name)] = fisher_information(model, m, noise_r, free=free,
+            reports[(mname, name)] = js.fisher_information(model, m, noise_r, free=free,
                                                         rudder_rate=rate, substeps=2)
     return {"nominal": {"Nomoto1": n1, "Nomoto2": n2}, "reports": reports,
             "duration": duration}

@@ -1,9 +1,9 @@
-"""Reproduction 1 of issue 3: the identification study of the thesis (Odegard 2009,
+"""The identification study of the thesis (Odegard 2009,
 seed 000, chapter 4) on the built-in thesis vessel.
 
 The experiment design of sec. 4.1 (turning circles at 5, 10, 20 and 40 deg, zig-zags
 5/5 to 40/40 and the thesis manoeuvre, each at 200 and 500 rpm) is simulated with
-`jaxship.get_vessel("thesis")`, measurement noise is added (`NOISE`), and three
+`jaxship.vessel("thesis")`, measurement noise is added (`NOISE`), and three
 response models are identified by prediction-error minimisation:
 
 - `Nomoto1` (thesis eq. 3.2-3.3; K and T),
@@ -32,24 +32,7 @@ import warnings
 
 import numpy as np
 
-from . import _manoeuvres as man
-from ._data import Experiment
-from ._estimate._fit import ConvergenceWarning, IdentifiabilityWarning, PredictionError, fit
-from ._estimate._linear import initial_estimate
-from ._estimate._lm import LevenbergMarquardt
-from ._simulate import Simulator, simulate
-from ._steering._base import AuxInputs, simulate_steering
-from ._steering.nomoto import Nomoto1
-from ._steering.ross import (
-    ROSS_FREE,
-    SPEED_RUDDER,
-    RossAutopilot,
-    reference_scales,
-    ross_initial_estimate,
-)
-from ._trials import initial_state
-from ._validate import fit_percent
-from ._vessel.catalogue import get_vessel
+import jaxship as js
 
 
 DEG = math.pi / 180.0
@@ -113,58 +96,66 @@ def _manoeuvre(spec, vessel, x0, s: Settings):
     tau = float(vessel.length) / float(x0.u)
     dt = s.dt / 2
     if kind == "turn":
-        return man.Turn(float(rest) * DEG, duration=s.approach + s.turn_length * tau, dt=dt,
+        return js.Turn(float(rest) * DEG, duration=s.approach + s.turn_length * tau, dt=dt,
                         execute=s.approach)
     if kind == "zigzag":
         a, h = (float(x) * DEG for x in rest.split("/"))
-        return man.ZigZag(a, h, duration=s.approach + s.zigzag_length * tau, dt=dt,
+        return js.ZigZag(a, h, duration=s.approach + s.zigzag_length * tau, dt=dt,
                           execute=s.approach)
     if kind == "thesis":
-        return man.thesis_manoeuvre(dt=dt)
+        return js.thesis_manoeuvre(dt=dt)
     raise ValueError(f"unknown trial {spec!r}")
 
 
+def reference_scales(vessel) -> dict:
+    """Reference scales of `RossAutopilot` for `vessel`: $L_{pp}$ [m], the nominal
+    speed [m/s] and propeller rate [rev/s]."""
+    return dict(length=float(vessel.length), speed=float(vessel.nominal_speed),
+                rate=float(vessel.nominal_n))
+
+
 def record_name(spec, rpm) -> str:
+    """The record name of trial `spec` at `rpm`, e.g. `"turn:40@500rpm"`."""
     return f"{spec}@{rpm:g}rpm"
 
 
 def thesis_experiments(vessel=None, *, families=None, settings: Settings = Settings()
-                       ) -> dict[str, Experiment]:
+                       ) -> dict[str, js.Experiment]:
     """Simulate the experiment design and return noisy records `{name: Experiment}`
     (names `"turn:40@500rpm"`), sampled at `settings.dt` with the noise of
     `settings.noise` added to psi, r, u, v and delta (n is exact)."""
-    vessel = get_vessel("thesis") if vessel is None else vessel
+    vessel = js.vessel("thesis") if vessel is None else vessel
     families = FAMILIES if families is None else families
     rng = np.random.default_rng(settings.seed)
     noise = dict(settings.noise)
     out = {}
-    simulator = Simulator(substeps=2)
+    simulator = js.Simulator(substeps=2)
     for family, specs in families.items():
         for spec in specs:
             for rpm in RPMS:
-                x0 = initial_state(vessel, rpm=rpm)
-                traj = simulate(vessel, _manoeuvre(spec, vessel, x0, settings), x0,
+                x0 = js.initial_state(vessel, rpm=rpm)
+                traj = js.simulate(vessel, _manoeuvre(spec, vessel, x0, settings), x0,
                                 simulator=simulator)
                 if not bool(traj.success):
                     raise RuntimeError(f"simulation of {spec} at {rpm:g} rpm failed")
-                exact = Experiment.from_trajectory(traj)
+                exact = js.Experiment.from_trajectory(traj)
                 keep = slice(None, None, 2)
                 channels = {k: getattr(exact, k)[keep].copy() for k in
                             ("t", "delta", "psi", "r", "u", "v", "n")}
                 for k, sigma in noise.items():
                     channels[k] = channels[k] + sigma * rng.standard_normal(channels[k].shape)
                 name = record_name(spec, rpm)
-                out[name] = Experiment(name=name, metadata=(("family", family),
+                out[name] = js.Experiment(name=name, metadata=(("family", family),
                                                             ("spec", spec), ("rpm", rpm)),
                                        **channels)
     return out
 
 
-def simulate_record(model, e: Experiment, substeps: int = 2) -> np.ndarray:
+def simulate_record(model, e: js.Experiment, substeps: int = 2) -> np.ndarray:
     """Yaw rate [rad/s] of `model` simulated over the record `e` from its first
     sample with its rudder, u, v and n replayed (no restarts: output error)."""
-    tr = simulate_steering(model, e.delta, e.dt, state0=model.initial_state(e.r[0]),
-                           psi0=e.psi[0], aux=AuxInputs(u=e.u, v=e.v, n=e.n),
+    tr = js.simulate_steering(model, e.delta, e.dt, state0=model.initial_state(e.r[0]),
+                           psi0=e.psi[0], aux=js.AuxInputs(u=e.u, v=e.v, n=e.n),
                            substeps=substeps)
     return np.asarray(tr.r)
 
@@ -176,14 +167,14 @@ def simulation_fit(model, records, substeps: int = 2) -> tuple[float, list[float
     for e in records:
         ys.append(e.r[1:])
         yh.append(simulate_record(model, e, substeps)[1:])
-    per = [fit_percent(y, h) for y, h in zip(ys, yh)]
+    per = [js.fit_percent(y, h) for y, h in zip(ys, yh)]
     n = max(len(y) for y in ys)
     pad = lambda a: np.concatenate([a, np.zeros(n - len(a))])
     mask = np.array([np.arange(n) < len(y) for y in ys])
-    return fit_percent(np.stack([pad(y) for y in ys]), np.stack([pad(h) for h in yh]), mask), per
+    return js.fit_percent(np.stack([pad(y) for y in ys]), np.stack([pad(h) for h in yh]), mask), per
 
 
-def nomoto_start(nomoto: Nomoto1, scales: dict) -> RossAutopilot:
+def nomoto_start(nomoto: js.Nomoto1, scales: dict) -> js.RossAutopilot:
     """A `RossAutopilot` that equals the fitted first-order Nomoto model at the
     reference speed ($u = U_0$): $\\dot r = (K\\delta - r)/T$ gives
     $a_{ur} = -L/(U_0T)$ and $a_\\delta = KL^2/(TU_0^2)$, all other terms zero. A
@@ -191,22 +182,22 @@ def nomoto_start(nomoto: Nomoto1, scales: dict) -> RossAutopilot:
     (e.g. a single turning circle)."""
     L, U = scales["length"], scales["speed"]
     K, T = float(nomoto.K), float(nomoto.T)
-    return RossAutopilot(**scales, n_ur=-L / (U * T), n_delta=K * L**2 / (T * U**2))
+    return js.RossAutopilot(**scales, n_ur=-L / (U * T), n_delta=K * L**2 / (T * U**2))
 
 
 def _quiet_fit(*args, **kwargs):
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", IdentifiabilityWarning)
-        warnings.simplefilter("ignore", ConvergenceWarning)
-        return fit(*args, **kwargs)
+        warnings.simplefilter("ignore", js.IdentifiabilityWarning)
+        warnings.simplefilter("ignore", js.ConvergenceWarning)
+        return js.fit(*args, **kwargs)
 
 
 def _estimators(settings: Settings):
-    solver = LevenbergMarquardt(rtol=settings.tolerance, atol=settings.tolerance)
+    solver = js.LevenbergMarquardt(rtol=settings.tolerance, atol=settings.tolerance)
     common = dict(channels=("r",), substeps=settings.substeps, solver=solver,
                   max_steps=settings.max_steps)
-    return (PredictionError(horizon=settings.horizon, **common),
-            PredictionError(horizon=None, **common))
+    return (js.PredictionError(horizon=settings.horizon, **common),
+            js.PredictionError(horizon=None, **common))
 
 
 def _safe_fit(model, records, free, estimator):
@@ -239,20 +230,20 @@ def identify(model_name, records, vessel, *, settings: Settings = Settings(), no
     """
     pe, oe = _estimators(settings)
     if nomoto is None or model_name == "nomoto":
-        nomoto = initial_estimate(Nomoto1(K=0.1, T=5.0), records)
+        nomoto = js.initial_estimate(js.Nomoto1(K=0.1, T=5.0), records)
         nomoto = _quiet_fit(nomoto, records, free=("K", "T"), estimator=pe).model
     if model_name == "nomoto":
         if not settings.output_error:
             return _quiet_fit(nomoto, records, free=("K", "T"), estimator=pe)
         return _quiet_fit(nomoto, records, free=("K", "T"), estimator=oe)
-    free = ROSS_FREE if model_name == "ross" else SPEED_RUDDER
+    free = js.ROSS_FREE if model_name == "ross" else js.SPEED_RUDDER
     scales = reference_scales(vessel)
     if model_name == "ross_speed_rudder" and base is not None:
         starts = [base]
     else:
         starts = [nomoto_start(nomoto, scales)]
         try:
-            starts.append(ross_initial_estimate(RossAutopilot(**scales), records, free=free,
+            starts.append(js.ross_initial_estimate(js.RossAutopilot(**scales), records, free=free,
                                                 span=settings.span))
         except ValueError:  # singular regression: the Nomoto start only
             pass
@@ -279,7 +270,7 @@ def identification_study(vessel=None, *, quick=False, settings: Settings = Setti
     10/10 and 40/40); `experiments`: records from `thesis_experiments` (simulated
     if None); `progress`: a callable taking a message string, or None.
     """
-    vessel = get_vessel("thesis") if vessel is None else vessel
+    vessel = js.vessel("thesis") if vessel is None else vessel
     families = QUICK_FAMILIES if quick else FAMILIES
     if experiments is None:
         experiments = thesis_experiments(vessel, families=families, settings=settings)

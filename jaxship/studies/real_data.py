@@ -1,4 +1,4 @@
-"""Identification on the measured data sets in `shared/data` (reproduction 4).
+"""Identification on the measured data sets in `shared/data`.
 
 - **Esso Osaka** (FRT-DS-ESSO, Osaka University 2020; Wakita et al. 2022, J. Mar.
   Sci. Technol. 27:772-785): the 3-DOF low-speed MMG model (`esso_osaka` preset) with
@@ -25,12 +25,7 @@ from pathlib import Path
 
 import optimistix as optx
 
-from ._data import Experiment, read_esso_osaka, read_hsva_kvlcc2, shared_data_dir
-from ._estimate._fit import FitResult, PredictionError, fit
-from ._estimate._linear import initial_estimate
-from ._estimate._predict import Prediction, predict
-from ._steering.nomoto import Nomoto1, Nomoto2
-from ._vessel.catalogue import get_vessel
+import jaxship as js
 
 
 ESSO_TEST = ("random_06-Aug-2020_16_24_25_3", "turn_14-Oct-2020_15_06_53",
@@ -44,7 +39,7 @@ HSVA_TEST = ("HSVA_CPMC_KVLCC2_Z_10_10_S", "HSVA_CPMC_KVLCC2_Z_20_10_S",
              "HSVA_CPMC_KVLCC2_Z_10_05", "HSVA_CPMC_KVLCC2_Z_20_05")
 
 
-def decimate(experiment: Experiment, factor: int) -> Experiment:
+def decimate(experiment: js.Experiment, factor: int) -> js.Experiment:
     """Every `factor`-th sample of `experiment` (measured channels only)."""
     factor = int(factor)
     if factor < 1:
@@ -52,12 +47,12 @@ def decimate(experiment: Experiment, factor: int) -> Experiment:
     if factor == 1:
         return experiment
     kept = {c: getattr(experiment, c)[::factor] for c in experiment.channels}
-    return Experiment(experiment.t[::factor], name=experiment.name,
+    return js.Experiment(experiment.t[::factor], name=experiment.name,
                       metadata=experiment.metadata, **kept)
 
 
 def _root(root, folder):
-    base = shared_data_dir() if root is None else Path(root)
+    base = js.shared_data_dir() if root is None else Path(root)
     if base is None or not (base / folder).is_dir():
         raise FileNotFoundError(f"measured data folder {folder!r} not found (looked in "
                                 f"{base}); set $JAXSHIP_DATA or pass `root`.")
@@ -68,21 +63,21 @@ def esso_osaka_split(root=None, *, factor: int = 5) -> tuple[list, list]:
     """`(train, test)` experiments of the Esso Osaka split (module docstring),
     decimated by `factor` (10 Hz / 5 = 2 Hz by default)."""
     folder = _root(root, "esso_osaka_frt")
-    train = [decimate(read_esso_osaka(p), factor) for p in sorted(folder.glob("random/*.csv"))
+    train = [decimate(js.read_esso_osaka(p), factor) for p in sorted(folder.glob("random/*.csv"))
              if p.stem not in ESSO_TEST]
     test = []
     for name in ESSO_TEST:
         found = sorted(folder.glob(f"*/{name}.csv"))
         if not found:
             raise FileNotFoundError(f"held-out run {name}.csv not found under {folder}.")
-        test.append(decimate(read_esso_osaka(found[0]), factor))
+        test.append(decimate(js.read_esso_osaka(found[0]), factor))
     return train, test
 
 
 def hsva_split(root=None, *, factor: int = 4, train=HSVA_TRAIN, test=HSVA_TEST):
     """`(train, test)` HSVA KVLCC2 zig-zags, decimated by `factor` (20 Hz / 4 = 5 Hz)."""
     folder = _root(root, "kvlcc2_simman2008_hsva")
-    read = lambda names: [decimate(read_hsva_kvlcc2(folder / f"{n}.dat"), factor)
+    read = lambda names: [decimate(js.read_hsva_kvlcc2(folder / f"{n}.dat"), factor)
                           for n in names]
     return read(train), read(test)
 
@@ -90,11 +85,12 @@ def hsva_split(root=None, *, factor: int = 4, train=HSVA_TRAIN, test=HSVA_TEST):
 @dataclasses.dataclass(frozen=True)
 class Identified:
     """One identified model: the `FitResult` on the training data and its validation
-    `Prediction`s on the test runs, keyed by predictor (`"T_p = 20 s"`, `"simulation"`)."""
+    predictions (`jaxship.predict`) on the test runs, keyed by predictor (`"T_p = 20 s"`,
+    `"simulation"`)."""
 
     label: str
-    result: FitResult
-    validation: dict[str, Prediction]
+    result: js.FitResult
+    validation: dict
 
 
 @dataclasses.dataclass(frozen=True)
@@ -105,7 +101,7 @@ class RealDataReport:
     models: tuple[Identified, ...]
     train: tuple[str, ...]
     test: tuple[str, ...]
-    baseline: dict[str, Prediction] = dataclasses.field(default_factory=dict)
+    baseline: dict = dataclasses.field(default_factory=dict)
 
     def rows(self) -> list[dict]:
         """One row per (model, predictor, test run or 'all'): fit % per channel."""
@@ -139,23 +135,23 @@ def _validate(model, test, estimator, horizons):
     out = {}
     for h in horizons:
         key = "simulation" if h is None else f"T_p = {h:g} s"
-        out[key] = predict(model, test, estimator=dataclasses.replace(estimator, horizon=h))
+        out[key] = js.predict(model, test, estimator=dataclasses.replace(estimator, horizon=h))
     return out
 
 
 def _quiet_fit(*args, **kwargs):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return fit(*args, **kwargs)
+        return js.fit(*args, **kwargs)
 
 
 def _nomoto_models(train, test, estimator, horizons):
     """Nomoto1 from the ARX start, then Nomoto2 from the fitted Nomoto1."""
     est = dataclasses.replace(estimator, channels=("psi", "r"), wind=False)
-    start1 = initial_estimate(Nomoto1(K=0.1, T=10.0), train)
+    start1 = js.initial_estimate(js.Nomoto1(K=0.1, T=10.0), train)
     fit1 = _quiet_fit(start1, train, estimator=est)
     K, T = float(fit1.model.K), float(fit1.model.T)
-    start2 = Nomoto2(K=K, T1=T, T2=0.1 * T, T3=0.05 * T)
+    start2 = js.Nomoto2(K=K, T1=T, T2=0.1 * T, T3=0.05 * T)
     fit2 = _quiet_fit(start2, train, estimator=est)
     return (Identified("Nomoto1", fit1, _validate(fit1.model, test, est, horizons)),
             Identified("Nomoto2", fit2, _validate(fit2.model, test, est, horizons)))
@@ -178,10 +174,10 @@ def identify_esso_osaka(root=None, *, factor: int = 5, horizon: float = 20.0,
     **Raises:** `FileNotFoundError` when the data are absent.
     """
     train, test = esso_osaka_split(root, factor=factor)
-    vessel = get_vessel("esso_osaka")
+    vessel = js.vessel("esso_osaka")
     # tolerances of 1e-6: relative cost changes below that are far inside the noise
     solver = optx.LevenbergMarquardt(rtol=tol, atol=tol)
-    est = PredictionError(horizon=horizon, wind=wind, substeps=substeps, max_steps=max_steps,
+    est = js.PredictionError(horizon=horizon, wind=wind, substeps=substeps, max_steps=max_steps,
                           solver=solver)
     horizons = (horizon, None)
     baseline = _validate(vessel, test, est, horizons)
@@ -198,6 +194,6 @@ def identify_kvlcc2_hsva(root=None, *, factor: int = 4, train=HSVA_TRAIN, test=H
     """Nomoto 1 and 2 from HSVA KVLCC2 zig-zags by output error (`horizon=None`),
     validated by simulation of the held-out zig-zags."""
     train_runs, test_runs = hsva_split(root, factor=factor, train=train, test=test)
-    est = PredictionError(horizon=None)
+    est = js.PredictionError(horizon=None)
     models = _nomoto_models(train_runs, test_runs, est, (None,))
     return RealDataReport("KVLCC2 HSVA", models, tuple(train), tuple(test))

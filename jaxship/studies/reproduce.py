@@ -5,7 +5,7 @@ Simulates the experiment design of the thesis (section 4.1): turning circles at 
 rpm, writes every trial as a trial CSV with its indices, a summary table, and the
 figures that correspond to the thesis' figs. 4.2-4.7; then identifies the Nomoto and
 Ross steering models from noisy records of the same design (sections 4.2-4.3,
-`jaxship._thesis_identification`) and writes their fit % next to the thesis' numbers
+`jaxship.studies.thesis`) and writes their fit % next to the thesis' numbers
 (`identification.json`, and a table in `summary.md`).
 """
 
@@ -16,11 +16,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 from tqdm.auto import tqdm
 
-from ._data import write_trial_csv
-from ._thesis_identification import identification_study, markdown_table, to_json
-from ._trials import run_trial, trial_indices
-from ._vessel.catalogue import get_vessel
-from .plotting import plot_trajectory
+import jaxship as js
+from jaxship.plotting import plot_trajectory
+from jaxship.studies.thesis import identification_study, markdown_table, to_json
 
 
 TRIALS = [
@@ -57,16 +55,16 @@ def reproduce(out, *, quick=False, progress=False, identification=True) -> dict:
     out = pathlib.Path(out)
     (out / "trials").mkdir(parents=True, exist_ok=True)
     (out / "figures").mkdir(exist_ok=True)
-    vessel = get_vessel("thesis")
+    vessel = js.vessel("thesis")
     jobs = [(spec, rpm) for rpm in RPMS for spec in (QUICK_TRIALS if quick else TRIALS)]
     summary, runs = {}, {}
     for spec, rpm in tqdm(jobs, desc="thesis trials", disable=not progress, unit="trial"):
-        manoeuvre, traj = run_trial(vessel, spec, rpm=rpm, dt=0.1)
+        manoeuvre, traj = js.run_trial(vessel, spec, rpm=rpm, dt=0.1)
         if not bool(traj.success):
             raise RuntimeError(f"simulation of {spec} at {rpm:g} rpm failed")
         name = _file_name(spec, rpm)
-        write_trial_csv(out / "trials" / f"{name}.csv", traj)
-        summary[name] = _finite(trial_indices(spec, manoeuvre, traj))
+        js.write_trial_csv(out / "trials" / f"{name}.csv", traj)
+        summary[name] = _finite(js.trial_indices(spec, manoeuvre, traj))
         runs[(spec, rpm)] = traj
     for spec, rpm, name, thesis_figure in FIGURES:
         if (spec, rpm) in runs:

@@ -1,0 +1,450 @@
+"""Parameter uncertainty and identifiability of least-squares estimates: covariances
+(`least_squares_covariance`, the Newey-West HAC sandwich `hac_covariance`,
+`hac_from_windows`) and the `ParameterReport` (`parameter_report`). Host-side NumPy
+(float64), following Ljung (1999), *System Identification*, 2nd ed., ch. 9 and 16.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ._validate import _to_plain
+
+
+# ---------------------------------------------------------------------------------------
+# parameter uncertainty
+
+
+def _normalised_inverse(jac, rcond):
+    """`(pinv, scale, undetermined, null)` of a Jacobian (N, d): `pinv` is
+    $(J_n^TJ_n)^+$ of the column-normalised $J_n = J/\\mathrm{scale}$, directions
+    with a singular value below `rcond` times the largest dropped; `null` the unit
+    vectors (d,) spanning them and `undetermined` the parameters taking part."""
+    d = jac.shape[1]
+    norms = np.sqrt(np.sum(jac**2, axis=0))
+    safe = np.where(norms > 0, norms, 1.0)
+    jn = jac / safe
+    _, s, vt = np.linalg.svd(jn, full_matrices=False)
+    tol = rcond * (s[0] if s.size and s[0] > 0 else 1.0)
+    good = (s > tol) & (s > 0)
+    null = [vt[i] for i in range(len(s)) if not good[i]]
+    for i in np.nonzero(norms == 0)[0]:  # zero columns: already in `null` via SVD, but be sure
+        if not any(abs(v[i]) > 0.5 for v in null):
+            unit = np.zeros(d)
+            unit[i] = 1.0
+            null.append(unit)
+    pinv_a = (vt[good].T / s[good] ** 2) @ vt[good]  # (Jn^T Jn)^+
+    undetermined = np.zeros(d, dtype=bool)
+    for v in null:
+        undetermined |= np.abs(v) > 1e-3
+    return pinv_a, safe, undetermined, null
+
+
+def least_squares_covariance(jacobian, residuals, groups=None, *, num_params=None,
+                             rcond: float = 1e-10):
+    """Covariance of a least-squares estimate from the Jacobian at the optimum.
+
+    With one group (all residuals equally weighted) this is
+    $\\hat\\sigma^2 (J^TJ)^{-1}$, $\\hat\\sigma^2 = \\sum\\varepsilon^2/(N - d)$
+    (Ljung 1999, eq. 9.18). With several groups (e.g. heading and yaw-rate residuals
+    with fixed weights) each group g gets its own variance
+    $\\hat\\sigma_g^2 = \\sum_g\\varepsilon^2 N/(N_g(N - d))$ and the covariance is the
+    sandwich $A^{-1}(\\sum_g\\hat\\sigma_g^2 J_g^TJ_g)A^{-1}$, $A = J^TJ$, which is
+    right for any fixed weights when the residuals are white within a group and
+    independent between groups. For correlated residuals see `hac_covariance`.
+
+    The computation is done on the column-normalised Jacobian (scale invariant);
+    directions whose singular value is below `rcond` times the largest are not
+    determined by the data: the parameters taking part in them get infinite
+    variance.
+
+    **Arguments:** `jacobian` (N, d) of the (weighted) residuals with respect to
+    the physical parameters; `residuals` (N,); `groups` (N,) integer labels or None.
+
+    **Returns:** `(covariance (d, d), null_directions)`, the second a list of unit
+    vectors (d,) spanning the undetermined directions (empty if none).
+    """
+    jac = np.asarray(jacobian, dtype=np.float64)
+    res = np.asarray(residuals, dtype=np.float64).reshape(-1)
+    num, d = jac.shape
+    if res.shape[0] != num:
+        raise ValueError(f"`residuals` has {res.shape[0]} entries, `jacobian` {num} rows.")
+    groups = np.zeros(num, dtype=int) if groups is None else np.asarray(groups).reshape(-1)
+    pinv_a, safe, undetermined, null = _normalised_inverse(jac, rcond)
+    jn = jac / safe
+    dof = max(num - d, 1)
+    middle = np.zeros((d, d))
+    for g in np.unique(groups):
+        sel = groups == g
+        num_g = int(sel.sum())
+        sigma2 = float(np.sum(res[sel] ** 2)) * num / (num_g * dof)
+        middle += sigma2 * jn[sel].T @ jn[sel]
+    cov_n = pinv_a @ middle @ pinv_a
+    cov = cov_n / safe[:, None] / safe[None, :]
+    cov[undetermined, :] = np.inf
+    cov[:, undetermined] = np.inf
+    return cov, null
+
+
+def _auto_lags(scores, valid) -> int:
+    """The automatic Bartlett bandwidth of Andrews (1991, eq. 6.2 and 6.4, AR(1)
+    plug-in) for scores `(E, N, k)` (zero at invalid samples): each column,
+    normalised to unit variance, gets an AR(1) fit $\\hat\\rho_a$ (pairs within one
+    experiment), $\\hat\\alpha(1) = \\sum_a 4\\hat\\rho_a^2\\hat\\sigma_a^4 /
+    ((1 - \\hat\\rho_a)^6(1 + \\hat\\rho_a)^2) \\,/\\, \\sum_a \\hat\\sigma_a^4 /
+    (1 - \\hat\\rho_a)^4$ and the bandwidth is
+    $S_T = 1.1447(\\hat\\alpha(1) T)^{1/3}$, T the number of valid samples; the lag
+    count is $\\lfloor S_T \\rfloor$ ($\\hat\\rho$ clipped to $\\pm 0.99$), at most the
+    longest experiment's span minus one."""
+    g = scores
+    count = valid.sum()
+    if count < 3 or g.shape[-1] == 0:
+        return 0
+    rms = np.sqrt(np.sum(g**2, axis=(0, 1)) / count)
+    keep = rms > 0
+    if not keep.any():
+        return 0
+    g = g[..., keep] / rms[keep]
+    pair = (valid[:, 1:] & valid[:, :-1])[..., None]
+    x, y = np.where(pair, g[:, 1:], 0.0), np.where(pair, g[:, :-1], 0.0)
+    num_pairs = int(pair.sum())
+    yy = np.sum(y**2, axis=(0, 1))
+    if num_pairs < 2 or not (yy > 0).all():
+        return 0
+    rho = np.clip(np.sum(x * y, axis=(0, 1)) / yy, -0.99, 0.99)
+    sigma4 = (np.sum((x - rho * y) ** 2, axis=(0, 1)) / num_pairs) ** 2
+    alpha = (np.sum(4 * rho**2 * sigma4 / ((1 - rho) ** 6 * (1 + rho) ** 2))
+             / np.sum(sigma4 / (1 - rho) ** 4))
+    span = 0
+    for row in valid:
+        idx = np.nonzero(row)[0]
+        if idx.size:
+            span = max(span, int(idx[-1] - idx[0]))
+    lags = int(math.floor(1.1447 * (alpha * float(count)) ** (1.0 / 3.0)))
+    return max(0, min(lags, span - 1 if span > 0 else 0))
+
+
+def bartlett_long_run(scores, lags: int) -> np.ndarray:
+    """$S = \\Gamma_0 + \\sum_{l=1}^{L}(1 - \\frac{l}{L+1})(\\Gamma_l + \\Gamma_l^T)$,
+    $\\Gamma_l = \\sum_e\\sum_t g_{e,t}g_{e,t-l}^T$, of scores `(E, N, k)` (zero where
+    invalid), summed over experiments and never across them. Computed exactly as
+    $\\frac{1}{L+1}\\sum_t B_tB_t^T$ with the moving sums
+    $B_t = \\sum_{s=t-L}^{t} g_s$ over the zero-padded series (each pair s, s' is
+    counted $L + 1 - |s - s'|$ times): one product instead of L."""
+    g = np.asarray(scores, dtype=np.float64)
+    if g.ndim == 2:
+        g = g[None]
+    lags = int(lags)
+    num_e, num, k = g.shape
+    csum = np.cumsum(np.concatenate([np.zeros((num_e, 1, k)), g, np.zeros((num_e, lags, k))],
+                                    axis=1), axis=1)
+    t = np.arange(num + lags)
+    # B_t = csum[t + 1] - csum[t - L]; csum[0] = 0 stands for every start before the series
+    blocks = csum[:, t + 1] - csum[:, np.maximum(t - lags, 0)]
+    return np.einsum("etp,etq->pq", blocks, blocks) / (lags + 1)
+
+
+def _hac(rows, scores, valid, lags, focus, rcond):
+    num, d = rows.shape
+    if num == 0:
+        raise ValueError("no valid residuals.")
+    pinv_a, safe, undetermined, _ = _normalised_inverse(rows, rcond)
+    g = scores / safe
+    if lags is None:
+        sel = g if focus is None else g[..., np.asarray(focus)]
+        lags = _auto_lags(sel, valid)
+    elif int(lags) != lags or lags < 0:
+        raise ValueError(f"`lags` must be None or a non-negative integer, got {lags!r}.")
+    lags = int(lags)
+    middle = bartlett_long_run(g, lags)
+    cov = pinv_a @ middle @ pinv_a * (num / max(num - d, 1))
+    cov = cov / safe[:, None] / safe[None, :]
+    cov[undetermined, :] = np.inf
+    cov[:, undetermined] = np.inf
+    return cov, lags
+
+
+def hac_covariance(jacobian, residuals, mask=None, *, lags=None, focus=None,
+                   rcond: float = 1e-10):
+    """Covariance of a (nonlinear) least-squares estimate that stays right when the
+    residuals are correlated in time and of unequal variance: the
+    heteroscedasticity and autocorrelation consistent (HAC) sandwich of Newey &
+    West (1987, *Econometrica* 55, 703-708, eq. 2-3), also White (1984, ch. 6):
+
+    $$\\Sigma = \\frac{N}{N - d}(J^TJ)^{-1} S (J^TJ)^{-1},\\quad
+    S = \\Gamma_0 + \\sum_{l=1}^{L} w_l(\\Gamma_l + \\Gamma_l^T),\\quad
+    w_l = 1 - \\frac{l}{L+1},\\quad \\Gamma_l = \\sum_t g_t g_{t-l}^T,$$
+
+    with the score of sample t, $g_t = \\sum_c J_{c,t}^T e_{c,t}$, summed over the
+    output channels c at that sample (channels of one sample are correlated too).
+    Lagged products are taken within one experiment only: the Gammas are summed over
+    experiments, never across them. N is the number of residuals and d of columns;
+    $N/(N - d)$ is the same small-sample factor as in `least_squares_covariance`, so
+    with white residuals and `lags=0` both agree to sampling error (lag 0 alone is
+    White's heteroscedasticity-robust covariance). The Bartlett weights keep S
+    positive semi-definite. Scale invariant (computed on the column-normalised
+    Jacobian); undetermined directions get infinite variance as in
+    `least_squares_covariance`. The sign convention of J (residuals or predictions)
+    does not matter.
+
+    **Bandwidth.** `lags=None` chooses L by the AR(1) plug-in rule of Andrews
+    (1991, *Econometrica* 59, 817-858, eq. 6.4 with the Bartlett constant 1.1447):
+    $L = \\lfloor 1.1447(\\hat\\alpha(1)T)^{1/3}\\rfloor$, where $\\hat\\alpha(1)$ comes from
+    AR(1) fits to the normalised score columns (`focus` selects the columns, e.g. the
+    physical parameters when the Jacobian also has nuisance columns) and T is the
+    number of valid samples. It grows with the correlation of the scores: for
+    scores with $\\rho = 0.81$ and T = 2000 it gives 40 lags, for $\\rho = 0.98$
+    about 200 (capped at the longest experiment's span). The common fixed rule
+    $\\lfloor 4(T/100)^{2/9}\\rfloor$ (Newey & West 1994) ignores the correlation:
+    it gives 6 lags for T = 1000 and, with AR(1) errors of $\\phi = 0.9$ and a
+    regressor as correlated, standard errors still 30-50 % too small, against
+    10-20 % too small with the rule used here (Bartlett's bias; measured in
+    tests/test_validate.py). Pass `lags=` to override.
+
+    **Arguments:**
+
+    - `jacobian`: `(C, E, N, d)`, `(E, N, d)` or `(N, d)`: the Jacobian of the
+      (weighted) residuals with respect to the parameters, samples in time order
+      within each experiment (channels, experiments, samples, parameters).
+    - `residuals`: `(C, E, N)`, `(E, N)` or `(N,)`, same scale as the Jacobian.
+    - `mask`: valid samples, broadcastable to the residuals' shape (e.g. `(E, N)`);
+      masked samples (padding) contribute nothing but still count as time steps.
+    - `lags`: the number L of lags, or None for the automatic rule.
+    - `focus`: column indices that choose the automatic bandwidth (default all).
+
+    **Returns:** `(covariance (d, d), lags)`.
+    """
+    jac = np.asarray(jacobian, dtype=np.float64)
+    res = np.asarray(residuals, dtype=np.float64)
+    if res.ndim not in (1, 2, 3) or jac.ndim != res.ndim + 1 or jac.shape[:-1] != res.shape:
+        raise ValueError(f"`residuals` must be (C, E, N), (E, N) or (N,) and `jacobian` the "
+                         f"same plus (d,), got {res.shape} and {jac.shape}.")
+    lead = (1,) * (3 - res.ndim)
+    res, jac = res.reshape(lead + res.shape), jac.reshape(lead + jac.shape)
+    if mask is None:
+        valid = np.ones(res.shape, dtype=bool)
+    else:
+        mask = np.asarray(mask, dtype=bool)
+        valid = np.broadcast_to(mask.reshape((1,) * (3 - mask.ndim) + mask.shape), res.shape)
+    bad = valid & ~(np.isfinite(res) & np.isfinite(jac).all(axis=-1))
+    if bad.any():
+        raise ValueError(f"non-finite residuals or Jacobian at {int(bad.sum())} valid samples.")
+    jac0 = np.where(valid[..., None], jac, 0.0)
+    scores = np.einsum("cenp,cen->enp", jac0, np.where(valid, res, 0.0))
+    return _hac(jac[valid], scores, valid.any(axis=0), lags, focus, rcond)
+
+
+def hac_from_windows(jacobian, residuals, layout, *, num_samples=None, lags=None,
+                     focus=None, rcond: float = 1e-10):
+    """`hac_covariance` of a windowed prediction-error fit: the Jacobian
+    `(C, E, W, L, d)` and residuals `(C, E, W, L)` at the window samples are put in
+    time order with `layout["target"]` (E, W, L) sample indices and `layout["mask"]`
+    (as `jaxship._estimate._windows.to_timeline` does); scores of window samples that
+    land on the same sample are added. `num_samples`: length of the timeline
+    (default the largest target index + 1). Returns `(covariance (d, d), lags)`."""
+    jac = np.asarray(jacobian, dtype=np.float64)
+    res = np.asarray(residuals, dtype=np.float64)
+    mask = np.asarray(layout["mask"], dtype=bool)
+    target = np.asarray(layout["target"])
+    if res.ndim == mask.ndim:
+        res, jac = res[None], jac[None]
+    if res.shape[1:] != mask.shape or jac.shape[:-1] != res.shape:
+        raise ValueError(f"window residuals {res.shape} and Jacobian {jac.shape} do not match "
+                         f"the layout's mask {mask.shape}.")
+    d = jac.shape[-1]
+    rows = np.concatenate([jac[c][mask] for c in range(res.shape[0])])
+    if not (np.isfinite(rows).all() and all(np.isfinite(r[mask]).all() for r in res)):
+        raise ValueError("non-finite residuals or Jacobian at valid window samples.")
+    jac0 = np.where(mask[None, ..., None], jac, 0.0)
+    per_window = np.einsum("cewlp,cewl->ewlp", jac0, np.where(mask[None], res, 0.0))
+    num = int(target[mask].max()) + 1 if num_samples is None else int(num_samples)
+    e_idx = np.broadcast_to(np.arange(mask.shape[0])[:, None, None], mask.shape)
+    scores = np.zeros((mask.shape[0], num, d))
+    np.add.at(scores, (e_idx[mask], target[mask]), per_window[mask])
+    valid = np.zeros((mask.shape[0], num), dtype=bool)
+    valid[e_idx[mask], target[mask]] = True
+    return _hac(rows, scores, valid, lags, focus, rcond)
+
+
+@dataclasses.dataclass(frozen=True)
+class ParameterReport:
+    """Estimates with their uncertainty and an identifiability verdict.
+
+    - `names`, `values`, `units`; `std`: standard errors (inf: not determined);
+    - `covariance`, `correlation` (d, d);
+    - `condition_number`: of the correlation matrix (scale free; 1 for independent
+      estimates, large when some combination is poorly determined; inf if singular);
+    - `flags`: plain-language findings: parameter pairs with $|\\rho| > 0.95$,
+      parameters with relative standard error above 50 %, combinations the data do
+      not determine at all, data problems (e.g. no excitation) and residuals that
+      are not white (see `uncertainty_flags`). Empty when the estimates are well
+      determined and the residuals white.
+    - `std_robust`: standard errors that do not assume white residuals (Newey-West
+      HAC, see `hac_covariance`); NaN where not computed;
+    - `residuals_white`: whether the residuals passed the whiteness test (None: not
+      tested);
+    - `hac_lags`: the number of lags of `std_robust` (None: not computed);
+    - `uncertainty_flags`: the flags (also in `flags`) about the standard errors
+      rather than about identifiability; `identifiable` ignores them.
+
+    `std`, `covariance` and `correlation` are the usual white-noise ones; when
+    `residuals_white` is False they understate the uncertainty and `std_robust` is
+    the one to quote.
+    """
+
+    names: tuple[str, ...]
+    values: np.ndarray
+    std: np.ndarray
+    covariance: np.ndarray
+    correlation: np.ndarray
+    condition_number: float
+    flags: tuple[str, ...]
+    units: tuple[str, ...] = ()
+    std_robust: np.ndarray | None = None
+    residuals_white: bool | None = None
+    hac_lags: int | None = None
+    uncertainty_flags: tuple[str, ...] = ()
+
+    def __post_init__(self):
+        if self.std_robust is None:
+            object.__setattr__(self, "std_robust", np.full(np.shape(self.values), np.nan))
+
+    @property
+    def identifiable(self) -> bool:
+        """No identifiability flag (flags about correlated residuals do not count)."""
+        return not [f for f in self.flags if f not in self.uncertainty_flags]
+
+    @property
+    def has_robust(self) -> bool:
+        """Robust (HAC) standard errors were computed."""
+        return bool(np.any(~np.isnan(self.std_robust)))
+
+    @property
+    def relative_std(self) -> np.ndarray:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(self.values != 0, self.std / np.abs(self.values), np.inf)
+
+    def table(self) -> str:
+        """The estimates as a text table: name, value, std, relative std, unit (and the
+        robust std when computed)."""
+        robust = self.has_robust
+        extra = f" {'std robust':>12}" if robust else ""
+        lines = [f"{'parameter':>12} {'value':>14} {'std':>12}{extra} {'rel. std':>9}  unit"]
+        units = self.units or ("",) * len(self.names)
+        for name, v, s, sr, rel, unit in zip(self.names, self.values, self.std, self.std_robust,
+                                             self.relative_std, units):
+            extra = f" {sr:12.4g}" if robust else ""
+            lines.append(f"{name:>12} {v:14.6g} {s:12.4g}{extra} {100 * rel:8.2f}%  {unit}")
+        lines.append(f"condition number of the correlation matrix: {self.condition_number:.4g}")
+        lines.extend(f"! {flag}" for flag in self.flags)
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        return {f.name: _to_plain(getattr(self, f.name)) for f in dataclasses.fields(self)}
+
+
+def _combination(names, vector):
+    order = np.argsort(-np.abs(vector))
+    terms = [f"{vector[i]:+.2f} {names[i]}" for i in order if abs(vector[i]) > 1e-3]
+    return " ".join(terms).lstrip("+")
+
+
+def parameter_report(names, values, covariance, *, units=(), corr_threshold: float = 0.95,
+                     rel_std_threshold: float = 0.5, null_directions=(),
+                     extra_flags=(), robust_covariance=None, white: bool | None = None,
+                     hac_lags: int | None = None) -> ParameterReport:
+    """Standard errors, correlation matrix, condition number and identifiability
+    flags of estimates `values` with `covariance` (see `ParameterReport`).
+
+    `null_directions` (from `least_squares_covariance`) are reported as combinations
+    the data do not determine; `extra_flags` are appended as they are.
+
+    `robust_covariance` (d, d), e.g. from `hac_covariance` with its `hac_lags`,
+    gives `std_robust`. `white`: the residuals passed the whiteness test (e.g.
+    `all(m.white for m in metrics)`); when False a flag says that the usual standard
+    errors are too small, by how much at most (the largest `std_robust / std`), and
+    the relative-error check uses the larger of `std` and `std_robust`.
+    """
+    names = tuple(names)
+    values = np.asarray(values, dtype=np.float64).reshape(-1)
+    cov = np.asarray(covariance, dtype=np.float64)
+    d = values.shape[0]
+    if cov.shape != (d, d):
+        raise ValueError(f"`covariance` must be ({d}, {d}), got {cov.shape}.")
+    var = np.diag(cov).copy()
+    std = np.sqrt(np.where(var >= 0, var, np.nan))
+    finite = np.isfinite(std) & (std > 0)
+    corr = np.full((d, d), np.nan)
+    sub = np.ix_(finite, finite)
+    corr[sub] = cov[sub] / std[finite][:, None] / std[finite][None, :]
+    np.fill_diagonal(corr, np.where(finite, 1.0, np.nan))
+    if finite.all() and d:
+        eig = np.linalg.eigvalsh(corr)
+        condition = float(eig[-1] / eig[0]) if eig[0] > 0 else math.inf
+    else:
+        condition = math.inf
+    flags = []
+    for v in null_directions:
+        v = np.asarray(v, dtype=float)
+        involved = [names[i] for i in np.nonzero(np.abs(v) > 1e-3)[0]]
+        if len(involved) == 1:
+            flags.append(f"{involved[0]} does not affect the fitted outputs: the data say "
+                         "nothing about it (freeze it or use data that excite it).")
+        else:
+            flags.append(f"the data do not determine the combination {_combination(names, v)} "
+                         f"of {', '.join(involved)} (information matrix singular): only other "
+                         "combinations of these parameters are identifiable.")
+    for i in range(d):
+        for j in range(i + 1, d):
+            rho = corr[i, j]
+            if np.isfinite(rho) and abs(rho) > corr_threshold:
+                flags.append(f"{names[i]} and {names[j]} are strongly correlated "
+                             f"(correlation {rho:+.3f}): the data barely separate them.")
+    if robust_covariance is None:
+        std_robust = np.full(d, np.nan)
+    else:
+        robust = np.asarray(robust_covariance, dtype=np.float64)
+        if robust.shape != (d, d):
+            raise ValueError(f"`robust_covariance` must be ({d}, {d}), got {robust.shape}.")
+        var_r = np.diag(robust)
+        std_robust = np.sqrt(np.where(var_r >= 0, var_r, np.nan))
+    use_robust = (white is False) & ~np.isnan(std_robust) & ~(std_robust <= std)
+    judged = np.where(use_robust, std_robust, std)
+    rel = np.abs(judged) / np.where(values != 0, np.abs(values), np.nan)
+    for i in range(d):
+        if np.isfinite(judged[i]) and not (rel[i] <= rel_std_threshold):
+            percent = f"{100 * rel[i]:.0f} %" if np.isfinite(rel[i]) else "inf %"
+            kind = "robust (HAC) standard error" if use_robust[i] else "standard error"
+            flags.append(f"{names[i]} = {values[i]:.4g} is poorly determined: {kind} "
+                         f"{judged[i]:.3g} is {percent} of the value (threshold "
+                         f"{100 * rel_std_threshold:.0f} %).")
+    flags.extend(extra_flags)
+    uncertainty = ()
+    if white is False:
+        uncertainty = (_not_white_flag(names, std, std_robust, hac_lags),)
+        flags.extend(uncertainty)
+    return ParameterReport(names, values, std, cov, corr, condition, tuple(flags), tuple(units),
+                           std_robust=std_robust, residuals_white=None if white is None
+                           else bool(white), hac_lags=None if hac_lags is None
+                           else int(hac_lags), uncertainty_flags=uncertainty)
+
+
+def _not_white_flag(names, std, std_robust, hac_lags) -> str:
+    head = ("residuals are not white (correlated in time): the usual standard errors "
+            "assume white residuals")
+    how = "Newey-West HAC" + ("" if hac_lags is None else
+                              f", {int(hac_lags)} lag{'' if int(hac_lags) == 1 else 's'}")
+    ok = np.isfinite(std) & np.isfinite(std_robust) & (std > 0)
+    if not ok.any():
+        if np.all(np.isnan(std_robust)):
+            return (f"{head} and understate the uncertainty; no robust standard errors were "
+                    "computed (see jaxship._validate.hac_covariance).")
+        return f"{head} and understate the uncertainty; use std_robust ({how})."
+    ratio = np.where(ok, std_robust / np.where(ok, std, 1.0), -np.inf)
+    i = int(np.argmax(ratio))
+    if ratio[i] > 1:
+        return (f"{head}, so they are too small by up to {ratio[i]:.3g}x ({names[i]}); use "
+                f"std_robust ({how}).")
+    return (f"{head}; here the robust standard errors ({how}) are not larger (largest ratio "
+            f"{ratio[i]:.3g} for {names[i]}), but quote std_robust.")

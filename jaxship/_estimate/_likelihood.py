@@ -1,0 +1,312 @@
+"""Innovations-form (PEM) and maximum-likelihood fits of steering models with their
+noise (`fit_ml`), by the extended Kalman filter of `jaxship._estimate._kalman` (the
+model, the filter and the likelihood are described there).
+"""
+
+import math
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optimistix as optx
+
+from .._covariance import ParameterReport, least_squares_covariance, parameter_report
+from .._params import Transform, as_arrays, rebuild, resolve_free
+from .._steering._base import AbstractSteeringModel
+from ._kalman import (
+    KALMAN_CHANNELS,
+    _augmented_names,
+    _batch_filter,
+    _check_inputs,
+    _records,
+    _variance,
+)
+from ._lm import LevenbergMarquardt, SolverOutcome, solve_least_squares
+from ._windows import channel_weights
+
+
+# -- estimation ---------------------------------------------------------------------
+
+
+class _Noise(eqx.Module):
+    """Layout of the noise parameters: the process entries (`"rudder"` or augmented
+    state names) and the channels; `estimated` flags, fixed log-variances `fixed`."""
+
+    names: tuple[str, ...] = eqx.field(static=True)  # process names, then channels
+    estimated: tuple[bool, ...] = eqx.field(static=True)
+    fixed: jax.Array  # log variances of all entries (used where not estimated)
+    state_index: tuple[int, ...] = eqx.field(static=True)  # -1: rudder, -2: channel
+    num_states: int = eqx.field(static=True)
+
+    def matrices(self, log_var):
+        """(Q, q_rudder, R) from the estimated log variances."""
+        full, j = [], 0
+        for i, est in enumerate(self.estimated):
+            if est:
+                full.append(log_var[j])
+                j += 1
+            else:
+                full.append(self.fixed[i])
+        var = jnp.exp(jnp.stack(full))
+        Q = jnp.zeros((self.num_states, self.num_states), var.dtype)
+        q_rudder = jnp.zeros((), var.dtype)
+        r_diag = []
+        for i, k in enumerate(self.state_index):
+            if k == -1:
+                q_rudder = var[i]
+            elif k == -2:
+                r_diag.append(var[i])
+            else:
+                Q = Q.at[k, k].set(var[i])
+        return Q, q_rudder, jnp.diag(jnp.stack(r_diag))
+
+
+def _split(z, d, transform, model):
+    p = transform.to_physical(z[:d])
+    return rebuild(model, transform.names, p), z[d:]
+
+
+def _nll(z, args):
+    model, transform, noise, rec = args
+    m, log_var = _split(z, len(transform.names), transform, model)
+    Q, q, R = noise.matrices(log_var)
+    return jnp.sum(_batch_filter(m, rec, Q, q, R).neg_log_likelihood)
+
+
+def _pem_residuals(z, args):
+    model, transform, noise, rec, weights = args
+    m, log_var = _split(z, len(transform.names), transform, model)
+    Q, q, R = noise.matrices(log_var)
+    e = _batch_filter(m, rec, Q, q, R).innovations  # (E, N, C), 0 where masked
+    return e * weights
+
+
+@eqx.filter_jit
+def _ml_solve(z0, model, transform, noise, rec, solver, max_steps):
+    # the loss per sample keeps the tolerances independent of the record length
+    count = jnp.sum(rec.mask[:, 1:])
+    fn = lambda z, args: _nll(z, args) / count
+    sol = optx.minimise(fn, solver, z0, args=(model, transform, noise, rec),
+                        max_steps=max_steps, throw=False)
+    return sol.value, sol.result, sol.stats["num_steps"]
+
+
+@eqx.filter_jit
+def _pem_solve(z0, model, transform, noise, rec, weights, solver, max_steps):
+    """LM on the weighted innovations; z, result, steps, the innovations and their
+    Jacobian with respect to the physical parameters and log variances."""
+    d = len(transform.names)
+    z, result, steps, _, res, jac = solve_least_squares(
+        _pem_residuals, solver, z0, (model, transform, noise, rec, weights), max_steps,
+        lambda z: _physical(z, d, transform))
+    return z, result, steps, res, jac
+
+
+def _physical(z, d, transform):
+    """Model parameters in physical units and log variances as one vector."""
+    return jnp.concatenate([transform.to_physical(z[:d]), z[d:]])
+
+
+@eqx.filter_jit
+def _ml_hessian(z, model, transform, noise, rec):
+    """NLL and its Hessian with respect to (physical parameters, log variances)."""
+    d = len(transform.names)
+    q = _physical(z, d, transform)
+
+    def f(q):
+        m = rebuild(model, transform.names, q[:d])
+        Q, qr, R = noise.matrices(q[d:])
+        return jnp.sum(_batch_filter(m, rec, Q, qr, R).neg_log_likelihood)
+
+    return f(q), jax.hessian(f)(q)
+
+
+class KalmanFitResult(SolverOutcome):
+    """Result of `fit_ml`.
+
+    - `model`: the model with the estimates (frozen parameters unchanged);
+    - `parameters`: `ParameterReport` of the free model parameters (values, standard
+      errors, covariance, correlation, flags);
+    - `noise`: `{name: variance}` of the noise at the optimum (process entries:
+      `"rudder"` [rad^2] or state names; channels `"psi"` [rad^2], `"r"`
+      [(rad/s)^2]); `noise_std`: their standard errors (0 when fixed);
+    - `criterion`: `"ml"` or `"pem"`; `loss`: the negative log likelihood (`"ml"`) or
+      half the sum of squared weighted innovations (`"pem"`);
+    - `result` (optimistix code), `success`, `message`, `num_steps`;
+    - `names`, `values`, `std`, `covariance`, `correlation`: shortcuts.
+    """
+
+    model: AbstractSteeringModel
+    parameters: ParameterReport
+    noise: dict
+    noise_std: dict
+    criterion: str
+    loss: float
+    result: optx.RESULTS
+    num_steps: int
+    experiment_names: tuple[str, ...]
+
+    names = property(lambda self: self.parameters.names)
+    values = property(lambda self: self.parameters.values)
+    std = property(lambda self: self.parameters.std)
+    covariance = property(lambda self: self.parameters.covariance)
+    correlation = property(lambda self: self.parameters.correlation)
+
+    def summary(self) -> str:
+        noise = ", ".join(f"{k} {v:.4g} +- {self.noise_std[k]:.2g}" for k, v in self.noise.items())
+        return (f"{type(self.model).__name__} by {self.criterion}: {self.message}, "
+                f"{self.num_steps} steps, loss {self.loss:.6g}\n{self.parameters.table()}\n"
+                f"noise variances: {noise}")
+
+
+def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
+    """The `_Noise` layout and the start log variances of the estimated entries.
+    Entry names: `"rudder"`, `"Q_<state>"` for process noise on a state, and the
+    channels `"psi"`, `"r"` for the measurement noise."""
+    names = _augmented_names(model)
+    if isinstance(process, str):
+        process = (process,)
+    process = tuple(process)
+    if not process:
+        raise ValueError("`process` is empty: name 'rudder' or states of the model.")
+    for p in process:
+        if p != "rudder" and p not in names:
+            raise ValueError(f"`process` names {p!r}, which is neither 'rudder' nor a state "
+                             f"of {type(model).__name__} ({', '.join(names)}).")
+    entries = tuple(p if p == "rudder" else f"Q_{p}" for p in process) + channels
+    index = tuple(-1 if p == "rudder" else names.index(p) for p in process)
+    index = index + (-2,) * len(channels)
+    # default start values: 10 % of the spread of each channel, 0.5 deg of rudder,
+    # 1 % of the spread of the yaw rate (heading for psi) per sample on a state
+    mask = np.asarray(ds.mask)
+    spread = {}
+    for c in ("psi", "r"):
+        y = np.asarray(getattr(ds, c), dtype=np.float64)
+        mean = np.sum(np.where(mask, y, 0.0), 1, keepdims=True) / mask.sum(1, keepdims=True)
+        spread[c] = float(np.sqrt(np.sum(np.where(mask, y - mean, 0.0) ** 2) / mask.sum())) or 1.0
+    default = {"rudder": math.radians(0.5) ** 2}
+    default.update({c: (0.1 * spread[c]) ** 2 for c in channels})
+    default.update({f"Q_{p}": (0.01 * spread["psi" if p == "psi" else "r"]) ** 2
+                    for p in process if p != "rudder"})
+    if isinstance(noise, str) and noise == "estimate":
+        fixed_values = {}
+    elif isinstance(noise, dict):
+        fixed_values = dict(noise)
+    else:
+        raise ValueError(f"`noise` must be 'estimate' or a dict of fixed variances, got "
+                         f"{noise!r}.")
+    starts = dict(noise_start or {})
+    for what, given in (("noise", fixed_values), ("noise_start", starts)):
+        for k in given:
+            if k not in entries:
+                raise ValueError(f"`{what}` names {k!r}, which is not a noise term of this fit "
+                                 f"({', '.join(entries)}).")
+    values, estimated = [], []
+    for e in entries:
+        if e in fixed_values:
+            v = _variance(e, fixed_values[e], "noise")
+        else:
+            v = _variance(e, starts.get(e, default[e]), "noise_start")
+        if v <= 0:
+            raise ValueError(f"noise variance of {e!r} must be positive, got {v}.")
+        values.append(math.log(v))
+        estimated.append(e not in fixed_values)
+    if criterion == "pem":
+        # the innovations do not fix the overall noise scale (scaling Q, R and P0 by one
+        # number leaves the gains unchanged): hold the first channel's variance
+        estimated[len(process)] = False
+    layout = _Noise(names=entries, estimated=tuple(estimated),
+                    fixed=jnp.asarray(values), state_index=index, num_states=len(names))
+    z = np.array([v for v, est in zip(values, estimated) if est])
+    return layout, z
+
+
+def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_CHANNELS,
+           criterion: str = "ml", process="rudder", noise="estimate", noise_start=None,
+           rudder: str = "delta", substeps: int = 1, max_steps: int = 512,
+           solver=None, hold=None) -> KalmanFitResult:
+    """Estimate a steering model with its noise by the Kalman filter's innovations.
+
+    **Arguments:**
+
+    - `model`, `dataset`, `free`: as `jaxship.fit` (start values in the model; `free`
+      names or `Free` specs).
+    - `channels`: measured outputs, `"psi"` and/or `"r"`.
+    - `criterion`: `"ml"` (default): minimise the negative log likelihood
+      $\\tfrac12\\sum_k(\\log\\det S_k + \\varepsilon_k^TS_k^{-1}\\varepsilon_k)$ over the
+      model parameters and the log noise variances with `optimistix.BFGS`; standard
+      errors from the inverse Hessian (`jax.hessian`) of $-\\log L$ (Ljung 1999,
+      sec. 7.4 and eq. 9.29). `"pem"`: prediction-error method with the innovations
+      predictor (Ljung 1999, sec. 4.3 and 7.2): minimise
+      $\\tfrac12\\sum_k\\|W\\varepsilon_k\\|^2$ ($W$ = 1/std of each channel) with
+      Levenberg-Marquardt and forward-mode Jacobians; the noise variances set the
+      filter gain and are estimated as well, except the first channel's, which fixes
+      the scale (the innovations are invariant to it); standard errors as `fit`.
+    - `process`: where the process noise enters: `"rudder"` (default; a rudder-equivalent
+      disturbance held over each interval) and/or names of the model's states or
+      `"psi"` (a diagonal $Q$ entry each, named `"Q_<state>"` in `noise`).
+    - `noise`: `"estimate"` (default) or a dict `{name: variance}` of values to hold
+      fixed (names `"rudder"`, `"Q_<state>"` and the channels; the others are estimated).
+    - `noise_start`: dict of start variances (default: 10 % of each channel's spread
+      for R, (0.5 deg)^2 for the rudder, 1 % of the spread on states).
+    - `rudder`, `substeps`: as `PredictionError`.
+    - `max_steps`, `solver`: optimiser step limit and an optimistix solver (default
+      `BFGS(rtol=1e-8, atol=1e-8)` for ML, jaxship's `LevenbergMarquardt(rtol=1e-9,
+      atol=1e-9)` with MINPACK's cost test for PEM).
+
+    **Returns:** a `KalmanFitResult`.
+    """
+    if criterion not in ("ml", "pem"):
+        raise ValueError(f"`criterion` must be 'ml' or 'pem', got {criterion!r}.")
+    ds, channels = _check_inputs(model, dataset, channels, rudder, substeps)
+    specs = resolve_free(model, free)
+    transform = Transform.from_specs(specs)
+    layout, z_noise = _noise_layout(model, ds, channels, process, noise, noise_start, criterion)
+    rec = _records(ds, channels, rudder, substeps, hold)
+    z0 = jnp.asarray(np.concatenate([transform.to_unconstrained([s.start for s in specs]),
+                                     z_noise]), dtype=float)
+    base = as_arrays(model)
+    d = len(specs)
+    if criterion == "ml":
+        solver = optx.BFGS(rtol=1e-8, atol=1e-8) if solver is None else solver
+        z, result, steps = _ml_solve(z0, base, transform, layout, rec, solver, int(max_steps))
+        loss, hess = _ml_hessian(z, base, transform, layout, rec)
+        hess = np.asarray(hess, dtype=np.float64)
+        try:
+            cov = np.linalg.inv(hess)
+        except np.linalg.LinAlgError:
+            cov = np.full_like(hess, np.inf)
+        if not np.all(np.isfinite(cov)) or np.any(np.diag(cov) <= 0):
+            cov = np.where(np.eye(hess.shape[0], dtype=bool), np.inf, 0.0)
+        loss = float(loss)
+    else:
+        solver = LevenbergMarquardt(rtol=1e-9, atol=1e-9) if solver is None else solver
+        weights = jnp.asarray(channel_weights(ds, channels, None), dtype=float)
+        z, result, steps, res, jac = _pem_solve(z0, base, transform, layout, rec, weights,
+                                                solver, int(max_steps))
+        mask = np.asarray(ds.mask).copy()
+        mask[:, 0] = False  # sample 0 is the prior, never predicted
+        res, jac = np.asarray(res), np.asarray(jac)
+        rows = np.concatenate([res[..., c][mask] for c in range(len(channels))])
+        jrows = np.concatenate([jac[..., c, :][mask] for c in range(len(channels))])
+        groups = np.repeat(np.arange(len(channels)), int(mask.sum()))
+        cov, _ = least_squares_covariance(jrows, rows, groups)
+        loss = 0.5 * float(np.sum(rows**2))
+    q = np.asarray(_physical(z, d, transform), dtype=np.float64)
+    values = q[:d]
+    fitted = rebuild(model, transform.names, [float(v) for v in values])
+    report = parameter_report(transform.names, values, cov[:d, :d],
+                              units=tuple(s.unit for s in specs))
+    log_var = np.asarray(layout.fixed, dtype=np.float64).copy()
+    log_std = np.zeros_like(log_var)
+    est_index = [i for i, e in enumerate(layout.estimated) if e]
+    log_var[est_index] = q[d:]
+    with np.errstate(invalid="ignore"):
+        log_std[est_index] = np.sqrt(np.diag(cov)[d:])
+    var = np.exp(log_var)
+    noise_out = {n: float(v) for n, v in zip(layout.names, var)}
+    noise_std = {n: float(v * s) for n, v, s in zip(layout.names, var, log_std)}
+    return KalmanFitResult(model=fitted, parameters=report, noise=noise_out, noise_std=noise_std,
+                           criterion=criterion, loss=loss, result=result, num_steps=int(steps),
+                           experiment_names=tuple(ds.names))

@@ -1,0 +1,486 @@
+"""File formats and readers of trials: the trial CSV format (`read_trial_csv`,
+`write_trial_csv`) and readers for the measured data sets (Esso Osaka FRT, HSVA and
+MARIN KVLCC2), all returning `jaxship.Experiment` in SI units and our sign convention.
+
+**Trial CSV format.** Comma-separated, one header row, one column per channel, each
+header `name [unit]`:
+
+| name | meaning | units |
+| --- | --- | --- |
+| `t` | time | s |
+| `delta` | actual rudder angle, positive to starboard | deg, rad |
+| `delta_c` | commanded rudder angle | deg, rad |
+| `psi` | heading, not wrapped | deg, rad |
+| `r` | yaw rate | deg/s, rad/s |
+| `u`, `v` | surge and sway velocity through the water (body axes, midship) | m/s |
+| `x`, `y` | north and east position | m |
+| `n` | propeller rate | rpm, rps |
+| `wind_speed` | true wind speed | m/s |
+| `wind_dir` | true wind direction the wind comes *from*, from north (x) | deg, rad |
+
+`t`, `delta` and one of `psi`, `r` are required, the rest optional; column order is
+free. Rows are numbered from 1 after the header ("row 3" is the third data row) and
+every error message names the file, the column, the row and its line. Blank lines and
+trailing rows whose cells are all empty (spreadsheet exports) are skipped; an empty or
+non-finite cell anywhere else is an error. Unknown column names are an error unless
+`allow_unknown=True`, which keeps them, unconverted, in `Experiment.extra`.
+"""
+
+import csv
+import math
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ._data import CHANNELS, Experiment
+from ._state import Trajectory
+
+
+_ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
+_RATE = {"rad/s": 1.0, "deg/s": math.pi / 180.0}
+# factors from the file's unit to SI (rad, rad/s, rev/s)
+_UNITS = {
+    "t": {"s": 1.0},
+    "delta": _ANGLE,
+    "delta_c": _ANGLE,
+    "psi": _ANGLE,
+    "r": _RATE,
+    "u": {"m/s": 1.0},
+    "v": {"m/s": 1.0},
+    "x": {"m": 1.0},
+    "y": {"m": 1.0},
+    "n": {"rps": 1.0, "rpm": 1.0 / 60.0},
+    "wind_speed": {"m/s": 1.0},
+    "wind_dir": _ANGLE,
+}
+_DISPLAY_UNITS = {"rad": "deg", "rad/s": "deg/s", "rps": "rpm"}
+_HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*\[([^\]]*)\]\s*$")
+
+KVLCC2_SCALE = 45.714  # lambda [-], INSEAN model 2487 (SIMMAN 2008)
+MARIN_DT = 0.13526  # full-scale sample interval [s] of the MARIN files (50 Hz model scale)
+
+
+def _to_si(value: np.ndarray, unit: str) -> np.ndarray:
+    """Convert from a file unit; degrees via `np.deg2rad` so that writing with
+    `np.rad2deg` round-trips to the last bit or two."""
+    if unit in ("deg", "deg/s"):
+        return np.deg2rad(value)
+    if unit == "rpm":
+        return value / 60.0
+    return value
+
+
+def _from_si(value: np.ndarray, unit: str) -> np.ndarray:
+    if unit in ("deg", "deg/s"):
+        return np.rad2deg(value)
+    if unit == "rpm":
+        return value * 60.0
+    return value
+
+
+# ---------------------------------------------------------------------------------------
+# CSV parsing shared by the trial format and the Esso Osaka files
+
+
+def _read_csv(path: Path, encoding: str = "utf-8-sig"):
+    """Header fields, header line number and the data records `(line, fields)`;
+    blank lines are skipped and so are trailing records with only empty cells."""
+    with open(path, newline="", encoding=encoding) as f:
+        reader = csv.reader(f)
+        header, header_line, records = None, 0, []
+        for fields in reader:
+            if not fields or (header is None and all(not s.strip() for s in fields)):
+                continue
+            if header is None:
+                header, header_line = [s.strip() for s in fields], reader.line_num
+            else:
+                records.append((reader.line_num, fields))
+    if header is None:
+        raise ValueError(f"{path}: the file is empty; expected a header row.")
+    while records and all(not s.strip() for s in records[-1][1]):
+        records.pop()
+    return header, header_line, records
+
+
+def _parse_numbers(path, headers, records) -> np.ndarray:
+    """Float table of `records`, with an error naming file, column and row on bad cells."""
+    ncol = len(headers)
+    data = np.empty((len(records), ncol))
+    for k, (line, fields) in enumerate(records):
+        if len(fields) != ncol:
+            raise ValueError(
+                f"{path}: row {k + 1} (line {line}) has {len(fields)} fields but the header "
+                f"has {ncol} columns."
+            )
+        for j, text in enumerate(fields):
+            where = f"{path}: column '{headers[j]}', row {k + 1} (line {line})"
+            if not text.strip():
+                raise ValueError(f"{where}: empty value.")
+            try:
+                value = float(text)
+            except ValueError:
+                raise ValueError(f"{where}: cannot read {text!r} as a number.") from None
+            if not math.isfinite(value):
+                raise ValueError(f"{where}: value {text.strip()!r} is not finite (NaN and "
+                                 "infinite values are not allowed).")
+            data[k, j] = value
+    return data
+
+
+def _check_time(path, header, t, lines, require_uniform, rtol):
+    if t.shape[0] < 2:
+        raise ValueError(f"{path}: needs at least two data rows, got {t.shape[0]}.")
+    steps = np.diff(t)
+    bad = np.nonzero(steps <= 0)[0]
+    if bad.size:
+        k = int(bad[0]) + 1
+        raise ValueError(
+            f"{path}: column '{header}', row {k + 1} (line {lines[k]}): time {float(t[k])!r} is "
+            f"not greater than the previous row's {float(t[k - 1])!r}; time must be strictly "
+            "increasing."
+        )
+    if require_uniform:
+        dt = float(np.median(steps))
+        bad = np.nonzero(np.abs(steps - dt) > rtol * dt)[0]
+        if bad.size:
+            k = int(bad[0]) + 1
+            raise ValueError(
+                f"{path}: column '{header}', row {k + 1} (line {lines[k]}): sampling interval "
+                f"{float(steps[k - 1])!r} s differs from the typical (median) interval {dt!r} s; "
+                "uniform sampling is required (require_uniform=True)."
+            )
+
+
+def _split_header(path, line, text):
+    match = _HEADER.match(text)
+    if match is None:
+        raise ValueError(
+            f"{path}: column '{text}' (header row, line {line}): a header must read "
+            "'name [unit]', e.g. 'psi [deg]'."
+        )
+    return match.group(1), match.group(2).strip()
+
+
+def read_trial_csv(path, *, require_uniform: bool = False, allow_unknown: bool = False,
+                   name: str | None = None, rtol: float = 1e-6) -> Experiment:
+    """Read a trial CSV (format in the module docstring) into an `Experiment` (SI).
+
+    **Arguments:**
+
+    - `path`: the file.
+    - `require_uniform`: also require a constant sample interval (to `rtol` relative).
+    - `allow_unknown`: keep columns with unknown names in `extra` (values as written)
+      instead of failing.
+    - `name`: experiment name; the file's stem by default.
+
+    **Raises:** `ValueError` naming the file, column and row for a malformed header,
+    missing required column, unknown unit or column, empty, unreadable or non-finite
+    value, non-increasing time or (with `require_uniform`) non-uniform sampling.
+    """
+    path = Path(path)
+    headers, header_line, records = _read_csv(path)
+    columns, extra_columns = {}, {}
+    for j, text in enumerate(headers):
+        key, unit = _split_header(path, header_line, text)
+        where = f"{path}: column '{text}' (header row, line {header_line})"
+        if key not in _UNITS:
+            if allow_unknown:
+                extra_columns[key] = j
+                continue
+            raise ValueError(
+                f"{where}: unknown column name {key!r}; known names are {', '.join(CHANNELS)} "
+                "(pass allow_unknown=True to keep unknown columns in `extra`)."
+            )
+        if key in columns:
+            raise ValueError(f"{where}: column {key!r} appears twice.")
+        if unit.lower() not in _UNITS[key]:
+            raise ValueError(
+                f"{where}: unknown unit {unit!r} for {key!r}; use one of "
+                f"{', '.join(_UNITS[key])}."
+            )
+        columns[key] = (j, unit.lower())
+    missing = [k for k in ("t", "delta") if k not in columns]
+    if missing:
+        raise ValueError(
+            f"{path}: header row (line {header_line}): missing required column "
+            f"{missing[0]!r} (required: t, delta and psi or r)."
+        )
+    if "psi" not in columns and "r" not in columns:
+        raise ValueError(
+            f"{path}: header row (line {header_line}): missing required column 'psi' or 'r' "
+            "(at least one of heading and yaw rate is needed)."
+        )
+    data = _parse_numbers(path, headers, records)
+    lines = [line for line, _ in records]
+    j_t = columns["t"][0]
+    _check_time(path, headers[j_t], data[:, j_t], lines, require_uniform, rtol)
+    values = {key: _to_si(data[:, j], unit) for key, (j, unit) in columns.items()}
+    return Experiment(
+        name=path.stem if name is None else name,
+        metadata={"file": str(path), "format": "trial csv"},
+        extra={k: data[:, j] for k, j in extra_columns.items()},
+        **values,
+    )
+
+
+def write_trial_csv(path, data, units: str = "display") -> None:
+    """Write an `Experiment` or an unbatched `jaxship.Trajectory` as a trial CSV.
+
+    `units="display"`: degrees, deg/s and rpm; `units="si"`: radians, rad/s and rev/s
+    (times in s, lengths in m and speeds in m/s either way). Values are written with
+    `repr`, the shortest text that reads back to the same float, so a write-read round
+    trip is exact up to the unit conversion (a few ulp for degrees and rpm).
+
+    An experiment's measured `channels` are written (derived and zero-filled ones are
+    not, so reading back recomputes them identically); a trajectory's valid samples are
+    written with t, delta, delta_c (`command.delta`), psi, r, u, v, x, y and n.
+    """
+    if units not in ("display", "si"):
+        raise ValueError(f"`units` must be 'display' or 'si', got {units!r}.")
+    if isinstance(data, Trajectory):
+        data = Experiment.from_trajectory(data)
+    elif not isinstance(data, Experiment):
+        raise ValueError(
+            f"`data` must be an Experiment or a Trajectory, got {type(data).__name__}."
+        )
+    keys = ("t",) + data.channels
+    unit_of = {}
+    for key in keys:
+        si = next(u for u, f in _UNITS[key].items() if f == 1.0)
+        unit_of[key] = _DISPLAY_UNITS.get(si, si) if units == "display" else si
+    columns = [_from_si(np.asarray(getattr(data, k), dtype=np.float64), unit_of[k]) for k in keys]
+    with open(path, "w", newline="", encoding="utf-8") as f:
+        writer = csv.writer(f, lineterminator="\n")
+        writer.writerow([f"{k} [{unit_of[k]}]" for k in keys])
+        for row in zip(*columns):
+            writer.writerow([repr(float(value)) for value in row])
+
+
+# ---------------------------------------------------------------------------------------
+# Readers for the measured data sets in shared/data
+
+
+def shared_data_dir() -> Path | None:
+    """The measured-data folder: `$JAXSHIP_DATA` if that variable is set (None if it
+    does not exist), else `../shared/data` next to the repository or the working
+    directory; None when absent (tests and notebooks skip on None)."""
+    env = os.environ.get("JAXSHIP_DATA")
+    if env:
+        path = Path(env).expanduser()
+        return path if path.is_dir() else None
+    for path in (Path(__file__).resolve().parents[2] / "shared" / "data",
+                 Path.cwd().resolve().parent / "shared" / "data"):
+        if path.is_dir():
+            return path
+    return None
+
+
+# Esso Osaka FRT column -> (channel, expected unit); positive delta already gives r > 0
+_ESSO_COLUMNS = {
+    "t": ("t", "s"),
+    "x_position_mid": ("x", "m"),
+    "y_position_mid": ("y", "m"),
+    "u_velo": ("u", "m/s"),
+    "vm_velo": ("v", "m/s"),
+    "psi_hat": ("psi", "rad"),
+    "r_angvelo": ("r", "rad/s"),
+    "n_prop": ("n", "rps"),
+    "delta_rudder": ("delta", "rad"),
+    "wind_velo_true": ("wind_speed", "m/s"),
+    "wind_dir_true": ("wind_dir", "rad"),
+    "wind_velo_relative_mid": ("wind_speed_relative", "m/s"),
+    "wind_dir_relative_mid": ("wind_dir_relative", "rad"),
+}
+_ESSO_REQUIRED = ("t", "psi_hat", "r_angvelo", "delta_rudder")
+
+
+def read_esso_osaka(path) -> Experiment:
+    """Read a run of the Esso Osaka 3 m free-running model tests (FRT-DS-ESSO,
+    Osaka University 2020; Wakita et al. 2022), model scale, SI.
+
+    The files are already SI, body-fixed u, v at midship and in our sign convention
+    (positive delta gives positive r). The heading `psi_hat` is wrapped to
+    [-pi, pi] in the files (the README's "not wrapped" is wrong: every turning run
+    jumps by 2 pi); it is unwrapped here with `np.unwrap`. x, y are the pond's
+    earth-fixed x0, y0 axes (not north/east; psi is measured from x0).
+    `wind_speed`/`wind_dir` are the TRUE wind, the direction it comes from, measured
+    from x0 (checked: the logged apparent
+    wind equals true wind minus ship velocity to 1e-4); the apparent wind is kept in
+    `extra` as `wind_speed_relative` [m/s] and `wind_dir_relative` [rad, from the bow,
+    coming from]. Trailing empty rows are dropped; files may start at t != 0.
+    """
+    path = Path(path)
+    headers, header_line, records = _read_csv(path)
+    columns = {}
+    for j, text in enumerate(headers):
+        key, unit = _split_header(path, header_line, text)
+        if key not in _ESSO_COLUMNS:
+            raise ValueError(
+                f"{path}: column '{text}' (header row, line {header_line}): unknown Esso Osaka "
+                f"column {key!r}; expected {', '.join(_ESSO_COLUMNS)}."
+            )
+        if unit != _ESSO_COLUMNS[key][1]:
+            raise ValueError(
+                f"{path}: column '{text}' (header row, line {header_line}): unit {unit!r}, "
+                f"expected {_ESSO_COLUMNS[key][1]!r}."
+            )
+        columns[key] = j
+    for key in _ESSO_REQUIRED:
+        if key not in columns:
+            raise ValueError(
+                f"{path}: header row (line {header_line}): missing required column "
+                f"'{key} [{_ESSO_COLUMNS[key][1]}]'."
+            )
+    data = _parse_numbers(path, headers, records)
+    lines = [line for line, _ in records]
+    _check_time(path, headers[columns["t"]], data[:, columns["t"]], lines, False, 0.0)
+    values = {_ESSO_COLUMNS[k][0]: data[:, j] for k, j in columns.items()}
+    values["psi"] = np.unwrap(values["psi"])  # wrapped to [-pi, pi] in the files
+    extra = {k: values.pop(k) for k in ("wind_speed_relative", "wind_dir_relative") if k in values}
+    return Experiment(
+        name=path.stem, extra=extra, **values,
+        metadata={
+            "file": str(path), "format": "esso_osaka", "vessel": "Esso Osaka 3 m model",
+            "source": "FRT-DS-ESSO, Osaka University (2020)", "scale": "model",
+            "lpp": 3.0, "frame": "pond x0/y0 axes",
+        },
+    )
+
+
+def _body_velocity(ue, ve, psi):
+    """Body-fixed (u, v) of the earth-fixed velocity (dx/dt, dy/dt) at heading psi [rad]."""
+    c, s = np.cos(psi), np.sin(psi)
+    return ue * c + ve * s, -ue * s + ve * c
+
+
+def _numeric_lines(path, lines, first_line, ncol, split):
+    """Float table of whitespace- or tab-separated `lines` (line numbers from
+    `first_line`), blank lines skipped; errors name the file, column and row."""
+    rows, numbers = [], []
+    for offset, text in enumerate(lines):
+        fields = [s for s in split(text)]
+        if all(not s.strip() for s in fields):
+            continue
+        numbers.append(first_line + offset)
+        rows.append(fields)
+    headers = [f"column {j + 1}" for j in range(ncol)]
+    table = _parse_numbers(path, headers, list(zip(numbers, rows)))
+    return table, numbers
+
+
+def read_hsva_kvlcc2(path) -> Experiment:
+    """Read an HSVA CPMC free-running zig-zag of the KVLCC2 (SIMMAN 2008), model
+    scale 1:45.714 (Lpp = 7 m), SI.
+
+    Columns: t, x0, y0, psi [deg], dx0/dt, dy0/dt (earth-fixed), r [deg/s], an
+    unidentified channel (ignored), delta [deg, positive = rudder to port], n [rps],
+    thrust [N], torque [N m]. Converted: angles to radians, the earth-fixed velocities
+    to body-fixed u, v with the heading, and delta negated into our convention
+    (positive turns to starboard). Thrust and torque go to `extra`.
+    """
+    path = Path(path)
+    text = path.read_text(encoding="cp1252").splitlines()
+    if not text or "HSVA" not in text[0]:
+        raise ValueError(f"{path}: not an HSVA file (line 1 should name HSVA).")
+    table, lines = _numeric_lines(path, text[4:], 5, 12, str.split)
+    t, x, y, psi_deg, ue, ve, r_deg, _, delta_deg, n, thrust, torque = table.T
+    _check_time(path, "column 1", t, lines, False, 0.0)
+    psi = np.deg2rad(psi_deg)
+    u, v = _body_velocity(ue, ve, psi)
+    return Experiment(
+        t, -np.deg2rad(delta_deg),  # HSVA: positive = rudder to port; ours: to starboard
+        psi=psi, r=np.deg2rad(r_deg), u=u, v=v, x=x, y=y, n=n,
+        name=path.stem, extra={"thrust": thrust, "torque": torque},
+        metadata={
+            "file": str(path), "format": "hsva_kvlcc2", "vessel": "KVLCC2",
+            "source": "HSVA CPMC, SIMMAN 2008", "scale": "model", "lambda": KVLCC2_SCALE,
+            "lpp": 7.0,
+            "title": " ".join(s.strip() for s in text[1:3]),
+        },
+    )
+
+
+def read_marin_kvlcc2(path, *, model_scale: bool = False, dt: float = MARIN_DT
+                      ) -> Experiment:
+    """Read a MARIN free-running KVLCC2 test (SIMMAN 2008), full scale (Lpp = 320 m).
+
+    Columns: t, x0, y0, phi [deg], psi [deg], dx0/dt, dy0/dt (earth-fixed), p [deg/s],
+    r [deg/s], delta [deg, positive = rudder to port], n [rpm], printed with 3
+    significant digits. The time column is too coarse to use (1 s steps above 100 s),
+    so time is rebuilt as $t_k = k\\,dt$ with `dt` = 0.13526 s (50 Hz at model scale);
+    the reader checks that this matches the printed times to within one printed digit.
+    Converted: angles to radians, n to rev/s, the earth-fixed velocities to body u, v
+    with the (1 deg resolution) heading, delta negated into our convention. Roll `phi`
+    [rad] and roll rate `p` [rad/s] go to `extra`. Trailing empty rows are dropped.
+
+    `model_scale=True` Froude-scales to the 1:45.714 model: lengths / lambda,
+    velocities and times / sqrt(lambda), yaw/roll rates and n * sqrt(lambda).
+    """
+    path = Path(path)
+    text = path.read_text(encoding="latin-1").splitlines()
+    if not text or not text[0].startswith("MARIN"):
+        raise ValueError(f"{path}: not a MARIN file (line 1 should start with 'MARIN').")
+    table, lines = _numeric_lines(path, text[2:], 3, 11, lambda s: s.split("\t"))
+    t_printed, x, y, phi, psi_deg, ue, ve, p, r_deg, delta_deg, rpm = table.T
+    t = dt * np.arange(table.shape[0])
+    quantum = 10.0 ** (np.floor(np.log10(np.maximum(np.abs(t_printed), 1e-300))) - 2)
+    off = np.abs(t - t_printed) > quantum + 1e-9
+    if np.any(off[1:]):
+        k = int(np.nonzero(off[1:])[0][0]) + 1
+        raise ValueError(
+            f"{path}: column 1 (time), row {k + 1} (line {lines[k]}): printed time "
+            f"{t_printed[k]} s does not match the reconstructed {t[k]:.3f} s = {k} * {dt} s."
+        )
+    psi = np.deg2rad(psi_deg)
+    u, v = _body_velocity(ue, ve, psi)
+    r, n = np.deg2rad(r_deg), rpm / 60.0
+    p = np.deg2rad(p)
+    scale = 1.0
+    if model_scale:
+        scale = KVLCC2_SCALE
+        root = math.sqrt(scale)
+        t, x, y, u, v = t / root, x / scale, y / scale, u / root, v / root
+        r, p, n = r * root, p * root, n * root
+    return Experiment(
+        t, -np.deg2rad(delta_deg),  # MARIN: positive = rudder to port; ours: to starboard
+        psi=psi, r=r, u=u, v=v, x=x, y=y, n=n,
+        name=path.stem, extra={"phi": np.deg2rad(phi), "p": p},
+        metadata={
+            "file": str(path), "format": "marin_kvlcc2", "vessel": "KVLCC2",
+            "source": "MARIN, SIMMAN 2008", "scale": "model" if model_scale else "full",
+            "lambda": KVLCC2_SCALE, "lpp": 320.0 / scale,
+            "title": text[1].strip() if len(text) > 1 else "",
+        },
+    )
+
+
+def read_measured(path, **kwargs) -> Experiment:
+    """Read any supported measurement file, recognised by extension and first line:
+    MARIN (`.dat`, line 1 starts with 'MARIN') -> `read_marin_kvlcc2`; HSVA (line 1
+    names HSVA) -> `read_hsva_kvlcc2`; a CSV with Esso Osaka headers (`psi_hat [rad]`)
+    -> `read_esso_osaka`; any other CSV -> `read_trial_csv`. Keyword arguments go to
+    the chosen reader."""
+    path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{path} is a folder; pass one measurement file.")
+    if not path.exists():
+        raise ValueError(f"{path}: no such file.")
+    with open(path, "rb") as f:
+        first = f.readline(4096).decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
+    suffix = path.suffix.lower()
+    if first.startswith("MARIN"):
+        return read_marin_kvlcc2(path, **kwargs)
+    if first.startswith("HSVA"):
+        return read_hsva_kvlcc2(path, **kwargs)
+    if suffix == ".csv" or ("[" in first and "," in first):
+        names = [_HEADER.match(s).group(1) if _HEADER.match(s) else s for s in first.split(",")]
+        if "psi_hat" in names or "delta_rudder" in names:
+            return read_esso_osaka(path, **kwargs)
+        if "t" in names:
+            return read_trial_csv(path, **kwargs)
+    raise ValueError(
+        f"{path}: unknown measurement format (first line {first[:60]!r}); supported: trial "
+        "CSV ('t [s],delta [deg],...'), Esso Osaka FRT CSV, HSVA and MARIN KVLCC2 .dat files."
+    )

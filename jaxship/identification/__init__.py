@@ -1,0 +1,22 @@
+"""The identification workflow behind `jaxship.identify` and `jaxship identify`: read
+and check records (`data`), the registry of identifiable models with their start values
+(`registry`, `starts`, `armax`), the output-error simulation of each model family
+(`simulation`), the assessment on training and held-out records (`assessment`), the
+report (`result`) and the workflow itself (`workflow`). Application layer: it uses the
+library through `import jaxship as js`."""
+
+from .assessment import Assessment as Assessment
+from .data import read_experiments as read_experiments
+from .registry import (
+    MODELS as MODELS,
+    ModelEntry as ModelEntry,
+    get_model_entry as get_model_entry,
+    model_key as model_key,
+)
+from .result import IdentificationResult as IdentificationResult
+from .simulation import (
+    simulate_armax_records as simulate_armax_records,
+    simulate_records as simulate_records,
+)
+from .starts import StartContext as StartContext
+from .workflow import Progress as Progress, identify as identify

@@ -1,0 +1,147 @@
+"""Reading and checking the records of `identify`: measurement files and folders into
+`Experiment`s, with errors that name the file and column before any fitting."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+import jaxship as js
+
+
+# file suffixes read from a folder (others, e.g. README.md, are skipped)
+DATA_SUFFIXES = (".csv", ".dat", ".txt")
+_HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*\[([^\]]*)\]\s*$")  # `name [unit]`
+
+
+def valid_samples(ds: js.Dataset, name: str) -> np.ndarray:
+    """The valid samples of channel `name` of every record, concatenated."""
+    return np.concatenate([np.asarray(getattr(ds, name))[i, :n] for i, n in enumerate(ds.lengths)])
+
+
+def rms(a) -> float:
+    """Root mean square (0 for an empty array)."""
+    a = np.asarray(a, dtype=np.float64)
+    return float(np.sqrt(np.mean(a**2))) if a.size else 0.0
+
+
+def mean_valid(ds: js.Dataset, name: str) -> float:
+    """Mean of the valid samples of channel `name` (0 when there are none)."""
+    values = valid_samples(ds, name)
+    return float(np.mean(values)) if values.size else 0.0
+
+
+def source(e: js.Experiment) -> str:
+    """The file an experiment was read from (its name if none)."""
+    return str(e.meta.get("file", e.name))
+
+
+def is_measurement_file(path: Path) -> bool:
+    """Whether `read_measured` recognises the format of `path` (the same test of the
+    first line: MARIN or HSVA .dat, Esso Osaka CSV, trial CSV with a `t` column), so
+    that a folder scan skips other files without reading them."""
+    with open(path, "rb") as f:
+        first = f.readline(4096).decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
+    if first.startswith(("MARIN", "HSVA")):
+        return True
+    if path.suffix.lower() == ".csv" or ("[" in first and "," in first):
+        names = {_HEADER.match(s).group(1) if _HEADER.match(s) else s for s in first.split(",")}
+        return bool(names & {"t", "psi_hat", "delta_rudder"})
+    return False
+
+
+def _renamed(e: js.Experiment, name: str) -> js.Experiment:
+    measured = {k: getattr(e, k) for k in e.channels}
+    return js.Experiment(e.t, name=name, metadata=e.metadata, extra=e.extra, **measured)
+
+
+def read_experiments(paths, *, role: str = "training") -> list[js.Experiment]:
+    """Read measurement files and folders into experiments.
+
+    A file is read with `read_measured` (trial CSV, Esso Osaka CSV, HSVA and MARIN
+    .dat); a folder contributes every file in it (not its subfolders) with a
+    `.csv`, `.dat` or `.txt` suffix whose format `read_measured` recognises
+    (others, such as a propeller open-water table, are skipped), in name order.
+    Experiments with equal names get their folder as a prefix.
+
+    **Raises:** `ValueError` naming the file: missing, unreadable or malformed
+    (the readers' messages name the column and row), or a folder with no records.
+    """
+    if isinstance(paths, (str, Path)):
+        paths = [paths]
+    experiments = []
+    for path in paths:
+        path = Path(path)
+        if path.is_dir():
+            found = [item for item in sorted(path.iterdir()) if item.is_file()
+                     and item.suffix.lower() in DATA_SUFFIXES and is_measurement_file(item)]
+            if not found:
+                raise ValueError(f"{path}: the {role} folder holds no measurement file "
+                                 "(trial CSV, Esso Osaka CSV, HSVA or MARIN .dat).")
+            experiments.extend(js.read_measured(item) for item in found)
+        elif not path.exists():
+            raise ValueError(f"{path}: no such {role} file or folder.")
+        else:
+            experiments.append(js.read_measured(path))
+    if not experiments:
+        raise ValueError(f"no {role} files given.")
+    names = [e.name for e in experiments]
+    out = []
+    for e in experiments:
+        if names.count(e.name) > 1:
+            e = _renamed(e, f"{Path(source(e)).parent.name}/{e.name}")
+        out.append(e)
+    names = [e.name for e in out]
+    for i, e in enumerate(out):  # still equal (same folder name): number them
+        if names.count(e.name) > 1:
+            out[i] = _renamed(e, f"{e.name}#{i}")
+    return out
+
+
+def as_experiments(data, role: str) -> list[js.Experiment]:
+    """`data` (an `Experiment`, a list of them, a `Dataset` or file paths) as a list
+    of experiments."""
+    if isinstance(data, js.Dataset):
+        return [data.experiment(i) for i in range(data.num_experiments)]
+    if isinstance(data, js.Experiment):
+        return [data]
+    if isinstance(data, (str, Path)):
+        return read_experiments([data], role=role)
+    if isinstance(data, Sequence) and data:
+        if all(isinstance(e, js.Experiment) for e in data):
+            return list(data)
+        if all(isinstance(e, (str, Path)) for e in data):
+            return read_experiments(data, role=role)
+    raise ValueError(f"the {role} data must be an Experiment, a list of Experiments, a "
+                     f"Dataset or file paths, got {type(data).__name__}.")
+
+
+def check_experiments(experiments, rudder: str, role: str, model: str = "",
+                      requires=()) -> None:
+    """Errors naming the file, before any fitting: the replayed rudder and the
+    channels the `model` `requires` must be measured, at least 3 uniform samples."""
+    for e in experiments:
+        where = f"{source(e)} ({role} record {e.name!r})"
+        have = ", ".join(c for c in e.channels) or "none"
+        if not e.has(rudder):
+            raise ValueError(f"{where}: no column {rudder!r} (the replayed rudder); measured "
+                             f"channels: {have}. Choose --rudder delta or delta_c.")
+        missing = [c for c in requires if not e.has(c)]
+        if missing:
+            raise ValueError(
+                f"{where}: model {model} needs the measured {' and '.join(map(repr, requires))}"
+                f" (the surge/sway velocities it is driven by or restarted from), but the record "
+                f"has no column {missing[0]!r}; measured channels: {have}. Use records with "
+                "them or a Nomoto model.")
+        if e.num_samples < 3:
+            raise ValueError(f"{where}: needs at least 3 samples, has {e.num_samples}.")
+        if not e.is_uniform():
+            steps = np.diff(e.t)
+            k = int(np.argmax(np.abs(steps - e.dt))) + 1
+            raise ValueError(
+                f"{where}: column 't': sampling is not uniform (t[{k}] - t[{k - 1}] = "
+                f"{steps[k - 1]!r} s, mean interval {e.dt!r} s); resample the record first."
+            )

@@ -1,0 +1,128 @@
+"""The model registry of `identify`: `MODELS` maps a command-line name to a `ModelEntry`
+(description, start values, outputs, required channels, simulation and, where it is
+not `jaxship.fit`, the estimator). Adding a model is adding one entry."""
+
+import dataclasses
+from collections.abc import Callable
+
+import jaxship as js
+
+from . import starts
+from .armax import fit_armax_entry, start_armax
+from .simulation import simulate_armax_records
+
+
+@dataclasses.dataclass(frozen=True)
+class ModelEntry:
+    """One identifiable model of `jaxship identify --model NAME`.
+
+    - `description`: one line for listings and the result.
+    - `start(train, context) -> model`: the start model from the training data
+      (`Dataset`) and a `StartContext`; its free parameters (its `param` defaults)
+      are estimated by `fit`, its frozen ones are kept. Raise `ValueError` when
+      the data cannot give start values; `fallback` is then used (and noted).
+    - `fallback(train, context) -> model`: a neutral start model when `start`
+      fails, e.g. on records without excitation (the fit then reports the problem
+      in its flags).
+    - `start_method`: how `start` gets its values, in words (for the report).
+    - `channels`: the output channels the model predicts (and can be fitted to).
+    - `default_channels`: the channels fitted when none are given.
+    - `requires`: channels every record must have measured (e.g. the surge and
+      sway velocities that drive `RossAutopilot`); a record without one is a
+      `ValueError` naming its file.
+    - `initial`: the window-start modes the fit supports (`PredictionError.initial`);
+      `"auto"` picks `"estimate"` for output error where it is supported.
+    - `simulate(model, dataset, rudder, channels, substeps=1) -> (predictions,
+      mask)`: the output-error simulation of the model on records, starting from
+      the measured state: `{channel: (E, N) array}` and the (E, N) mask of
+      simulated samples. None: `simulate_records`, which serves every steering
+      model and vessel.
+    - `fit(start, train, context) -> FitResult`: replaces the prediction-error fit
+      (`jaxship.fit` with `context.estimator`) for models it does not serve, e.g.
+      the discrete ARMAX model; None: `jaxship.fit`.
+    """
+
+    description: str
+    start: Callable
+    fallback: Callable
+    start_method: str = "linear least squares (initial_estimate)"
+    channels: tuple[str, ...] = ("psi", "r")
+    simulate: Callable | None = None
+    default_channels: tuple[str, ...] = ("psi", "r")
+    requires: tuple[str, ...] = ()
+    initial: tuple[str, ...] = ("measured", "estimate")
+    fit: Callable | None = None
+
+
+def _vessel_entry(name: str) -> ModelEntry:
+    def start(train, context):
+        return js.vessel(name)
+
+    return ModelEntry(
+        "vessel preset (3-DOF, default_free estimated): " + js.VESSELS[name].description,
+        start, start,
+        start_method=f"the preset's coefficients (get_vessel({name!r}))",
+        channels=("psi", "r", "u", "v"), default_channels=("psi", "r", "u", "v"),
+        requires=("u", "v"), initial=("measured",),
+    )
+
+
+MODELS: dict[str, ModelEntry] = {
+    "nomoto1": ModelEntry(
+        "first-order Nomoto model T r' + r = K (delta + delta0): K [1/s], T [s]",
+        starts.start_nomoto1, starts.fallback_nomoto1,
+    ),
+    "nomoto2": ModelEntry(
+        "second-order Nomoto model K (1 + T3 s) / ((1 + T1 s)(1 + T2 s)): K [1/s], T1, T2, "
+        "T3 [s]",
+        starts.start_nomoto2, starts.fallback_nomoto2,
+        start_method="a fitted Nomoto1 (linear least-squares start), its T spread over T1, T2, "
+        "T3",
+    ),
+    "nomoto1-nonlinear": ModelEntry(
+        "nonlinear first-order Nomoto model T r' + n3 r^3 + n1 r = K delta (Norrbin): K [1/s], "
+        "T [s], n3 [s^2/rad^2]",
+        starts.start_nonlinear, starts.fallback_nonlinear,
+    ),
+    "ross-autopilot": ModelEntry(
+        "Ross (2008) autopilot model without roll, driven by the measured u, v (thesis eq. "
+        "3.6-3.7): 12 hull terms and the rudder term, scaled coefficients [-]",
+        starts.start_ross, starts.fallback_ross, requires=("u", "v"),
+        start_method="equation-error linear least squares (ross_initial_estimate)",
+    ),
+    "linear-sway-yaw": ModelEntry(
+        "linear sway-yaw model in prime derivatives driven by the measured u (Astrom & "
+        "Kallstrom 1979, eq. 3): Y'v, Y'r, N'v, N'r, Y'delta, N'delta [-]",
+        starts.start_linear_sway_yaw, starts.start_linear_sway_yaw, channels=("psi", "r", "v"),
+        requires=("u",), start_method="the sea_stratus_linear preset (LinearSwayYaw.from_vessel)",
+    ),
+    "norrbin-crossflow": ModelEntry(
+        "Norrbin's cross-flow model: the linear sway-yaw model plus cross-flow drag C [-] "
+        "(Astrom & Kallstrom 1979, sec. 2)",
+        starts.start_norrbin, starts.start_norrbin, channels=("psi", "r", "v"), requires=("u",),
+        start_method="the sea_stratus_nonlinear preset (NorrbinCrossFlow.from_vessel)",
+    ),
+    "armax": ModelEntry(
+        "ARMAX(2,2,2), delay 1 sample, of the yaw rate (Astrom & Kallstrom 1979, eq. 7): "
+        "a1, a2 [-], b0, b1 [1/s], c1, c2 [-]; one training record",
+        start_armax, start_armax, channels=("psi", "r"), default_channels=("r",),
+        initial=("measured",), simulate=simulate_armax_records, fit=fit_armax_entry,
+        start_method="pseudo-linear regression (extended least squares) of fit_armax",
+    ),
+    **{name: _vessel_entry(name) for name in js.VESSELS},
+}
+
+
+def model_key(name: str) -> str:
+    """The registry name of `name` (case-insensitive; `-` and `_` interchangeable);
+    `ValueError` listing the known names otherwise."""
+    key = str(name).strip().lower()
+    for candidate in (key, key.replace("-", "_"), key.replace("_", "-")):
+        if candidate in MODELS:
+            return candidate
+    raise ValueError(f"unknown model {name!r}; choose from {', '.join(MODELS)}.")
+
+
+def get_model_entry(name: str) -> ModelEntry:
+    """The registry entry of `name`; `ValueError` listing the known names otherwise."""
+    return MODELS[model_key(name)]

@@ -1,0 +1,316 @@
+"""`identify`: estimate a named steering model from measured trials and validate it.
+
+One call runs the whole identification workflow of the thesis (seed 000, ch. 3) and
+of MATLAB's System Identification Toolbox: read the records, compute start values by
+linear least squares (`initial_estimate`), fit by prediction error (`fit`), simulate
+the fitted model on the training and on held-out records (output error, starting
+from the measured state), and collect loss, FPE, AIC/BIC, fit %, residual tests,
+standard errors, the correlation matrix and plain-language identifiability flags
+in an `IdentificationResult`.
+
+The library stays quiet: progress goes to the `progress` callable (see `Progress`),
+which the `jaxship identify` command turns into a tqdm bar; identifiability and
+convergence problems are `IdentifiabilityWarning`/`ConvergenceWarning` and flags in
+the result.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import warnings
+from collections.abc import Callable
+
+import jax
+import numpy as np
+
+import jaxship as js
+
+from .._params import parameter_fields
+from .assessment import assess
+from .data import as_experiments, check_experiments, valid_samples
+from .registry import MODELS, model_key
+from .result import IdentificationResult
+from .simulation import simulate_records
+from .starts import StartContext
+
+
+@dataclasses.dataclass(frozen=True)
+class Progress:
+    """A progress report of `identify`, passed to its `progress` callable.
+
+    - `stage`: `"start"` (start values), `"fit"` (an optimisation), `"validate"`
+      (simulation on the data);
+    - `message`: what is being done, in words;
+    - `step`: the optimiser's step count during a fit (None for stage messages);
+    - `total`: the step limit of the fit;
+    - `cost`: the cost $\\frac12\\sum\\varepsilon^2$ of the last accepted step;
+    - `done`: True for the last report of a stage.
+    """
+
+    stage: str
+    message: str
+    step: int | None = None
+    total: int | None = None
+    cost: float | None = None
+    done: bool = False
+
+
+# The host-side receivers of the optimiser's step reports. The solver's verbose hook
+# is one module-level function (so that a new `progress` never recompiles the fit);
+# it sends each step through `jax.debug.callback` to the receiver of the `identify`
+# call that is running, pushed here for the duration of its fits.
+_RECEIVERS: list = []
+
+
+def _receive_step(step, cost):
+    if _RECEIVERS:
+        step = int(step)  # before the first step the accepted cost is not yet known
+        _RECEIVERS[-1](step, float(cost) if step > 0 else None)
+
+
+def _verbose_hook(**kwargs):
+    jax.debug.callback(_receive_step, kwargs["num_steps"][1],
+                       kwargs["loss_last_accepted_step"][1])
+
+
+def _values_text(model) -> str:
+    names = tuple(parameter_fields(model))
+    if not names:  # a vessel: its default free coefficients
+        names = js.default_free(model)
+    return ", ".join(f"{n} = {float(getattr(model, n)):.4g}" for n in names)
+
+
+def _parse_channels(channels, allowed) -> tuple[str, ...]:
+    if isinstance(channels, str):
+        channels = [c for c in channels.replace(" ", "").split(",") if c]
+    channels = tuple(channels)
+    if not channels:
+        raise ValueError(f"no output channel given; choose from {', '.join(allowed)}.")
+    for c in channels:
+        if c not in allowed:
+            raise ValueError(f"unknown output channel {c!r}; choose from {', '.join(allowed)}.")
+    if len(set(channels)) != len(channels):
+        raise ValueError(f"output channels repeat: {', '.join(channels)}.")
+    return channels
+
+
+def identify(train, *, model: str, horizon: float | None = None, validate=None,
+             rudder: str = "delta", channels=None, initial: str = "auto",
+             max_steps: int = 256, substeps: int = 1,
+             progress: Callable[[Progress], None] | None = None) -> IdentificationResult:
+    """Estimate a registered steering model from training records and validate it.
+
+    **Arguments:**
+
+    - `train`: the training records: an `Experiment`, a list of them, a `Dataset`,
+      or file/folder paths (see `read_experiments`).
+    - `model`: a name in `MODELS`: `nomoto1`, `nomoto2`, `nomoto1-nonlinear`,
+      `ross-autopilot`, `linear-sway-yaw`, `norrbin-crossflow`, `armax` or a vessel
+      preset of `jaxship.VESSELS` (its `default_free` coefficients are estimated
+      from the preset's values; records need u and v).
+    - `horizon`: prediction horizon of the fit [s] (`PredictionError.horizon`):
+      None (default) output error, 0 equation error, else windows of `horizon`
+      seconds from the measured state.
+    - `validate`: held-out records (same forms as `train`) or None. The fitted
+      model is simulated on them from each record's measured first state (output
+      error) and assessed with the same figures.
+    - `rudder`: the replayed rudder channel, `"delta"` or `"delta_c"`.
+    - `channels`: fitted outputs, a subset of the entry's `channels` (or a text
+      such as `"psi,r"`); None: the entry's `default_channels` (`psi, r`; `psi, r,
+      u, v` for vessel presets; `r` for armax).
+    - `initial`: start of each fitted window (`PredictionError.initial`):
+      `"measured"` (the measured r and psi), `"estimate"` (corrections of them are
+      estimated with the parameters, which removes the bias a noisy start sample
+      gives output error) or `"auto"` (default): `"estimate"` for output error
+      (`horizon=None`) where the entry supports it, `"measured"` otherwise. Validation
+      simulations always start from the measured state.
+    - `max_steps`: optimiser step limit; `substeps`: RK4 steps per sample interval.
+    - `progress`: a callable receiving `Progress` reports, or None (quiet).
+
+    Start values: the entry's `start` (linear least squares by `initial_estimate`,
+    or a nested fit); if it fails (e.g. no excitation) the entry's neutral
+    `fallback`, with a note. Then `fit` with `PredictionError(horizon, channels,
+    rudder)`.
+
+    **Returns:** an `IdentificationResult`; `to_json()` gives `model`,
+    `parameters` (`{name: {value, std, unit, relative_std, start}}`, SI), `frozen`,
+    `fit` (optimiser result), `train` (the fit criterion), `train_simulation` and
+    `validation` (output error; None without held-out data), each with
+    `channels: {psi|r|u|v: {loss, fpe, aic, bic, fit_percent,
+    fit_percent_per_experiment, whiteness, input_independence, ...}}`,
+    `correlation` (`names`, `matrix`), `identifiability` (`identifiable`,
+    `condition_number`, plain-language `flags`), `data`, `start`, `options`,
+    `notes`, `warnings`.
+
+    **Raises:** `ValueError` naming the file/record and column for unknown models
+    or channels, missing files, a missing rudder column, a missing u or v the model
+    needs (`ross-autopilot`, vessel presets; u for the sway-yaw models), non-finite
+    values or non-uniform sampling; for `armax`, more than one training record.
+
+    **Warns:** `IdentifiabilityWarning` when the estimates are flagged (e.g. no
+    excitation: the fit still returns, with infinite standard errors), and
+    `ConvergenceWarning` when the optimiser did not converge.
+    """
+    name = model_key(model)
+    entry = MODELS[name]
+    if rudder not in ("delta", "delta_c"):
+        raise ValueError(f"unknown rudder channel {rudder!r}; choose 'delta' (measured angle) "
+                         "or 'delta_c' (command).")
+    default_channels = channels is None
+    channels = _parse_channels(entry.default_channels if default_channels else channels,
+                               entry.channels)
+    if horizon is not None:
+        horizon = float(horizon)
+        if not (math.isfinite(horizon) and horizon >= 0):
+            raise ValueError(f"the horizon must be a non-negative number of seconds or None "
+                             f"(output error), got {horizon}.")
+    if initial not in ("auto", "measured", "estimate"):
+        raise ValueError(f"unknown initial state {initial!r}; choose 'auto', 'measured' or "
+                         "'estimate'.")
+    if initial == "auto":
+        initial = "estimate" if horizon is None and "estimate" in entry.initial else "measured"
+    if initial not in entry.initial:
+        raise ValueError(f"model {name} supports initial {' or '.join(entry.initial)}, not "
+                         f"{initial!r}.")
+    if int(max_steps) < 1:
+        raise ValueError(f"`max_steps` must be a positive integer, got {max_steps}.")
+    train_exps = as_experiments(train, "training")
+    check_experiments(train_exps, rudder, "training", name, entry.requires)
+    held_out = None
+    if validate is not None:
+        held_out = as_experiments(validate, "validation")
+        check_experiments(held_out, rudder, "validation", name, entry.requires)
+    train_ds = js.Dataset.from_experiments(train_exps)
+    valid_ds = None if held_out is None else js.Dataset.from_experiments(held_out)
+    notes, caught = [], []
+    if default_channels:  # a default u or v that never varies (e.g. no surge dynamics)
+        constant = [c for c in channels
+                    if c in ("u", "v") and np.ptp(valid_samples(train_ds, c)) == 0]
+        if constant and len(constant) < len(channels):
+            channels = tuple(c for c in channels if c not in constant)
+            notes.append(f"the measured {', '.join(constant)} is constant in the training "
+                         f"records: not fitted (channels {', '.join(channels)}).")
+
+    report = progress if progress is not None else (lambda event: None)
+    solver = js.LevenbergMarquardt(rtol=1e-9, atol=1e-9, verbose=_verbose_hook)
+    estimator = js.PredictionError(horizon=horizon, channels=channels, rudder=rudder,
+                                substeps=int(substeps), solver=solver,
+                                max_steps=int(max_steps), initial=initial)
+
+    def run_fit(start_model, *, free=None, stage="fitting", custom=None):
+        total = int(max_steps)
+        report(Progress("fit", stage, step=0, total=total))
+        _RECEIVERS.append(lambda step, cost: report(Progress("fit", stage, step=step,
+                                                             total=total, cost=cost)))
+        try:
+            with warnings.catch_warnings(record=True) as got:
+                warnings.simplefilter("always")
+                if custom is None:
+                    result = js.fit(start_model, train_ds, estimator=estimator, free=free)
+                else:  # an entry's own estimator (e.g. ARMAX)
+                    result = custom(start_model, train_ds, context)
+        finally:
+            _RECEIVERS.pop()
+        report(Progress("fit", stage, step=int(result.num_steps), total=total,
+                        cost=float(result.cost), done=True))
+        return result, got
+
+    def nested_fit(start_model, *, free=None, stage="fitting"):
+        result, got = run_fit(start_model, free=free, stage=stage)
+        for w in got:  # the nested fit's problems are reported by the main fit, if at all
+            if not issubclass(w.category, (js.IdentifiabilityWarning, js.ConvergenceWarning)):
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        return result
+
+    context = StartContext(rudder=rudder, channels=channels, estimator=estimator,
+                           fit=nested_fit, note=notes.append)
+    report(Progress("start", "start values"))
+    try:
+        start = entry.start(train_ds, context)
+        method, neutral = entry.start_method, False
+    except ValueError as error:
+        start = entry.fallback(train_ds, context)
+        method, neutral = "neutral fallback (the start-value regression failed)", True
+        notes.append(f"start values: {error} A neutral start was used instead; the fit "
+                     "below says whether the data determine the parameters.")
+    report(Progress("start", "start values", done=True))
+
+    def attempt(start_model):
+        try:
+            outcome = run_fit(start_model, stage=f"fitting {name}", custom=entry.fit)
+        except np.linalg.LinAlgError as error:  # NaN residuals: the simulation blew up
+            return None, str(error)
+        if not math.isfinite(outcome[0].cost):
+            return None, f"cost {outcome[0].cost}"
+        return outcome, ""
+
+    outcome, why = attempt(start)
+    if outcome is None and not neutral:
+        notes.append(f"the fit from the {method} start diverged (non-finite model outputs: "
+                     f"{why}); restarted from the neutral fallback start.")
+        start = entry.fallback(train_ds, context)
+        method = "neutral fallback (the fit from the regression start diverged)"
+        outcome, why = attempt(start)
+    if outcome is None:
+        raise ValueError(
+            f"the fit of {name} diverged: the model's outputs became non-finite ({why}) from "
+            f"the start {_values_text(start)}; try a finite --horizon, --initial measured or "
+            "another model."
+        )
+    result, got = outcome
+    for w in got:
+        if issubclass(w.category, (js.IdentifiabilityWarning, js.ConvergenceWarning)):
+            caught.append(str(w.message))
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+    d = len(result.names)
+    simulate = entry.simulate or simulate_records
+    max_lag = int(estimator.max_lag)
+    # the criterion's horizon: the estimator's, or the entry's own (ARMAX: one sample)
+    criterion = result.horizon
+    train_block = assess("prediction" if criterion is not None else "simulation", criterion,
+                          train_ds, rudder, result.predictions, result.predicted,
+                          int(result.metrics[channels[0]].num_params), max_lag,
+                          start="estimated" if initial == "estimate" else "measured")
+    report(Progress("validate", "simulating the training records"))
+    def measured(ds):  # psi and r always exist (derived if need be); other outputs if measured
+        return tuple(c for c in entry.channels if c in ("psi", "r") or c in ds.channels)
+
+    predictions, mask = simulate(result.model, train_ds, rudder, measured(train_ds),
+                                 substeps=int(substeps))
+    train_sim = assess("simulation", None, train_ds, rudder, predictions, mask, d, max_lag,
+                        notes)
+    valid_block = None
+    if valid_ds is not None:
+        report(Progress("validate", "simulating the validation records"))
+        predictions, mask = simulate(result.model, valid_ds, rudder, measured(valid_ds),
+                                     substeps=int(substeps))
+        valid_block = assess("simulation", None, valid_ds, rudder, predictions, mask, d,
+                              max_lag, notes)
+    report(Progress("validate", "validation", done=True))
+
+    frozen = list(result.to_dict()["frozen"])
+    if len(frozen) > 12:  # a vessel preset: listed in the report's "frozen"
+        notes.append(f"{len(frozen)} coefficients of the preset are frozen (not estimated); "
+                     "see `frozen`.")
+    elif frozen:
+        notes.append("frozen parameters (not estimated): "
+                     + ", ".join(f"{n} = {float(getattr(result.model, n)):.6g}" for n in frozen)
+                     + ".")
+    out = IdentificationResult(
+        model_name=name, description=entry.description, fit=result, start=start,
+        start_method=method, train=train_block, train_simulation=train_sim,
+        validation=valid_block,
+        options={"horizon_s": horizon, "rudder": rudder, "channels": list(channels),
+                 "initial": initial, "max_steps": int(max_steps), "substeps": int(substeps)},
+        notes=tuple(notes), warnings=tuple(caught),
+    )
+    if not result.success:
+        warnings.warn(f"identify {name}: the optimiser stopped without converging "
+                      f"({result.message}).", js.ConvergenceWarning, stacklevel=2)
+    if result.flags:
+        warnings.warn(f"identify {name}: " + " ".join(result.flags), js.IdentifiabilityWarning,
+                      stacklevel=2)
+    return out

@@ -1,0 +1,131 @@
+"""The package's layers (docs/architecture.md): every module imports only from its own
+layer or the layers below it, there are no import cycles, no imports inside functions
+(except optional dependencies), and nothing outside the package imports private names."""
+
+import ast
+import pathlib
+import subprocess
+
+import pytest
+
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "jaxship"
+
+# bottom to top; a module not listed belongs to the layer of its folder
+LAYERS = {
+    "foundation": ["_params", "_state", "_kinematics", "_frames", "_sharding", "_validate",
+                   "_covariance"],
+    "models": ["_actuators", "_environment", "_vessel", "_steering", "_effects", "_manoeuvres",
+               "_armax_model"],
+    "simulate": ["_simulate", "_simulate_steering", "_batch", "_data", "_readers"],
+    "estimate": ["_estimate"],
+    "analysis": ["_design", "_indices"],
+    "application": ["identification", "studies", "_trials", "cli", "plotting", "__init__"],
+}
+RANK = {name: i for i, names in enumerate(LAYERS.values()) for name in names}
+# imported inside functions on purpose: optional dependencies, and the CLI's heavy imports
+# deferred so that `jaxship --help` answers at once
+OPTIONAL = {"pandas", "sklearn", "matplotlib", "tqdm"}
+
+
+def modules():
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = path.relative_to(ROOT).with_suffix("").parts
+        yield ".".join(parts), path
+
+
+def rank(module: str) -> int:
+    top = module.split(".")[1] if "." in module else "__init__"
+    return RANK[top]
+
+
+def imports(module: str, path: pathlib.Path):
+    """(imported jaxship module, line, inside a function) for every import."""
+    tree = ast.parse(path.read_text())
+    package = module if path.name == "__init__.py" else module.rsplit(".", 1)[0]
+    functions = [n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef,
+                                                               ast.AsyncFunctionDef))]
+    inner = {id(n) for f in functions for n in ast.walk(f)}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            base = package.split(".")
+            if node.level:
+                base = base[: len(base) - node.level + 1]
+                name = ".".join(base + ([node.module] if node.module else []))
+            else:
+                name = node.module or ""
+            targets = [name] if node.module else [f"{name}.{a.name}" for a in node.names]
+        elif isinstance(node, ast.Import):
+            targets = [a.name for a in node.names]
+        else:
+            continue
+        for target in targets:
+            yield target, node.lineno, id(node) in inner
+
+
+def test_every_module_has_a_layer():
+    for module, _ in modules():
+        rank(module)  # raises KeyError for a module outside the table
+
+
+def test_imports_point_down_only():
+    upward = []
+    for module, path in modules():
+        for target, line, _ in imports(module, path):
+            if target.startswith("jaxship.") and rank(target) > rank(module):
+                upward.append(f"{module}:{line} imports {target}")
+    assert not upward, "\n".join(upward)
+
+
+def test_no_import_cycles():
+    graph = {}
+    for module, path in modules():
+        graph[module] = {t for t, _, inner in imports(module, path)
+                         if t.startswith("jaxship") and not inner}
+    names = set(graph)
+
+    def resolve(target):  # "jaxship._steering.Nomoto1" -> the module "jaxship._steering"
+        while target and target not in names:
+            target = target.rpartition(".")[0]
+        return target
+
+    graph = {m: {resolve(t) for t in ts} - {m, ""} for m, ts in graph.items()}
+    state, cycles = {}, []
+
+    def visit(m, stack):
+        state[m] = 1
+        for n in graph.get(m, ()):
+            if n == "jaxship" or n.startswith("jaxship.") and n.count(".") == 0:
+                continue
+            if state.get(n) == 1 and n != "jaxship":
+                cycles.append(" -> ".join(stack[stack.index(n):] + [n]))
+            elif n not in state:
+                visit(n, stack + [n])
+        state[m] = 2
+
+    for m in sorted(graph):
+        if m not in state:
+            visit(m, [m])
+    # the application layer imports the public package (`import jaxship as js`)
+    cycles = [c for c in cycles if not c.startswith("jaxship ->") and " jaxship ->" not in c]
+    assert not cycles, "\n".join(cycles)
+
+
+def test_no_imports_inside_functions_but_optional_dependencies():
+    found = []
+    for module, path in modules():
+        for target, line, inner in imports(module, path):
+            if inner and target.split(".")[0] not in OPTIONAL:
+                found.append(f"{module}:{line} imports {target} inside a function")
+    assert not found, "\n".join(found)
+
+
+def test_no_private_imports_outside_the_package():
+    try:
+        out = subprocess.run(["git", "grep", "-n", "-E", r"(from|import) jaxship\._", "--",
+                              "README.md", "docs", "notebooks", "benchmarks"],
+                             cwd=ROOT, capture_output=True, text=True, check=False)
+    except FileNotFoundError:
+        pytest.skip("git is not installed")
+    assert out.stdout == "", out.stdout

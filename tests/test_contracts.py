@@ -1,0 +1,184 @@
+"""The shared contract, run over registries of every vessel, steering model, effect and
+controller: vmap equals a Python loop, forward-mode derivatives equal finite
+differences, new parameter values do not retrace, an effect at zero equals its base
+bit for bit, and a controller's state travels in the simulated state (so the closed
+loop is differentiable and vmappable over its gains)."""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import jaxship as js
+from jaxship._params import default_free, get_path, rebuild
+
+
+DEG = np.pi / 180
+VESSELS = sorted(js.VESSELS)
+STEERING = {
+    "nomoto1": js.Nomoto1(K=0.06, T=25.0),
+    "nomoto2": js.Nomoto2(K=0.06, T1=25.0, T2=3.0, T3=5.0),
+    "nonlinear_nomoto": js.NonlinearNomoto(K=0.06, T=25.0, n3=300.0),
+    "nonlinear_nomoto2": js.NonlinearNomoto2(K=0.06, T1=25.0, T2=3.0, T3=5.0, beta1=100.0),
+    "ross_autopilot": js.RossAutopilot(length=4.0, speed=1.5, rate=8.0, n_ur=-4.0,
+                                       n_delta=2.5, n_uv=-1.0),
+    "linear_sway_yaw": js.LinearSwayYaw.from_vessel(js.vessel("sea_stratus_linear")),
+    "norrbin_crossflow": js.NorrbinCrossFlow.from_vessel(js.vessel("sea_stratus_nonlinear")),
+}
+# effect, a parameter name and a non-zero value for it, the families it acts on
+EFFECTS = {
+    "rudder_offset": (js.RudderOffset(), "delta0", 0.02, ("vessel", "steering")),
+    "yaw_moment_bias": (js.YawMomentBias(), "n0", 1e-4, ("steering",)),
+    "sway_force_bias": (js.SwayForceBias(), "y0", 1e4, ("vessel",)),
+    "yaw_rate_sensor_bias": (js.YawRateSensorBias(), "bias", 1e-3, ("vessel", "steering")),
+    "heading_sensor_bias": (js.HeadingSensorBias(), "bias", 0.01, ("vessel", "steering")),
+}
+CONTROLLERS = {
+    "turn": js.Turn(15 * DEG, duration=40.0, dt=0.5),
+    "zigzag": js.ZigZag(10 * DEG, 2 * DEG, duration=40.0, dt=0.5),
+    "schedule": js.multi_step_3211(10 * DEG, 3.0, settle=10.0, dt=0.5),
+    "reverse_spiral": js.ReverseSpiral(rates=np.array([0.002, -0.002]), hold=20.0, kp=20.0,
+                                       ki=0.5, duration=40.0, dt=0.5),
+    "heading_autopilot": js.HeadingAutopilot(5 * DEG, 30.0, kp=2.0, ki=0.01, kd=20.0,
+                                             duration=40.0, dt=0.5),
+    "stop": js.Stop(-0.5, duration=40.0, dt=0.5),
+}
+
+
+def short_run(vessel):
+    return js.ZigZag(15 * DEG, 5 * DEG, duration=10 * float(vessel.length / vessel.nominal_speed),
+                     dt=0.5)
+
+
+def vessel_final(vessel, name, manoeuvre=None):
+    """psi at the end of a short zig-zag as a function of the coefficient `name`."""
+    x0 = js.straight_run(vessel)
+    man = short_run(vessel) if manoeuvre is None else manoeuvre
+    return lambda p: js.simulate(rebuild(vessel, (name,), (p,)), man, x0).state.psi[-1]
+
+
+@pytest.mark.parametrize("name", VESSELS)
+def test_vessel_contract(name):
+    vessel = js.vessel(name)
+    coefficient = default_free(vessel)[0]
+    p0 = float(get_path(vessel, coefficient))
+    f = vessel_final(vessel, coefficient)
+    values = p0 * jnp.array([0.9, 1.0, 1.1])
+    batched = jax.vmap(f)(values)
+    looped = jnp.stack([f(v) for v in values])
+    np.testing.assert_allclose(batched, looped, rtol=1e-10, atol=1e-12)
+    eps = 1e-5 * abs(p0)
+    fd = (f(p0 + eps) - f(p0 - eps)) / (2 * eps)
+    fwd = jax.jvp(f, (jnp.asarray(p0),), (jnp.asarray(1.0),))[1]
+    np.testing.assert_allclose(fwd, fd, rtol=1e-4, atol=1e-9)
+    counted = eqx.debug.assert_max_traces(f, max_traces=1)
+    jitted = jax.jit(counted)
+    for v in values:
+        jitted(v)  # new values, one trace
+
+
+def steering_final(model, name):
+    delta = np.deg2rad(10) * np.sign(np.sin(2 * np.pi * np.arange(120) / 60.0) + 1e-9)
+    aux = js.AuxInputs(u=1.5, v=0.05, n=8.0)
+    return lambda p: js.simulate_steering(rebuild(model, (name,), (p,)), delta, 0.5,
+                                          aux=aux).psi[-1]
+
+
+@pytest.mark.parametrize("name", sorted(STEERING))
+def test_steering_model_contract(name):
+    model = STEERING[name]
+    parameter = next(n for n in default_free(model) if float(get_path(model, n)) != 0.0)
+    p0 = float(get_path(model, parameter))
+    f = steering_final(model, parameter)
+    values = p0 * jnp.array([0.9, 1.0, 1.1])
+    np.testing.assert_allclose(jax.vmap(f)(values), jnp.stack([f(v) for v in values]),
+                               rtol=1e-10, atol=1e-12)
+    eps = 1e-6 * abs(p0)
+    fd = (f(p0 + eps) - f(p0 - eps)) / (2 * eps)
+    fwd = jax.jvp(f, (jnp.asarray(p0),), (jnp.asarray(1.0),))[1]
+    np.testing.assert_allclose(fwd, fd, rtol=1e-5, atol=1e-10)
+    jitted = jax.jit(eqx.debug.assert_max_traces(f, max_traces=1))
+    for v in values:
+        jitted(v)
+
+
+@pytest.mark.parametrize("effect", sorted(EFFECTS))
+def test_effect_contract(effect):
+    """At zero the augmented model equals the base bit for bit; a non-zero value changes
+    it; the parameter is named "<id>.<field>", free by default and differentiable."""
+    zero, field, value, families = EFFECTS[effect]
+    name = f"{effect}.{field}"
+    assert zero.id == effect
+    if "vessel" in families:
+        vessel = js.vessel("mariner")
+        man, x0 = short_run(vessel), js.straight_run(vessel)
+        base = js.simulate(vessel, man, x0)
+        augmented = js.augment(vessel, zero)
+        same = js.simulate(augmented, man, x0)
+        for key in ("u", "v", "r", "psi", "delta"):
+            np.testing.assert_array_equal(getattr(same.state, key), getattr(base.state, key))
+        assert name in default_free(augmented)
+        moved = rebuild(augmented, (name,), (value,))
+        data = js.Experiment.from_trajectory(js.simulate(moved, man, x0))
+        plain = js.predict(augmented, data, estimator=js.PredictionError(horizon=None))
+        assert plain.fit_percent()["psi"] < 100 - 1e-6  # the effect shows in the data
+    if "steering" in families:
+        model = js.Nomoto1(K=0.06, T=25.0)
+        delta = np.deg2rad(10) * np.sign(np.sin(2 * np.pi * np.arange(200) / 80.0) + 1e-9)
+        base = js.simulate_steering(model, delta, 0.5)
+        augmented = js.augment(model, zero)
+        same = js.simulate_steering(augmented, delta, 0.5)
+        np.testing.assert_array_equal(same.psi, base.psi)
+        np.testing.assert_array_equal(same.r, base.r)
+        data = js.Experiment(np.asarray(base.t), delta, psi=np.asarray(base.psi),
+                             r=np.asarray(base.r))
+
+        def cost(p):
+            m = rebuild(augmented, (name,), (p,))
+            out = js.predict(m, data, estimator=js.PredictionError(horizon=None))
+            return sum(float(np.sum(v**2)) for v in out.predictions.values())
+
+        moved = rebuild(augmented, (name,), (value,))
+        reading = moved.measure("psi", 0.0) != 0.0 or moved.measure("r", 0.0) != 0.0
+        # a sensor bias shows in the readings; it cancels in predictions that start from
+        # the measured state (a heading bias is not identifiable from psi alone)
+        assert reading or cost(value) != cost(0.0)
+
+
+@pytest.mark.parametrize("name", sorted(CONTROLLERS))
+def test_controller_contract(name):
+    """The controller's memory is part of the simulated state: its closed loop under vmap
+    over the approach speed equals a loop, and the final heading is differentiable
+    (forward mode equals finite differences) in a vessel coefficient through it."""
+    vessel = js.vessel("mariner")
+    man = CONTROLLERS[name]
+    speeds = jnp.array([6.0, 7.7175])
+    batched = js.simulate_batch(vessel, man, js.straight_state(speeds, 0.0),
+                                in_axes=(None, None, 0, None))
+    for i, u in enumerate(speeds):
+        single = js.simulate(vessel, man, js.straight_state(u, 0.0))
+        np.testing.assert_allclose(batched.state.psi[i], single.state.psi, rtol=1e-10,
+                                   atol=1e-12)
+    f = vessel_final(vessel, "n_r", man)
+    p0 = float(vessel.n_r)
+    eps = 1e-5 * abs(p0)
+    fd = (f(p0 + eps) - f(p0 - eps)) / (2 * eps)
+    fwd = jax.jvp(f, (jnp.asarray(p0),), (jnp.asarray(1.0),))[1]
+    np.testing.assert_allclose(fwd, fd, rtol=1e-3, atol=1e-9)
+
+
+def test_controller_gains_are_differentiable_and_vmappable():
+    vessel = js.vessel("mariner")
+    x0 = js.straight_run(vessel)
+
+    def final_error(kp):
+        pilot = js.HeadingAutopilot(5 * DEG, 120.0, kp=kp, ki=0.0, kd=30.0, duration=60.0,
+                                    dt=0.5)
+        return js.simulate(vessel, pilot, x0).state.psi[-1] - 5 * DEG
+
+    gains = jnp.array([1.0, 2.0, 3.0])
+    np.testing.assert_allclose(jax.vmap(final_error)(gains),
+                               jnp.stack([final_error(k) for k in gains]), rtol=1e-10)
+    fd = (final_error(2.0 + 1e-5) - final_error(2.0 - 1e-5)) / 2e-5
+    np.testing.assert_allclose(jax.grad(final_error)(2.0), fd, rtol=1e-4)
