@@ -24,6 +24,7 @@ from ._environment import Current as Current, Environment as Environment, Wind a
 from ._estimate._armax import ARMAXResult as ARMAXResult, fit_armax as fit_armax
 from ._estimate._discrete import fit_discrete_response as fit_discrete_response
 from ._estimate._fit import (
+    AbstractEstimator as AbstractEstimator,
     ConvergenceWarning as ConvergenceWarning,
     FitResult as FitResult,
     IdentifiabilityWarning as IdentifiabilityWarning,
@@ -37,7 +38,7 @@ from ._estimate._kalman import (
     rts_smoother as rts_smoother,
     smooth_states as smooth_states,
 )
-from ._estimate._likelihood import KalmanFitResult as KalmanFitResult, fit_ml as fit_ml
+from ._estimate._likelihood import Innovations as Innovations, fit_ml as fit_ml
 from ._estimate._linear import (
     initial_estimate as initial_estimate,
     ross_initial_estimate as ross_initial_estimate,

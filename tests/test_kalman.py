@@ -237,3 +237,20 @@ def test_smoothed_window_starts_remove_the_bias_of_noisy_starts():
     assert np.all(errors["smoothed"] < 3), errors
     with pytest.raises(ValueError, match="one SmoothedStates per experiment"):
         js.fit(start, [exp, exp], estimator=js.PredictionError(horizon=10.0, initial=smoothed))
+
+
+def test_fit_with_the_innovations_estimator_is_fit_ml():
+    """`fit(..., estimator=Innovations(...))` is `fit_ml`, with one result type: the
+    FitResult carries the noise, the criterion and the filter's one-step predictions."""
+    exp, _, _ = noisy_record(TRUTH, 400, 11)
+    start = Nomoto1(K=0.05, T=20.0)
+    direct = js.fit_ml(start, exp, criterion="pem")
+    res = js.fit(start, exp, estimator=js.Innovations(criterion="pem"))
+    assert isinstance(res, js.FitResult) and res.criterion == "pem"
+    np.testing.assert_allclose(res.values, direct.values, rtol=1e-12)
+    assert res.noise == direct.noise and set(res.metrics) == {"psi", "r"}
+    assert not res.predicted[0, 0] and res.predicted[0, 1:].all()
+    assert res.metrics["psi"].fit_percent > 90.0  # one step ahead
+    assert "innovations (pem" in res.summary()
+    with pytest.raises(ValueError, match="estimator"):
+        js.fit(start, exp, estimator="pem")

@@ -10,6 +10,7 @@ cost-based stopping rule added, `_lm.py`), the Jacobian by forward-mode autodiff
 through the RK4 scan, computed once per evaluation (`_lm.stored_jacobian`).
 """
 
+import abc
 import dataclasses
 import math
 import warnings
@@ -44,7 +45,19 @@ class ConvergenceWarning(UserWarning):
     """The optimiser stopped without meeting its tolerances."""
 
 
-class PredictionError(eqx.Module):
+class AbstractEstimator(eqx.Module):
+    """A strategy of `fit`: how the model is compared with the data and the comparison
+    minimised. Subclasses implement `fit(model, dataset, free, verbose) -> FitResult`:
+    `PredictionError` (output error, equation error and every horizon between) and
+    `Innovations` (the Kalman filter's one-step-ahead errors, by prediction error or
+    maximum likelihood with estimated noise)."""
+
+    @abc.abstractmethod
+    def fit(self, model, dataset, free, verbose) -> "FitResult":
+        """Estimate the free parameters of `model` from `dataset` (see `jaxship.fit`)."""
+
+
+class PredictionError(AbstractEstimator):
     """Prediction-error estimator: the loss and the optimiser of `fit`.
 
     **Arguments:**
@@ -105,6 +118,9 @@ class PredictionError(eqx.Module):
     initial: str | list = "measured"
     wind: bool = False
     hold: str | dict | None = None
+
+    def fit(self, model, dataset, free=None, verbose=False) -> "FitResult":
+        return _fit_prediction_error(self, model, dataset, free, verbose)
 
 
 def _predict(model, w: Windows, offsets=None):
@@ -193,6 +209,9 @@ class FitResult(SolverOutcome):
       residuals at the optimum;
     - `weights`: `{channel: weight}`; `window_samples`: samples per window for each
       experiment; `horizon`: the estimator's horizon [s] (None: output error);
+    - `criterion`: what was minimised (`"prediction error"`, or `"ml"`/`"pem"` of the
+      innovations); `noise`, `noise_std`: the noise variances an `Innovations`
+      estimator estimates with the model (None otherwise);
     - `names`, `values`, `std`, `covariance`, `correlation`: shortcuts.
     """
 
@@ -208,6 +227,9 @@ class FitResult(SolverOutcome):
     window_samples: tuple[int, ...]
     horizon: float | None
     experiment_names: tuple[str, ...]
+    criterion: str = "prediction error"
+    noise: dict | None = None  # innovations estimators: {name: variance} at the optimum
+    noise_std: dict | None = None  # their standard errors (0 where held fixed)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -246,10 +268,15 @@ class FitResult(SolverOutcome):
 
     def summary(self) -> str:
         horizon = "none (output error)" if self.horizon is None else f"{self.horizon} s"
+        how = (f"horizon {horizon}" if self.noise is None else
+               f"innovations ({self.criterion}, one step of {horizon})")
         lines = [f"{type(self.model).__name__} fitted to {len(self.experiment_names)} "
-                 f"experiment(s), horizon {horizon}: {self.message}, "
+                 f"experiment(s), {how}: {self.message}, "
                  f"{self.num_steps} steps, cost {self.cost:.6g}",
                  self.parameters.table()]
+        if self.noise is not None:
+            lines.append("noise variances: " + ", ".join(
+                f"{k} {v:.4g} +- {self.noise_std[k]:.2g}" for k, v in self.noise.items()))
         for c, m in self.metrics.items():
             lines.append(f"{c}: fit {m.fit_percent:.2f} %, loss {m.loss:.4g}, FPE {m.fpe:.4g}, "
                          f"residuals {'white' if m.white else 'not white'}")
@@ -276,6 +303,9 @@ class FitResult(SolverOutcome):
             "num_steps": int(self.num_steps),
             "cost": float(self.cost),
             "horizon": self.horizon,
+            "criterion": self.criterion,
+            "noise": self.noise,
+            "noise_std": self.noise_std,
             "window_samples": list(self.window_samples),
             "weights": {k: float(v) for k, v in self.weights.items()},
             "experiments": list(self.experiment_names),
@@ -341,7 +371,7 @@ def _excitation_flags(ds, rudder) -> list[str]:
     return flags
 
 
-def fit(model, dataset, *, estimator: PredictionError = PredictionError(), free=None,
+def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), free=None,
         verbose=False) -> FitResult:
     """Estimate the free parameters of a steering model or a vessel from measured data.
 
@@ -355,7 +385,9 @@ def fit(model, dataset, *, estimator: PredictionError = PredictionError(), free=
       different lengths, sample intervals and propeller rates are fine). Each needs
       a measured rudder and uniform sampling; r and psi are measured or derived; a
       vessel's windows start from the measured u and v too.
-    - `estimator`: a `PredictionError` (horizon, channels, weights, holds, solver).
+    - `estimator`: the strategy (`AbstractEstimator`): `PredictionError` (horizon,
+      channels, weights, holds, solver; the default) or `Innovations` (the Kalman
+      filter's innovations, maximum likelihood with the noise).
     - `free`: which parameters to estimate: `None` (the model's defaults: its `param`
       fields declared free, or a vessel's `free_by_default`), a sequence of field
       names, or `{name: Free(value, lower=, upper=, scale=) or None}`.
@@ -377,6 +409,14 @@ def fit(model, dataset, *, estimator: PredictionError = PredictionError(), free=
     correlations, large relative errors, undetermined combinations, no excitation);
     `ConvergenceWarning` when the optimiser did not converge.
     """
+    if not isinstance(estimator, AbstractEstimator):
+        raise ValueError(f"`estimator` must be a jaxship estimator (PredictionError, "
+                         f"Innovations), got {type(estimator).__name__}.")
+    return estimator.fit(model, dataset, free, verbose)
+
+
+def _fit_prediction_error(estimator, model, dataset, free, verbose) -> FitResult:
+    """`PredictionError.fit`: windows, Levenberg-Marquardt, the report."""
     ds, windows, layout = _prepare(model, dataset, estimator)
     specs = resolve_free(model, free)
     estimate_starts = estimator.initial == "estimate"
@@ -401,14 +441,12 @@ def fit(model, dataset, *, estimator: PredictionError = PredictionError(), free=
                                                 solver, int(estimator.max_steps))
     return _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
                    result, num_steps, estimate_starts=estimate_starts, verbose=verbose,
-                   stacklevel=3)
+                   stacklevel=4)
 
 
 def _prepare(model, dataset, estimator):
     """Check the model, data and estimator and build the windows: `(ds, windows,
     layout)`, shared by `fit` and `predict`."""
-    if not isinstance(estimator, PredictionError):
-        raise ValueError(f"`estimator` must be a PredictionError, got {type(estimator).__name__}.")
     if not all(hasattr(model, m) for m in ("replay_field", "replay_state", "channel_index")):
         raise ValueError(f"`model` must be a jaxship steering model (AbstractSteeringModel) "
                          f"or vessel (AbstractVessel), got {type(model).__name__}.")

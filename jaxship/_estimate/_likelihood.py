@@ -11,9 +11,11 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
-from .._covariance import ParameterReport, least_squares_covariance, parameter_report
+from .._covariance import least_squares_covariance, parameter_report
 from .._params import Transform, as_arrays, rebuild, resolve_free
 from .._steering._base import AbstractSteeringModel
+from .._validate import validate
+from ._fit import AbstractEstimator, FitResult
 from ._kalman import (
     KALMAN_CHANNELS,
     _augmented_names,
@@ -22,7 +24,7 @@ from ._kalman import (
     _records,
     _variance,
 )
-from ._lm import LevenbergMarquardt, SolverOutcome, solve_least_squares
+from ._lm import LevenbergMarquardt, solve_least_squares
 from ._windows import channel_weights
 
 
@@ -122,42 +124,52 @@ def _ml_hessian(z, model, transform, noise, rec):
     return f(q), jax.hessian(f)(q)
 
 
-class KalmanFitResult(SolverOutcome):
-    """Result of `fit_ml`.
+@eqx.filter_jit
+def _innovations(z, model, transform, noise, rec):
+    """The filter's innovations (E, N, C) and one-step-ahead predictions at z."""
+    m, log_var = _split(z, len(transform.names), transform, model)
+    Q, q, R = noise.matrices(log_var)
+    e = _batch_filter(m, rec, Q, q, R).innovations
+    return e, rec.y - e
 
-    - `model`: the model with the estimates (frozen parameters unchanged);
-    - `parameters`: `ParameterReport` of the free model parameters (values, standard
-      errors, covariance, correlation, flags);
-    - `noise`: `{name: variance}` of the noise at the optimum (process entries:
-      `"rudder"` [rad^2] or state names; channels `"psi"` [rad^2], `"r"`
-      [(rad/s)^2]); `noise_std`: their standard errors (0 when fixed);
-    - `criterion`: `"ml"` or `"pem"`; `loss`: the negative log likelihood (`"ml"`) or
-      half the sum of squared weighted innovations (`"pem"`);
-    - `result` (optimistix code), `success`, `message`, `num_steps`;
-    - `names`, `values`, `std`, `covariance`, `correlation`: shortcuts.
-    """
 
-    model: AbstractSteeringModel
-    parameters: ParameterReport
-    noise: dict
-    noise_std: dict
-    criterion: str
-    loss: float
-    result: optx.RESULTS
-    num_steps: int
-    experiment_names: tuple[str, ...]
-
-    names = property(lambda self: self.parameters.names)
-    values = property(lambda self: self.parameters.values)
-    std = property(lambda self: self.parameters.std)
-    covariance = property(lambda self: self.parameters.covariance)
-    correlation = property(lambda self: self.parameters.correlation)
-
-    def summary(self) -> str:
-        noise = ", ".join(f"{k} {v:.4g} +- {self.noise_std[k]:.2g}" for k, v in self.noise.items())
-        return (f"{type(self.model).__name__} by {self.criterion}: {self.message}, "
-                f"{self.num_steps} steps, loss {self.loss:.6g}\n{self.parameters.table()}\n"
-                f"noise variances: {noise}")
+def _report(model, ds, channels, rudder, specs, transform, layout, rec, z, cov, loss,
+            result, steps, criterion, max_lag=25) -> FitResult:
+    """The `FitResult` of an innovations fit: the parameter report, the noise, and the
+    one-step-ahead predictions of the filter validated per channel."""
+    d = len(specs)
+    q = np.asarray(_physical(z, d, transform), dtype=np.float64)
+    values = q[:d]
+    fitted = rebuild(model, transform.names, [float(v) for v in values])
+    report = parameter_report(transform.names, values, cov[:d, :d],
+                              units=tuple(s.unit for s in specs))
+    log_var = np.asarray(layout.fixed, dtype=np.float64).copy()
+    log_std = np.zeros_like(log_var)
+    est_index = [i for i, e in enumerate(layout.estimated) if e]
+    log_var[est_index] = q[d:]
+    with np.errstate(invalid="ignore"):
+        log_std[est_index] = np.sqrt(np.diag(cov)[d:])
+    var = np.exp(log_var)
+    _, pred = _innovations(z, as_arrays(model), transform, layout, rec)
+    pred = np.asarray(pred, dtype=np.float64)
+    predicted = np.asarray(ds.mask).copy()
+    predicted[:, 0] = False  # sample 0 is the prior, never predicted
+    u = np.asarray(getattr(ds, rudder), dtype=np.float64)
+    predictions, metrics = {}, {}
+    for c, name in enumerate(channels):
+        predictions[name] = np.where(predicted, pred[..., c], 0.0)
+        metrics[name] = validate(np.asarray(getattr(ds, name), dtype=np.float64),
+                                 predictions[name], predicted, num_params=int(q.shape[0]),
+                                 u=u, max_lag=max_lag, channel=name)
+    return FitResult(
+        model=fitted, parameters=report, metrics=metrics, predictions=predictions,
+        predicted=predicted, result=result, num_steps=int(steps), cost=float(loss),
+        weights=dict(zip(channels, channel_weights(ds, channels, None).tolist())),
+        window_samples=(1,) * ds.num_experiments, horizon=float(np.min(ds.dt)),
+        experiment_names=tuple(ds.names), criterion=criterion,
+        noise={n: float(v) for n, v in zip(layout.names, var)},
+        noise_std={n: float(v * s) for n, v, s in zip(layout.names, var, log_std)},
+    )
 
 
 def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
@@ -225,7 +237,7 @@ def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
 def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_CHANNELS,
            criterion: str = "ml", process="rudder", noise="estimate", noise_start=None,
            rudder: str = "delta", substeps: int = 1, max_steps: int = 512,
-           solver=None, hold=None) -> KalmanFitResult:
+           solver=None, hold=None) -> FitResult:
     """Estimate a steering model with its noise by the Kalman filter's innovations.
 
     **Arguments:**
@@ -255,7 +267,8 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
       `BFGS(rtol=1e-8, atol=1e-8)` for ML, jaxship's `LevenbergMarquardt(rtol=1e-9,
       atol=1e-9)` with MINPACK's cost test for PEM).
 
-    **Returns:** a `KalmanFitResult`.
+    **Returns:** a `FitResult` with the noise variances (`noise`, `noise_std`), the
+    criterion, and the filter's one-step-ahead predictions and their metrics.
     """
     if criterion not in ("ml", "pem"):
         raise ValueError(f"`criterion` must be 'ml' or 'pem', got {criterion!r}.")
@@ -267,7 +280,6 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
     z0 = jnp.asarray(np.concatenate([transform.to_unconstrained([s.start for s in specs]),
                                      z_noise]), dtype=float)
     base = as_arrays(model)
-    d = len(specs)
     if criterion == "ml":
         solver = optx.BFGS(rtol=1e-8, atol=1e-8) if solver is None else solver
         z, result, steps = _ml_solve(z0, base, transform, layout, rec, solver, int(max_steps))
@@ -293,20 +305,31 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
         groups = np.repeat(np.arange(len(channels)), int(mask.sum()))
         cov, _ = least_squares_covariance(jrows, rows, groups)
         loss = 0.5 * float(np.sum(rows**2))
-    q = np.asarray(_physical(z, d, transform), dtype=np.float64)
-    values = q[:d]
-    fitted = rebuild(model, transform.names, [float(v) for v in values])
-    report = parameter_report(transform.names, values, cov[:d, :d],
-                              units=tuple(s.unit for s in specs))
-    log_var = np.asarray(layout.fixed, dtype=np.float64).copy()
-    log_std = np.zeros_like(log_var)
-    est_index = [i for i, e in enumerate(layout.estimated) if e]
-    log_var[est_index] = q[d:]
-    with np.errstate(invalid="ignore"):
-        log_std[est_index] = np.sqrt(np.diag(cov)[d:])
-    var = np.exp(log_var)
-    noise_out = {n: float(v) for n, v in zip(layout.names, var)}
-    noise_std = {n: float(v * s) for n, v, s in zip(layout.names, var, log_std)}
-    return KalmanFitResult(model=fitted, parameters=report, noise=noise_out, noise_std=noise_std,
-                           criterion=criterion, loss=loss, result=result, num_steps=int(steps),
-                           experiment_names=tuple(ds.names))
+    return _report(model, ds, channels, rudder, specs, transform, layout, rec, z, cov, loss,
+                   result, steps, criterion)
+
+
+class Innovations(AbstractEstimator):
+    """The innovations estimator of `jaxship.fit`: the extended Kalman filter's
+    one-step-ahead prediction errors, minimised by maximum likelihood with the noise
+    variances (`criterion="ml"`) or as a prediction error (`"pem"`); the arguments
+    are those of `fit_ml`. The `FitResult` carries the noise (`noise`, `noise_std`)
+    and the filter's predictions."""
+
+    criterion: str = "ml"
+    channels: tuple[str, ...] = KALMAN_CHANNELS
+    process: str | tuple = "rudder"
+    noise: str | dict = "estimate"
+    noise_start: dict | None = None
+    rudder: str = "delta"
+    substeps: int = 1
+    max_steps: int = 512
+    solver: object = None
+    hold: str | dict | None = None
+
+    def fit(self, model, dataset, free=None, verbose=False) -> FitResult:
+        return fit_ml(model, dataset, free=free, channels=self.channels,
+                      criterion=self.criterion, process=self.process, noise=self.noise,
+                      noise_start=self.noise_start, rudder=self.rudder,
+                      substeps=self.substeps, max_steps=self.max_steps, solver=self.solver,
+                      hold=self.hold)

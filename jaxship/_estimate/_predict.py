@@ -51,6 +51,9 @@ def predict(model, dataset, *, estimator: PredictionError = PredictionError()) -
 
     Raises `ValueError` for bad data as `fit` does.
     """
+    if not isinstance(estimator, PredictionError):
+        raise ValueError(f"`estimator` must be a PredictionError, got "
+                         f"{type(estimator).__name__}.")
     ds, windows, layout = _prepare(model, dataset, estimator)
     channels = windows.channels
     pred = _predict_jit(as_arrays(model), windows)
