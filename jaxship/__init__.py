@@ -60,7 +60,7 @@ from ._indices import (
 from ._kinematics import body_to_earth as body_to_earth, ssa as ssa
 from ._manoeuvres import (
     AbstractManoeuvre as AbstractManoeuvre,
-    HeadingAutopilot as HeadingAutopilot,
+    HeadingPerturbations as HeadingPerturbations,
     Replay as Replay,
     ReverseSpiral as ReverseSpiral,
     Schedule as Schedule,

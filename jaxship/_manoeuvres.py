@@ -298,8 +298,9 @@ class ReverseSpiral(AbstractManoeuvre):
         return delta, integral
 
 
-class HeadingAutopilot(AbstractManoeuvre):
-    """Heading-reference perturbations under a PID autopilot (Astrom & Kallstrom 1979, sec. 4).
+class HeadingPerturbations(AbstractManoeuvre):
+    """Heading-reference perturbations under a PID heading controller (the closed-loop
+    identification experiments of Astrom & Kallstrom 1979, sec. 4).
 
     Reference: initial heading plus a square wave of `amplitude` [rad] and `period`
     [s]. Rudder law: $\\delta_c = k_p e + k_i \\int e\\,dt - k_d r$ with

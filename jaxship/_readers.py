@@ -264,14 +264,17 @@ def write_trial_csv(path, data, units: str = "display") -> None:
 
 def shared_data_dir() -> Path | None:
     """The measured-data folder: `$JAXSHIP_DATA` if that variable is set (None if it
-    does not exist), else `../shared/data` next to the repository or the working
-    directory; None when absent (tests and notebooks skip on None)."""
+    does not exist), else the first `shared/data` beside the working directory or one of
+    its parents (so `../shared/data` is found from the repository and from
+    `notebooks/`, whether jaxship is installed editable or not), else beside the
+    source tree; None when absent (tests and notebooks skip on None, except under CI)."""
     env = os.environ.get("JAXSHIP_DATA")
     if env:
         path = Path(env).expanduser()
         return path if path.is_dir() else None
-    for path in (Path(__file__).resolve().parents[2] / "shared" / "data",
-                 Path.cwd().resolve().parent / "shared" / "data"):
+    cwd = Path.cwd().resolve()
+    for folder in (cwd, *cwd.parents, Path(__file__).resolve().parents[2]):
+        path = folder / "shared" / "data"
         if path.is_dir():
             return path
     return None

@@ -23,7 +23,7 @@ from .plotting import plot_trajectory
 SPEC_HELP = (
     "turn:ANGLE, zigzag:ANGLE/HEADING (negative ANGLE: port first), spiral, "
     "reverse-spiral, pullout:ANGLE, stop, prbs:AMPLITUDE, 3211:AMPLITUDE, thesis, "
-    "autopilot:AMPLITUDE (angles in degrees)"
+    "heading-steps:AMPLITUDE (angles in degrees)"
 )
 
 
@@ -47,7 +47,7 @@ class TrialSpec:
             "prbs": 1,
             "3211": 1,
             "thesis": 0,
-            "autopilot": 1,
+            "heading-steps": 1,
         }
         if kind not in expected:
             raise ValueError(f"Unknown manoeuvre {text!r}; use one of: {SPEC_HELP}.")
@@ -105,8 +105,8 @@ def build_manoeuvre(spec: TrialSpec, vessel, x0, *, duration=None, dt=None):
         return man.multi_step_3211(amp, unit=tau, settle=pick(30 * tau) - 7 * tau, dt=dt)
     if spec.kind == "thesis":
         return man.thesis_manoeuvre(dt=dt)
-    if spec.kind == "autopilot":
-        return man.HeadingAutopilot(
+    if spec.kind == "heading-steps":
+        return man.HeadingPerturbations(
             rad(v[0]),
             period=20 * tau,
             kp=2.0,

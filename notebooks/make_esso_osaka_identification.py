@@ -34,7 +34,8 @@ the cells below do nothing when it is absent).
   \\|y - \\bar y\\|)$, for the 20 s-ahead predictor and for free simulation of each whole run.
 
 The records are decimated to 2 Hz (every 5th sample) to keep the notebook fast."""),
-    new_code_cell("""import time
+    new_code_cell("""import os
+import time
 import jax
 jax.config.update("jax_enable_x64", True)
 import numpy as np
@@ -47,7 +48,9 @@ data = js.shared_data_dir()
 HAVE_ESSO = data is not None and (data / "esso_osaka_frt").is_dir()
 HAVE_HSVA = data is not None and (data / "kvlcc2_simman2008_hsva").is_dir()
 print("Esso Osaka data:", "found" if HAVE_ESSO else "absent: its cells are skipped")
-print("HSVA KVLCC2 data:", "found" if HAVE_HSVA else "absent: its cells are skipped")"""),
+print("HSVA KVLCC2 data:", "found" if HAVE_HSVA else "absent: its cells are skipped")
+if os.environ.get("CI") and not (HAVE_ESSO and HAVE_HSVA):
+    raise FileNotFoundError("CI: ../shared/data must be beside the checkout")"""),
     new_markdown_cell("## Identification (3-DOF model, Nomoto 1 and 2)"),
     new_code_cell("""if HAVE_ESSO:
     t0 = time.perf_counter()

@@ -215,9 +215,9 @@ def test_reverse_spiral_reaches_the_yaw_rate_levels(vessel, x0):
     np.testing.assert_allclose(turn.state.r[-1], rates[-1], rtol=2e-2)
 
 
-def test_heading_autopilot_tracks_the_square_wave(vessel, x0):
+def test_heading_perturbations_track_the_square_wave(vessel, x0):
     A, period, dt = 10 * DEG, 600.0, 0.5
-    pd = js.HeadingAutopilot(A, period, kp=2.0, ki=0.0, kd=100.0, duration=1200.0, dt=dt)
+    pd = js.HeadingPerturbations(A, period, kp=2.0, ki=0.0, kd=100.0, duration=1200.0, dt=dt)
     traj = js.simulate(vessel, pd, js.straight_state(x0.u, x0.n, psi=1.0))
     t, psi = np.asarray(traj.t), np.asarray(traj.state.psi)
     for k in range(1, 5):  # at the end of each half period, heading within 0.1 deg of the ref
@@ -226,7 +226,7 @@ def test_heading_autopilot_tracks_the_square_wave(vessel, x0):
         assert abs(psi[i] - reference) < 0.1 * DEG, (k, (psi[i] - reference) / DEG)
     # the rudder law, recomputed from the sampled states (PID with anti-windup clip)
     kp, ki, kd = 2.0, 0.005, 60.0
-    pid = js.HeadingAutopilot(A, period, kp=kp, ki=ki, kd=kd, duration=600.0, dt=dt)
+    pid = js.HeadingPerturbations(A, period, kp=kp, ki=ki, kd=kd, duration=600.0, dt=dt)
     traj = js.simulate(vessel, pid, x0, simulator=AT_SAMPLES)
     t, psi = np.asarray(traj.t), np.asarray(traj.state.psi)
     r, order = np.asarray(traj.state.r), np.asarray(traj.command.delta)
