@@ -267,6 +267,38 @@ def hac_from_windows(jacobian, residuals, layout, *, num_samples=None, lags=None
     return _hac(rows, scores, valid, lags, focus, rcond)
 
 
+def cluster_from_windows(jacobian, residuals, mask, *, rcond: float = 1e-10):
+    """Cluster-robust covariance of a windowed prediction-error fit, each prediction
+    window a cluster (Liang & Zeger 1986; Cameron & Miller 2015, *J. Human Resources*
+    50, eq. 11):
+
+    $$\\Sigma = \\frac{G}{G - 1}(J^TJ)^{-1}\\Big(\\sum_g s_gs_g^T\\Big)(J^TJ)^{-1},
+    \\qquad s_g = \\sum_{t \\in g} J_t^Te_t.$$
+
+    Within a window the prediction error grows from the measured start, so its
+    residuals are strongly correlated; windows restart from measurements, so
+    different windows are nearly independent: the sandwich allows any correlation
+    inside a cluster. Needs many windows (G of 20 or more). `jacobian` (C, E, W, L, d),
+    `residuals` (C, E, W, L), `mask` (E, W, L). Returns `(covariance, G)`."""
+    jac = np.asarray(jacobian, dtype=np.float64)
+    res = np.asarray(residuals, dtype=np.float64)
+    mask = np.asarray(mask, dtype=bool)
+    rows = np.concatenate([jac[c][mask] for c in range(res.shape[0])])
+    pinv_a, safe, undetermined, _ = _normalised_inverse(rows, rcond)
+    jac0 = np.where(mask[None, ..., None], jac, 0.0)
+    scores = np.einsum("cewlp,cewl->ewp", jac0, np.where(mask[None], res, 0.0))
+    used = mask.any(axis=-1)
+    g = scores[used] / safe
+    count = int(used.sum())
+    if count < 2:
+        raise ValueError("a cluster-robust covariance needs at least two windows.")
+    cov = pinv_a @ (g.T @ g) @ pinv_a * (count / (count - 1))
+    cov = cov / safe[:, None] / safe[None, :]
+    cov[undetermined, :] = np.inf
+    cov[:, undetermined] = np.inf
+    return cov, count
+
+
 @dataclasses.dataclass(frozen=True)
 class ParameterReport:
     """Estimates with their uncertainty and an identifiability verdict.
@@ -353,15 +385,17 @@ def _combination(names, vector):
 def parameter_report(names, values, covariance, *, units=(), corr_threshold: float = 0.95,
                      rel_std_threshold: float = 0.5, null_directions=(),
                      extra_flags=(), robust_covariance=None, white: bool | None = None,
-                     hac_lags: int | None = None) -> ParameterReport:
+                     hac_lags: int | None = None,
+                     robust_method: str | None = None) -> ParameterReport:
     """Standard errors, correlation matrix, condition number and identifiability
     flags of estimates `values` with `covariance` (see `ParameterReport`).
 
     `null_directions` (from `least_squares_covariance`) are reported as combinations
     the data do not determine; `extra_flags` are appended as they are.
 
-    `robust_covariance` (d, d), e.g. from `hac_covariance` with its `hac_lags`,
-    gives `std_robust`. `white`: the residuals passed the whiteness test (e.g.
+    `robust_covariance` (d, d), e.g. from `hac_covariance` with its `hac_lags` or
+    `cluster_from_windows`, gives `std_robust`; `robust_method` names it in the flag.
+    `white`: the residuals passed the whiteness test (e.g.
     `all(m.white for m in metrics)`); when False a flag says that the usual standard
     errors are too small, by how much at most (the largest `std_robust / std`), and
     the relative-error check uses the larger of `std` and `std_robust`.
@@ -422,7 +456,7 @@ def parameter_report(names, values, covariance, *, units=(), corr_threshold: flo
     flags.extend(extra_flags)
     uncertainty = ()
     if white is False:
-        uncertainty = (_not_white_flag(names, std, std_robust, hac_lags),)
+        uncertainty = (_not_white_flag(names, std, std_robust, hac_lags, robust_method),)
         flags.extend(uncertainty)
     return ParameterReport(names, values, std, cov, corr, condition, tuple(flags), tuple(units),
                            std_robust=std_robust, residuals_white=None if white is None
@@ -430,11 +464,11 @@ def parameter_report(names, values, covariance, *, units=(), corr_threshold: flo
                            else int(hac_lags), uncertainty_flags=uncertainty)
 
 
-def _not_white_flag(names, std, std_robust, hac_lags) -> str:
+def _not_white_flag(names, std, std_robust, hac_lags, robust_method=None) -> str:
     head = ("residuals are not white (correlated in time): the usual standard errors "
             "assume white residuals")
-    how = "Newey-West HAC" + ("" if hac_lags is None else
-                              f", {int(hac_lags)} lag{'' if int(hac_lags) == 1 else 's'}")
+    how = robust_method or "Newey-West HAC" + (
+        "" if hac_lags is None else f", {int(hac_lags)} lag{'' if int(hac_lags) == 1 else 's'}")
     ok = np.isfinite(std) & np.isfinite(std_robust) & (std > 0)
     if not ok.any():
         if np.all(np.isnan(std_robust)):

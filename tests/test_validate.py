@@ -8,6 +8,7 @@ import pytest
 
 from jaxship._covariance import (
     bartlett_long_run,
+    cluster_from_windows,
     hac_covariance,
     hac_from_windows,
     least_squares_covariance,
@@ -354,3 +355,34 @@ def test_not_white_flag_and_robust_std_in_the_report():
     # not white without robust errors: still flagged
     rep = parameter_report(["K", "T"], [0.05, 10.0], cov, white=False)
     assert len(rep.flags) == 1 and "no robust standard errors" in rep.flags[0]
+
+
+def test_window_cluster_covariance_is_the_sandwich_over_windows():
+    """`cluster_from_windows` equals G/(G-1) (J'J)^-1 (sum_w s_w s_w') (J'J)^-1 written
+    out, ignores padding, and under errors correlated within windows (independent
+    between them) its standard errors match the spread of the estimates over seeds."""
+    rng = np.random.default_rng(3)
+    E, W, L = 2, 30, 12
+    x = rng.standard_normal((E, W, L))
+    jac = np.stack([np.ones((E, W, L)), x], axis=-1)[None]  # (1, E, W, L, 2)
+    mask = np.ones((E, W, L), dtype=bool)
+    mask[1, -3:] = False
+    estimates, stds = [], []
+    for seed in range(300):
+        r = np.random.default_rng(seed)
+        common = r.standard_normal((E, W, 1))  # shared within a window
+        y = 0.5 + 2.0 * x + common + 0.3 * r.standard_normal((E, W, L))
+        rows = jac[0][mask]
+        beta = np.linalg.lstsq(rows, y[mask], rcond=None)[0]
+        res = np.where(mask, y - jac[0] @ beta, 0.0)[None]
+        cov, count = cluster_from_windows(jac, res, mask)
+        estimates.append(beta)
+        stds.append(np.sqrt(np.diag(cov)))
+        if seed == 0:
+            assert count == 2 * W - 3
+            s = np.einsum("ewlp,ewl->ewp", jac[0] * mask[..., None], res[0])[mask.any(-1)]
+            bread = np.linalg.inv(rows.T @ rows)
+            explicit = bread @ (s.T @ s) @ bread * count / (count - 1)
+            np.testing.assert_allclose(cov, explicit, rtol=1e-10)
+    ratio = np.mean(stds, axis=0) / np.std(estimates, axis=0)
+    assert np.all((ratio > 0.85) & (ratio < 1.15)), ratio

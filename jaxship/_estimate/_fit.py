@@ -23,6 +23,7 @@ import optimistix as optx
 
 from .._covariance import (
     ParameterReport,
+    cluster_from_windows,
     hac_from_windows,
     least_squares_covariance,
     parameter_report,
@@ -34,6 +35,11 @@ from .._simulate import Simulator, integrate, replay_policy
 from .._validate import _to_plain, validate
 from ._lm import LevenbergMarquardt, SolverOutcome, solve_least_squares
 from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_data, to_timeline
+
+
+# windows needed for window-clustered standard errors (Cameron & Miller 2015 advise
+# against few clusters); with fewer, the Newey-West HAC covariance is used
+MIN_CLUSTERS = 20
 
 
 class IdentifiabilityWarning(UserWarning):
@@ -441,7 +447,7 @@ def _fit_prediction_error(estimator, model, dataset, free, verbose) -> FitResult
                                                 solver, int(estimator.max_steps))
     return _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
                    result, num_steps, estimate_starts=estimate_starts, verbose=verbose,
-                   stacklevel=4)
+                   stacklevel=6)  # _report, this, PredictionError.fit, its wrapper, fit, caller
 
 
 def _prepare(model, dataset, estimator):
@@ -574,15 +580,22 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
         measured = np.asarray(getattr(ds, name), dtype=np.float64)
         metrics[name] = validate(measured, timeline, hit, num_params=num_params, u=u,
                                  max_lag=estimator.max_lag, channel=name)
-    # standard errors that do not assume white residuals (Newey-West HAC), reported and
-    # flagged when the residuals fail the whiteness test
+    # standard errors that do not assume white residuals, reported and flagged when the
+    # residuals fail the whiteness test: clustered by prediction window when there are
+    # enough windows (they restart from measurements), else Newey-West HAC in time
     white = all(m.white for m in metrics.values())
-    robust, lags = hac_from_windows(jac[..., columns], resid, layout, num_samples=shape[1],
-                                    focus=np.arange(d))
+    windows_used = int(mask.any(axis=-1).sum())
+    if windows_used >= MIN_CLUSTERS:
+        robust, _ = cluster_from_windows(jac[..., columns], resid, mask)
+        lags, method = None, f"clustered by prediction window, {windows_used} windows"
+    else:
+        robust, lags = hac_from_windows(jac[..., columns], resid, layout,
+                                        num_samples=shape[1], focus=np.arange(d))
+        method = f"Newey-West HAC, {lags} lags"
     report = parameter_report(transform.names, values, covariance,
                               units=tuple(s.unit for s in specs), null_directions=null,
                               extra_flags=flags, robust_covariance=robust[:d, :d],
-                              white=white, hac_lags=lags)
+                              white=white, hac_lags=lags, robust_method=method)
     out = FitResult(
         model=fitted, parameters=report, metrics=metrics, predictions=predictions,
         predicted=hit, result=result, num_steps=int(num_steps), cost=cost,
