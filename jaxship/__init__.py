@@ -59,7 +59,9 @@ from ._indices import (
 )
 from ._kinematics import body_to_earth as body_to_earth, ssa as ssa
 from ._manoeuvres import (
+    AbstractController as AbstractController,
     AbstractManoeuvre as AbstractManoeuvre,
+    Controlled as Controlled,
     HeadingPerturbations as HeadingPerturbations,
     Replay as Replay,
     ReverseSpiral as ReverseSpiral,

@@ -20,8 +20,25 @@ from ._kinematics import ssa
 from ._state import Command
 
 
-class AbstractManoeuvre(eqx.Module):
-    """Base of all manoeuvres.
+class AbstractController(eqx.Module):
+    """The controller seam. `init(x0)` gives the controller's memory (a pytree) at the
+    initial state; `command(t, state, memory, h)` the `Command` for the control step
+    $[t, t + h]$ and the new memory. The simulator calls it at every control step
+    (`Simulator.max_step`, 0.1 s by default, whatever the output interval) and carries
+    the memory in its scan state, so a closed loop is differentiable (tune gains by
+    gradient) and vmappable (over gains, speeds, seeds)."""
+
+    @abc.abstractmethod
+    def init(self, x0):
+        """The controller's memory at the initial `ShipState` `x0`."""
+
+    @abc.abstractmethod
+    def command(self, t, state, memory, h):
+        """The command for the control step `[t, t + h]` and the new memory."""
+
+
+class AbstractManoeuvre(AbstractController):
+    """A controller run for a duration with an output sampling: what `simulate` takes.
 
     Every manoeuvre has `duration` [s], a sample interval `dt` [s], the time `start`
     [s] of its first sample, a propeller command `n` [rev/s] (`None`: hold the
@@ -40,6 +57,28 @@ class AbstractManoeuvre(eqx.Module):
             self.num_samples = int(round(float(self.duration) / float(self.dt))) + 1
         if self.num_samples < 2:
             raise ValueError(f"`duration` ({self.duration} s) must cover at least one `dt`.")
+
+
+class Controlled(AbstractManoeuvre):
+    """Any `AbstractController` run for `duration` [s] with output every `dt` [s]."""
+
+    controller: AbstractController
+    duration: ArrayLike
+    dt: ArrayLike = 0.1
+    start: ArrayLike = 0.0
+    n: None = None
+    num_samples: int | None = eqx.field(static=True, default=None)
+
+    def init(self, x0):
+        return self.controller.init(x0)
+
+    def command(self, t, state, memory, h):
+        return self.controller.command(t, state, memory, h)
+
+
+class AbstractTrial(AbstractManoeuvre):
+    """The standard trials: a rudder law (`rudder`) and a propeller order, with the
+    initial heading and propeller rate kept in the memory."""
 
     def init(self, x0):
         """Controller memory at the first sample: initial rpm, initial heading, own state."""
@@ -71,7 +110,7 @@ def _step(tau, execute):
     return jnp.where(tau >= execute, 1.0, 0.0)
 
 
-class Turn(AbstractManoeuvre):
+class Turn(AbstractTrial):
     """Turning circle: rudder `angle` ordered at `execute` and held (ITTC 7.5-04-02-01 2.2.1)."""
 
     angle: ArrayLike  # delta [rad]; positive turns to starboard
@@ -89,7 +128,7 @@ class Turn(AbstractManoeuvre):
         return self.angle * _step(tau, self.execute), memory
 
 
-class ZigZag(AbstractManoeuvre):
+class ZigZag(AbstractTrial):
     """Kempf zig-zag `angle`/`heading` (IMO MSC.137(76) 4.2.7; ITTC 2.2.2).
 
     The rudder goes to `angle` at `execute` (negative `angle`: port first) and is
@@ -127,7 +166,7 @@ class ZigZag(AbstractManoeuvre):
         return side * jnp.abs(self.angle) * _step(tau, self.execute), side
 
 
-class Schedule(AbstractManoeuvre):
+class Schedule(AbstractTrial):
     """Open-loop piecewise-linear rudder schedule through the points `(times, angles)`.
 
     The building block of the direct spiral, pull-out, 3-2-1-1, PRBS and the thesis
@@ -243,7 +282,7 @@ def thesis_manoeuvre(
     return Schedule(np.array(times), np.array(angles), duration=t + end_hold, dt=dt, n=n)
 
 
-class Stop(AbstractManoeuvre):
+class Stop(AbstractTrial):
     """Crash stop (ITTC 2.2.7): propeller to `astern_n` [rev/s] at `execute`, rudder midships."""
 
     astern_n: ArrayLike  # n_astern [rev/s], negative
@@ -264,7 +303,7 @@ class Stop(AbstractManoeuvre):
         return jnp.where(tau >= self.execute, self.astern_n, n)
 
 
-class ReverseSpiral(AbstractManoeuvre):
+class ReverseSpiral(AbstractTrial):
     """Bech's reverse spiral: a yaw-rate controller holds each rate in `rates` [rad/s]
     for `hold` s; the mean rudder needed gives the delta(r) curve (MSC/Circ.1053 app. 4).
 
@@ -298,7 +337,7 @@ class ReverseSpiral(AbstractManoeuvre):
         return delta, integral
 
 
-class HeadingPerturbations(AbstractManoeuvre):
+class HeadingPerturbations(AbstractTrial):
     """Heading-reference perturbations under a PID heading controller (the closed-loop
     identification experiments of Astrom & Kallstrom 1979, sec. 4).
 
@@ -334,7 +373,7 @@ class HeadingPerturbations(AbstractManoeuvre):
         return jnp.clip(delta, -self.max_angle, self.max_angle), integral
 
 
-class Replay(AbstractManoeuvre):
+class Replay(AbstractTrial):
     """Open-loop replay of recorded rudder and propeller commands.
 
     `delta_record` [rad] and `n_record` [rev/s] are sampled every `dt` from `start`.
