@@ -25,9 +25,6 @@ from ._estimate._armax import ARMAXResult as ARMAXResult, fit_armax as fit_armax
 from ._estimate._discrete import fit_discrete_response as fit_discrete_response
 from ._estimate._fit import (
     AbstractEstimator as AbstractEstimator,
-    ConvergenceWarning as ConvergenceWarning,
-    FitResult as FitResult,
-    IdentifiabilityWarning as IdentifiabilityWarning,
     PredictionError as PredictionError,
     fit as fit,
 )
@@ -45,6 +42,11 @@ from ._estimate._linear import (
 )
 from ._estimate._lm import LevenbergMarquardt as LevenbergMarquardt
 from ._estimate._predict import predict as predict
+from ._estimate._result import (
+    ConvergenceWarning as ConvergenceWarning,
+    FitResult as FitResult,
+    IdentifiabilityWarning as IdentifiabilityWarning,
+)
 from ._indices import (
     format_table as format_table,
     imo_criteria as imo_criteria,

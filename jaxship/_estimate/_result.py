@@ -1,0 +1,146 @@
+"""`FitResult`, the one result type of `jaxship.fit` whatever the estimator, and the
+warnings a fit gives."""
+
+import equinox as eqx
+import numpy as np
+import optimistix as optx
+from scipy.special import ndtri
+
+from .._covariance import ParameterReport
+from .._frames import fit_to_dataframe
+from .._params import get_path, parameter_fields
+from .._validate import _to_plain
+from ._lm import SolverOutcome
+
+
+class IdentifiabilityWarning(UserWarning):
+    """The data do not determine some estimated parameters well (see the flags of
+    `FitResult.parameters`)."""
+
+
+class ConvergenceWarning(UserWarning):
+    """The optimiser stopped without meeting its tolerances."""
+
+
+class FitResult(SolverOutcome):
+    """Result of `fit`.
+
+    - `model`: the model with the estimates (frozen parameters unchanged);
+    - `parameters`: `ParameterReport` (values, standard errors, covariance,
+      correlation, condition number, identifiability flags) of the free
+      parameters, in the model's field order;
+    - `metrics`: `{channel: ValidationReport}` on the fitted data, with the
+      residuals of the chosen horizon (for `horizon=None` the simulation error);
+    - `predictions`: `{channel: (E, N) array}` of model predictions at the dataset's
+      samples; `predicted`: (E, N) mask of samples that were predicted (the first
+      sample of each experiment is a start value, never predicted);
+    - `result`: the optimistix `RESULTS` code; `success`; `message`;
+    - `num_steps`: optimiser steps; `cost`: $\\frac12\\sum$ of the squared weighted
+      residuals at the optimum;
+    - `weights`: `{channel: weight}`; `window_samples`: samples per window for each
+      experiment; `horizon`: the estimator's horizon [s] (None: output error);
+    - `criterion`: what was minimised (`"prediction error"`, or `"ml"`/`"pem"` of the
+      innovations); `noise`, `noise_std`: the noise variances an `Innovations`
+      estimator estimates with the model (None otherwise);
+    - `names`, `values`, `std`, `covariance`, `correlation`: shortcuts.
+    """
+
+    model: eqx.Module  # an AbstractSteeringModel or an AbstractVessel
+    parameters: ParameterReport
+    metrics: dict
+    predictions: dict
+    predicted: np.ndarray
+    result: optx.RESULTS
+    num_steps: int
+    cost: float
+    weights: dict
+    window_samples: tuple[int, ...]
+    horizon: float | None
+    experiment_names: tuple[str, ...]
+    criterion: str = "prediction error"
+    noise: dict | None = None  # innovations estimators: {name: variance} at the optimum
+    noise_std: dict | None = None  # their standard errors (0 where held fixed)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return self.parameters.names
+
+    @property
+    def values(self) -> np.ndarray:
+        return self.parameters.values
+
+    @property
+    def std(self) -> np.ndarray:
+        return self.parameters.std
+
+    @property
+    def covariance(self) -> np.ndarray:
+        return self.parameters.covariance
+
+    @property
+    def correlation(self) -> np.ndarray:
+        return self.parameters.correlation
+
+    @property
+    def flags(self) -> tuple[str, ...]:
+        return self.parameters.flags
+
+    def to_dataframe(self):
+        """One row per free parameter: name, value, std, std_robust, unit and the 95 %
+        interval (pandas, an optional dependency)."""
+        return fit_to_dataframe(self)
+
+    def interval(self, level: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
+        """Normal confidence intervals `(lower, upper)` of the estimates at `level`
+        (two-sided), from the standard errors."""
+        z = float(ndtri(0.5 + level / 2))
+        return self.values - z * self.std, self.values + z * self.std
+
+    def summary(self) -> str:
+        horizon = "none (output error)" if self.horizon is None else f"{self.horizon} s"
+        how = (f"horizon {horizon}" if self.noise is None else
+               f"innovations ({self.criterion}, one step of {horizon})")
+        lines = [f"{type(self.model).__name__} fitted to {len(self.experiment_names)} "
+                 f"experiment(s), {how}: {self.message}, "
+                 f"{self.num_steps} steps, cost {self.cost:.6g}",
+                 self.parameters.table()]
+        if self.noise is not None:
+            lines.append("noise variances: " + ", ".join(
+                f"{k} {v:.4g} +- {self.noise_std[k]:.2g}" for k, v in self.noise.items()))
+        for c, m in self.metrics.items():
+            lines.append(f"{c}: fit {m.fit_percent:.2f} %, loss {m.loss:.4g}, FPE {m.fpe:.4g}, "
+                         f"residuals {'white' if m.white else 'not white'}")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary: model name, parameters (value, std, unit), frozen
+        values, metrics per channel, correlation, condition number, flags, result."""
+        fields = {n: get_path(self.model, n) for n in _field_names(self.model)}
+        params = {
+            n: {"value": float(v), "std": _to_plain(float(s)), "unit": u}
+            for n, v, s, u in zip(self.names, self.values, self.std, self.parameters.units)
+        }
+        return {
+            "model": type(self.model).__name__,
+            "parameters": params,
+            "frozen": {n: _to_plain(float(v)) for n, v in fields.items() if n not in params},
+            "train": {c: m.to_dict() for c, m in self.metrics.items()},
+            "correlation": _to_plain(self.correlation),
+            "condition_number": _to_plain(self.parameters.condition_number),
+            "flags": list(self.flags),
+            "result": self.message,
+            "success": self.success,
+            "num_steps": int(self.num_steps),
+            "cost": float(self.cost),
+            "horizon": self.horizon,
+            "criterion": self.criterion,
+            "noise": self.noise,
+            "noise_std": self.noise_std,
+            "window_samples": list(self.window_samples),
+            "weights": {k: float(v) for k, v in self.weights.items()},
+            "experiments": list(self.experiment_names),
+        }
+
+
+def _field_names(model):
+    return tuple(parameter_fields(model))
