@@ -21,7 +21,7 @@ from ._effects import (
     augment as augment,
 )
 from ._environment import Current as Current, Environment as Environment, Wind as Wind
-from ._estimate._armax import ARMAXResult as ARMAXResult, fit_armax as fit_armax
+from ._estimate._armax import ARMAX as ARMAX, ARMAXResult as ARMAXResult, fit_armax as fit_armax
 from ._estimate._discrete import fit_discrete_response as fit_discrete_response
 from ._estimate._fit import (
     AbstractEstimator as AbstractEstimator,

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter
 
+import jaxship as js
 from jaxship._armax_model import ARMAXModel, simulate_armax
 from jaxship._estimate._armax import fit_armax
 from jaxship._estimate._discrete import discretise
@@ -90,3 +91,23 @@ def test_armax_model_simulation_equals_the_recursion():
             r[k] = 0.02 * x[k - 1] + 0.015 * x[k - 2] + 1.6 * r[k - 1] - 0.65 * r[k - 2]
         np.testing.assert_allclose(row, r[2:], rtol=1e-12, atol=1e-15)
     np.testing.assert_array_equal(simulate_armax(model, delta[1], r0[1]), got[1])
+
+
+def test_fit_with_the_armax_estimator_gives_a_fit_result():
+    """`js.fit(js.ARMAXModel(), data, estimator=js.ARMAX())` is `fit_armax` on the record,
+    as the one result type: coefficients with standard errors, one-step predictions."""
+    rng = np.random.default_rng(5)
+    u = np.repeat(rng.choice([-0.2, 0.2], 150), 4)
+    e = 0.002 * rng.standard_normal(u.size)
+    a, b, c = [1.0, -1.5, 0.56], [0.0, 0.02, 0.015], [1.0, 0.3, 0.1]
+    y = lfilter(b, a, u) + lfilter(c, a, e)
+    data = js.Experiment(0.5 * np.arange(u.size), u, r=y, psi=np.cumsum(y) * 0.5)
+    direct = js.fit_armax(y, u, dt=0.5, na=2, nb=2, nc=2, nk=1)
+    res = js.fit(js.ARMAXModel(), data, estimator=js.ARMAX())
+    assert isinstance(res, js.FitResult) and res.success
+    np.testing.assert_allclose(res.values, np.concatenate([direct.A[1:], direct.B,
+                                                          direct.C[1:]]), rtol=1e-12)
+    np.testing.assert_allclose(res.values[:2], a[1:], atol=0.05)
+    assert res.metrics["r"].fit_percent > 90.0
+    with pytest.raises(ValueError, match="ARMAXModel"):
+        js.fit(js.Nomoto1(K=0.1, T=10.0), data, estimator=js.ARMAX())

@@ -22,9 +22,17 @@ import dataclasses
 import math
 
 import numpy as np
+import optimistix as optx
 from scipy.signal import lfilter
 
+from .._armax_model import ARMAX_NAMES, ARMAX_ORDERS, ARMAXModel
+from .._covariance import parameter_report
+from .._params import parameter_fields
+from .._validate import validate
 from ._discrete import continuous_parameters
+from ._fit import AbstractEstimator
+from ._result import FitResult
+from ._windows import as_dataset, check_data
 
 
 def _lags(x, lags, start):
@@ -215,3 +223,55 @@ def fit_armax(y, u, *, na: int = 2, nb: int = 2, nc: int = 2, nk: int = 1,
         cov = np.full((theta.size, theta.size), np.nan)
     return ARMAXResult(A, B, C, int(nk), None if dt is None else float(dt), sigma2, cov, loss,
                        it, converged)
+
+
+class ARMAX(AbstractEstimator):
+    """The ARMAX estimator of `jaxship.fit` for `ARMAXModel`: `fit_armax` (one-step
+    prediction error, Gauss-Newton; Astrom & Kallstrom 1979, eq. 7) on one record's
+    yaw rate and replayed rudder `rudder`, reported as a `FitResult` with the one-step
+    predictions (horizon one sample). `free` must be None: all six coefficients are
+    estimated."""
+
+    rudder: str = "delta"
+    max_iter: int = 100
+    max_lag: int = 25
+
+    def fit(self, model, dataset, free=None, verbose=False) -> FitResult:
+        if not isinstance(model, ARMAXModel):
+            raise ValueError(f"the ARMAX estimator fits an ARMAXModel, got "
+                             f"{type(model).__name__}.")
+        if free is not None:
+            raise ValueError("the ARMAX estimator estimates all six coefficients; `free` "
+                             "must be None.")
+        ds = as_dataset(dataset)
+        check_data(ds, self.rudder, ("r",))
+        if ds.num_experiments != 1:
+            raise ValueError(f"ARMAX is fitted to one record, got {ds.num_experiments} "
+                             f"({', '.join(ds.names)}).")
+        n = int(ds.lengths[0])
+        y = np.asarray(ds.r, dtype=np.float64)[0, :n]
+        u = np.asarray(getattr(ds, self.rudder), dtype=np.float64)[0, :n]
+        dt = float(np.asarray(ds.dt)[0])
+        res = fit_armax(y, u, dt=dt, max_iter=self.max_iter, **ARMAX_ORDERS)
+        fitted = ARMAXModel.from_result(res, dt)
+        fields = parameter_fields(fitted)
+        values = np.array([float(getattr(fitted, k)) for k in ARMAX_NAMES])
+        report = parameter_report(ARMAX_NAMES, values, np.asarray(res.covariance),
+                                  units=tuple(fields[k].unit for k in ARMAX_NAMES))
+        first = max(ARMAX_ORDERS["na"], ARMAX_ORDERS["nk"] + ARMAX_ORDERS["nb"] - 1,
+                    ARMAX_ORDERS["nc"], 1)  # the first sample of fit_armax's loss
+        eps = res.residuals(y, u)
+        line, mask = np.zeros((1, ds.num_samples)), np.zeros((1, ds.num_samples), bool)
+        line[0, :n], mask[0, first:n] = y - eps, True
+        rudder = np.asarray(getattr(ds, self.rudder), dtype=np.float64)
+        metrics = {"r": validate(np.asarray(ds.r, dtype=np.float64), line, mask,
+                                 num_params=len(ARMAX_NAMES), u=rudder, max_lag=self.max_lag,
+                                 channel="r")}
+        return FitResult(
+            model=fitted, parameters=report, metrics=metrics, predictions={"r": line},
+            predicted=mask, result=optx.RESULTS.successful if res.converged
+            else optx.RESULTS.nonlinear_max_steps_reached, num_steps=int(res.iterations),
+            cost=0.5 * float(np.sum(eps[first:] ** 2)), weights={"r": 1.0},
+            window_samples=(1,), horizon=dt, experiment_names=tuple(ds.names),
+            criterion="one-step prediction error (ARMAX)",
+            noise={"innovations": float(res.noise_variance)}, noise_std={"innovations": math.nan})

@@ -59,7 +59,7 @@ class FitResult(SolverOutcome):
     experiment_names: tuple[str, ...]
     criterion: str = "prediction error"
     noise: dict | None = None  # innovations estimators: {name: variance} at the optimum
-    noise_std: dict | None = None  # their standard errors (0 where held fixed)
+    noise_std: dict | None = None  # their standard errors (0 where held, NaN: not computed)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -134,8 +134,8 @@ class FitResult(SolverOutcome):
             "cost": float(self.cost),
             "horizon": self.horizon,
             "criterion": self.criterion,
-            "noise": self.noise,
-            "noise_std": self.noise_std,
+            "noise": _to_plain(self.noise),
+            "noise_std": _to_plain(self.noise_std),
             "window_samples": list(self.window_samples),
             "weights": {k: float(v) for k, v in self.weights.items()},
             "experiments": list(self.experiment_names),

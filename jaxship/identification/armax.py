@@ -4,15 +4,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
-import optimistix as optx
 
 import jaxship as js
 
-from .._armax_model import ARMAX_NAMES, ARMAX_ORDERS, ARMAXModel
-from .._params import parameter_fields
+from .._armax_model import ARMAX_ORDERS, ARMAXModel
 from .starts import StartContext
 
 
@@ -54,39 +53,25 @@ def start_armax(train: js.Dataset, context: StartContext) -> ARMAXModel:
 
 
 def fit_armax_entry(start: ARMAXModel, train: js.Dataset, context: StartContext) -> js.FitResult:
-    """`fit_armax` on the training record as a `FitResult`: the one-step prediction
-    of r is the criterion (horizon one sample)."""
+    """`jaxship.fit` with the `ARMAX` estimator on the training record: the one-step
+    prediction of r is the criterion (horizon one sample)."""
     if context.estimator.horizon is not None:
         context.note(f"armax is fitted by its one-step prediction error (maximum likelihood); "
                      f"--horizon {context.estimator.horizon:g} is not used.")
     if tuple(context.channels) != ("r",):
         raise ValueError("armax models the yaw rate: fit it with channels 'r'.")
-    res, y, u, dt = _fit_raw(train, context.rudder)
-    model = ARMAXModel.from_result(res, dt)
-    values = np.array([float(getattr(model, n)) for n in ARMAX_NAMES])
-    units = tuple(parameter_fields(model)[n].unit for n in ARMAX_NAMES)
-    report = js.parameter_report(ARMAX_NAMES, values, np.asarray(res.covariance), units=units,
-                                 extra_flags=_excitation_flags(train, context.rudder))
-    first = max(ARMAX_ORDERS["na"], ARMAX_ORDERS["nk"] + ARMAX_ORDERS["nb"] - 1,
-                ARMAX_ORDERS["nc"], 1)  # the first sample of fit_armax's loss
-    eps = res.residuals(y, u)
-    shape = (1, train.num_samples)
-    line, mask = np.zeros(shape), np.zeros(shape, dtype=bool)
-    line[0, :y.size] = y - eps
-    mask[0, first:y.size] = True
-    rudder = np.asarray(getattr(train, context.rudder), dtype=np.float64)
-    metrics = {"r": js.validate(np.asarray(train.r, dtype=np.float64), line, mask,
-                                num_params=len(ARMAX_NAMES), u=rudder,
-                                max_lag=context.estimator.max_lag, channel="r")}
-    result = js.FitResult(
-        model=model, parameters=report, metrics=metrics, predictions={"r": line},
-        predicted=mask,
-        result=optx.RESULTS.successful if res.converged
-        else optx.RESULTS.nonlinear_max_steps_reached,
-        num_steps=int(res.iterations), cost=0.5 * float(np.sum(eps[first:] ** 2)),
-        weights={"r": 1.0}, window_samples=(1,), horizon=dt,
-        experiment_names=tuple(train.names))
-    if report.flags:
-        warnings.warn("fit of ARMAX: " + " ".join(report.flags), js.IdentifiabilityWarning,
-                      stacklevel=2)
+    _record(train, context.rudder)  # one record, named in the error otherwise
+    estimator = js.ARMAX(rudder=context.rudder, max_lag=context.estimator.max_lag)
+    try:
+        result = js.fit(start, train, estimator=estimator)
+    except ValueError as error:
+        raise ValueError(f"{_record(train, context.rudder)[3]}: armax: {error}") from None
+    flags = _excitation_flags(train, context.rudder)
+    if flags:
+        report = js.parameter_report(result.names, result.values, result.covariance,
+                                     units=result.parameters.units, extra_flags=flags)
+        result = dataclasses.replace(result, parameters=report)
+    if result.parameters.flags:
+        warnings.warn("fit of ARMAX: " + " ".join(result.parameters.flags),
+                      js.IdentifiabilityWarning, stacklevel=2)
     return result
