@@ -44,9 +44,9 @@ MIN_CLUSTERS = 20
 class AbstractEstimator(eqx.Module):
     """A strategy of `fit`: how the model is compared with the data and the comparison
     minimised. Subclasses implement `fit(model, dataset, free, verbose) -> FitResult`:
-    `PredictionError` (output error, equation error and every horizon between) and
+    `PredictionError` (output error, equation error and every horizon between),
     `Innovations` (the Kalman filter's one-step-ahead errors, by prediction error or
-    maximum likelihood with estimated noise)."""
+    maximum likelihood with estimated noise) and `ARMAX` (for `ARMAXModel`)."""
 
     @abc.abstractmethod
     def fit(self, model, dataset, free, verbose) -> "FitResult":
