@@ -272,6 +272,7 @@ def _records(data, rudder):
 
 def _svr(x, y, C, epsilon, tol, max_iter):
     try:
+        from sklearn.exceptions import ConvergenceWarning as LiblinearWarning
         from sklearn.svm import LinearSVR
     except ImportError as err:  # pragma: no cover - depends on the environment
         raise ImportError("method='svr' needs scikit-learn: pip install 'jaxship[svm]'.") from err
@@ -290,7 +291,7 @@ def _svr(x, y, C, epsilon, tol, max_iter):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         reg.fit(q * math.sqrt(n), y / ys)
-    converged = not any("converge" in str(w.message).lower() for w in caught)
+    converged = not any(issubclass(w.category, LiblinearWarning) for w in caught)
     coef = np.linalg.solve(rmat, reg.coef_ * math.sqrt(n)) * ys
     return coef, converged
 

@@ -1,20 +1,16 @@
 """The vessel catalogue: preset names, factories and their sources."""
 
 import dataclasses
-import importlib
 from collections.abc import Callable
+
+from . import esso_osaka, mariner, mmg, nomoto, ross, sway_yaw
 
 
 @dataclasses.dataclass(frozen=True)
 class Preset:
-    """A named preset: `module:function` of its factory."""
+    """A named preset: the factory that builds it."""
 
-    target: str
-
-    @property
-    def factory(self) -> Callable:
-        module, _, name = self.target.partition(":")
-        return getattr(importlib.import_module(f"jaxship._vessel.{module}"), name)
+    factory: Callable
 
     @property
     def description(self) -> str:
@@ -23,16 +19,16 @@ class Preset:
 
 
 VESSELS = {
-    "thesis": Preset("ross:thesis_vessel"),
-    "mariner": Preset("mariner:mariner"),
-    "kvlcc2": Preset("mmg:kvlcc2"),
-    "esso_osaka": Preset("esso_osaka:esso_osaka"),
-    "sea_stratus_linear": Preset("sway_yaw:sea_stratus_linear"),
-    "sea_stratus_nonlinear": Preset("sway_yaw:sea_stratus_nonlinear"),
-    "compass_island_linear": Preset("sway_yaw:compass_island_linear"),
-    "compass_island_nonlinear": Preset("sway_yaw:compass_island_nonlinear"),
-    "sea_swift": Preset("sway_yaw:sea_swift"),
-    "sea_scout": Preset("nomoto:sea_scout"),
+    "thesis": Preset(ross.thesis_vessel),
+    "mariner": Preset(mariner.mariner),
+    "kvlcc2": Preset(mmg.kvlcc2),
+    "esso_osaka": Preset(esso_osaka.esso_osaka),
+    "sea_stratus_linear": Preset(sway_yaw.sea_stratus_linear),
+    "sea_stratus_nonlinear": Preset(sway_yaw.sea_stratus_nonlinear),
+    "compass_island_linear": Preset(sway_yaw.compass_island_linear),
+    "compass_island_nonlinear": Preset(sway_yaw.compass_island_nonlinear),
+    "sea_swift": Preset(sway_yaw.sea_swift),
+    "sea_scout": Preset(nomoto.sea_scout),
 }
 
 
