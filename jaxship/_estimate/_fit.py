@@ -1,4 +1,4 @@
-"""`fit`: prediction-error identification of response models with Levenberg-Marquardt.
+"""`fit`, the one verb of estimation, and its prediction-error strategy.
 
 The estimator restarts the model from the measured state every `horizon` seconds
 and sums the squared, weighted output errors of all windows of all experiments
@@ -7,7 +7,8 @@ and sums the squared, weighted output errors of all windows of all experiments
 of one sample equation error. The optimiser is `optimistix.LevenbergMarquardt` in
 the scaled, unconstrained parameter space of `_params.Transform` (with MINPACK's
 cost-based stopping rule added, `_lm.py`), the Jacobian by forward-mode autodiff
-through the RK4 scan, computed once per evaluation (`_lm.stored_jacobian`).
+through the simulator's time loop (`_simulate.integrate`), computed once per evaluation
+(`_lm.stored_jacobian`). Steering models and vessels alike (the shared model contract).
 """
 
 import abc
@@ -77,7 +78,7 @@ class PredictionError(AbstractEstimator):
       dimensionless.
     - `rudder`: the replayed rudder channel, `"delta"` (measured angle) or
       `"delta_c"` (command).
-    - `substeps`: RK4 steps per sample interval.
+    - `substeps`: solver steps per sample interval.
     - `solver`: an `optimistix` least-squares solver; by default jaxship's
       `LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-10)`: optimistix's solver that
       also stops, like MINPACK, once an accepted step lowers the cost by at most

@@ -2,8 +2,9 @@
 
 A record of N samples is cut into windows of L samples (L = round(T_p / dt), at
 least 1, at most N - 1). Window w starts at sample s = wL from the measured state
-and predicts samples s + 1 .. s + L with the measured inputs held over each
-interval, so every sample but the first of each experiment is predicted exactly once.
+and predicts samples s + 1 .. s + L with the recorded inputs replayed between samples
+as `resolve_holds` says (linear for measured signals, held for commands), so every
+sample but the first of each experiment is predicted exactly once.
 L = N - 1 (one window) is output error (simulation error); L = 1 is equation error
 (one-step-ahead prediction). Experiments of different lengths and sample intervals
 are padded to common (windows, steps) shapes with a mask.
@@ -83,8 +84,8 @@ def check_data(ds: Dataset, rudder: str, channels, *, rtol: float = 1e-6) -> Non
             k = int(off[0]) + 1
             raise ValueError(
                 f"{where}: sampling is not uniform (t[{k}] - t[{k - 1}] = {steps[k - 1]!r} s, "
-                f"mean interval {dt!r} s); the rudder is replayed with a zero-order hold at a "
-                "constant interval: resample the record first."
+                f"mean interval {dt!r} s); the inputs are replayed at a constant interval: "
+                "resample the record first."
             )
 
 

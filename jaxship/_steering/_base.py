@@ -18,8 +18,8 @@ from jaxtyping import Array, ArrayLike
 
 
 class AuxInputs(eqx.Module):
-    """Measured quantities a response model may use besides the rudder, held over the
-    sample interval: surge `u` and sway `v` velocity [m/s] at midship (through the
+    """Measured quantities a response model may use besides the rudder, at the time the
+    model is evaluated: surge `u` and sway `v` velocity [m/s] at midship (through the
     water) and the propeller rate `n` [rev/s]. Unused by the Nomoto models."""
 
     u: ArrayLike = 0.0
