@@ -177,10 +177,6 @@ def integrate(field, y0, policy, policy_state, t0, dt, num, simulator: Simulator
     return out, ok & finite
 
 
-_FIELDS = STATE_FIELDS
-_flatten, _unflatten = to_vector, from_vector
-
-
 def simulate(
     vessel: AbstractVessel,
     manoeuvre,
@@ -231,7 +227,7 @@ def vessel_field(vessel, environment, *, wind=True):
 
     def field(t, y, args):
         command, t_k = args
-        return _flatten(_state_derivative(vessel, _unflatten(y), command.at(t - t_k),
+        return to_vector(_state_derivative(vessel, from_vector(y), command.at(t - t_k),
                                           environment, mass_inverse, wind=wind, t=t))
 
     return field
@@ -247,23 +243,23 @@ def _simulate(vessel, manoeuvre, x0, environment, simulator, steps, wind=True, p
     (the batching layer uses it) but costs a little per step for a single run.
     """
     t0 = manoeuvre.start
-    y0 = _flatten(x0)
+    y0 = to_vector(x0)
     dt = jnp.asarray(manoeuvre.dt, dtype=float)
     num = manoeuvre.num_samples
 
     def policy(t, y, memory, h):
-        return manoeuvre.command(t, _unflatten(y), memory, h)
+        return manoeuvre.command(t, from_vector(y), memory, h)
 
     def observe(y, command):
         delta, n = jnp.asarray(command.delta, float), jnp.asarray(command.n, float)
         if per_field:
-            return tuple(y[i] for i in range(len(_FIELDS))) + (delta, n)
+            return tuple(y[i] for i in range(len(STATE_FIELDS))) + (delta, n)
         return jnp.concatenate([y, jnp.stack([delta, n])])
 
     out, ok = integrate(vessel_field(vessel, environment, wind=wind), y0, policy,
                         manoeuvre.init(x0), t0, dt, num, simulator, steps, observe)
     if not per_field:
-        out = tuple(out[:, i] for i in range(len(_FIELDS) + 2))
+        out = tuple(out[:, i] for i in range(len(STATE_FIELDS) + 2))
     state, command = ShipState(*out[:-2]), Command(*out[-2:])
     t = t0 + jnp.arange(num) * dt
     return Trajectory(

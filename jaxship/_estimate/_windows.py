@@ -140,16 +140,6 @@ class Windows(eqx.Module):
     holds: tuple = eqx.field(static=True, default=())
     servo: bool = eqx.field(static=True, default=False)
 
-    @property
-    def delta(self):
-        """The replayed rudder at the start of each interval (E, W, L)."""
-        return self.records["delta"][..., :-1]
-
-    @property
-    def aux(self) -> AuxInputs:
-        """The auxiliary inputs at the start of each interval (E, W, L)."""
-        return AuxInputs(*(self.records[k][..., :-1] for k in ("u", "v", "n")))
-
 
 def window_lengths(ds: Dataset, horizon) -> tuple[int, ...]:
     """Samples per window for each experiment: round(horizon / dt) clipped to
