@@ -71,7 +71,7 @@ class Simulator(eqx.Module):
     - `solver`: a diffrax solver; default `jaxship.RK4()`.
     - `max_step`: the longest control step [s]: each output sample interval `dt` is
       split into `ceil(dt / max_step)` equal control steps (at least `substeps`), and
-      controllers (zig-zag switching, autopilots) act at every control step, so trial
+      controllers (zig-zag switching, heading control) act at every control step, so trial
       indices do not depend on the output interval. Replayed records are sampled at
       their own interval; set `max_step=inf` to integrate one step per sample.
     - `substeps`: the least number of steps per output sample.
