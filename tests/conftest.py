@@ -1,3 +1,4 @@
+import gc
 import os
 
 import jax
@@ -15,3 +16,13 @@ def pytest_sessionstart(session):
     if os.environ.get("CI") and js.shared_data_dir() is None:
         raise pytest.UsageError("CI is set but ../shared/data was not found (set "
                                 "JAXSHIP_DATA or put shared/ beside the checkout).")
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _release_compiled_code():
+    """Free the compiled executables of each test module when it ends. Every XLA CPU
+    executable holds memory mappings, and a whole test run would otherwise pass the
+    kernel's limit of 65,530 (vm.max_map_count) and crash in the compiler."""
+    yield
+    jax.clear_caches()
+    gc.collect()
