@@ -1,26 +1,21 @@
 """jaxship: differentiable ship-manoeuvring simulation and steering-model identification."""
 
-from ._actuators import RudderServo as RudderServo, Shaft as Shaft
-from ._batch import simulate_batch as simulate_batch, stack as stack
-from ._covariance import parameter_report as parameter_report
-from ._data import Dataset as Dataset, Experiment as Experiment
-from ._design import (
+from ._analysis._design import (
     excitation_order as excitation_order,
     fisher_information as fisher_information,
 )
-from ._effects import (
-    AbstractEffect as AbstractEffect,
-    AugmentedSteering as AugmentedSteering,
-    AugmentedVessel as AugmentedVessel,
-    HeadingSensorBias as HeadingSensorBias,
-    RecordedDisturbance as RecordedDisturbance,
-    RudderOffset as RudderOffset,
-    SwayForceBias as SwayForceBias,
-    YawMomentBias as YawMomentBias,
-    YawRateSensorBias as YawRateSensorBias,
-    augment as augment,
+from ._analysis._indices import (
+    format_table as format_table,
+    imo_criteria as imo_criteria,
+    initial_turning_indices as initial_turning_indices,
+    loop_width as loop_width,
+    pull_out_indices as pull_out_indices,
+    reverse_spiral_curve as reverse_spiral_curve,
+    spiral_curve as spiral_curve,
+    stopping_indices as stopping_indices,
+    turning_indices as turning_indices,
+    zigzag_indices as zigzag_indices,
 )
-from ._environment import Current as Current, Environment as Environment, Wind as Wind
 from ._estimate._armax import ARMAX as ARMAX, ARMAXResult as ARMAXResult, fit_armax as fit_armax
 from ._estimate._discrete import fit_discrete_response as fit_discrete_response
 from ._estimate._fit import (
@@ -47,20 +42,36 @@ from ._estimate._result import (
     FitResult as FitResult,
     IdentifiabilityWarning as IdentifiabilityWarning,
 )
-from ._indices import (
-    format_table as format_table,
-    imo_criteria as imo_criteria,
-    initial_turning_indices as initial_turning_indices,
-    loop_width as loop_width,
-    pull_out_indices as pull_out_indices,
-    reverse_spiral_curve as reverse_spiral_curve,
-    spiral_curve as spiral_curve,
-    stopping_indices as stopping_indices,
-    turning_indices as turning_indices,
-    zigzag_indices as zigzag_indices,
+from ._foundation._covariance import parameter_report as parameter_report
+from ._foundation._kinematics import body_to_earth as body_to_earth, ssa as ssa
+from ._foundation._params import Free as Free, default_free as default_free, param as param
+from ._foundation._state import (
+    Command as Command,
+    ShipState as ShipState,
+    Trajectory as Trajectory,
+    straight_state as straight_state,
 )
-from ._kinematics import body_to_earth as body_to_earth, ssa as ssa
-from ._manoeuvres import (
+from ._foundation._validate import (
+    ValidationReport as ValidationReport,
+    final_prediction_error as final_prediction_error,
+    fit_percent as fit_percent,
+    validate as validate,
+)
+from ._models._actuators import RudderServo as RudderServo, Shaft as Shaft
+from ._models._effects import (
+    AbstractEffect as AbstractEffect,
+    AugmentedSteering as AugmentedSteering,
+    AugmentedVessel as AugmentedVessel,
+    HeadingSensorBias as HeadingSensorBias,
+    RecordedDisturbance as RecordedDisturbance,
+    RudderOffset as RudderOffset,
+    SwayForceBias as SwayForceBias,
+    YawMomentBias as YawMomentBias,
+    YawRateSensorBias as YawRateSensorBias,
+    augment as augment,
+)
+from ._models._environment import Current as Current, Environment as Environment, Wind as Wind
+from ._models._manoeuvres import (
     AbstractController as AbstractController,
     AbstractManoeuvre as AbstractManoeuvre,
     Controlled as Controlled,
@@ -77,28 +88,7 @@ from ._manoeuvres import (
     spiral as spiral,
     thesis_manoeuvre as thesis_manoeuvre,
 )
-from ._params import Free as Free, default_free as default_free, param as param
-from ._readers import (
-    read_esso_osaka as read_esso_osaka,
-    read_hsva_kvlcc2 as read_hsva_kvlcc2,
-    read_marin_kvlcc2 as read_marin_kvlcc2,
-    read_measured as read_measured,
-    read_trial_csv as read_trial_csv,
-    shared_data_dir as shared_data_dir,
-    write_trial_csv as write_trial_csv,
-)
-from ._simulate import RK4 as RK4, Simulator as Simulator, simulate as simulate
-from ._simulate_steering import (
-    SteeringTrajectory as SteeringTrajectory,
-    simulate_steering as simulate_steering,
-)
-from ._state import (
-    Command as Command,
-    ShipState as ShipState,
-    Trajectory as Trajectory,
-    straight_state as straight_state,
-)
-from ._steering import (
+from ._models._steering import (
     AbstractSteeringModel as AbstractSteeringModel,
     AuxInputs as AuxInputs,
     LinearSwayYaw as LinearSwayYaw,
@@ -108,40 +98,50 @@ from ._steering import (
     NorrbinCrossFlow as NorrbinCrossFlow,
     RossAutopilot as RossAutopilot,
 )
-from ._steering.nonlinear_nomoto2 import NonlinearNomoto2 as NonlinearNomoto2
-from ._validate import (
-    ValidationReport as ValidationReport,
-    final_prediction_error as final_prediction_error,
-    fit_percent as fit_percent,
-    validate as validate,
-)
-from ._vessel._base import (
+from ._models._steering.nonlinear_nomoto2 import NonlinearNomoto2 as NonlinearNomoto2
+from ._models._vessel._base import (
     AbstractVessel as AbstractVessel,
     state_derivative as state_derivative,
     straight_run as straight_run,
 )
-from ._vessel.catalogue import VESSELS as VESSELS, get_vessel as get_vessel
-from ._vessel.esso_osaka import LowSpeedMMGVessel as LowSpeedMMGVessel
-from ._vessel.mariner import Mariner as Mariner
-from ._vessel.mmg import MMGVessel as MMGVessel
-from ._vessel.nomoto import NomotoVessel as NomotoVessel
-from ._vessel.ross import RossVessel as RossVessel
-from ._vessel.sway_yaw import SwayYawVessel as SwayYawVessel
+from ._models._vessel.catalogue import VESSELS as VESSELS, get_vessel as get_vessel
+from ._models._vessel.esso_osaka import LowSpeedMMGVessel as LowSpeedMMGVessel
+from ._models._vessel.mariner import Mariner as Mariner
+from ._models._vessel.mmg import MMGVessel as MMGVessel
+from ._models._vessel.nomoto import NomotoVessel as NomotoVessel
+from ._models._vessel.ross import RossVessel as RossVessel
+from ._models._vessel.sway_yaw import SwayYawVessel as SwayYawVessel
+from ._simulation._batch import simulate_batch as simulate_batch, stack as stack
+from ._simulation._data import Dataset as Dataset, Experiment as Experiment
+from ._simulation._readers import (
+    read_esso_osaka as read_esso_osaka,
+    read_hsva_kvlcc2 as read_hsva_kvlcc2,
+    read_marin_kvlcc2 as read_marin_kvlcc2,
+    read_measured as read_measured,
+    read_trial_csv as read_trial_csv,
+    shared_data_dir as shared_data_dir,
+    write_trial_csv as write_trial_csv,
+)
+from ._simulation._simulate import RK4 as RK4, Simulator as Simulator, simulate as simulate
+from ._simulation._simulate_steering import (
+    SteeringTrajectory as SteeringTrajectory,
+    simulate_steering as simulate_steering,
+)
 
 
 __version__ = "0.1.0"
 
 # study and application helpers, added for jaxship.studies and the notebooks
-from ._armax_model import ARMAXModel as ARMAXModel
-from ._batch import (
-    batch_turning_indices as batch_turning_indices,
-    straight_run_batch as straight_run_batch,
-)
-from ._simulate_steering import steer_manoeuvre as steer_manoeuvre
-from ._steering.ross import (
+from ._models._armax_model import ARMAXModel as ARMAXModel
+from ._models._steering.ross import (
     ROSS_FREE as ROSS_FREE,
     SPEED_RUDDER as SPEED_RUDDER,
 )
+from ._simulation._batch import (
+    batch_turning_indices as batch_turning_indices,
+    straight_run_batch as straight_run_batch,
+)
+from ._simulation._simulate_steering import steer_manoeuvre as steer_manoeuvre
 from ._trials import (
     initial_state as initial_state,
     run_trial as run_trial,

@@ -12,11 +12,12 @@ import pathlib
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import _indices as ix, _manoeuvres as man
-from ._readers import write_trial_csv
-from ._simulate import Simulator, simulate
-from ._state import straight_state
-from ._vessel._base import straight_run, surge_force
+from ._analysis import _indices as ix
+from ._foundation._state import straight_state
+from ._models import _manoeuvres as man
+from ._models._vessel._base import straight_run, surge_force
+from ._simulation._readers import write_trial_csv
+from ._simulation._simulate import Simulator, simulate
 from .plotting import plot_trajectory
 
 

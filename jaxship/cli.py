@@ -13,8 +13,8 @@ from tqdm.auto import tqdm
 
 matplotlib.use("Agg")  # the command writes files; it never opens a window
 
+from ._models._vessel.catalogue import VESSELS, get_vessel  # noqa: E402
 from ._trials import simulate_to_folder  # noqa: E402
-from ._vessel.catalogue import VESSELS, get_vessel  # noqa: E402
 from .identification import MODELS, get_model_entry, identify, read_experiments  # noqa: E402
 from .plotting import save_identification_figures  # noqa: E402
 from .studies.reproduce import reproduce  # noqa: E402

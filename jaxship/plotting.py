@@ -123,7 +123,7 @@ def plot_residuals(assessment, *, title: str = ""):
     """Prediction errors and their correlation tests, one row per output channel
     (like MATLAB's `resid`): the residuals over time (each record), their
     autocorrelation and their cross-correlation with the rudder, with the 99 %
-    confidence bands of `jaxship._validate` (Ljung 1999, sec. 16.6).
+    confidence bands of `jaxship._foundation._validate` (Ljung 1999, sec. 16.6).
 
     **Arguments:** `assessment` as in `plot_comparison`; `title`.
     **Returns:** the matplotlib `Figure`.

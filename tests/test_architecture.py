@@ -12,15 +12,13 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "jaxship"
 
-# bottom to top; a module not listed belongs to the layer of its folder
+# bottom to top: a layer is a folder of the package (the application is its top level)
 LAYERS = {
-    "foundation": ["_params", "_state", "_kinematics", "_frames", "_sharding", "_validate",
-                   "_covariance"],
-    "models": ["_actuators", "_environment", "_vessel", "_steering", "_effects", "_manoeuvres",
-               "_armax_model"],
-    "simulate": ["_simulate", "_simulate_steering", "_batch", "_data", "_readers"],
+    "foundation": ["_foundation"],
+    "models": ["_models"],
+    "simulate": ["_simulation"],
     "estimate": ["_estimate"],
-    "analysis": ["_design", "_indices"],
+    "analysis": ["_analysis"],
     "application": ["identification", "studies", "_trials", "cli", "plotting", "__init__"],
 }
 RANK = {name: i for i, names in enumerate(LAYERS.values()) for name in names}
@@ -85,7 +83,7 @@ def test_no_import_cycles():
                          if t.startswith("jaxship") and not inner}
     names = set(graph)
 
-    def resolve(target):  # "jaxship._steering.Nomoto1" -> the module "jaxship._steering"
+    def resolve(target):  # "jaxship._models._steering.Nomoto1" -> its module
         while target and target not in names:
             target = target.rpartition(".")[0]
         return target
@@ -129,3 +127,12 @@ def test_no_private_imports_outside_the_package():
     except FileNotFoundError:
         pytest.skip("git is not installed")
     assert out.stdout == "", out.stdout
+
+
+def test_the_top_level_holds_only_the_application():
+    """Library modules live in their layer's folder; the package's top level holds the
+    public API and the application (docs/architecture.md)."""
+    top = {p.stem for p in PACKAGE.glob("*.py")} | {p.name for p in PACKAGE.iterdir()
+                                                    if (p / "__init__.py").exists()}
+    library = set(top) - set(LAYERS["application"])
+    assert library == {n for layer in list(LAYERS.values())[:-1] for n in layer}, library

@@ -5,9 +5,9 @@ import pytest
 from scipy.signal import lfilter
 
 import jaxship as js
-from jaxship._armax_model import ARMAXModel, simulate_armax
 from jaxship._estimate._armax import fit_armax
 from jaxship._estimate._discrete import discretise
+from jaxship._models._armax_model import ARMAXModel, simulate_armax
 
 
 def _input(n=4000, seed=1):

@@ -14,9 +14,9 @@ import pytest
 from helpers import tree_allclose
 
 import jaxship as js
-import jaxship._batch as jb
-from jaxship._indices import turning_indices
-from jaxship._vessel.mariner import mariner
+import jaxship._simulation._batch as jb
+from jaxship._analysis._indices import turning_indices
+from jaxship._models._vessel.mariner import mariner
 
 
 DEG = np.pi / 180
@@ -120,7 +120,7 @@ def test_turning_indices_match_numpy_indices():
 
 
 def test_straight_run_batch_matches_straight_run():
-    from jaxship._vessel.catalogue import get_vessel
+    from jaxship._models._vessel.catalogue import get_vessel
 
     vessel = get_vessel("kvlcc2")
     rates = np.array([0.8, 1.0, 1.2]) * vessel.nominal_n
@@ -138,7 +138,7 @@ jax.config.update("jax_enable_x64", True)
 import numpy as np
 sys.path.insert(0, {tests!r})
 from test_batch import _inputs
-import jaxship._batch as jb
+import jaxship._simulation._batch as jb
 vessel, manoeuvres, x0s = _inputs()
 traj = jb.simulate_batch(vessel, manoeuvres, x0s)
 take = lambda tree, index: jax.tree.map(lambda a: np.asarray(a)[index], tree)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._params import default_free, get_path, rebuild
+from jaxship._foundation._params import default_free, get_path, rebuild
 
 
 DEG = np.pi / 180

@@ -17,7 +17,7 @@ from jaxship import (
     shared_data_dir,
     write_trial_csv,
 )
-from jaxship._data import CHANNELS
+from jaxship._simulation._data import CHANNELS
 
 
 def synthetic_experiment(num=201, dt=0.1, t0=5.0):

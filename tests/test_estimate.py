@@ -20,7 +20,7 @@ from jaxship._estimate._fit import (
     fit,
 )
 from jaxship._estimate._linear import initial_estimate
-from jaxship._params import Free, Transform, resolve_free
+from jaxship._foundation._params import Free, Transform, resolve_free
 
 
 DEG = np.pi / 180
@@ -184,7 +184,7 @@ def test_assert_max_traces_for_new_parameter_and_data_values():
     counted = eqx.filter_jit(eqx.debug.assert_max_traces(_fit._solve.__wrapped__,
                                                         max_traces=1))
     from jaxship._estimate._windows import build_windows
-    from jaxship._params import as_arrays
+    from jaxship._foundation._params import as_arrays
 
     for K, scale in [(0.03, 1.0), (0.05, 1.1)]:
         data = record(Nomoto1(K=0.06 * scale, T=25.0), zigzag_like(200, 6))

@@ -1,4 +1,4 @@
-"""pandas DataFrames of trajectories and fit results (`jaxship._frames`)."""
+"""pandas DataFrames of trajectories and fit results (`jaxship._foundation._frames`)."""
 
 import builtins
 import warnings
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._frames import Z95, fit_to_dataframe, trajectory_to_dataframe
+from jaxship._foundation._frames import Z95, fit_to_dataframe, trajectory_to_dataframe
 
 
 pd = pytest.importorskip("pandas")

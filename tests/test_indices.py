@@ -18,7 +18,7 @@ from jaxship import (
     turning_indices,
     zigzag_indices,
 )
-from jaxship._indices import (
+from jaxship._analysis._indices import (
     CriterionRow,
     InitialTurningIndices,
     SpiralCurve,

@@ -8,7 +8,7 @@ import pytest
 from helpers import linear_test_vessel
 
 import jaxship as js
-from jaxship._indices import reverse_spiral_curve
+from jaxship._analysis._indices import reverse_spiral_curve
 
 
 AT_SAMPLES = js.Simulator(max_step=math.inf)  # controllers act at the output samples

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._vessel.mariner import mariner
+from jaxship._models._vessel.mariner import mariner
 
 
 DEG = np.pi / 180
@@ -206,8 +206,8 @@ def test_zigzag_overshoots(runs, angle, published, port_first):
 
 
 def test_library_indices_agree(runs):
-    """`jaxship._indices` (if present) gives the same turning indices and overshoots."""
-    indices = pytest.importorskip("jaxship._indices")
+    """`jaxship._analysis._indices` (if present) gives the same turning indices and overshoots."""
+    indices = pytest.importorskip("jaxship._analysis._indices")
     for name in ("turn+35", "turn-35"):
         traj, _, ref = runs[name]
         ti = indices.turning_indices(traj)

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._vessel.ross import RossVessel, clarke83, thesis_vessel
+from jaxship._models._vessel.ross import RossVessel, clarke83, thesis_vessel
 
 
 DEG = np.pi / 180

@@ -23,8 +23,8 @@ from jaxship import (
     ross_initial_estimate,
     simulate_steering,
 )
-from jaxship._params import parameter_fields
-from jaxship._steering.ross import HULL_TERMS
+from jaxship._foundation._params import parameter_fields
+from jaxship._models._steering.ross import HULL_TERMS
 from jaxship.studies import thesis as ti
 
 

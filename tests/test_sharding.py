@@ -15,7 +15,7 @@ import pytest
 
 import jaxship as js
 from jaxship._estimate import _fit
-from jaxship._vessel.catalogue import get_vessel
+from jaxship._models._vessel.catalogue import get_vessel
 
 
 DEG = np.pi / 180

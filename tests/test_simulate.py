@@ -179,7 +179,7 @@ def test_reverse_gradient_matches_finite_difference(vessel, x0, simulator):
 
 
 def test_new_parameter_values_do_not_retrace(vessel, x0):
-    from jaxship._simulate import _simulate
+    from jaxship._simulation._simulate import _simulate
 
     man = js.Turn(10 * DEG, duration=20.0)
     counted = eqx.debug.assert_max_traces(_simulate.__wrapped__, max_traces=1)
@@ -192,7 +192,7 @@ def test_new_parameter_values_do_not_retrace(vessel, x0):
 
 def test_python_floats_do_not_retrace(vessel, x0):
     """Plain-float parameters are traced by `simulate`: the jit cache does not grow."""
-    from jaxship._simulate import _simulate
+    from jaxship._simulation._simulate import _simulate
 
     js.simulate(vessel, js.Turn(10 * DEG, duration=20.0), x0)
     size = _simulate._cached._cache_size()

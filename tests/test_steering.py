@@ -10,7 +10,7 @@ import pytest
 
 import jaxship as js
 from jaxship import AuxInputs, Nomoto1, Nomoto2, NonlinearNomoto, simulate_steering
-from jaxship._steering import WindowStart
+from jaxship._models._steering import WindowStart
 
 
 DEG = np.pi / 180
@@ -114,7 +114,7 @@ def test_forward_mode_derivatives_match_finite_differences():
 
 
 def test_vmap_over_parameters_equals_loop_and_no_retrace():
-    from jaxship._simulate_steering import _simulate_steering
+    from jaxship._simulation._simulate_steering import _simulate_steering
 
     delta = np.repeat(np.array([10, -10, 20]) * DEG, 30)
     gains = jnp.array([0.03, 0.05, 0.08])

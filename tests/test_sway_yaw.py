@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._vessel.nomoto import NomotoVessel, sea_scout
-from jaxship._vessel.sway_yaw import (
+from jaxship._models._vessel.nomoto import NomotoVessel, sea_scout
+from jaxship._models._vessel.sway_yaw import (
     SwayYawVessel,
     _cross_flow_integrals,
     _derive_mass_terms,

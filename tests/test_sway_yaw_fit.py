@@ -21,9 +21,9 @@ from jaxship import (
     fit,
     simulate_steering,
 )
-from jaxship._steering import WindowStart
-from jaxship._vessel._base import state_derivative
-from jaxship._vessel.sway_yaw import sea_stratus_linear, sea_stratus_nonlinear
+from jaxship._models._steering import WindowStart
+from jaxship._models._vessel._base import state_derivative
+from jaxship._models._vessel.sway_yaw import sea_stratus_linear, sea_stratus_nonlinear
 from jaxship.studies.astrom import FREE, TABLE3_START, NoiseLevels, simulate_disturbed, zigzag_trial
 
 

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from jaxship._covariance import (
+from jaxship._foundation._covariance import (
     bartlett_long_run,
     cluster_from_windows,
     hac_covariance,
@@ -14,7 +14,7 @@ from jaxship._covariance import (
     least_squares_covariance,
     parameter_report,
 )
-from jaxship._validate import (
+from jaxship._foundation._validate import (
     Z99,
     chi2_quantile_99,
     final_prediction_error,

@@ -13,8 +13,8 @@ import pytest
 import jaxship as js
 from jaxship._estimate import _fit
 from jaxship._estimate._fit import IdentifiabilityWarning, PredictionError, fit
-from jaxship._params import Free, default_free, parameter_fields, resolve_free
-from jaxship._steering._base import AbstractSteeringModel
+from jaxship._foundation._params import Free, default_free, parameter_fields, resolve_free
+from jaxship._models._steering._base import AbstractSteeringModel
 
 
 DEG = np.pi / 180

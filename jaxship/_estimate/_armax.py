@@ -25,10 +25,10 @@ import numpy as np
 import optimistix as optx
 from scipy.signal import lfilter
 
-from .._armax_model import ARMAX_NAMES, ARMAX_ORDERS, ARMAXModel
-from .._covariance import parameter_report
-from .._params import parameter_fields
-from .._validate import validate
+from .._foundation._covariance import parameter_report
+from .._foundation._params import parameter_fields
+from .._foundation._validate import validate
+from .._models._armax_model import ARMAX_NAMES, ARMAX_ORDERS, ARMAXModel
 from ._discrete import continuous_parameters
 from ._fit import AbstractEstimator
 from ._result import FitResult

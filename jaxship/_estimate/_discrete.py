@@ -47,9 +47,9 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.linalg import expm
 
-from .._data import Experiment
-from .._steering.nomoto import Nomoto1, Nomoto2, NonlinearNomoto
-from .._steering.nonlinear_nomoto2 import NonlinearNomoto2
+from .._models._steering.nomoto import Nomoto1, Nomoto2, NonlinearNomoto
+from .._models._steering.nonlinear_nomoto2 import NonlinearNomoto2
+from .._simulation._data import Experiment
 
 
 STRUCTURES = ("linear1", "nonlinear1", "linear2", "nonlinear2")

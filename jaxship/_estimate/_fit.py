@@ -22,16 +22,16 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
-from .._covariance import (
+from .._foundation._covariance import (
     cluster_from_windows,
     hac_from_windows,
     least_squares_covariance,
     parameter_report,
 )
-from .._params import Transform, as_arrays, rebuild, resolve_free
-from .._sharding import sharded_vmap
-from .._simulate import Simulator, integrate, replay_policy
-from .._validate import validate
+from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
+from .._foundation._sharding import sharded_vmap
+from .._foundation._validate import validate
+from .._simulation._simulate import Simulator, integrate, replay_policy
 from ._lm import LevenbergMarquardt, solve_least_squares
 from ._result import ConvergenceWarning, FitResult, IdentifiabilityWarning
 from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_data, to_timeline
@@ -245,7 +245,7 @@ def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), fre
 
     **Returns:** a `FitResult`. The covariance is $\\hat\\sigma^2(J^TJ)^{-1}$ in the
     physical parameters (per-channel noise variances: see
-    `jaxship._covariance.least_squares_covariance`), which is right for white
+    `jaxship._foundation._covariance.least_squares_covariance`), which is right for white
     residuals: output error with measurement noise only, or a horizon that makes the
     residuals white. Check `metrics[c].white`.
 

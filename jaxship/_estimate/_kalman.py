@@ -7,7 +7,7 @@ fits on top of them are in `jaxship._estimate._likelihood`).
 interval the recorded rudder and auxiliary inputs are replayed as `fit` replays them
 (the measured angle linear between $\\delta_k$ and $\\delta_{k+1}$, a command held) and
 the interval map $F$ is the simulator's time loop over the interval
-(`jaxship._simulate.integrate`, the same numerics as `simulate_steering` and `fit`):
+(`jaxship._simulation._simulate.integrate`, the same numerics as `simulate_steering` and `fit`):
 
 $$z_{k+1} = F(z_k, \\delta_k + w_k) + v_k, \\qquad y_k = h(z_k) + e_k,$$
 
@@ -54,11 +54,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._data import Experiment
-from .._params import as_arrays
-from .._simulate import Held, Simulator, integrate
-from .._simulate_steering import steering_field
-from .._steering._base import AbstractSteeringModel, AuxInputs, WindowStart
+from .._foundation._params import as_arrays
+from .._models._steering._base import AbstractSteeringModel, AuxInputs, WindowStart
+from .._simulation._data import Experiment
+from .._simulation._simulate import Held, Simulator, integrate
+from .._simulation._simulate_steering import steering_field
 from ._windows import as_dataset, check_data, resolve_holds
 
 

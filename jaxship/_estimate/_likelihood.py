@@ -11,10 +11,10 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
-from .._covariance import least_squares_covariance, parameter_report
-from .._params import Transform, as_arrays, rebuild, resolve_free
-from .._steering._base import AbstractSteeringModel
-from .._validate import validate
+from .._foundation._covariance import least_squares_covariance, parameter_report
+from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
+from .._foundation._validate import validate
+from .._models._steering._base import AbstractSteeringModel
 from ._fit import AbstractEstimator, FitResult
 from ._kalman import (
     KALMAN_CHANNELS,

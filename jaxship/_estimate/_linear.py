@@ -24,10 +24,10 @@ import math
 import equinox as eqx
 import numpy as np
 
-from .._params import resolve_free
-from .._steering._base import AuxInputs
-from .._steering.nomoto import Nomoto1, NonlinearNomoto
-from .._steering.ross import HULL_TERMS, RUDDER_TERMS, RossAutopilot
+from .._foundation._params import resolve_free
+from .._models._steering._base import AuxInputs
+from .._models._steering.nomoto import Nomoto1, NonlinearNomoto
+from .._models._steering.ross import HULL_TERMS, RUDDER_TERMS, RossAutopilot
 from ._windows import as_dataset, check_data, resolve_holds
 
 

@@ -12,8 +12,8 @@ import dataclasses
 import equinox as eqx
 import numpy as np
 
-from .._params import as_arrays
-from .._validate import ValidationReport, validate
+from .._foundation._params import as_arrays
+from .._foundation._validate import ValidationReport, validate
 from ._fit import PredictionError, _predict, _prepare
 from ._windows import to_timeline
 

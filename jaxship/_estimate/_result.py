@@ -6,10 +6,10 @@ import numpy as np
 import optimistix as optx
 from scipy.special import ndtri
 
-from .._covariance import ParameterReport
-from .._frames import fit_to_dataframe
-from .._params import get_path, parameter_fields
-from .._validate import _to_plain
+from .._foundation._covariance import ParameterReport
+from .._foundation._frames import fit_to_dataframe
+from .._foundation._params import get_path, parameter_fields
+from .._foundation._validate import _to_plain
 from ._lm import SolverOutcome
 
 

@@ -17,8 +17,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._data import Dataset, Experiment
-from .._steering._base import AuxInputs, WindowStart
+from .._models._steering._base import AuxInputs, WindowStart
+from .._simulation._data import Dataset, Experiment
 
 
 # fittable outputs: heading and yaw rate for every model; surge and sway velocity for

@@ -11,7 +11,7 @@ import numpy as np
 
 import jaxship as js
 
-from .._armax_model import ARMAX_ORDERS, ARMAXModel
+from .._models._armax_model import ARMAX_ORDERS, ARMAXModel
 from .starts import StartContext
 
 

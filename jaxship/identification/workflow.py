@@ -26,7 +26,7 @@ import numpy as np
 
 import jaxship as js
 
-from .._params import parameter_fields
+from .._foundation._params import parameter_fields
 from .assessment import assess
 from .data import as_experiments, check_experiments, valid_samples
 from .registry import MODELS, model_key

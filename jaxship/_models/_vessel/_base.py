@@ -8,9 +8,16 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array
 
+from ..._foundation._state import (
+    STATE_FIELDS,
+    Command,
+    ShipState,
+    from_vector,
+    straight_state,
+    to_vector,
+)
 from .._actuators import RudderServo, Shaft
 from .._environment import Environment, Wind
-from .._state import STATE_FIELDS, Command, ShipState, from_vector, straight_state, to_vector
 
 
 class AbstractVessel(eqx.Module):

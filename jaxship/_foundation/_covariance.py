@@ -473,7 +473,7 @@ def _not_white_flag(names, std, std_robust, hac_lags, robust_method=None) -> str
     if not ok.any():
         if np.all(np.isnan(std_robust)):
             return (f"{head} and understate the uncertainty; no robust standard errors were "
-                    "computed (see jaxship._validate.hac_covariance).")
+                    "computed (see jaxship._foundation._validate.hac_covariance).")
         return f"{head} and understate the uncertainty; use std_robust ({how})."
     ratio = np.where(ok, std_robust / np.where(ok, std, 1.0), -np.inf)
     i = int(np.argmax(ratio))

@@ -4,7 +4,7 @@ import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
-from ._kinematics import body_to_earth, earth_to_body
+from .._foundation._kinematics import body_to_earth, earth_to_body
 
 
 RHO_AIR = 1.225  # air density [kg/m^3], ISA sea level

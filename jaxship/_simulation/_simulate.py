@@ -22,10 +22,17 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._environment import Environment
-from ._manoeuvres import interpolate
-from ._state import STATE_FIELDS, Command, ShipState, Trajectory, from_vector, to_vector
-from ._vessel._base import AbstractVessel, _state_derivative, inverse3
+from .._foundation._state import (
+    STATE_FIELDS,
+    Command,
+    ShipState,
+    Trajectory,
+    from_vector,
+    to_vector,
+)
+from .._models._environment import Environment
+from .._models._manoeuvres import interpolate
+from .._models._vessel._base import AbstractVessel, _state_derivative, inverse3
 
 
 class RK4(dfx.AbstractSolver):

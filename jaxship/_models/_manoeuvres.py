@@ -16,8 +16,8 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import ArrayLike
 
-from ._kinematics import ssa
-from ._state import Command
+from .._foundation._kinematics import ssa
+from .._foundation._state import Command
 
 
 class AbstractController(eqx.Module):

@@ -19,7 +19,7 @@ terms), and $N_R$ is the rudder moment, the right-hand side "N" of eq. 3.6.
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
-from .._params import param
+from ..._foundation._params import param
 from ._base import AbstractSteeringModel, AuxInputs, WindowStart
 
 

@@ -13,10 +13,10 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
-from ._params import as_arrays
+from .._foundation._params import as_arrays
+from .._foundation._state import ShipState
+from .._models._steering._base import AbstractSteeringModel, AuxInputs
 from ._simulate import Held, Simulator, integrate, replay_policy
-from ._state import ShipState
-from ._steering._base import AbstractSteeringModel, AuxInputs
 
 
 INPUTS = ("delta", "u", "v", "n")  # the replayed signals of a steering model

@@ -1,10 +1,10 @@
 """Measured and simulated trials: `Experiment` and `Dataset` (file formats and
-readers in `jaxship._readers`).
+readers in `jaxship._simulation._readers`).
 
 Inside the library every channel is SI with angles in radians and propeller rates in
 rev/s, in our sign convention (positive rudder angle turns the ship to starboard,
 $r > 0$; x north / forward, y east / starboard, heading from x towards y). Degrees,
-rpm and the sign conventions of the sources live only in `jaxship._readers`.
+rpm and the sign conventions of the sources live only in `jaxship._simulation._readers`.
 """
 
 from collections.abc import Sequence
@@ -14,8 +14,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._manoeuvres import Replay
-from ._state import ShipState, Trajectory
+from .._foundation._state import ShipState, Trajectory
+from .._models._manoeuvres import Replay
 
 
 # channel order of files and of `Experiment`; `t` first

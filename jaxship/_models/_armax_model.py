@@ -10,7 +10,7 @@ import equinox as eqx
 import numpy as np
 from scipy.signal import lfilter, lfiltic
 
-from ._params import param
+from .._foundation._params import param
 
 
 ARMAX_ORDERS = dict(na=2, nb=2, nc=2, nk=1)

@@ -14,11 +14,11 @@ import jax.numpy as jnp
 import numpy as np
 from jax.sharding import PartitionSpec as P
 
-from ._environment import Environment
-from ._sharding import AXIS, batch_mesh, pad_batch
+from .._foundation._sharding import AXIS, batch_mesh, pad_batch
+from .._foundation._state import Trajectory, straight_state
+from .._models._environment import Environment
+from .._models._vessel._base import surge_force
 from ._simulate import Simulator, _as_arrays, _is_static_zero, _simulate
-from ._state import Trajectory, straight_state
-from ._vessel._base import surge_force
 
 
 def stack(modules: Sequence) -> eqx.Module:

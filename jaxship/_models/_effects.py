@@ -27,7 +27,7 @@ import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
-from ._params import param
+from .._foundation._params import param
 from ._steering._base import AbstractSteeringModel
 from ._vessel._base import AbstractVessel
 

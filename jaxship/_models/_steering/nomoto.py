@@ -4,7 +4,7 @@ model with Norrbin's manoeuvring characteristic (thesis eq. 3.1-3.5)."""
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
-from .._params import param
+from ..._foundation._params import param
 from ._base import AbstractSteeringModel, AuxInputs, WindowStart
 
 

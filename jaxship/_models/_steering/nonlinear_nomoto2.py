@@ -3,7 +3,7 @@
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
-from .._params import param
+from ..._foundation._params import param
 from ._base import AbstractSteeringModel, AuxInputs, WindowStart
 
 

@@ -34,8 +34,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .._foundation._state import Trajectory
 from ._data import CHANNELS, Experiment
-from ._state import Trajectory
 
 
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}

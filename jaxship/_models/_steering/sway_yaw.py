@@ -22,7 +22,7 @@ m'x'_G - N'_{\\dot v} & L(I'_z - N'_{\\dot r})\\end{pmatrix}
 
 with Norrbin's (1976) cross-flow drag $C f$ in `NorrbinCrossFlow` (one effective
 coefficient $C$; $f$ the integral of $-\\tfrac12\\rho T|v + xr|(v + xr)$ over the hull,
-`jaxship._vessel.sway_yaw._cross_flow_integrals`). The rudder sign is jaxship's
+`jaxship._models._vessel.sway_yaw._cross_flow_integrals`). The rudder sign is jaxship's
 (positive $\\delta$ turns to starboard): $Y'_\\delta$, $N'_\\delta$ are minus the
 published values.
 
@@ -37,8 +37,8 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
+from ..._foundation._params import param
 from .._actuators import RudderServo
-from .._params import param
 from .._vessel.sway_yaw import SwayYawVessel
 from ._base import AbstractSteeringModel, AuxInputs, WindowStart
 

@@ -21,10 +21,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._manoeuvres import AbstractManoeuvre
-from ._params import as_arrays, rebuild, resolve_free
-from ._simulate_steering import simulate_steering, steer_manoeuvre
-from ._steering._base import AbstractSteeringModel
+from .._foundation._params import as_arrays, rebuild, resolve_free
+from .._models._manoeuvres import AbstractManoeuvre
+from .._models._steering._base import AbstractSteeringModel
+from .._simulation._simulate_steering import simulate_steering, steer_manoeuvre
 
 
 def excitation_order(u, *, max_order: int | None = None, rtol: float | None = None) -> int:
