@@ -1,5 +1,21 @@
 """jaxship: differentiable ship-manoeuvring simulation and steering-model identification."""
 
+import importlib.metadata
+
+from ._analysis._autopilot import (
+    TunedAutopilot as TunedAutopilot,
+    design_autopilot as design_autopilot,
+    tune_autopilot as tune_autopilot,
+    yaw_inertia as yaw_inertia,
+)
+from ._analysis._closed_loop import (
+    ClosedLoop as ClosedLoop,
+    ClosedLoopMetrics as ClosedLoopMetrics,
+    YawDisturbance as YawDisturbance,
+    closed_loop as closed_loop,
+    closed_loop_metrics as closed_loop_metrics,
+    tracking_objective as tracking_objective,
+)
 from ._analysis._design import (
     excitation_order as excitation_order,
     fisher_information as fisher_information,
@@ -18,6 +34,7 @@ from ._analysis._indices import (
 )
 from ._estimate._armax import ARMAX as ARMAX, ARMAXResult as ARMAXResult, fit_armax as fit_armax
 from ._estimate._discrete import fit_discrete_response as fit_discrete_response
+from ._estimate._discrete_estimator import DiscreteResponse as DiscreteResponse
 from ._estimate._fit import (
     AbstractEstimator as AbstractEstimator,
     PredictionError as PredictionError,
@@ -58,17 +75,28 @@ from ._foundation._validate import (
     validate as validate,
 )
 from ._models._actuators import RudderServo as RudderServo, Shaft as Shaft
+from ._models._control import (
+    Feedforward as Feedforward,
+    HeadingAutopilot as HeadingAutopilot,
+    HeadingSteps as HeadingSteps,
+    ReferenceModel as ReferenceModel,
+)
 from ._models._effects import (
     AbstractEffect as AbstractEffect,
     AugmentedSteering as AugmentedSteering,
     AugmentedVessel as AugmentedVessel,
     HeadingSensorBias as HeadingSensorBias,
     RecordedDisturbance as RecordedDisturbance,
+    RudderDelay as RudderDelay,
+    RudderLag as RudderLag,
     RudderOffset as RudderOffset,
+    RudderRateLimit as RudderRateLimit,
     SwayForceBias as SwayForceBias,
+    YawCubicDamping as YawCubicDamping,
     YawMomentBias as YawMomentBias,
     YawRateSensorBias as YawRateSensorBias,
     augment as augment,
+    nonlinear_nomoto2 as nonlinear_nomoto2,
 )
 from ._models._environment import Current as Current, Environment as Environment, Wind as Wind
 from ._models._manoeuvres import (
@@ -98,7 +126,6 @@ from ._models._steering import (
     NorrbinCrossFlow as NorrbinCrossFlow,
     RossAutopilot as RossAutopilot,
 )
-from ._models._steering.nonlinear_nomoto2 import NonlinearNomoto2 as NonlinearNomoto2
 from ._models._vessel._base import (
     AbstractVessel as AbstractVessel,
     state_derivative as state_derivative,
@@ -129,7 +156,7 @@ from ._simulation._simulate_steering import (
 )
 
 
-__version__ = "0.1.0"
+__version__ = importlib.metadata.version("jaxship")  # from pyproject.toml
 
 # study and application helpers, added for jaxship.studies and the notebooks
 from ._models._armax_model import ARMAXModel as ARMAXModel

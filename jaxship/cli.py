@@ -1,6 +1,7 @@
 """The `jaxship` command: a thin layer over the public API (float64 is enabled here)."""
 
 import argparse
+import importlib.metadata
 import json
 import pathlib
 import sys
@@ -22,6 +23,8 @@ from .studies.reproduce import reproduce  # noqa: E402
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="jaxship", description=__doc__)
+    parser.add_argument("--version", action="version",
+                        version=f"jaxship {importlib.metadata.version('jaxship')}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     sub.add_parser("vessels", help="list the vessel presets and their sources")

@@ -64,3 +64,10 @@ def test_mariner_zigzag_overshoots_match_reference(tmp_path):
 def test_bad_input_is_a_clear_error(tmp_path, capsys, args, message):
     assert main(["simulate", *args, "--out", str(tmp_path / "x")]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["--version"])
+    assert stop.value.code == 0
+    assert capsys.readouterr().out.strip() == f"jaxship {js.__version__}"

@@ -20,7 +20,7 @@ STEERING = {
     "nomoto1": js.Nomoto1(K=0.06, T=25.0),
     "nomoto2": js.Nomoto2(K=0.06, T1=25.0, T2=3.0, T3=5.0),
     "nonlinear_nomoto": js.NonlinearNomoto(K=0.06, T=25.0, n3=300.0),
-    "nonlinear_nomoto2": js.NonlinearNomoto2(K=0.06, T1=25.0, T2=3.0, T3=5.0, beta1=100.0),
+    "nonlinear_nomoto2": js.nonlinear_nomoto2(K=0.06, T1=25.0, T2=3.0, T3=5.0, beta1=100.0),
     "ross_autopilot": js.RossAutopilot(length=4.0, speed=1.5, rate=8.0, n_ur=-4.0,
                                        n_delta=2.5, n_uv=-1.0),
     "linear_sway_yaw": js.LinearSwayYaw.from_vessel(js.vessel("sea_stratus_linear")),
@@ -33,6 +33,10 @@ EFFECTS = {
     "sway_force_bias": (js.SwayForceBias(), "y0", 1e4, ("vessel",)),
     "yaw_rate_sensor_bias": (js.YawRateSensorBias(), "bias", 1e-3, ("vessel", "steering")),
     "heading_sensor_bias": (js.HeadingSensorBias(), "bias", 0.01, ("vessel", "steering")),
+    "yaw_cubic_damping": (js.YawCubicDamping(), "beta", 300.0, ("steering",)),
+    "rudder_lag": (js.RudderLag(), "time_constant", 2.0, ("vessel", "steering")),
+    "rudder_delay": (js.RudderDelay(), "delay", 1.5, ("vessel", "steering")),
+    "rudder_rate_limit": (js.RudderRateLimit(), "inverse_rate", 60.0, ("vessel", "steering")),
 }
 CONTROLLERS = {
     "turn": js.Turn(15 * DEG, duration=40.0, dt=0.5),
@@ -43,6 +47,10 @@ CONTROLLERS = {
     "heading_perturbations": js.HeadingPerturbations(5 * DEG, 30.0, kp=2.0, ki=0.01, kd=20.0,
                                              duration=40.0, dt=0.5),
     "stop": js.Stop(-0.5, duration=40.0, dt=0.5),
+    "heading_autopilot": js.Controlled(
+        js.design_autopilot(js.Nomoto1(K=0.06, T=40.0), natural_frequency=0.05,
+                            steps=js.HeadingSteps((5.0,), (10 * DEG,))),
+        duration=40.0, dt=0.5),
 }
 
 

@@ -3,12 +3,14 @@
 import numpy as np
 import pytest
 
+import jaxship as js
 from jaxship import Experiment, Nomoto1, Nomoto2, fit_discrete_response, simulate_steering
 from jaxship._estimate._discrete import (
     COEFFICIENTS,
     DiscreteResponseFit,
     continuous_parameters,
     discretise,
+    regressors,
 )
 
 
@@ -110,3 +112,58 @@ def test_bad_inputs():
     other = Experiment(e.t * 2, e.delta, r=e.r)
     with pytest.raises(ValueError, match="sample intervals"):
         fit_discrete_response("linear1", [e, other])
+
+
+STEERING = {
+    "linear1": lambda: Nomoto1(K=0.05, T=10.0),
+    "nonlinear1": lambda: js.NonlinearNomoto(K=0.05, T=10.0),
+    "linear2": lambda: Nomoto2(K=0.05, T1=10.0, T2=2.0, T3=1.0),
+    "nonlinear2": lambda: js.nonlinear_nomoto2(0.05, 10.0, 2.0, 1.0),
+}
+
+
+@pytest.mark.parametrize("structure", list(CASES))
+def test_the_discrete_response_estimator_returns_a_fit_result(structure):
+    """`fit(model, data, estimator=DiscreteResponse())`: the model's class picks the
+    structure; the estimates equal `fit_discrete_response`'s, as the fitted model."""
+    _, e = _record(structure)
+    result = js.fit(STEERING[structure](), e, estimator=js.DiscreteResponse())
+    direct = fit_discrete_response(structure, e)
+    assert isinstance(result, js.FitResult) and result.success
+    values = dict(zip(result.names, result.values))
+    model = direct.to_steering()
+    for name, value in values.items():
+        expected = (float(model.lookup("yaw_cubic_damping").beta) if "." in name
+                    else float(getattr(model, name) if not hasattr(model, "base")
+                               else getattr(model.base, name)))
+        assert value == pytest.approx(expected, rel=1e-12), name
+    assert result.metrics["r"].fit_percent > 99.99  # one-step predictions, noise-free
+    assert np.all(np.isfinite(result.std)) and np.all(result.std >= 0)
+
+
+def test_discrete_response_standard_errors_by_the_delta_method():
+    """linear1 with equation noise: $K = a_2/(1 - a_1)$, $T = -h/\\ln a_1$; the reported
+    std equals the delta method written out from the least-squares covariance."""
+    rng = np.random.default_rng(3)
+    c = discretise("linear1", CASES["linear1"], H, discretisation="zoh")
+    d = _rudder()
+    r = np.zeros(d.size)
+    for k in range(1, d.size):
+        r[k] = c["a1"] * r[k - 1] + c["a2"] * d[k - 1] + c["b0"] + 2e-4 * rng.normal()
+    e = Experiment(np.arange(d.size) * H, d, r=r)
+    result = js.fit(Nomoto1(K=0.1, T=20.0), e, estimator=js.DiscreteResponse())
+    f = fit_discrete_response("linear1", e)
+    x, _ = regressors("linear1", r, d)
+    cov = f.rms**2 * f.num_rows / (f.num_rows - 3) * np.linalg.inv(x.T @ x)
+    a1, a2 = f.coefficients["a1"], f.coefficients["a2"]
+    grad_k = np.array([a2 / (1 - a1) ** 2, 1 / (1 - a1), 0.0])
+    grad_t = np.array([H / (a1 * np.log(a1) ** 2), 0.0, 0.0])
+    std = dict(zip(result.names, result.std))
+    assert std["K"] == pytest.approx(np.sqrt(grad_k @ cov @ grad_k), rel=1e-5)
+    assert std["T"] == pytest.approx(np.sqrt(grad_t @ cov @ grad_t), rel=1e-5)
+
+
+def test_the_discrete_response_estimator_rejects_other_models():
+    with pytest.raises(ValueError, match="DiscreteResponse estimator fits"):
+        js.fit(js.RossAutopilot(length=4.0, speed=1.5, rate=8.0), _record("linear1")[1],
+               estimator=js.DiscreteResponse())

@@ -179,7 +179,7 @@ def test_reverse_gradient_matches_finite_difference(vessel, x0, simulator):
 
 
 def test_new_parameter_values_do_not_retrace(vessel, x0):
-    from jaxship._simulation._simulate import _simulate
+    from jaxship._simulation._simulate import _as_arrays, _simulate
 
     man = js.Turn(10 * DEG, duration=20.0)
     counted = eqx.debug.assert_max_traces(_simulate.__wrapped__, max_traces=1)
@@ -187,7 +187,7 @@ def test_new_parameter_values_do_not_retrace(vessel, x0):
     for nr, angle in [(-0.0016, 10.0), (-0.0020, 25.0), (-0.0030, -5.0)]:
         v = eqx.tree_at(lambda s: s.nr, vessel, nr)
         m = eqx.tree_at(lambda s: s.angle, man, angle * DEG)
-        jitted(*js._simulate._as_arrays((v, m, x0, js.Environment())), js.Simulator(), 1)
+        jitted(*_as_arrays((v, m, x0, js.Environment())), js.Simulator(), 1)
 
 
 def test_python_floats_do_not_retrace(vessel, x0):

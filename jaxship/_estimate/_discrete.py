@@ -47,8 +47,8 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.linalg import expm
 
+from .._models._effects import nonlinear_nomoto2
 from .._models._steering.nomoto import Nomoto1, Nomoto2, NonlinearNomoto
-from .._models._steering.nonlinear_nomoto2 import NonlinearNomoto2
 from .._simulation._data import Experiment
 
 
@@ -340,8 +340,9 @@ class DiscreteResponseFit:
         """The continuous model (Lu & Zhao eqs. 1-4) as a jaxship steering model:
         `Nomoto1`, `NonlinearNomoto` (with $n_1 = \\mathrm{sign}\\,\\alpha_1$,
         $n_3 = \\beta_1/|\\alpha_1|$, $n_0 = -K\\delta_r$), `Nomoto2` or
-        `NonlinearNomoto2`; the offset is `delta0`. Raises `ValueError` when the
-        second-order time constants are complex or not positive."""
+        `nonlinear_nomoto2` (`Nomoto2` with `YawCubicDamping`); the offset is
+        `delta0`. Raises `ValueError` when the second-order time constants are complex
+        or not positive."""
         p = self.parameters
         if self.structure == "linear1":
             return Nomoto1(K=p["K"], T=p["T"], delta0=p["delta_r"])
@@ -355,8 +356,11 @@ class DiscreteResponseFit:
                              "model, `simulate`).")
         if self.structure == "linear2":
             return Nomoto2(K=p["K"], T1=p["T1"], T2=p["T2"], T3=p["T3"], delta0=p["delta_r"])
-        return NonlinearNomoto2(K=p["K"], T1=p["T1"], T2=p["T2"], T3=p["T3"],
-                                alpha1=p["alpha1"], beta1=p["beta1"], delta0=p["delta_r"])
+        if p["alpha1"] != 1.0:
+            raise ValueError(f"nonlinear2 with alpha1 = {p['alpha1']} (not 1) has no "
+                             "Nomoto2 realisation here; fit it with alpha1=1.")
+        return nonlinear_nomoto2(K=p["K"], T1=p["T1"], T2=p["T2"], T3=p["T3"],
+                                 beta1=p["beta1"], delta0=p["delta_r"])
 
 
 def fit_discrete_response(structure: str, data, *, method: str = "ls",

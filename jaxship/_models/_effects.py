@@ -11,11 +11,15 @@ other, by the name `"<effect id>.<field>"` (e.g. `"rudder_offset.delta0"`).
 An effect may act on one or more of four places, each a method with a neutral
 default:
 
-- the actuator path, `rudder(delta)`: the rudder angle the hydrodynamics see;
+- the actuator path, `rudder(delta, z)`: the rudder angle the hydrodynamics see, with
+  the effect's own states `z` (`state_names`, `initial_state`, `state_rate`: a lag, a
+  delay or a rate limit; they travel in the simulated state after the model's own);
 - the loads, `loads(t, vessel, u, v, r, delta, n)`: body-fixed (X, Y, N) [N, N, N m]
   added to a vessel's (Fossen 2021, eq. 6.1: $M\\dot\\nu = \\tau + \\tau_{effect}$);
-- the yaw equation of a steering model, `yaw_acceleration(t, model, x, delta)`:
-  added to $\\dot r$ [rad/s^2];
+- the yaw equation of a steering model, `yaw_term(model, x, delta)`: a term $f$
+  added to its right-hand side where the rudder's moment enters (for Nomoto
+  $T\\dot r + r = K\\delta + f$ [rad/s]; for models written as $\\dot r = \\dots$,
+  [rad/s^2]); the model's `forcing(x)` says how it moves the state;
 - the measurement, `measure(channel, value)`: what a sensor reports.
 
 Adding an effect is writing one such Module; discovery scores them by name.
@@ -28,22 +32,39 @@ import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
 from .._foundation._params import param
+from .._foundation._state import STATE_FIELDS
 from ._steering._base import AbstractSteeringModel
+from ._steering.nomoto import Nomoto2
 from ._vessel._base import AbstractVessel
+
+
+# Below this time constant [s] a rudder lag or delay is treated as absent: the default
+# control step (0.1 s) of classical RK4 is stable for time constants above ~0.036 s,
+# and a lag this short is not resolved by it anyway.
+SHORTEST_TIME_CONSTANT = 0.05
 
 
 class AbstractEffect(eqx.Module):
     """Base of all effects; `id` is the catalogue name (`"rudder_offset"`, ...)."""
 
     id: eqx.AbstractClassVar[str]
+    state_names: ClassVar[tuple[str, ...]] = ()  # the effect's own states, if any
 
-    def rudder(self, delta: ArrayLike) -> ArrayLike:
+    def initial_state(self, delta) -> Array:
+        """The effect's states in a steady state at rudder `delta` [rad]."""
+        return jnp.zeros((len(self.state_names),)) + 0.0 * delta
+
+    def state_rate(self, z, delta) -> Array:
+        """The time derivative of the effect's states `z` at the rudder `delta` it sees."""
+        return jnp.zeros_like(z)
+
+    def rudder(self, delta: ArrayLike, z) -> ArrayLike:
         return delta
 
     def loads(self, t, vessel, u, v, r, delta, n) -> ArrayLike:
         return 0.0
 
-    def yaw_acceleration(self, t, model, x, delta) -> ArrayLike:
+    def yaw_term(self, model, x, delta) -> ArrayLike:
         return 0.0
 
     def measure(self, channel: str, value: ArrayLike) -> ArrayLike:
@@ -61,22 +82,108 @@ class RudderOffset(AbstractEffect):
     delta0: ArrayLike = param(0.0, lower=-0.1, upper=0.1, scale=0.01, unit="rad")
     id: ClassVar[str] = "rudder_offset"
 
-    def rudder(self, delta):
+    def rudder(self, delta, z):
         return delta + self.delta0
 
 
 class YawMomentBias(AbstractEffect):
-    """A constant yaw moment: $N_0$ [N m] on a vessel; on a steering model the yaw
-    acceleration $N_0$ [rad/s^2] it causes (moment over yaw inertia)."""
+    """A constant yaw moment: $N_0$ [N m] on a vessel; on a steering model the term
+    $N_0$ in its yaw equation (`yaw_term`: [rad/s] for Nomoto models, where it equals
+    a rudder offset $N_0/K$; [rad/s^2] for models written as $\\dot r = \\dots$)."""
 
-    n0: ArrayLike = param(0.0, unit="N m | rad/s^2")
+    n0: ArrayLike = param(0.0, unit="N m | rad/s | rad/s^2")
     id: ClassVar[str] = "yaw_moment_bias"
 
     def loads(self, t, vessel, u, v, r, delta, n):
         return jnp.stack([0.0 * u, 0.0 * u, self.n0 + 0.0 * u])
 
-    def yaw_acceleration(self, t, model, x, delta):
+    def yaw_term(self, model, x, delta):
         return self.n0
+
+
+class YawCubicDamping(AbstractEffect):
+    """Cubic yaw damping $-\\beta r^3$ in a steering model's yaw equation: with
+    `Nomoto2` it is the second-order nonlinear model of Lu & Zhao (2008, eq. 4),
+    $T_1T_2\\ddot r + (T_1 + T_2)\\dot r + r + \\beta r^3 = K\\delta + KT_3\\dot\\delta$;
+    with `Nomoto1` Norrbin's characteristic with $n_3 = \\beta$ (Norrbin 1963).
+    Steering models only (a vessel has its own $N_{rrr}$)."""
+
+    beta: ArrayLike = param(0.0, scale=10.0, unit="s^2/rad^2")
+    id: ClassVar[str] = "yaw_cubic_damping"
+
+    def yaw_term(self, model, x, delta):
+        return -self.beta * model.output(x) ** 3
+
+
+def _lag_gate(time_constant):
+    """(active, safe time constant): a lag shorter than `SHORTEST_TIME_CONSTANT` is off."""
+    active = time_constant > SHORTEST_TIME_CONSTANT
+    return active, jnp.where(active, time_constant, 1.0)
+
+
+class RudderLag(AbstractEffect):
+    """A first-order lag between the recorded and the acting rudder (a steering gear
+    slower than logged, or a rudder angle read upstream of the gear):
+    $T_l\\dot\\delta' = \\delta - \\delta'$ (Fossen 2021, eq. 9.8). Off (the base model
+    exactly) for $T_l \\le$ `SHORTEST_TIME_CONSTANT`."""
+
+    time_constant: ArrayLike = param(0.0, lower=0.0, upper=20.0, scale=0.5, unit="s")
+    id: ClassVar[str] = "rudder_lag"
+    state_names: ClassVar[tuple[str, ...]] = ("delta_lagged",)
+
+    def initial_state(self, delta):
+        return jnp.reshape(jnp.asarray(delta, float), (1,))
+
+    def state_rate(self, z, delta):
+        active, tau = _lag_gate(self.time_constant)
+        return jnp.where(active, (delta - z) / tau, 0.0)
+
+    def rudder(self, delta, z):
+        return jnp.where(_lag_gate(self.time_constant)[0], z[0], delta)
+
+
+class RudderDelay(AbstractEffect):
+    """A pure delay $\\tau_d$ of the rudder, $\\delta'(t) = \\delta(t - \\tau_d)$, by its
+    first-order Pade approximant $e^{-s\\tau_d} \\approx (1 - s\\tau_d/2)/(1 + s\\tau_d/2)$
+    (Franklin, Powell & Emami-Naeini 2015, sec. 5.6): $\\delta' = 2z - \\delta$,
+    $(\\tau_d/2)\\dot z = \\delta - z$. Off for $\\tau_d/2 \\le$ `SHORTEST_TIME_CONSTANT`."""
+
+    delay: ArrayLike = param(0.0, lower=0.0, upper=10.0, scale=0.5, unit="s")
+    id: ClassVar[str] = "rudder_delay"
+    state_names: ClassVar[tuple[str, ...]] = ("delta_pade",)
+
+    def initial_state(self, delta):
+        return jnp.reshape(jnp.asarray(delta, float), (1,))
+
+    def state_rate(self, z, delta):
+        active, half = _lag_gate(self.delay / 2)
+        return jnp.where(active, (delta - z) / half, 0.0)
+
+    def rudder(self, delta, z):
+        return jnp.where(_lag_gate(self.delay / 2)[0], 2 * z[0] - delta, delta)
+
+
+class RudderRateLimit(AbstractEffect):
+    """A steering gear slower than the recorded (commanded) rudder: the acting rudder
+    follows it with time constant `tracking` (0.1 s) at no more than
+    $\\dot\\delta_{max} = 1/s$ [rad/s] (Fossen 2021, sec. 9.3). Parametrised by the
+    inverse rate $s$ [s/rad], so $s = 0$ (no limit) is the base model exactly."""
+
+    inverse_rate: ArrayLike = param(0.0, lower=0.0, upper=100.0, scale=5.0, unit="s/rad")
+    tracking: float = eqx.field(static=True, default=0.1)  # [s], not fitted
+    id: ClassVar[str] = "rudder_rate_limit"
+    state_names: ClassVar[tuple[str, ...]] = ("delta_limited",)
+
+    def initial_state(self, delta):
+        return jnp.reshape(jnp.asarray(delta, float), (1,))
+
+    def state_rate(self, z, delta):
+        active = self.inverse_rate > 0
+        rate = 1.0 / jnp.where(active, self.inverse_rate, 1.0)
+        return jnp.where(active, jnp.clip((delta - z) / self.tracking, -rate, rate), 0.0)
+
+    def rudder(self, delta, z):
+        return jnp.where(self.inverse_rate > 0, z[0], delta)
 
 
 class SwayForceBias(AbstractEffect):
@@ -134,8 +241,8 @@ class RecordedDisturbance(AbstractEffect):
 
 
 class _Augmented(eqx.Module):
-    """What both augmented models share: the base, the effects and the parameter names
-    `"<effect id>.<field>"` of the effects."""
+    """What both augmented models share: the base, the effects, the parameter names
+    `"<effect id>.<field>"` of the effects and the effects' own states."""
 
     base: eqx.AbstractVar[eqx.Module]
     effects: eqx.AbstractVar[tuple[AbstractEffect, ...]]
@@ -147,24 +254,39 @@ class _Augmented(eqx.Module):
                 return effect
         return getattr(self.base, name)
 
-    def _rudder(self, delta):
+    @property
+    def effect_state_size(self) -> int:
+        """How many states the effects add (after the base model's)."""
+        return sum(len(e.state_names) for e in self.effects)
+
+    def effect_initial(self, delta):
+        """The effects' states in a steady state at the rudder `delta` [rad]."""
+        return jnp.concatenate([jnp.zeros((0,))] + [e.initial_state(delta)
+                                                    for e in self.effects])
+
+    def rudder_path(self, delta, z):
+        """The rudder angle the base model sees, after every effect's actuator path in
+        order, and the time derivative of the effects' states `z`."""
+        rates, i = [jnp.zeros((0,))], 0
         for effect in self.effects:
-            delta = effect.rudder(delta)
-        return delta
+            k = len(effect.state_names)
+            rates.append(effect.state_rate(z[i:i + k], delta))
+            delta = effect.rudder(delta, z[i:i + k])
+            i += k
+        return delta, jnp.concatenate(rates)
 
     def measure(self, channel: str, value):
         for effect in self.effects:
             value = effect.measure(channel, value)
         return value
 
-    def replay_state(self, start, servo: bool = False):
-        """The base's state at a window start, from the true r and psi behind the
-        readings (sensor effects removed)."""
+    def true_start(self, start):
+        """A window start with the true r and psi behind the readings (sensor effects
+        removed)."""
         true = lambda channel, value: _unmeasure(self.effects, channel, value)
-        start = eqx.tree_at(lambda s: (s.r, s.psi, s.r_first, s.psi_first), start,
-                            (true("r", start.r), true("psi", start.psi),
-                             true("r", start.r_first), true("psi", start.psi_first)))
-        return self.base.replay_state(start, servo)
+        return eqx.tree_at(lambda s: (s.r, s.psi, s.r_first, s.psi_first), start,
+                           (true("r", start.r), true("psi", start.psi),
+                            true("r", start.r_first), true("psi", start.psi_first)))
 
 
 def _unmeasure(effects, channel, value):
@@ -186,13 +308,17 @@ def _check_effects(effects):
 
 class AugmentedVessel(_Augmented, AbstractVessel):
     """A vessel with effects: $\\tau = \\tau_{base}(u, v, r, \\delta', n) +
-    \\sum_e \\tau_e$, $\\delta'$ the rudder after the effects' actuator path."""
+    \\sum_e \\tau_e$, $\\delta'$ the rudder after the effects' actuator path. The
+    effects' states follow the eight of `ShipState` in the simulated state vector;
+    `held` carries their values into `loads` during an evaluation (None: a steady
+    state at the current rudder)."""
 
     base: AbstractVessel
     effects: tuple[AbstractEffect, ...]
+    held: Array | None = None
 
-    def __init__(self, base: AbstractVessel, effects=()):
-        self.base, self.effects = base, _check_effects(effects)
+    def __init__(self, base: AbstractVessel, effects=(), held=None):
+        self.base, self.effects, self.held = base, _check_effects(effects), held
 
     @property
     def length(self):
@@ -233,40 +359,80 @@ class AugmentedVessel(_Augmented, AbstractVessel):
         return self.loads(0.0, u, v, r, delta, n)
 
     def loads(self, t, u, v, r, delta, n):
-        tau = self.base.loads(t, u, v, r, self._rudder(delta), n)
+        z = self.effect_initial(delta) if self.held is None else self.held
+        tau = self.base.loads(t, u, v, r, self.rudder_path(delta, z)[0], n)
         for effect in self.effects:
             tau = tau + effect.loads(t, self.base, u, v, r, delta, n)
         return tau
 
+    def holding(self, z) -> "AugmentedVessel":
+        """This vessel with the effects' states `z` for its `loads`."""
+        return AugmentedVessel(self.base, self.effects, z)
+
+    def replay_state(self, start, servo: bool = False):
+        y = self.base.replay_state(self.true_start(start), servo)
+        return jnp.concatenate([y, self.effect_initial(y[6])])
+
+    def replay_field(self, servo: bool = False):
+        if not self.effect_state_size:
+            return AbstractVessel.replay_field(self, servo)
+        size = len(STATE_FIELDS)
+
+        def field(t, y, inputs):
+            z = y[size:]
+            y_dot = AbstractVessel.replay_field(self.holding(z), servo)(t, y[:size], inputs)
+            delta = y[STATE_FIELDS.index("delta")] if servo else inputs["delta"]
+            return jnp.concatenate([y_dot, self.rudder_path(delta, z)[1]])
+
+        return field
+
 
 class AugmentedSteering(_Augmented, AbstractSteeringModel):
-    """A steering model with effects: $\\dot x = f(x, \\delta', a) + e_r
-    \\sum_e \\dot r_e$, with $\\delta'$ the rudder after the effects' actuator path and
-    $e_r$ the yaw-rate state."""
+    """A steering model with effects: $\\dot x = f(x, \\delta', a) + b(x)\\sum_e f_e$,
+    $\\delta'$ the rudder after the effects' actuator path, $f_e$ their terms in the
+    yaw equation and $b$ the model's `forcing`; the effects' states follow the
+    model's own (the heading stays last)."""
 
     base: AbstractSteeringModel
     effects: tuple[AbstractEffect, ...]
+
     def __init__(self, base: AbstractSteeringModel, effects=()):
         self.base, self.effects = base, _check_effects(effects)
 
     @property
     def state_names(self):
-        return self.base.state_names
+        return self.base.state_names + tuple(f"{e.id}.{name}" for e in self.effects
+                                             for name in e.state_names)
+
+    def _split(self, state):
+        k = len(self.base.state_names)
+        return state[:k], state[k:]
 
     def rhs(self, state, delta, aux):
-        x_dot = self.base.rhs(state, self._rudder(delta), aux)
-        extra = sum(jnp.asarray(e.yaw_acceleration(0.0, self.base, state, delta), float)
-                    for e in self.effects)
-        return x_dot.at[0].add(extra)
+        x, z = self._split(state)
+        seen, z_dot = self.rudder_path(delta, z)
+        term = sum(jnp.asarray(e.yaw_term(self.base, x, delta), float) for e in self.effects)
+        x_dot = self.base.rhs(x, seen, aux) + self.base.forcing(x) * term
+        return jnp.concatenate([x_dot, z_dot])
+
+    def forcing(self, state):
+        return jnp.concatenate([self.base.forcing(self._split(state)[0]),
+                                jnp.zeros((self.effect_state_size,))])
 
     def output(self, state):
-        return self.base.output(state)
+        return self.base.output(self._split(state)[0])
 
     def initial_state(self, r):
-        return self.base.initial_state(r)
+        """The base's steady state at yaw rate `r`, the effects' at zero rudder."""
+        return jnp.concatenate([self.base.initial_state(r), self.effect_initial(0.0)])
 
     def window_state(self, start):
-        return self.base.window_state(start)
+        """The base's window state, the effects' steady at the window's rudder."""
+        return jnp.concatenate([self.base.window_state(start),
+                                self.effect_initial(start.delta)])
+
+    def replay_state(self, start, servo: bool = False):
+        return AbstractSteeringModel.replay_state(self, self.true_start(start), servo)
 
 
 def augment(model, *effects):
@@ -279,3 +445,12 @@ def augment(model, *effects):
             return augmented(model, effects)
     raise ValueError(f"`model` must be a jaxship vessel or steering model, got "
                      f"{type(model).__name__}.")
+
+
+def nonlinear_nomoto2(K, T1, T2, T3, beta1=0.0, delta0=0.0) -> AugmentedSteering:
+    """The second-order nonlinear response model of Lu & Zhao (2008, eq. 4; seed 002),
+    $T_1T_2\\ddot r + (T_1 + T_2)\\dot r + r + \\beta_1 r^3 = K(\\delta + \\delta_0)
+    + KT_3\\dot\\delta$ ($\\alpha_1 = 1$, as they fix it): `Nomoto2` with the effect
+    `YawCubicDamping` (its parameter `"yaw_cubic_damping.beta"` is $\\beta_1$)."""
+    return AugmentedSteering(Nomoto2(K=K, T1=T1, T2=T2, T3=T3, delta0=delta0),
+                             (YawCubicDamping(beta=beta1),))

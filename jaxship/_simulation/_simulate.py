@@ -227,17 +227,35 @@ def _as_arrays(tree):
     return jax.tree.map(lambda x: np.asarray(x, dtype=dtype) if is_number(x) else x, tree)
 
 
+def initial_vector(vessel, x0: ShipState):
+    """The state vector at `x0`: its eight fields, then the vessel's effect states in
+    their steady state at the rudder angle of `x0`."""
+    y0 = to_vector(x0)
+    if vessel.effect_state_size:
+        y0 = jnp.concatenate([y0, vessel.effect_initial(x0.delta)])
+    return y0
+
+
 def vessel_field(vessel, environment, *, wind=True):
     """The vector field of `integrate` for a vessel driven by a `Command` policy: the
-    flat state `(u, v, r, x, y, psi, delta, n)` and the command at time `t`."""
+    flat state `(u, v, r, x, y, psi, delta, n)` (then any effect states) and the
+    command at time `t`."""
     mass_inverse = inverse3(vessel.mass_matrix())  # once per run, outside the time loop
+    size = len(STATE_FIELDS)
 
     def field(t, y, args):
         command, t_k = args
         return to_vector(_state_derivative(vessel, from_vector(y), command.at(t - t_k),
                                           environment, mass_inverse, wind=wind, t=t))
 
-    return field
+    def field_with_effects(t, y, args):
+        command, t_k = args
+        z = y[size:]
+        y_dot = _state_derivative(vessel.holding(z), from_vector(y), command.at(t - t_k),
+                                  environment, mass_inverse, wind=wind, t=t)
+        return jnp.concatenate([to_vector(y_dot), vessel.rudder_path(y[6], z)[1]])
+
+    return field_with_effects if vessel.effect_state_size else field
 
 
 @eqx.filter_jit
@@ -250,7 +268,7 @@ def _simulate(vessel, manoeuvre, x0, environment, simulator, steps, wind=True, p
     (the batching layer uses it) but costs a little per step for a single run.
     """
     t0 = manoeuvre.start
-    y0 = to_vector(x0)
+    y0 = initial_vector(vessel, x0)
     dt = jnp.asarray(manoeuvre.dt, dtype=float)
     num = manoeuvre.num_samples
 
@@ -261,7 +279,7 @@ def _simulate(vessel, manoeuvre, x0, environment, simulator, steps, wind=True, p
         delta, n = jnp.asarray(command.delta, float), jnp.asarray(command.n, float)
         if per_field:
             return tuple(y[i] for i in range(len(STATE_FIELDS))) + (delta, n)
-        return jnp.concatenate([y, jnp.stack([delta, n])])
+        return jnp.concatenate([y[:len(STATE_FIELDS)], jnp.stack([delta, n])])
 
     out, ok = integrate(vessel_field(vessel, environment, wind=wind), y0, policy,
                         manoeuvre.init(x0), t0, dt, num, simulator, steps, observe)

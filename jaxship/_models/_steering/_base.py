@@ -95,6 +95,13 @@ class AbstractSteeringModel(eqx.Module):
     def window_state(self, start: WindowStart) -> Array:
         """The state at a window start, reconstructed from the record."""
 
+    def forcing(self, state: Array) -> Array:
+        """$b(x) = \\partial\\dot x/\\partial f$: how a term $f$ added to the right-hand
+        side of the yaw equation, where the rudder's moment enters, moves the state
+        (effects use it, `jaxship.YawMomentBias`). Here the yaw equation is
+        $\\dot r = \\dots$, so $b = e_r$; Nomoto models override it."""
+        return jnp.zeros_like(state).at[0].set(1.0)
+
     # -- the model contract shared with vessels: the simulated state is y = (x, psi) --
 
     def channel_index(self, channel: str) -> int:

@@ -34,6 +34,10 @@ class Nomoto1(AbstractSteeringModel):
     def output(self, state: Array) -> Array:
         return state[0]
 
+    def forcing(self, state: Array) -> Array:
+        # T r' + ... = K delta + f
+        return jnp.ones_like(state) / self.T
+
     def initial_state(self, r: ArrayLike) -> Array:
         return jnp.reshape(jnp.asarray(r, dtype=float), (1,))
 
@@ -88,6 +92,11 @@ class Nomoto2(AbstractSteeringModel):
     def output(self, state: Array) -> Array:
         return state[0]
 
+    def forcing(self, state: Array) -> Array:
+        # T1 T2 r'' + (T1 + T2) r' + r = K (delta + delta0) + K T3 delta' + f enters
+        # where K (delta + delta0) does: r_aux' = K (delta + delta0) - r + f
+        return jnp.zeros_like(state).at[1].set(1.0)
+
     def initial_state(self, r: ArrayLike) -> Array:
         r = jnp.asarray(r, dtype=float)
         return jnp.stack([r, (self.T1 + self.T2 - self.T3) * r])
@@ -134,6 +143,10 @@ class NonlinearNomoto(AbstractSteeringModel):
 
     def output(self, state: Array) -> Array:
         return state[0]
+
+    def forcing(self, state: Array) -> Array:
+        # T r' + ... = K delta + f
+        return jnp.ones_like(state) / self.T
 
     def initial_state(self, r: ArrayLike) -> Array:
         return jnp.reshape(jnp.asarray(r, dtype=float), (1,))

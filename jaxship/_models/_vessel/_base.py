@@ -49,6 +49,9 @@ class AbstractVessel(eqx.Module):
     start_channels: ClassVar[tuple[str, ...]] = ("u", "v")
     wind_loads: ClassVar[bool] = True
     has_servo: ClassVar[bool] = True
+    # states of effects (a rudder lag, ...) after the eight of `ShipState`; see
+    # `jaxship.AugmentedVessel`
+    effect_state_size: ClassVar[int] = 0
 
     @abc.abstractmethod
     def mass_matrix(self) -> Array:

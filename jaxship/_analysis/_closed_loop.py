@@ -1,0 +1,286 @@
+"""Closed-loop runs of heading autopilots on a plant (a truth vessel or a steering
+model), batched over autopilots x speeds, and their metrics (Odegard 2009, sec. 5.4)."""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array
+
+from .._foundation._kinematics import ssa
+from .._foundation._state import ShipState, from_vector
+from .._models._control import HeadingAutopilot
+from .._models._effects import RecordedDisturbance, augment
+from .._models._environment import Environment
+from .._models._steering._base import AbstractSteeringModel
+from .._models._vessel._base import AbstractVessel, straight_run
+from .._simulation._batch import stack, straight_run_batch
+from .._simulation._simulate import (
+    Held,
+    Simulator,
+    _as_arrays,
+    initial_vector,
+    integrate,
+    vessel_field,
+)
+from .._simulation._simulate_steering import steering_field
+
+
+class YawDisturbance(eqx.Module):
+    """A slowly varying yaw moment (a sea-state stand-in): first-order filtered white
+    noise (a first-order Gauss-Markov process), $x_{k+1} = a x_k +
+    \\sqrt{1 - a^2}\\,\\sigma w_k$, $a = e^{-\\Delta/T}$, stationary standard deviation
+    $\\sigma$ = `rudder_std` [rad] expressed as the rudder angle whose yaw moment it
+    equals at the vessel's nominal straight run, time constant `time_constant` [s],
+    held over `sample_interval` [s], drawn from `seed` (NumPy). Vessels only; added
+    with `RecordedDisturbance` through `augment`. No wave filter is modelled."""
+
+    rudder_std: float = float(np.deg2rad(2.0))
+    time_constant: float = 30.0
+    sample_interval: float = 1.0
+    seed: int = eqx.field(static=True, default=0)
+
+    def effect(self, vessel: AbstractVessel, duration: float) -> RecordedDisturbance:
+        """The `RecordedDisturbance` covering `duration` [s] for `vessel`."""
+        rng = np.random.default_rng(self.seed)
+        count = int(np.ceil(duration / self.sample_interval)) + 2
+        a = np.exp(-self.sample_interval / self.time_constant)
+        noise = rng.standard_normal(count)
+        x = np.empty(count)
+        x[0] = noise[0]
+        for k in range(1, count):
+            x[k] = a * x[k - 1] + np.sqrt(1 - a * a) * noise[k]
+        s0 = straight_run(vessel)
+        per_rad = jax.grad(lambda d: vessel.forces(s0.u, s0.v, s0.r, d, s0.n)[2])(0.0)
+        moment = self.rudder_std * float(per_rad) * x
+        return RecordedDisturbance(dt=self.sample_interval, yaw_moment=jnp.asarray(moment),
+                                   sway_force=jnp.zeros(count))
+
+
+class ClosedLoop(eqx.Module):
+    """Closed-loop runs: `t` [s] (N,); heading `psi`, desired heading `psi_d` (the
+    reference model's output), ordered heading `psi_ref` [rad], yaw rate `r`, desired
+    rate `r_d` [rad/s], actual rudder `delta` and rudder command `delta_c` [rad], each
+    (autopilots, speeds, N); `speed` (speeds,) the initial surge speed [m/s];
+    `max_rate` [rad/s] and `control_period` [s] of each autopilot; `success` per run."""
+
+    t: Array
+    psi: Array
+    psi_d: Array
+    psi_ref: Array
+    r: Array
+    r_d: Array
+    delta: Array
+    delta_c: Array
+    speed: Array
+    max_rate: Array
+    control_period: Array
+    success: Array
+
+
+def _autopilot_batch(autopilots) -> HeadingAutopilot:
+    """One autopilot, a list of them, or a `stack` of them, as a stack."""
+    if isinstance(autopilots, (list, tuple)):
+        return stack(list(autopilots))
+    if not isinstance(autopilots, HeadingAutopilot):
+        raise ValueError(f"`autopilots` must be HeadingAutopilot(s), got "
+                         f"{type(autopilots).__name__}.")
+    return autopilots if np.ndim(autopilots.kp) == 1 else stack([autopilots])
+
+
+def initial_states(plant, speeds=None, rpm=None) -> ShipState:
+    """Straight runs of `plant` at `speeds` [m/s] or `rpm` (one of them, or neither:
+    the nominal approach of a vessel, rest for a steering model), batched. A steering
+    model keeps u = speed and n = rpm/60 as constant auxiliary inputs."""
+    if speeds is not None and rpm is not None:
+        raise ValueError("give `speeds` or `rpm`, not both.")
+    n = None if rpm is None else np.atleast_1d(np.asarray(rpm, dtype=float)) / 60.0
+    speeds = None if speeds is None else np.atleast_1d(np.asarray(speeds, dtype=float))
+    if isinstance(plant, AbstractVessel):
+        if speeds is None and n is None:
+            return jax.tree.map(lambda a: jnp.asarray(a)[None], straight_run(plant))
+        return straight_run_batch(plant, speed=speeds, n=n)
+    if not isinstance(plant, AbstractSteeringModel):
+        raise ValueError(f"`plant` must be a vessel or a steering model, got "
+                         f"{type(plant).__name__}.")
+    size = len(speeds if speeds is not None else n if n is not None else [0.0])
+    zero = jnp.zeros(size)
+    u = zero if speeds is None else jnp.asarray(speeds)
+    return ShipState(u=u, v=zero, r=zero, x=zero, y=zero, psi=zero, delta=zero,
+                     n=zero if n is None else jnp.asarray(n))
+
+
+def closed_loop(plant, autopilots, *, speeds=None, rpm=None, duration: float = 300.0,
+                dt: float = 0.1, disturbance: YawDisturbance | None = None,
+                simulator: Simulator = Simulator()) -> ClosedLoop:
+    """Run each autopilot on `plant` from straight runs at each of `speeds` [m/s] or
+    `rpm` (see `initial_states`) for `duration` [s], output every `dt` [s].
+
+    - `plant`: a vessel (the autopilot's command goes through its rudder servo) or a
+      steering model (ideal rudder: the command is the angle; constant auxiliary
+      inputs u = speed, v = 0, n = rpm/60).
+    - `autopilots`: a `HeadingAutopilot`, a list of them or a `jaxship.stack` of them.
+    - `disturbance`: an optional `YawDisturbance` (vessels only), one realisation
+      shared by all runs.
+
+    One compiled call, vmapped over autopilots x speeds; differentiable in the
+    autopilots' gains. **Returns:** a `ClosedLoop` with axes (autopilots, speeds, N).
+    """
+    setup = _setup(plant, speeds, rpm, duration, dt, disturbance, simulator)
+    return _closed_loop(setup[0], _as_arrays(_autopilot_batch(autopilots)), *setup[1:])
+
+
+def _setup(plant, speeds, rpm, duration, dt, disturbance, simulator):
+    """What `_closed_loop` needs besides the autopilots: `(plant, x0, dt, num,
+    simulator, steps)`, the plant with the disturbance added."""
+    x0 = initial_states(plant, speeds, rpm)
+    if disturbance is not None:
+        if not isinstance(plant, AbstractVessel):
+            raise ValueError("`disturbance` acts on vessels only (a yaw moment).")
+        plant = augment(plant, disturbance.effect(plant, duration))
+    num = int(round(duration / dt)) + 1
+    return (_as_arrays(plant), x0, jnp.asarray(dt, float), num, simulator,
+            simulator.steps_per_sample(dt))
+
+
+@eqx.filter_jit
+def _closed_loop(plant, batch, x0, dt, num, simulator, steps):
+    one = lambda autopilot, state0: _run(plant, autopilot, state0, dt, num, simulator, steps)
+    runs = jax.vmap(jax.vmap(one, in_axes=(None, 0)), in_axes=(0, None))(batch, x0)
+    psi, psi_d, psi_ref, r, r_d, delta, delta_c, ok = runs
+    return ClosedLoop(t=jnp.arange(num) * dt, psi=psi, psi_d=psi_d, psi_ref=psi_ref, r=r,
+                      r_d=r_d, delta=delta, delta_c=delta_c, speed=jnp.asarray(x0.u),
+                      max_rate=jnp.asarray(batch.max_rate) + 0.0 * batch.kp,
+                      control_period=jnp.maximum(batch.interval, dt / steps) + 0.0 * batch.kp,
+                      success=ok)
+
+
+def _run(plant, autopilot, x0, dt, num, simulator, steps):
+    """One closed-loop run from `x0` at t = 0: the records of `ClosedLoop` and success."""
+    vessel = isinstance(plant, AbstractVessel)
+    if vessel:
+        y0, base = initial_vector(plant, x0), vessel_field(plant, Environment(), wind=False)
+        ship = lambda y, memory: from_vector(y)
+    else:
+        y0 = jnp.concatenate([plant.initial_state(x0.r), jnp.reshape(x0.psi, (1,))])
+        base, zero = steering_field(plant), jnp.zeros_like(x0.u)
+
+        def ship(y, memory):  # ideal rudder: the actual angle is the held command
+            return ShipState(u=x0.u, v=zero, r=plant.output(y[:-1]), x=zero, y=zero,
+                             psi=y[-1], delta=memory.command, n=x0.n)
+
+    def policy(t, y, memory, h):
+        command, new = autopilot.command(t, ship(y, memory), memory, h)
+        record = (memory.reference[0], memory.reference[1],
+                  memory.origin + autopilot.steps(t + 0.5 * h), command.delta)
+        if not vessel:
+            held = dict(delta=command.delta, u=x0.u, v=zero, n=x0.n)
+            command = Held(held, jax.tree.map(jnp.zeros_like, held))
+        return (command, record), new
+
+    def field(t, y, args):
+        (inputs, _), t_k = args
+        return base(t, y, (inputs, t_k))
+
+    def observe(y, inputs):
+        psi_d, r_d, psi_ref, delta_c = inputs[1]
+        if vessel:
+            return y[5], psi_d, psi_ref, y[2], r_d, y[6], delta_c
+        return y[-1], psi_d, psi_ref, plant.output(y[:-1]), r_d, delta_c, delta_c
+
+    out, ok = integrate(field, y0, policy, autopilot.init(x0), 0.0, dt, num, simulator, steps,
+                        observe)
+    return (*out, ok)
+
+
+class ClosedLoopMetrics(eqx.Module):
+    """Metrics of closed-loop runs, SI units, one value per run (autopilots, speeds):
+
+    - `residual_sum`: thesis eq. 3.19, $\\sum_k|\\psi_d(t_k) - \\psi(t_k)|$ [rad] over the
+      samples every `sample_interval` in the window; it scales with 1/`sample_interval`
+      (the thesis does not state its sampling; its Tables 5.2-5.7 give 17-185,
+      plausibly degrees summed at 1 s over 100-200 s, i.e. `to_dict_deg` with
+      `sample_interval=1.0, window=(100, 200)`);
+    - `rms_error`: $\\sqrt{\\overline{(\\psi_d - \\psi)^2}}$ [rad] over the same samples;
+    - `overshoot`: the largest heading past the final ordered heading after the last
+      step, in the direction of the step [rad] (0 if none);
+    - `settling_time`: from the last step until the heading stays within 2 % of the
+      step size of the final ordered heading [s] (inf if it never does);
+    - `mean_abs_rudder` $\\overline{|\\delta|}$ and `rudder_travel` $\\sum|\\Delta\\delta|$
+      [rad] of the actual rudder over the window;
+    - `time_at_rate_limit` [s]: time the command moved at the autopilot's rate limit
+      (from the command's changes between output samples).
+    """
+
+    residual_sum: Array
+    rms_error: Array
+    overshoot: Array
+    settling_time: Array
+    mean_abs_rudder: Array
+    rudder_travel: Array
+    time_at_rate_limit: Array
+    sample_interval: float = eqx.field(static=True, default=1.0)
+
+    def to_dict_deg(self) -> dict:
+        """The metrics as lists, angles in degrees, times in seconds (for JSON)."""
+        deg = lambda a: np.degrees(np.asarray(a)).tolist()
+        return dict(residual_sum_deg=deg(self.residual_sum), rms_error_deg=deg(self.rms_error),
+                    overshoot_deg=deg(self.overshoot),
+                    settling_time_s=np.asarray(self.settling_time).tolist(),
+                    mean_abs_rudder_deg=deg(self.mean_abs_rudder),
+                    rudder_travel_deg=deg(self.rudder_travel),
+                    time_at_rate_limit_s=np.asarray(self.time_at_rate_limit).tolist(),
+                    sample_interval_s=self.sample_interval)
+
+
+def closed_loop_metrics(run: ClosedLoop, sample_interval: float = 1.0,
+                        window: tuple[float, float] | None = None) -> ClosedLoopMetrics:
+    """`ClosedLoopMetrics` of `run`; `sample_interval` [s] (a multiple of the run's
+    output interval) samples eq. 3.19, `window` = (start, end) [s] limits the
+    residual, RMS and rudder metrics (default: the whole run)."""
+    t = np.asarray(run.t)
+    dt = float(t[1] - t[0])
+    every = int(round(sample_interval / dt))
+    if every < 1 or abs(every * dt - sample_interval) > 1e-9 * max(1.0, sample_interval):
+        raise ValueError(f"`sample_interval` ({sample_interval} s) must be a multiple of the "
+                         f"run's output interval ({dt} s).")
+    start, end = (t[0], t[-1]) if window is None else window
+    inside = (t >= start - 1e-9 * dt) & (t <= end + 1e-9 * dt)
+    first = int(np.argmax(inside))
+    sampled = np.zeros_like(inside)
+    sampled[first::every] = True
+    sampled &= inside
+    error = ssa(run.psi_d - run.psi)
+    pick = lambda a, mask: a[..., np.flatnonzero(mask)]
+    final = run.psi_ref[..., -1:]
+    changed = jnp.abs(jnp.diff(run.psi_ref, axis=-1)) > 0
+    last = jnp.max(jnp.where(changed, jnp.arange(1, t.size), 0), axis=-1, keepdims=True)
+    size = final - jnp.take_along_axis(run.psi_ref, jnp.maximum(last - 1, 0), axis=-1)
+    after = jnp.arange(t.size) >= last
+    past = jnp.where(after, jnp.sign(size) * (run.psi - final), 0.0)
+    outside = after & (jnp.abs(run.psi - final) > 0.02 * jnp.abs(size))
+    j = jnp.max(jnp.where(outside, jnp.arange(t.size), -1), axis=-1)
+    t_last = jnp.asarray(t)[last[..., 0]]
+    settle = jnp.where(j < 0, 0.0, jnp.asarray(t)[jnp.minimum(j + 1, t.size - 1)] - t_last)
+    delta = pick(run.delta, inside)
+    command = pick(run.delta_c, inside)
+    limit = (run.max_rate * jnp.maximum(dt, run.control_period))[:, None, None]
+    moved = jnp.abs(jnp.diff(command, axis=-1)) >= (1 - 1e-6) * limit
+    return ClosedLoopMetrics(
+        residual_sum=jnp.sum(jnp.abs(pick(error, sampled)), axis=-1),
+        rms_error=jnp.sqrt(jnp.mean(pick(error, sampled) ** 2, axis=-1)),
+        overshoot=jnp.maximum(jnp.max(past, axis=-1), 0.0),
+        settling_time=jnp.where(j >= t.size - 1, jnp.inf, settle),
+        mean_abs_rudder=jnp.mean(jnp.abs(delta), axis=-1),
+        rudder_travel=jnp.sum(jnp.abs(jnp.diff(delta, axis=-1)), axis=-1),
+        time_at_rate_limit=jnp.sum(moved, axis=-1) * jnp.maximum(dt, run.control_period)[
+            :, None],
+        sample_interval=float(sample_interval),
+    )
+
+
+def tracking_objective(run: ClosedLoop, rudder_weight: float = 0.1) -> Array:
+    """The tuning objective of `tune_autopilot`: $\\overline{\\tilde\\psi^2} + w\\,
+    \\overline{\\delta_c^2}$ [rad^2], means over all runs and samples, $\\tilde\\psi =
+    \\mathrm{ssa}(\\psi_d - \\psi)$, $w$ = `rudder_weight`."""
+    return jnp.mean(ssa(run.psi_d - run.psi) ** 2) + rudder_weight * jnp.mean(run.delta_c**2)

@@ -1,0 +1,249 @@
+"""The heading autopilot: a third-order reference model and a PID controller with
+reference feed-forward (Odegard 2009, ch. 5, eq. 5.1-5.7; Fossen 2011, ch. 12), run
+inside the simulation as an `AbstractController`.
+
+Sign convention of jaxship: a positive rudder angle turns the ship to starboard
+($r > 0$), so the feedback terms carry a plus sign on the errors $\\tilde\\psi =
+\\mathrm{ssa}(\\psi_d - \\psi)$, $\\tilde r = r_d - r$ (the thesis, after Fossen, writes
+$\\tau_N = \\tau_{FF} - K_p\\tilde\\psi - K_d\\tilde r - K_i\\int\\tilde\\psi$ with the
+errors the other way round, $\\tilde\\psi = \\psi - \\psi_d$: the same law).
+"""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array, ArrayLike
+
+from .._foundation._kinematics import ssa
+from .._foundation._state import Command, ShipState
+from ._manoeuvres import AbstractController
+from ._steering._base import AbstractSteeringModel, AuxInputs
+from ._vessel._base import AbstractVessel, inverse3
+
+
+def _floats(x):
+    """Numbers and sequences as float NumPy arrays (cast to JAX's default float when
+    traced); JAX arrays and tracers as they are."""
+    return x if isinstance(x, jax.Array) else np.asarray(x, dtype=float)
+
+
+class ReferenceModel(eqx.Module):
+    """Third-order reference model (thesis eq. 5.7, after Fossen 2011, ch. 10)
+
+    $$\\frac{\\psi_d}{\\psi_{ref}}(s) = \\frac{\\omega^3}{(s + \\omega)(s^2 + 2\\zeta\\omega s
+    + \\omega^2)},\\quad \\psi_d^{(3)} + (2\\zeta + 1)\\omega\\ddot\\psi_d + (2\\zeta + 1)
+    \\omega^2\\dot\\psi_d + \\omega^3\\psi_d = \\omega^3\\psi_{ref},$$
+
+    with the state $(\\psi_d, r_d, a_d) = (\\psi_d, \\dot\\psi_d, \\ddot\\psi_d)$. `step`
+    advances it over a control step of `h` seconds with $\\psi_{ref}$ held, by the
+    classical RK4 (relative error $(\\omega h)^5/120$ per step, 3e-11 at the defaults
+    and h = 0.1 s), then saturates the rate at `max_rate` and the acceleration at
+    `max_acceleration` (the velocity saturation of Fossen's MSS `refModel3`); while the
+    rate is at its limit the acceleration pushing past it is set to zero, so the filter
+    does not wind up.
+    """
+
+    natural_frequency: ArrayLike = 0.2  # omega [rad/s], thesis Table 5.1
+    damping: ArrayLike = 1.0  # zeta [-], thesis Table 5.1
+    max_rate: ArrayLike = float("inf")  # |r_d| limit [rad/s]
+    max_acceleration: ArrayLike = float("inf")  # |a_d| limit [rad/s^2]
+
+    def derivative(self, state: Array, psi_ref: ArrayLike) -> Array:
+        """$(\\dot\\psi_d, \\dot r_d, \\dot a_d)$ of eq. 5.7 at `state`."""
+        w, z = self.natural_frequency, self.damping
+        psi_d, r_d, a_d = state[0], state[1], state[2]
+        jerk = w**3 * (psi_ref - psi_d) - (2 * z + 1) * w**2 * r_d - (2 * z + 1) * w * a_d
+        return jnp.stack([r_d, a_d, jerk])
+
+    def step(self, state: Array, psi_ref: ArrayLike, h: ArrayLike) -> Array:
+        """The state `h` seconds later with `psi_ref` [rad] held (RK4, then the limits)."""
+        k1 = self.derivative(state, psi_ref)
+        k2 = self.derivative(state + 0.5 * h * k1, psi_ref)
+        k3 = self.derivative(state + 0.5 * h * k2, psi_ref)
+        k4 = self.derivative(state + h * k3, psi_ref)
+        psi_d, r_d, a_d = state + h * (k1 + 2 * k2 + 2 * k3 + k4) / 6
+        r_d = jnp.clip(r_d, -self.max_rate, self.max_rate)
+        a_d = jnp.clip(a_d, -self.max_acceleration, self.max_acceleration)
+        at_limit = (jnp.abs(r_d) >= self.max_rate) & (a_d * r_d > 0)
+        return jnp.stack([psi_d, r_d, jnp.where(at_limit, 0.0, a_d)])
+
+
+class HeadingSteps(eqx.Module):
+    """The ordered heading: $\\psi_{ref}(t) = \\psi_0 + $ `headings[k]` from `times[k]`
+    on (the last step taken), $\\psi_0$ before the first step; relative to the initial
+    heading $\\psi_0$. Default: thesis Table 5.1, a 45 deg step at 100 s."""
+
+    times: ArrayLike = eqx.field(converter=_floats, default=(100.0,))  # [s], ascending
+    headings: ArrayLike = eqx.field(converter=_floats, default=(np.pi / 4,))  # [rad]
+
+    def __check_init__(self):
+        if np.shape(self.times) != np.shape(self.headings) or np.ndim(self.times) < 1:
+            raise ValueError(f"`times` and `headings` must be 1-D of one length, got shapes "
+                             f"{np.shape(self.times)} and {np.shape(self.headings)}.")
+
+    def __call__(self, t: ArrayLike) -> Array:
+        """The heading change ordered at time `t` [s] [rad]."""
+        taken = jnp.searchsorted(jnp.asarray(self.times), t, side="right")
+        values = jnp.concatenate([jnp.zeros((1,)), jnp.asarray(self.headings, dtype=float)])
+        return values[taken]
+
+
+def yaw_acceleration(model, r: ArrayLike, delta: ArrayLike, state: ShipState) -> Array:
+    """$\\dot r$ [rad/s^2] of `model` at yaw rate `r`, rudder angle `delta` and the
+    measured surge, sway and propeller rate of `state`.
+
+    - a vessel: the yaw row of $M^{-1}\\tau(u, v, r, \\delta, n)$ (Fossen 2021, eq. 6.1),
+      with `forces` (time-invariant loads; give the model without disturbances);
+    - a steering model: $\\dot r = h'(x)f(x, \\delta, a)$ at the state of a steady turn
+      $x =$ `initial_state(r)` with $a =$ `AuxInputs(u, v, n)`. For models with
+      more than one state (Nomoto 2, sway-yaw) the hidden states are taken at their
+      steady-turn values for `r`, an approximation while the yaw rate changes (for
+      Nomoto 2 it gives $\\delta = r/K + T_1T_2\\dot r/(KT_3)$, large for small
+      $T_3$, and no feed-forward at $T_3 = 0$ where $\\dot r$ does not depend on
+      $\\delta$).
+    """
+    if isinstance(model, AbstractVessel):
+        tau = model.forces(state.u, state.v, r, delta, state.n)
+        return inverse3(model.mass_matrix())[2] @ tau
+    if isinstance(model, AbstractSteeringModel):
+        x = model.initial_state(r)
+        x_dot = model.rhs(x, delta, AuxInputs(state.u, state.v, state.n))
+        return jax.jvp(model.output, (x,), (x_dot,))[1]
+    raise ValueError(f"the feed-forward model must be a jaxship vessel or steering model, got "
+                     f"{type(model).__name__}.")
+
+
+class Feedforward(eqx.Module):
+    """Reference feed-forward by inverting the yaw equation of `model` (a vessel or a
+    steering model) along the reference: the rudder $\\delta_{ff}$ with
+    $\\dot r(r_d, \\delta_{ff}; u, v, n) = \\dot r_d$ (see `yaw_acceleration`).
+
+    Solved by `newton_steps` Newton steps in $\\delta$ from 0 (derivative by
+    `jax.jvp`), each iterate kept within the rudder limit; exact after one step for
+    models linear in $\\delta$. For `Nomoto1` it is thesis eq. 5.2,
+    $\\delta_{ff} = (T\\dot r_d + r_d)/K$ (less the offset $\\delta_0$); for
+    `RossAutopilot` thesis eq. 5.6 (the hull moment along the reference, divided by
+    the rudder's moment per angle). Where the rudder has no effect (zero speed) it
+    returns 0.
+    """
+
+    model: AbstractVessel | AbstractSteeringModel
+    newton_steps: int = eqx.field(static=True, default=2)
+
+    def __call__(self, r_d: ArrayLike, r_dot_d: ArrayLike, state: ShipState,
+                 limit: ArrayLike = np.pi / 2) -> Array:
+        """$\\delta_{ff}$ [rad] for the desired yaw rate `r_d` and acceleration `r_dot_d`
+        at the measured `state`, within $\\pm$`limit`."""
+        def residual(delta):
+            return yaw_acceleration(self.model, r_d, delta, state) - r_dot_d
+
+        delta = jnp.zeros_like(jnp.asarray(r_d, dtype=float))
+        for _ in range(self.newton_steps):
+            value, slope = jax.jvp(residual, (delta,), (jnp.ones_like(delta),))
+            usable = jnp.abs(slope) > 1e-300
+            delta = delta - jnp.where(usable, value / jnp.where(usable, slope, 1.0), 0.0)
+            delta = jnp.clip(delta, -limit, limit)
+        return delta
+
+
+class AutopilotMemory(eqx.Module):
+    """The autopilot's memory, carried in the simulated state: the reference model's
+    state (psi_d, r_d, a_d) at the step's start, the integral of the heading error
+    [rad s], the command held [rad], the time of the next update [s] (-inf before the
+    first) and the initial heading the steps are relative to [rad]."""
+
+    reference: Array
+    integral: Array
+    command: Array
+    next_update: Array
+    origin: Array
+
+
+class HeadingAutopilot(AbstractController):
+    """PID heading autopilot with reference feed-forward (thesis eq. 5.1):
+
+    $$\\delta_c = \\delta_{ff}(r_d, \\dot r_d) + K_p\\tilde\\psi + K_d\\tilde r
+    + K_i\\int\\tilde\\psi\\,dt,\\qquad \\tilde\\psi = \\mathrm{ssa}(\\psi_d - \\psi),
+    \\quad \\tilde r = r_d - r,$$
+
+    with $(\\psi_d, r_d, \\dot r_d)$ from `reference` (eq. 5.7) driven by `steps`
+    (relative to the initial heading), and $\\delta_{ff}$ from `feedforward` (None: no
+    feed-forward) clipped to `max_angle`.
+
+    **Sampling.** The controller updates at its own `interval` [s]: at the first
+    control step whose start is within half a step of the scheduled time (a fixed grid,
+    so the mean rate is exact; every step when `interval` <= h), and holds its command
+    in between. The integral advances by $\\tilde\\psi\\,T_u$, $T_u = \\max$(`interval`,
+    h) (backward rectangle). The reference model advances every control step.
+
+    **Limits.** The command is rate-limited to `max_rate` $T_u$ per update from the
+    last command and clipped to `max_angle`. Anti-windup (`anti_windup=True`) by
+    conditional integration: the integral is frozen while the command saturates (in
+    angle or rate) and the error would drive it further into saturation. Chosen over
+    back-calculation because it needs no tracking time constant, leaves the
+    integrator exactly the pole-placement design when nothing saturates, and handles
+    the rate limit as well as the angle limit.
+
+    The gains `kp` [-], `ki` [1/s], `kd` [s] are arrays: differentiable and vmappable.
+    """
+
+    kp: ArrayLike  # K_p [rad rudder / rad heading]
+    ki: ArrayLike  # K_i [1/s]
+    kd: ArrayLike  # K_d [s]
+    reference: ReferenceModel = ReferenceModel()
+    steps: HeadingSteps = HeadingSteps()
+    feedforward: Feedforward | None = None
+    max_angle: ArrayLike = float(np.deg2rad(35.0))  # delta_max [rad]
+    max_rate: ArrayLike = float("inf")  # delta_dot_max [rad/s]
+    interval: ArrayLike = 0.1  # control interval [s]
+    anti_windup: bool = eqx.field(static=True, default=True)
+
+    def __check_init__(self):
+        for name in ("max_angle", "max_rate", "interval"):
+            value = getattr(self, name)
+            if isinstance(value, (int, float)) and not value > 0:
+                raise ValueError(f"HeadingAutopilot.{name} must be positive, got {value}.")
+
+    def init(self, x0: ShipState) -> AutopilotMemory:
+        psi0 = jnp.asarray(x0.psi, dtype=float)
+        zero = jnp.zeros_like(psi0)
+        return AutopilotMemory(reference=jnp.stack([psi0, zero, zero]), integral=zero,
+                               command=zero + x0.delta, next_update=zero - jnp.inf,
+                               origin=psi0)
+
+    def command(self, t, state: ShipState, memory: AutopilotMemory, h):
+        psi_d, r_d, a_d = memory.reference[0], memory.reference[1], memory.reference[2]
+        period = jnp.maximum(self.interval, h)
+        update = t >= memory.next_update - 0.5 * h
+        error = ssa(psi_d - state.psi)
+        fixed = self.kp * error + self.kd * (r_d - state.r)  # all but the integral term
+        if self.feedforward is not None:
+            fixed = fixed + jnp.clip(self.feedforward(r_d, a_d, state, self.max_angle),
+                                           -self.max_angle, self.max_angle)
+        move = self.max_rate * period
+
+        def saturate(integral):
+            wanted = fixed + self.ki * integral
+            limited = jnp.clip(wanted, memory.command - move, memory.command + move)
+            return wanted, jnp.clip(limited, -self.max_angle, self.max_angle)
+
+        integral = memory.integral + error * period
+        wanted, delta = saturate(integral)
+        if self.anti_windup:
+            excess = wanted - delta
+            winding = (excess != 0) & (excess * self.ki * error > 0)
+            integral = jnp.where(winding, memory.integral, integral)
+            delta = saturate(integral)[1]
+        scheduled = jnp.where(jnp.isfinite(memory.next_update),
+                              jnp.maximum(memory.next_update + self.interval, t + 0.5 * h),
+                              t + self.interval)
+        psi_ref = memory.origin + self.steps(t + 0.5 * h)
+        memory = AutopilotMemory(
+            reference=self.reference.step(memory.reference, psi_ref, h),
+            integral=jnp.where(update, integral, memory.integral),
+            command=jnp.where(update, delta, memory.command),
+            next_update=jnp.where(update, scheduled, memory.next_update),
+            origin=memory.origin,
+        )
+        return Command(memory.command, state.n), memory
