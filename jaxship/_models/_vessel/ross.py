@@ -48,7 +48,9 @@ class RossVessel(AbstractVessel):
     $C_N = \\sin\\alpha_R\\,[f_\\alpha(1 - s) + C_{N,90}\\, s]$,
     $s = \\tfrac12(1 + \\tanh((\\alpha_R^2 - \\alpha_s^2)/(2\\alpha_s\\Delta\\alpha)))$:
     Fujii's slope $f_\\alpha$ below the stall angle $\\alpha_s$, a flat-plate normal
-    force above it.
+    force above it. $\\alpha_s$ is the stall of the rudder where it works, i.e. in the
+    propeller race for a rudder behind a running screw, which stalls much later than in
+    open water (docs/thesis_vessel.md, sec. 16).
 
     Positive $\\delta$ turns to starboard ($r > 0$) as everywhere in jaxship; the
     model is port/starboard symmetric (no constant terms).
@@ -125,7 +127,7 @@ class RossVessel(AbstractVessel):
     rudder_area: float  # A_R [m^2], total of all rudders
     lift_slope: float  # f_alpha [1/rad], Fujii: 6.13 Lambda / (Lambda + 2.25)
     normal_force_90: float  # C_N,90 [-], post-stall normal force coefficient at 90 deg
-    stall_angle: float  # alpha_s [rad], effective angle of attack at stall
+    stall_angle: float  # alpha_s [rad], effective angle of attack at mid-stall (s = 1/2)
     stall_width: float  # Delta alpha [rad], width of the stall transition
     x_rudder: float  # x_R [m]
     flow_straightening: float  # gamma_R [-]
@@ -319,7 +321,7 @@ def thesis_vessel() -> RossVessel:
     kcf = half * T * hoerner_cd(B, T)
     cy, cn = crossflow_cross_terms()
 
-    # resistance: ITTC-57 line, form factor and a residuary term (tuned, docs sec. 5)
+    # resistance: ITTC-57 line, form factor and a residuary term (tuned, docs sec. 6, 12)
     S = 2.361  # wetted surface [m^2], SIMMAN 5415 model
     x_uu, x_uuu = resistance_fit(L, S, rho, nu, form_factor=1.10, residuary=1.0e-3,
                                  speeds=np.linspace(0.2, 2.0, 37))
@@ -327,7 +329,7 @@ def thesis_vessel() -> RossVessel:
     # induced drag of the hull lift as a wing of span 2T: X_vv = -Y_uv^2 / (2 pi rho T^2)
     x_vv = -(y_uv**2) / (2 * np.pi * rho * T**2)
 
-    aspect = 1.5  # rudder geometric aspect ratio Lambda (assumed, docs sec. 7)
+    aspect = 1.5  # rudder geometric aspect ratio Lambda (assumed, docs sec. 10)
     return RossVessel(
         length=L,
         rudder=RudderServo(
@@ -335,10 +337,10 @@ def thesis_vessel() -> RossVessel:
             max_rate=float(np.deg2rad(15.0)),  # thesis Table 4.1
             time_constant=1.0,  # T_delta [s], MSS convention
         ),
-        shaft=Shaft(max_rate=10.0, time_constant=1.0),  # 600 rpm, T_n = 1 s (docs sec. 6)
+        shaft=Shaft(max_rate=10.0, time_constant=1.0),  # 600 rpm, T_n = 1 s (docs sec. 9)
         nominal_speed=1.5429721868551294,  # straight run at 500 rpm (tests/test_ross.py)
         nominal_n=500.0 / 60.0,  # thesis sec. 4.1
-        frontal_wind_area=float(B * 0.2),  # bare hull, freeboard ~0.2 m (docs sec. 8)
+        frontal_wind_area=float(B * 0.2),  # bare hull, freeboard ~0.2 m (docs sec. 11)
         lateral_wind_area=float(L * 0.2),
         rho=rho,
         mass=float(m),
@@ -368,16 +370,22 @@ def thesis_vessel() -> RossVessel:
         n_absr_r=float(-kcf * L**4 / 32),
         n_propellers=2.0,  # twin screws, SIMMAN 5415
         prop_diameter=0.173,  # SIMMAN 5415 model propeller
-        kt0=0.5012,  # quadratic fit of B5-58, P/D = 1.15, J in [0, 1.2] (docs sec. 6)
+        kt0=0.5012,  # quadratic fit of B5-58, P/D = 1.15, J in [0, 1.2] (docs sec. 9)
         kt1=-0.2276,
         kt2=-0.1487,
-        wake=0.045,  # Holtrop (1984) twin-screw formula (docs sec. 6)
+        wake=0.045,  # Holtrop (1984) twin-screw formula (docs sec. 9)
         thrust_deduction=0.058,  # Holtrop (1984) twin-screw formula
-        rudder_area=0.018,  # tuned: 74 % of the twin SIMMAN rudders' 2 x 0.0122 (docs sec. 9)
+        rudder_area=0.018,  # tuned: 74 % of the twin SIMMAN rudders' 2 x 0.0122 (docs sec. 12)
         lift_slope=6.13 * aspect / (aspect + 2.25),  # Fujii & Tuda (1961)
         normal_force_90=1.2,  # flat plate of low aspect ratio (Hoerner 1965)
-        stall_angle=float(np.deg2rad(28.0)),  # tuned (docs sec. 7, 9)
-        stall_width=float(np.deg2rad(4.0)),
+        # stall in the propeller race (docs sec. 16): the rudders lie wholly in the race
+        # (eta = 1), where stall is delayed to 35-45 deg effective incidence (Molland &
+        # Turnock 2007, "Marine Rudders and Control Surfaces", ch. on rudder-propeller
+        # interaction; Brix 1993); MMG has no stall up to 35 deg (Yasukawa & Yoshimura 2015).
+        # alpha_s = 50 deg puts the C_N peak at 44.9 deg, the hard-over angle: the thesis'
+        # vessel turns hardest at 45 deg (Odegard 2009, sec. 4.1, figs. 4.7, 4.16).
+        stall_angle=float(np.deg2rad(50.0)),
+        stall_width=float(np.deg2rad(4.0)),  # assumed (docs sec. 10)
         x_rudder=-0.5 * L,  # MMG x'_R = -0.5
         flow_straightening=0.5,  # gamma_R, MMG range 0.4-0.64
         race_kappa=0.5,  # MMG KVLCC2 value
