@@ -20,6 +20,12 @@ from ._analysis._design import (
     excitation_order as excitation_order,
     fisher_information as fisher_information,
 )
+from ._analysis._discover._catalogue import (
+    DISCOVERY_CATALOGUE as DISCOVERY_CATALOGUE,
+    Candidate as Candidate,
+)
+from ._analysis._discover._report import DiscoveryReport as DiscoveryReport
+from ._analysis._discover._workflow import discover as discover
 from ._analysis._indices import (
     format_table as format_table,
     imo_criteria as imo_criteria,
@@ -99,6 +105,17 @@ from ._models._effects import (
     nonlinear_nomoto2 as nonlinear_nomoto2,
 )
 from ._models._environment import Current as Current, Environment as Environment, Wind as Wind
+from ._models._hydro_effects import (
+    AddedMassError as AddedMassError,
+    CrossflowDrag as CrossflowDrag,
+    PropellerAsymmetry as PropellerAsymmetry,
+    RudderStall as RudderStall,
+    SpeedDependentRudder as SpeedDependentRudder,
+    SurgeTurnResistance as SurgeTurnResistance,
+    UniformCurrent as UniformCurrent,
+    Windage as Windage,
+    YawQuadraticDamping as YawQuadraticDamping,
+)
 from ._models._manoeuvres import (
     AbstractController as AbstractController,
     AbstractManoeuvre as AbstractManoeuvre,

@@ -26,17 +26,45 @@ STEERING = {
     "linear_sway_yaw": js.LinearSwayYaw.from_vessel(js.vessel("sea_stratus_linear")),
     "norrbin_crossflow": js.NorrbinCrossFlow.from_vessel(js.vessel("sea_stratus_nonlinear")),
 }
-# effect, a parameter name and a non-zero value for it, the families it acts on
+# effect, a parameter name, a non-zero value of realistic size for the Mariner and
+# Nomoto 1 (K = 0.06 1/s, T = 25 s) -- one number, or one per family where the units
+# differ -- and the families it acts on
+U0 = 7.7175  # the Mariner's nominal speed [m/s]
 EFFECTS = {
     "rudder_offset": (js.RudderOffset(), "delta0", 0.02, ("vessel", "steering")),
     "yaw_moment_bias": (js.YawMomentBias(), "n0", 1e-4, ("steering",)),
     "sway_force_bias": (js.SwayForceBias(), "y0", 1e4, ("vessel",)),
     "yaw_rate_sensor_bias": (js.YawRateSensorBias(), "bias", 1e-3, ("vessel", "steering")),
     "heading_sensor_bias": (js.HeadingSensorBias(), "bias", 0.01, ("vessel", "steering")),
-    "yaw_cubic_damping": (js.YawCubicDamping(), "beta", 300.0, ("steering",)),
+    "yaw_cubic_damping": (js.YawCubicDamping(), "beta",
+                          {"vessel": 2e12, "steering": 300.0}, ("vessel", "steering")),
     "rudder_lag": (js.RudderLag(), "time_constant", 2.0, ("vessel", "steering")),
     "rudder_delay": (js.RudderDelay(), "delay", 1.5, ("vessel", "steering")),
     "rudder_rate_limit": (js.RudderRateLimit(), "inverse_rate", 60.0, ("vessel", "steering")),
+    "yaw_quadratic_damping": (js.YawQuadraticDamping(), "beta",
+                              {"vessel": 4e10, "steering": 10.0}, ("vessel", "steering")),
+    "crossflow_drag": (js.CrossflowDrag(), "coefficient", 0.04, ("vessel",)),
+    "speed_dependent_rudder": (js.SpeedDependentRudder(nominal_speed=U0), "kappa", 0.5,
+                               ("vessel", "steering")),
+    "rudder_stall": (js.RudderStall(), "c", 0.3, ("vessel", "steering")),
+    "propeller_asymmetry": (js.PropellerAsymmetry(), "moment",
+                            {"vessel": 1.4e6, "steering": 2.6e-4}, ("vessel", "steering")),
+    "surge_turn_resistance": (js.SurgeTurnResistance(), "x_vr", 0.004, ("vessel",)),
+    "added_mass_error": (js.AddedMassError(), "s_r", 0.2, ("vessel",)),
+    "current": (js.UniformCurrent(), "north", 0.5, ("vessel",)),
+    "wind": (js.Windage(), "lateral_area", 2000.0, ("vessel",)),
+}
+# what some effects need to show beyond a calm-water zig-zag of the Mariner from its
+# straight run (or Nomoto 1 without auxiliary inputs): wind (replayed as logged wind,
+# `PredictionError(wind=True)`), a propeller rate [rev/s] (the Mariner has none), the
+# measured u and n of a steering model, or the track (a current leaves the
+# through-water u, v, r, psi unchanged)
+_T = np.arange(200) * 0.5
+SHOWN_BY = {
+    "wind": {"environment": js.Environment(wind=js.Wind(15.0, np.deg2rad(60.0)))},
+    "current": {"track": True},
+    "propeller_asymmetry": {"n": 1.5, "aux": {"n": 2.0 + 0.0 * _T}},
+    "speed_dependent_rudder": {"aux": {"u": U0 * (0.85 + 0.15 * np.cos(2 * np.pi * _T / 80))}},
 }
 CONTROLLERS = {
     "turn": js.Turn(15 * DEG, duration=40.0, dt=0.5),
@@ -111,47 +139,70 @@ def test_steering_model_contract(name):
         jitted(v)
 
 
+def _with_wind(data, environment):
+    """`data` with the wind of `environment` as logged true wind."""
+    wind = environment.wind
+    return js.Experiment(data.t, data.delta, psi=data.psi, r=data.r, u=data.u, v=data.v,
+                         x=data.x, y=data.y, n=data.n, delta_c=data.delta_c,
+                         wind_speed=np.full(data.t.shape, float(wind.speed)),
+                         wind_dir=np.full(data.t.shape, float(wind.direction)))
+
+
 @pytest.mark.parametrize("effect", sorted(EFFECTS))
 def test_effect_contract(effect):
     """At zero the augmented model equals the base bit for bit; a non-zero value changes
     it; the parameter is named "<id>.<field>", free by default and differentiable."""
-    zero, field, value, families = EFFECTS[effect]
+    zero, field, values, families = EFFECTS[effect]
+    shown = SHOWN_BY.get(effect, {})
+    value = lambda family: values[family] if isinstance(values, dict) else values
     name = f"{effect}.{field}"
     assert zero.id == effect
     if "vessel" in families:
         vessel = js.vessel("mariner")
-        man, x0 = short_run(vessel), js.straight_run(vessel)
-        base = js.simulate(vessel, man, x0)
+        environment = shown.get("environment", js.Environment())
+        man = short_run(vessel)
+        x0 = js.straight_state(vessel.nominal_speed, shown["n"]) if "n" in shown else \
+            js.straight_run(vessel)
+        base = js.simulate(vessel, man, x0, environment=environment)
         augmented = js.augment(vessel, zero)
-        same = js.simulate(augmented, man, x0)
-        for key in ("u", "v", "r", "psi", "delta"):
+        same = js.simulate(augmented, man, x0, environment=environment)
+        for key in ("u", "v", "r", "x", "y", "psi", "delta"):
             np.testing.assert_array_equal(getattr(same.state, key), getattr(base.state, key))
         assert name in default_free(augmented)
-        moved = rebuild(augmented, (name,), (value,))
-        data = js.Experiment.from_trajectory(js.simulate(moved, man, x0))
-        plain = js.predict(augmented, data, estimator=js.PredictionError(horizon=None))
-        assert plain.fit_percent()["psi"] < 100 - 1e-6  # the effect shows in the data
+        moved = rebuild(augmented, (name,), (value("vessel"),))
+        truth = js.simulate(moved, man, x0, environment=environment)
+        if shown.get("track"):  # through-water velocities: only the track moves
+            assert np.max(np.abs(truth.state.x - base.state.x)) > 1.0
+        else:
+            data = js.Experiment.from_trajectory(truth)
+            wind = "environment" in shown
+            data = _with_wind(data, environment) if wind else data
+            plain = js.predict(augmented, data,
+                               estimator=js.PredictionError(horizon=None, wind=wind))
+            assert plain.fit_percent()["psi"] < 100 - 1e-6  # the effect shows in the data
     if "steering" in families:
         model = js.Nomoto1(K=0.06, T=25.0)
         delta = np.deg2rad(10) * np.sign(np.sin(2 * np.pi * np.arange(200) / 80.0) + 1e-9)
-        base = js.simulate_steering(model, delta, 0.5)
+        measured = shown.get("aux", {})
+        aux = js.AuxInputs(**measured)
+        base = js.simulate_steering(model, delta, 0.5, aux=aux)
         augmented = js.augment(model, zero)
-        same = js.simulate_steering(augmented, delta, 0.5)
+        same = js.simulate_steering(augmented, delta, 0.5, aux=aux)
         np.testing.assert_array_equal(same.psi, base.psi)
         np.testing.assert_array_equal(same.r, base.r)
         data = js.Experiment(np.asarray(base.t), delta, psi=np.asarray(base.psi),
-                             r=np.asarray(base.r))
+                             r=np.asarray(base.r), **measured)
 
         def cost(p):
             m = rebuild(augmented, (name,), (p,))
             out = js.predict(m, data, estimator=js.PredictionError(horizon=None))
             return sum(float(np.sum(v**2)) for v in out.predictions.values())
 
-        moved = rebuild(augmented, (name,), (value,))
+        moved = rebuild(augmented, (name,), (value("steering"),))
         reading = moved.measure("psi", 0.0) != 0.0 or moved.measure("r", 0.0) != 0.0
         # a sensor bias shows in the readings; it cancels in predictions that start from
         # the measured state (a heading bias is not identifiable from psi alone)
-        assert reading or cost(value) != cost(0.0)
+        assert reading or cost(value("steering")) != cost(0.0)
 
 
 @pytest.mark.parametrize("name", sorted(CONTROLLERS))

@@ -2,9 +2,11 @@
 equation of a steering model: their physics against closed-form responses, and their
 parameters recovered by `fit` like any other."""
 
+import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from scipy.integrate import quad
 
 import jaxship as js
 
@@ -131,3 +133,196 @@ def test_a_yaw_moment_on_nomoto_equals_a_rudder_offset():
             np.testing.assert_allclose(moment.r, offset.r, rtol=1e-12, atol=1e-15)
         else:  # Nomoto 2: the offset also enters through K T3 (delta + delta0)
             assert np.max(np.abs(moment.r - offset.r)) < 1e-2 * np.max(np.abs(offset.r))
+
+
+# -- hull, rudder, propeller and environment effects (`_hydro_effects.py`) --
+
+MARINER = js.vessel("mariner")
+U0 = MARINER.nominal_speed
+# (u, v, r, delta, n): straight, a starboard turn (v < 0 at midship), a port turn astern
+STATES = [(U0, 0.0, 0.0, 0.0, 1.5), (0.8 * U0, -0.4, 0.012, 0.3, 1.5),
+          (0.6 * U0, 0.3, -0.02, -0.5, -1.2)]
+
+
+def added_loads(effect, state):
+    """The loads `effect` adds to the Mariner at `state`."""
+    return np.asarray(js.augment(MARINER, effect).forces(*state) - MARINER.forces(*state))
+
+
+@pytest.mark.parametrize("effect, expected", [
+    (js.YawCubicDamping(beta=2e12), lambda u, v, r, d, n: (0, 0, -2e12 * r**3)),
+    (js.YawQuadraticDamping(beta=4e10), lambda u, v, r, d, n: (0, 0, -4e10 * r * abs(r))),
+    (js.PropellerAsymmetry(moment=1.4e6), lambda u, v, r, d, n: (0, 0, 1.4e6 * n * abs(n))),
+    (js.SurgeTurnResistance(x_vr=0.004),
+     lambda u, v, r, d, n: (0.004 * 0.5 * 1025.0 * MARINER.length**3 * v * r, 0, 0)),
+])
+def test_load_effects_add_their_closed_form_to_a_vessel(effect, expected):
+    """The augmented Mariner's loads minus the Mariner's are the effect's term; positive
+    damping opposes r, and added turn resistance slows a drifting, turning ship."""
+    for state in STATES:
+        np.testing.assert_allclose(added_loads(effect, state), expected(*state), rtol=1e-6,
+                                   atol=1e-9 * float(np.max(np.abs(MARINER.forces(*state)))))
+    turning = STATES[1]
+    if isinstance(effect, (js.YawCubicDamping, js.YawQuadraticDamping)):
+        assert added_loads(effect, turning)[2] < 0  # r > 0: a moment to port
+    if isinstance(effect, js.SurgeTurnResistance):
+        assert added_loads(effect, turning)[0] < 0  # v r < 0: more resistance
+
+
+def steady_r(model, angle, aux=None, num=800, dt=1.0):
+    """The yaw rate after `num` samples of a rudder step to `angle` from rest."""
+    out = js.simulate_steering(model, step(num, angle), dt, aux=aux, hold="zoh", substeps=2)
+    return float(out.r[-1])
+
+
+def test_quadratic_damping_shifts_the_steady_turn_of_nomoto1():
+    """$r + \\beta r|r| = K\\delta$: $r = (\\sqrt{1 + 4\\beta K\\delta} - 1)/(2\\beta)$, odd in
+    the rudder (to 1e-9, after 32 time constants)."""
+    beta, angle = 10.0, 10 * DEG
+    model = js.augment(js.Nomoto1(K=K, T=T), js.YawQuadraticDamping(beta=beta))
+    expected = (np.sqrt(1 + 4 * beta * K * angle) - 1) / (2 * beta)
+    assert expected < 0.92 * K * angle  # a visible shift: 9 % below the linear turn
+    assert steady_r(model, angle) == pytest.approx(expected, rel=1e-9)
+    assert steady_r(model, -angle) == pytest.approx(-expected, rel=1e-9)
+
+
+def test_crossflow_drag_integrates_the_strip_loads_exactly():
+    """Pure sway: $Y = -\\frac12\\rho cL^2v|v|$, N = 0; pure yaw: Y = 0,
+    $N = -\\frac12\\rho cL^5r|r|/32$; a turn (the flow reverses along the hull) against
+    an adaptive quadrature of the strip integrals."""
+    c, L, rho = 0.04, MARINER.length, 1025.0
+    effect = js.CrossflowDrag(coefficient=c)
+    q = 0.5 * rho * c * L
+    for v in (0.4, -0.7):
+        np.testing.assert_allclose(added_loads(effect, (U0, v, 0.0, 0.0, 0.0)),
+                                   (0, -q * L * v * abs(v), 0), rtol=1e-12, atol=1e-6)
+    for r in (0.01, -0.02):
+        np.testing.assert_allclose(added_loads(effect, (U0, 0.0, r, 0.0, 0.0)),
+                                   (0, 0, -q * L**4 / 32 * r * abs(r)), rtol=1e-6, atol=1e-4)
+    for v, r in ((-0.4, 0.012), (0.3, 0.002), (0.5, -0.03)):
+        w = lambda x: abs(v + x * r) * (v + x * r)
+        kink = [-v / r] if abs(r) * L / 2 > abs(v) else None
+        sway = quad(w, -L / 2, L / 2, points=kink, epsabs=0, epsrel=1e-13)[0]
+        yaw = quad(lambda x: x * w(x), -L / 2, L / 2, points=kink, epsabs=0, epsrel=1e-13)[0]
+        np.testing.assert_allclose(added_loads(effect, (U0, v, r, 0.0, 0.0)),
+                                   (0, -q * sway, -q * yaw), rtol=1e-6, atol=1e-3)
+
+
+def test_speed_dependent_rudder_is_the_base_at_the_nominal_speed():
+    """Vessel: at $u = U_0$ the loads are the Mariner's bit for bit; at $0.8U_0$ the
+    rudder's share $\\tau(\\delta) - \\tau(0)$ is scaled by $1 + \\kappa(0.64 - 1)$.
+    Nomoto 1: the steady turn is $K\\delta(1 + \\kappa(u^2/U_0^2 - 1))$."""
+    kappa = 0.5
+    vessel = js.augment(MARINER, js.SpeedDependentRudder(kappa=kappa))
+    for _, v, r, d, n in STATES:
+        np.testing.assert_array_equal(vessel.forces(U0, v, r, d, n),
+                                      MARINER.forces(U0, v, r, d, n))
+        u = 0.8 * U0
+        share = MARINER.forces(u, v, r, d, n) - MARINER.forces(u, v, r, 0.0, n)
+        np.testing.assert_allclose(vessel.forces(u, v, r, d, n),
+                                   MARINER.forces(u, v, r, d, n) + kappa * (0.64 - 1) * share,
+                                   rtol=1e-12, atol=1e-3)
+    effect = js.SpeedDependentRudder(kappa=kappa, nominal_speed=U0)
+    model = js.augment(js.Nomoto1(K=K, T=T), effect)
+    base = js.Nomoto1(K=K, T=T)
+    delta = step(100)
+    at_nominal = js.AuxInputs(u=U0)
+    np.testing.assert_array_equal(js.simulate_steering(model, delta, 1.0, aux=at_nominal).r,
+                                  js.simulate_steering(base, delta, 1.0, aux=at_nominal).r)
+    slow = js.AuxInputs(u=0.8 * U0)
+    assert steady_r(model, 10 * DEG, slow) == pytest.approx(
+        K * 10 * DEG * (1 + kappa * (0.64 - 1)), rel=1e-9)
+    with pytest.raises(ValueError, match="nominal_speed"):
+        js.simulate_steering(js.augment(base, js.SpeedDependentRudder(kappa=kappa)), delta, 1.0)
+
+
+def test_rudder_stall_saturates_only_large_rudder_angles():
+    """$\\delta' = \\delta - c\\delta^3$: monotonic to 46 deg at the upper bound; Nomoto 1
+    turns at $K\\delta'$; on the Mariner at 0.6 deg the yaw moment changes by
+    $-c\\delta^2$ of the rudder's (third order) within 0.1 %."""
+    upper = 0.5  # the plausible bound
+    angles = np.deg2rad(np.linspace(0, 46, 47))
+    effect = js.RudderStall(c=upper)
+    seen = np.array([effect.rudder(a, None) for a in angles])
+    assert np.all(np.diff(seen) > 0)
+    c = 0.3
+    model = js.augment(js.Nomoto1(K=K, T=T), js.RudderStall(c=c))
+    angle = 30 * DEG
+    assert steady_r(model, angle) == pytest.approx(K * (angle - c * angle**3), rel=1e-9)
+    small = 0.01
+    stalled = js.augment(MARINER, js.RudderStall(c=c)).forces(U0, 0.0, 0.0, small, 0.0)
+    rudder = MARINER.forces(U0, 0.0, 0.0, small, 0.0) - MARINER.forces(U0, 0.0, 0.0, 0.0, 0.0)
+    change = stalled - MARINER.forces(U0, 0.0, 0.0, small, 0.0)
+    assert float(change[2] / rudder[2]) == pytest.approx(-c * small**2, rel=1e-3)
+
+
+def test_propeller_asymmetry_on_nomoto1_turns_with_the_propeller_rate():
+    """$T\\dot r + r = K\\delta + a_pn|n|$: steady $r = K\\delta + a_pn|n|$ with the
+    measured n, reversed when the propeller is."""
+    a_p = 2.6e-4
+    model = js.augment(js.Nomoto1(K=K, T=T), js.PropellerAsymmetry(moment=a_p))
+    for n in (2.0, -1.0):
+        assert steady_r(model, 5 * DEG, js.AuxInputs(n=n)) == pytest.approx(
+            K * 5 * DEG + a_p * n * abs(n), rel=1e-9)
+
+
+def test_added_mass_error_scales_the_mass_matrix():
+    """$M_{22}(1 + s_v)$, $M_{33}(1 + s_r)$, the rest unchanged; the accelerations are
+    $M^{-1}\\tau$ of that matrix."""
+    s_v, s_r = 0.2, -0.1
+    vessel = js.augment(MARINER, js.AddedMassError(s_v=s_v, s_r=s_r))
+    m = np.asarray(MARINER.mass_matrix())
+    expected = m.copy()
+    expected[1, 1] *= 1 + s_v
+    expected[2, 2] *= 1 + s_r
+    np.testing.assert_array_equal(vessel.mass_matrix(), expected)
+    state = js.ShipState(u=0.8 * U0, v=-0.4, r=0.012, x=0.0, y=0.0, psi=0.3, delta=0.3, n=0.0)
+    d = js.state_derivative(vessel, state, js.Command(0.3, 0.0), js.Environment())
+    tau = np.asarray(MARINER.forces(0.8 * U0, -0.4, 0.012, 0.3, 0.0))
+    np.testing.assert_allclose([d.u, d.v, d.r], np.linalg.solve(expected, tau), rtol=1e-10)
+
+
+def test_current_drifts_the_track_and_leaves_the_water_velocities():
+    """A current of (0.5, -0.3) m/s (north, east), added to the environment's (0.2 m/s
+    to the east): u, v, r, psi bit for bit the Mariner's, the track moved by
+    $V_c t$."""
+    man, x0 = js.ZigZag(10 * DEG, 10 * DEG, duration=60.0, dt=1.0), js.straight_run(MARINER)
+    environment = js.Environment(current=js.Current(0.2, np.pi / 2))
+    base = js.simulate(MARINER, man, x0, environment=environment)
+    drifted = js.simulate(js.augment(MARINER, js.UniformCurrent(north=0.5, east=-0.3)), man,
+                          x0, environment=environment)
+    for key in ("u", "v", "r", "psi", "delta"):
+        np.testing.assert_array_equal(getattr(drifted.state, key), getattr(base.state, key))
+    t = np.asarray(base.t) - float(base.t[0])
+    np.testing.assert_allclose(drifted.state.x - base.state.x, 0.5 * t, atol=1e-8)
+    np.testing.assert_allclose(drifted.state.y - base.state.y, -0.3 * t, atol=1e-8)
+
+
+def test_windage_is_the_vessel_with_those_areas_when_wind_is_logged():
+    """Calm water: nothing changes. In a 15 m/s wind, simulated and predicted from
+    logged wind (`PredictionError(wind=True)`), the Mariner with `Windage` equals the
+    Mariner with those areas bit for bit; without the logged wind the effect is absent."""
+    areas = {"frontal_wind_area": 350.0, "lateral_wind_area": 2000.0}
+    windy = js.augment(MARINER, js.Windage(frontal_area=350.0, lateral_area=2000.0))
+    assert (windy.frontal_wind_area, windy.lateral_wind_area) == (350.0, 2000.0)
+    with_areas = eqx.tree_at(lambda v: (v.frontal_wind_area, v.lateral_wind_area), MARINER,
+                             tuple(areas.values()))
+    man, x0 = js.ZigZag(10 * DEG, 10 * DEG, duration=80.0, dt=1.0), js.straight_run(MARINER)
+    calm = js.simulate(windy, man, x0)
+    np.testing.assert_array_equal(calm.state.psi, js.simulate(MARINER, man, x0).state.psi)
+    wind = js.Wind(15.0, np.deg2rad(60.0))
+    environment = js.Environment(wind=wind)
+    truth = js.simulate(windy, man, x0, environment=environment)
+    np.testing.assert_array_equal(
+        truth.state.psi, js.simulate(with_areas, man, x0, environment=environment).state.psi)
+    assert np.max(np.abs(truth.state.psi - calm.state.psi)) > 0.1 * DEG
+    e = js.Experiment.from_trajectory(truth)
+    data = js.Experiment(e.t, e.delta, psi=e.psi, r=e.r, u=e.u, v=e.v, n=e.n,
+                         wind_speed=np.full(e.t.shape, 15.0),
+                         wind_dir=np.full(e.t.shape, np.deg2rad(60.0)))
+    logged = js.PredictionError(horizon=None, wind=True)
+    got = js.predict(windy, data, estimator=logged).predictions["psi"]
+    np.testing.assert_array_equal(got, js.predict(with_areas, data,
+                                                  estimator=logged).predictions["psi"])
+    calm_replay = js.predict(windy, data, estimator=js.PredictionError(horizon=None))
+    assert np.max(np.abs(np.asarray(calm_replay.predictions["psi"]) - np.asarray(got))) > 0.1 * DEG

@@ -286,11 +286,15 @@ def _fit_prediction_error(estimator, model, dataset, free, verbose) -> FitResult
     if verbose and hasattr(solver, "verbose"):
         solver = eqx.tree_at(lambda s: s.verbose, solver, verbose if callable(verbose)
                              else _progress)
-    _, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows, offset_scale,
+    z, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows, offset_scale,
                                                 solver, int(estimator.max_steps))
-    return _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
-                   result, num_steps, estimate_starts=estimate_starts, verbose=verbose,
-                   stacklevel=6)  # _report, this, PredictionError.fit, its wrapper, fit, caller
+    out = _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
+                  result, num_steps, estimate_starts=estimate_starts, verbose=verbose,
+                  stacklevel=6)  # _report, this, PredictionError.fit, its wrapper, fit, caller
+    if estimate_starts:
+        offsets = _split(z, transform, windows, offset_scale)[1]
+        out = dataclasses.replace(out, start_offsets=np.asarray(offsets, dtype=np.float64))
+    return out
 
 
 def _prepare(model, dataset, estimator):

@@ -8,21 +8,32 @@ range, free by default); with every parameter at zero it adds nothing, so the
 augmented model equals its base bit for bit. Its parameters are fitted like any
 other, by the name `"<effect id>.<field>"` (e.g. `"rudder_offset.delta0"`).
 
-An effect may act on one or more of four places, each a method with a neutral
+An effect may act on one or more of these places, each a method with a neutral
 default:
 
-- the actuator path, `rudder(delta, z)`: the rudder angle the hydrodynamics see, with
-  the effect's own states `z` (`state_names`, `initial_state`, `state_rate`: a lag, a
-  delay or a rate limit; they travel in the simulated state after the model's own);
+- the actuator path, `rudder(delta, z, aux)`: the rudder angle the hydrodynamics see,
+  with the effect's own states `z` (`state_names`, `initial_state`, `state_rate`: a
+  lag, a delay or a rate limit; they travel in the simulated state after the model's
+  own) and, on a steering model, its auxiliary inputs `aux` (`AuxInputs`: measured u,
+  v, n; None on a vessel, whose effects see u, v, r, n in `loads`);
 - the loads, `loads(t, vessel, u, v, r, delta, n)`: body-fixed (X, Y, N) [N, N, N m]
-  added to a vessel's (Fossen 2021, eq. 6.1: $M\\dot\\nu = \\tau + \\tau_{effect}$);
-- the yaw equation of a steering model, `yaw_term(model, x, delta)`: a term $f$
+  added to a vessel's (Fossen 2021, eq. 6.1: $M\\dot\\nu = \\tau + \\tau_{effect}$),
+  `delta` the rudder after the actuator path;
+- the yaw equation of a steering model, `yaw_term(model, x, delta, aux)`: a term $f$
   added to its right-hand side where the rudder's moment enters (for Nomoto
   $T\\dot r + r = K\\delta + f$ [rad/s]; for models written as $\\dot r = \\dots$,
   [rad/s^2]); the model's `forcing(x)` says how it moves the state;
+- a vessel's mass matrix, `mass(M)`, its environment (current and wind) in the
+  equations of motion, `environment(env)`, and its wind areas,
+  `wind_areas(frontal, lateral)` [m^2]: each returns the corrected value;
 - the measurement, `measure(channel, value)`: what a sensor reports.
 
-Adding an effect is writing one such Module; discovery scores them by name.
+A parameter acting on several families has one unit per family ("family units",
+e.g. `YawMomentBias.n0`: N m on a vessel, rad/s on a Nomoto model); such parameters
+carry no bounds (no one range is plausible in all of them) and are scaled from the
+Jacobian when a fit starts them at zero. The hull, rudder, propeller and environment
+effects are in `_hydro_effects.py`. Adding an effect is writing one such Module;
+discovery scores them by name.
 """
 
 from typing import ClassVar
@@ -58,14 +69,30 @@ class AbstractEffect(eqx.Module):
         """The time derivative of the effect's states `z` at the rudder `delta` it sees."""
         return jnp.zeros_like(z)
 
-    def rudder(self, delta: ArrayLike, z) -> ArrayLike:
+    def rudder(self, delta: ArrayLike, z, aux=None) -> ArrayLike:
+        """The rudder angle [rad] the model sees for `delta`, with the effect's states
+        `z` and a steering model's `AuxInputs` `aux` (None on a vessel)."""
         return delta
 
     def loads(self, t, vessel, u, v, r, delta, n) -> ArrayLike:
+        """Loads (X, Y, N) [N, N, N m] added to `vessel`'s at the rudder `delta` it sees."""
         return 0.0
 
-    def yaw_term(self, model, x, delta) -> ArrayLike:
+    def yaw_term(self, model, x, delta, aux) -> ArrayLike:
+        """The term added to steering `model`'s yaw equation at its state `x`."""
         return 0.0
+
+    def mass(self, matrix: Array) -> Array:
+        """A vessel's mass matrix $M$ [kg, kg m, kg m^2] with the effect's correction."""
+        return matrix
+
+    def environment(self, environment):
+        """The `Environment` (current, wind) a vessel's equations of motion see."""
+        return environment
+
+    def wind_areas(self, frontal, lateral):
+        """A vessel's frontal and lateral projected wind areas [m^2]."""
+        return frontal, lateral
 
     def measure(self, channel: str, value: ArrayLike) -> ArrayLike:
         return value
@@ -82,7 +109,7 @@ class RudderOffset(AbstractEffect):
     delta0: ArrayLike = param(0.0, lower=-0.1, upper=0.1, scale=0.01, unit="rad")
     id: ClassVar[str] = "rudder_offset"
 
-    def rudder(self, delta, z):
+    def rudder(self, delta, z, aux=None):
         return delta + self.delta0
 
 
@@ -97,21 +124,34 @@ class YawMomentBias(AbstractEffect):
     def loads(self, t, vessel, u, v, r, delta, n):
         return jnp.stack([0.0 * u, 0.0 * u, self.n0 + 0.0 * u])
 
-    def yaw_term(self, model, x, delta):
+    def yaw_term(self, model, x, delta, aux):
         return self.n0
 
 
 class YawCubicDamping(AbstractEffect):
-    """Cubic yaw damping $-\\beta r^3$ in a steering model's yaw equation: with
-    `Nomoto2` it is the second-order nonlinear model of Lu & Zhao (2008, eq. 4),
-    $T_1T_2\\ddot r + (T_1 + T_2)\\dot r + r + \\beta r^3 = K\\delta + KT_3\\dot\\delta$;
-    with `Nomoto1` Norrbin's characteristic with $n_3 = \\beta$ (Norrbin 1963).
-    Steering models only (a vessel has its own $N_{rrr}$)."""
+    """Cubic yaw damping, $\\beta > 0$ more damping in both families.
 
-    beta: ArrayLike = param(0.0, scale=10.0, unit="s^2/rad^2")
+    - Steering models: $-\\beta r^3$ in the yaw equation. With `Nomoto2` it is the
+      second-order nonlinear model of Lu & Zhao (2008, eq. 4),
+      $T_1T_2\\ddot r + (T_1 + T_2)\\dot r + r + \\beta r^3 = K\\delta + KT_3\\dot\\delta$;
+      with `Nomoto1` Norrbin's characteristic with $n_3 = \\beta$ (Norrbin 1963)
+      [s^2/rad^2; s/rad^2 for models written as $\\dot r = \\dots$].
+    - Vessels: $N \\mathrel{+}= -\\beta r^3$ [N m s^3/rad^3], i.e. $N_{rrr} = -\\beta$
+      of an Abkowitz (1964) expansion, in addition to any the vessel has. In the
+      prime system ($r' = rL/U$), $\\beta = -N'_{rrr}\\,\\tfrac12\\rho L^6/U$: about
+      $10^{12}$ for the Mariner.
+
+    Family units, hence no bounds; physically $\\beta \\ge 0$ (Norrbin's $n_3 > 0$).
+    Typical sizes: 10^2-10^4 s^2/rad^2 on Nomoto models of ships ($n_3' = n_3
+    (U/L)^2 \\approx 0.1$-$10$)."""
+
+    beta: ArrayLike = param(0.0, unit="N m s^3/rad^3 | s^2/rad^2 | s/rad^2")
     id: ClassVar[str] = "yaw_cubic_damping"
 
-    def yaw_term(self, model, x, delta):
+    def loads(self, t, vessel, u, v, r, delta, n):
+        return jnp.stack(jnp.broadcast_arrays(0.0 * u, 0.0 * u, -self.beta * r**3))
+
+    def yaw_term(self, model, x, delta, aux):
         return -self.beta * model.output(x) ** 3
 
 
@@ -138,7 +178,7 @@ class RudderLag(AbstractEffect):
         active, tau = _lag_gate(self.time_constant)
         return jnp.where(active, (delta - z) / tau, 0.0)
 
-    def rudder(self, delta, z):
+    def rudder(self, delta, z, aux=None):
         return jnp.where(_lag_gate(self.time_constant)[0], z[0], delta)
 
 
@@ -159,7 +199,7 @@ class RudderDelay(AbstractEffect):
         active, half = _lag_gate(self.delay / 2)
         return jnp.where(active, (delta - z) / half, 0.0)
 
-    def rudder(self, delta, z):
+    def rudder(self, delta, z, aux=None):
         return jnp.where(_lag_gate(self.delay / 2)[0], 2 * z[0] - delta, delta)
 
 
@@ -182,7 +222,7 @@ class RudderRateLimit(AbstractEffect):
         rate = 1.0 / jnp.where(active, self.inverse_rate, 1.0)
         return jnp.where(active, jnp.clip((delta - z) / self.tracking, -rate, rate), 0.0)
 
-    def rudder(self, delta, z):
+    def rudder(self, delta, z, aux=None):
         return jnp.where(self.inverse_rate > 0, z[0], delta)
 
 
@@ -264,14 +304,15 @@ class _Augmented(eqx.Module):
         return jnp.concatenate([jnp.zeros((0,))] + [e.initial_state(delta)
                                                     for e in self.effects])
 
-    def rudder_path(self, delta, z):
+    def rudder_path(self, delta, z, aux=None):
         """The rudder angle the base model sees, after every effect's actuator path in
-        order, and the time derivative of the effects' states `z`."""
+        order, and the time derivative of the effects' states `z`; `aux`: a steering
+        model's auxiliary inputs (None for a vessel)."""
         rates, i = [jnp.zeros((0,))], 0
         for effect in self.effects:
             k = len(effect.state_names)
             rates.append(effect.state_rate(z[i:i + k], delta))
-            delta = effect.rudder(delta, z[i:i + k])
+            delta = effect.rudder(delta, z[i:i + k], aux)
             i += k
         return delta, jnp.concatenate(rates)
 
@@ -308,7 +349,9 @@ def _check_effects(effects):
 
 class AugmentedVessel(_Augmented, AbstractVessel):
     """A vessel with effects: $\\tau = \\tau_{base}(u, v, r, \\delta', n) +
-    \\sum_e \\tau_e$, $\\delta'$ the rudder after the effects' actuator path. The
+    \\sum_e \\tau_e(u, v, r, \\delta', n)$, $\\delta'$ the rudder after the effects'
+    actuator path; the mass matrix, the environment and the wind areas after the
+    effects' corrections (`mass`, `environment`, `wind_areas`), in order. The
     effects' states follow the eight of `ShipState` in the simulated state vector;
     `held` carries their values into `loads` during an evaluation (None: a steady
     state at the current rudder)."""
@@ -342,27 +385,43 @@ class AugmentedVessel(_Augmented, AbstractVessel):
 
     @property
     def frontal_wind_area(self):
-        return self.base.frontal_wind_area
+        return self._wind_areas()[0]
 
     @property
     def lateral_wind_area(self):
-        return self.base.lateral_wind_area
+        return self._wind_areas()[1]
+
+    def _wind_areas(self):
+        areas = (self.base.frontal_wind_area, self.base.lateral_wind_area)
+        for effect in self.effects:
+            areas = effect.wind_areas(*areas)
+        return areas
 
     @property
     def free_by_default(self):
         return self.base.free_by_default
 
     def mass_matrix(self):
-        return self.base.mass_matrix()
+        matrix = self.base.mass_matrix()
+        for effect in self.effects:
+            matrix = effect.mass(matrix)
+        return matrix
+
+    def environment(self, environment):
+        environment = self.base.environment(environment)
+        for effect in self.effects:
+            environment = effect.environment(environment)
+        return environment
 
     def forces(self, u, v, r, delta, n):
         return self.loads(0.0, u, v, r, delta, n)
 
     def loads(self, t, u, v, r, delta, n):
         z = self.effect_initial(delta) if self.held is None else self.held
-        tau = self.base.loads(t, u, v, r, self.rudder_path(delta, z)[0], n)
+        seen = self.rudder_path(delta, z)[0]
+        tau = self.base.loads(t, u, v, r, seen, n)
         for effect in self.effects:
-            tau = tau + effect.loads(t, self.base, u, v, r, delta, n)
+            tau = tau + effect.loads(t, self.base, u, v, r, seen, n)
         return tau
 
     def holding(self, z) -> "AugmentedVessel":
@@ -410,8 +469,9 @@ class AugmentedSteering(_Augmented, AbstractSteeringModel):
 
     def rhs(self, state, delta, aux):
         x, z = self._split(state)
-        seen, z_dot = self.rudder_path(delta, z)
-        term = sum(jnp.asarray(e.yaw_term(self.base, x, delta), float) for e in self.effects)
+        seen, z_dot = self.rudder_path(delta, z, aux)
+        term = sum(jnp.asarray(e.yaw_term(self.base, x, delta, aux), float)
+                   for e in self.effects)
         x_dot = self.base.rhs(x, seen, aux) + self.base.forcing(x) * term
         return jnp.concatenate([x_dot, z_dot])
 

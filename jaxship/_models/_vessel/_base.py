@@ -62,6 +62,11 @@ class AbstractVessel(eqx.Module):
         them (`jaxship.AugmentedVessel`)."""
         return self.forces(u, v, r, delta, n)
 
+    def environment(self, environment: Environment) -> Environment:
+        """The environment (current, wind) the equations of motion see for the given
+        one: itself here; effects change it (`jaxship.UniformCurrent`)."""
+        return environment
+
     @abc.abstractmethod
     def forces(self, u, v, r, delta, n) -> Array:
         """Loads $\\tau = (X, Y, N)$ [N, N, N m] at velocities `u, v` [m/s], `r`
@@ -134,7 +139,9 @@ def _state_derivative(
     """`state_derivative` with $M^{-1}$ given (the simulator inverts $M$ once per run, not
     four times per step) and, with `wind=False`, without the wind loads (the simulator
     passes it when the wind speed is a static zero, where the loads vanish identically);
-    `t` [s] for loads that vary in time."""
+    `t` [s] for loads that vary in time. The vessel's `environment` hook sees the
+    environment first."""
+    environment = vessel.environment(environment)
     tau = vessel.loads(t, state.u, state.v, state.r, state.delta, state.n)
     xdot, ydot = environment.ground_velocity(state.u, state.v, state.psi)
     if wind:

@@ -1,0 +1,93 @@
+"""Monte-Carlo benchmark of `jaxship.discover` on hidden-effect data (not run in CI).
+
+For every scenario (an effect at a size, two effects, the white null and the coloured
+null with a slowly varying yaw moment) it runs discovery on `--seeds` independent data
+sets (`jaxship.studies.discovery`: Nomoto 1 truth integrated finely, rate-limited
+rudder logged at 2 Hz, 4 training zig-zags, 2 held-out turning circles) and prints:
+
+- detection: the hidden effect (or each of two) named or in a named class, nothing
+  else named;
+- false alarm: anything named on null data;
+- wrong name: a named effect whose class holds no hidden one;
+- parameter recovery: median |estimate - truth| / truth of correctly named single
+  effects, and how often the truth lies inside the reported 95 % interval;
+- runtime per discovery.
+
+Goals (issue 11): detection >= 90 % at moderate size, false alarms <= 5 % on both
+nulls, wrong names <= 5 %, both of two effects >= 80 %.
+
+    python benchmarks/discovery.py --seeds 20
+"""
+
+import argparse
+import time
+
+import jax
+import numpy as np
+
+import jaxship as js
+from jaxship.studies.discovery import outcome, run_case
+
+
+DEG = np.pi / 180
+K = 0.06
+SCENARIOS = {  # name: (hidden effects, coloured-disturbance std [rad], true values)
+    "null (white)": ((), 0.0, {}),
+    "null (coloured, 1 deg)": ((), 1.0 * DEG, {}),
+    "rudder offset 0.3 deg": ((js.RudderOffset(delta0=0.3 * DEG),), 0.0,
+                              {"rudder_offset.delta0": 0.3 * DEG,
+                               "yaw_moment_bias.n0": K * 0.3 * DEG}),
+    "rudder offset 0.3 deg, coloured": ((js.RudderOffset(delta0=0.3 * DEG),), 1.0 * DEG, {}),
+    "cubic yaw damping 300": ((js.YawCubicDamping(beta=300.0),), 0.0,
+                              {"yaw_cubic_damping.beta": 300.0}),
+    "rudder lag 1.5 s": ((js.RudderLag(time_constant=1.5),), 0.0,
+                         {"rudder_lag.time_constant": 1.5}),
+    "gyro bias 0.02 deg/s": ((js.YawRateSensorBias(bias=0.02 * DEG),), 0.0,
+                             {"yaw_rate_sensor_bias.bias": 0.02 * DEG}),
+    "offset + cubic": ((js.RudderOffset(delta0=0.3 * DEG), js.YawCubicDamping(beta=300.0)),
+                       0.0, {}),
+}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument("--only", nargs="*", default=None, help="scenario names to run")
+    args = parser.parse_args()
+    jax.config.update("jax_enable_x64", True)
+    rows = []
+    for name, (effects, colour, truth) in SCENARIOS.items():
+        if args.only and name not in args.only:
+            continue
+        counts, errors, covered, times = {}, [], [], []
+        hidden = tuple(e.id for e in effects)
+        for seed in range(args.seeds):
+            report, seconds = run_case(effects, 1000 + seed, disturbance_std=colour)
+            result = outcome(report, hidden)
+            counts[result] = counts.get(result, 0) + 1
+            times.append(seconds)
+            if result == "correct" and len(hidden) == 1:
+                for p_name, p in report.effects[0]["parameters"].items():
+                    if p_name in truth:
+                        errors.append(abs(p["value"] - truth[p_name]) / abs(truth[p_name]))
+                        covered.append(abs(p["value"] - truth[p_name]) <= 1.96 * p["std"])
+        n = args.seeds
+        share = lambda key: 100.0 * counts.get(key, 0) / n
+        row = (name, share("correct") if hidden else share("nothing"), share("wrong"),
+               share("missed"), np.median(errors) * 100 if errors else np.nan,
+               100.0 * np.mean(covered) if covered else np.nan, np.median(times))
+        rows.append(row)
+        print(f"{name:34s} {'detected' if hidden else 'silent':>8s} {row[1]:5.1f} %  "
+              f"wrong {row[2]:5.1f} %  missed {row[3]:5.1f} %  "
+              f"recovery err {row[4]:6.2f} %  95% CI coverage {row[5]:5.1f} %  "
+              f"{row[6]:5.1f} s/run", flush=True)
+    print("\n| scenario | detected (null: silent) % | wrong name % | missed % | median rel. "
+          "error % | 95 % CI coverage % | s per run |\n|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r[0]} | {r[1]:.0f} | {r[2]:.0f} | {r[3]:.0f} | {r[4]:.2f} | {r[5]:.0f} | "
+              f"{r[6]:.1f} |")
+    print(f"\n{args.seeds} seeds per scenario; {time.strftime('%Y-%m-%d')}.")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,1 @@
+"""Discovery of missing effects (`jaxship.discover`)."""

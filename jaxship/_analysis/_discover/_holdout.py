@@ -1,0 +1,102 @@
+"""Held-out checks of a discovery: the cost and fit % of a model simulated over
+records it was not fitted to (output error), and the manoeuvre indices of each
+record, measured and predicted."""
+
+import numpy as np
+
+from ..._estimate._fit import PredictionError
+from ..._estimate._predict import predict
+from ..._estimate._windows import as_dataset
+from .._indices import turning_indices, zigzag_indices
+
+
+def holdout_check(model, holdout, channels) -> dict:
+    """Output-error predictions of `holdout` by `model`: `cost` (half the sum of
+    squared residuals, each channel divided by the standard deviation of its measured
+    record, so models compare on one scale), `fit_percent` per channel and the
+    predicted timelines `predictions` `{channel: (E, N)}`."""
+    ds = as_dataset(holdout)
+    out = predict(model, ds, estimator=PredictionError(horizon=None, channels=channels))
+    cost, filled = 0.0, {}
+    for c in channels:
+        measured = np.asarray(getattr(ds, c), dtype=np.float64)
+        hit = out.predicted & ds.mask
+        scale = float(np.std(measured[hit])) or 1.0
+        cost += 0.5 * float(np.sum(((measured - out.predictions[c])[hit] / scale) ** 2))
+        filled[c] = np.where(out.predicted, out.predictions[c], measured)  # the start sample
+    return {"cost": cost, "fit_percent": out.fit_percent(), "predictions": filled}
+
+
+def _track(t, psi, u, v):
+    """North-east positions from speed through water and heading (trapezoid rule)."""
+    xdot = u * np.cos(psi) - v * np.sin(psi)
+    ydot = u * np.sin(psi) + v * np.cos(psi)
+    step = np.diff(t)
+    x = np.concatenate([[0.0], np.cumsum(0.5 * step * (xdot[1:] + xdot[:-1]))])
+    y = np.concatenate([[0.0], np.cumsum(0.5 * step * (ydot[1:] + ydot[:-1]))])
+    return x, y
+
+
+def record_kind(delta) -> str | None:
+    """`"zigzag"` when the rudder reverses at least twice with one amplitude,
+    `"turn"` when it goes to one side and stays, else None."""
+    delta = np.asarray(delta, dtype=float)
+    amplitude = float(np.max(np.abs(delta)))
+    if amplitude < np.deg2rad(2.0):
+        return None
+    large = delta[np.abs(delta) > 0.5 * amplitude]
+    reversals = int(np.sum(np.diff(np.sign(large)) != 0))
+    if reversals >= 2:
+        return "zigzag"
+    if reversals == 0 and np.mean(np.abs(delta[-len(delta) // 3:])) > 0.5 * amplitude:
+        return "turn"
+    return None
+
+
+def record_indices(t, delta, psi, u=None, v=None) -> dict:
+    """The indices of one record [deg, m]: a zig-zag's first and second overshoots
+    (heading switch = the rudder amplitude, as in x/x zig-zags), a turn's advance and
+    tactical diameter (track from u, v and the heading). Empty when neither."""
+    kind = record_kind(delta)
+    try:
+        if kind == "zigzag":
+            switch = float(np.median(np.abs(delta[np.abs(delta) > 0.5 * np.max(np.abs(delta))])))
+            z = zigzag_indices(heading_switch=switch, t=t, psi=psi, delta=delta)
+            out = {}
+            for k, value in enumerate(np.asarray(z.overshoots)[:2]):
+                out[f"overshoot_{k + 1}_deg"] = float(np.rad2deg(value))
+            return out
+        if kind == "turn" and u is not None and v is not None:
+            x, y = _track(t, psi, u, v)
+            ti = turning_indices(t=t, x=x, y=y, psi=psi, u=u, v=v, delta=delta)
+            return {"advance_m": float(ti.advance),
+                    "tactical_diameter_m": float(ti.tactical_diameter)}
+    except ValueError:  # the record does not complete the manoeuvre
+        return {}
+    return {}
+
+
+def holdout_indices(holdout, before: dict, after: dict) -> dict:
+    """`{record: {index: {"measured", "before", "after"}}}` from the measured records
+    and the predictions of the base and the augmented models."""
+    ds = as_dataset(holdout)
+    out = {}
+    for i, name in enumerate(ds.names):
+        n = int(ds.lengths[i])
+        t = np.asarray(ds.t[i, :n])
+        delta = np.asarray(ds.delta[i, :n])
+        measured_uv = "u" in ds.experiment_channels[i] and "v" in ds.experiment_channels[i]
+        u = np.asarray(ds.u[i, :n]) if measured_uv else None
+        v = np.asarray(ds.v[i, :n]) if measured_uv else None
+
+        def indices(source, u=u, v=v):
+            psi = np.asarray(source["psi"][i, :n]) if source else np.asarray(ds.psi[i, :n])
+            if source and "u" in source:
+                u, v = np.asarray(source["u"][i, :n]), np.asarray(source["v"][i, :n])
+            return record_indices(t, delta, psi, u, v)
+
+        measured = indices(None)
+        b, a = indices(before), indices(after)
+        out[name] = {k: {"measured": measured[k], "before": b.get(k), "after": a.get(k)}
+                     for k in measured}
+    return out

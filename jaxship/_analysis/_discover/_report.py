@@ -1,0 +1,118 @@
+"""`DiscoveryReport`: what `jaxship.discover` found, as data (`to_dict`, the JSON of
+`jaxship discover`) and as a page (`to_markdown`)."""
+
+import equinox as eqx
+
+
+class DiscoveryReport(eqx.Module):
+    """The outcome of `discover`.
+
+    - `verdict`: `"missing_effect"` or `"nothing_missing"`;
+    - `effects`: the accepted effects in order, each a dict with `id`, `name`,
+      `parameters` (`{name: {value, std, unit}}`, robust standard errors), `score`
+      (robust score statistic), `score_naive`, `likelihood_ratio` (robust),
+      `p_value`, `delta_bic`, `equivalent_to` (`[{id, separate}]`: candidates these
+      data cannot tell apart from it, with the experiment that would) and
+      `holdout_cost`;
+    - `rejected`: candidates refitted or scored that did not pass, with `why`;
+    - `scores`: every candidate's score test at the base fit;
+    - `model_before`, `model_after`: the fitted base and augmented models;
+    - `train_cost_*`, `holdout_cost_*` (half the sum of squared normalised
+      residuals), `holdout_fit_percent_*` per channel, `holdout_indices` per
+      held-out record `{index: {measured, before, after}}`;
+    - `alpha`: the family-wise false-alarm rate; `channels`: the fitted outputs.
+    """
+
+    verdict: str
+    effects: list
+    rejected: list
+    scores: dict
+    model_before: eqx.Module
+    model_after: eqx.Module
+    train_cost_before: float
+    train_cost_after: float
+    holdout_cost_before: float | None
+    holdout_cost_after: float | None
+    holdout_fit_percent_before: dict | None
+    holdout_fit_percent_after: dict | None
+    holdout_indices: dict
+    alpha: float
+    channels: tuple
+
+    @property
+    def named(self) -> tuple[str, ...]:
+        """The ids of the accepted effects, in order."""
+        return tuple(e["id"] for e in self.effects)
+
+    def names_or_classes(self) -> list[set]:
+        """Per accepted effect, the set of its id and the ids it cannot be told from."""
+        return [{e["id"], *(q["id"] for q in e["equivalent_to"])} for e in self.effects]
+
+    def to_dict(self) -> dict:
+        """The JSON of `jaxship discover` (plain Python numbers and strings)."""
+        keys = ("verdict", "effects", "rejected", "scores", "train_cost_before",
+                "train_cost_after", "holdout_cost_before", "holdout_cost_after",
+                "holdout_fit_percent_before", "holdout_fit_percent_after",
+                "holdout_indices", "alpha")
+        return _plain({k: getattr(self, k) for k in keys} | {"channels": list(self.channels)})
+
+    def to_markdown(self) -> str:
+        """The story in a page: verdict, effects, rejected candidates, the gap."""
+        lines = ["# Discovery report", ""]
+        if self.effects:
+            lines += [f"**Verdict: missing effect(s): {', '.join(self.named)}** (family-wise "
+                      f"false-alarm rate {self.alpha:g}).", ""]
+            lines += ["| effect | parameter | value | std | unit | score | LR | p | dBIC | "
+                      "cannot be told from |", "|---|---|---|---|---|---|---|---|---|---|"]
+            for e in self.effects:
+                twins = "; ".join(f"{q['id']} ({q['separate']})" for q in e["equivalent_to"])
+                for name, p in e["parameters"].items():
+                    unit = p["unit"].replace("|", "or")
+                    lines.append(f"| {e['name']} | `{name}` | {p['value']:.4g} | "
+                                 f"{p['std']:.2g} | {unit} | {e['score']:.3g} | "
+                                 f"{e['likelihood_ratio']:.3g} | {e['p_value']:.2g} | "
+                                 f"{e['delta_bic']:.1f} | {twins or '-'} |")
+        else:
+            best = max(self.scores.items(), key=lambda kv: kv[1]["score"], default=None)
+            lines.append("**Verdict: nothing missing.** No candidate passed the calibrated "
+                         f"tests (family-wise false-alarm rate {self.alpha:g}).")
+            if best:
+                lines.append(f"The largest robust score was {best[1]['score']:.3g} "
+                             f"({best[0]}), against a threshold of {best[1]['threshold']:.3g}.")
+        lines += ["", "## Candidates at the base fit", "",
+                  "| candidate | robust score | naive score | threshold |", "|---|---|---|---|"]
+        for k, s in sorted(self.scores.items(), key=lambda kv: -kv[1]["score"]):
+            lines.append(f"| {k} | {s['score']:.3g} | {s['score_naive']:.3g} | "
+                         f"{s['threshold']:.3g} |")
+        if self.rejected:
+            lines += ["", "## Rejected", ""]
+            lines += [f"- iteration {r['iteration']}, {r['id']}: {'; '.join(r['why'])}"
+                      for r in self.rejected]
+        lines += ["", "## The gap", "",
+                  f"Training cost {self.train_cost_before:.5g} -> {self.train_cost_after:.5g}."]
+        if self.holdout_cost_before is not None:
+            lines.append(f"Held-out cost (output error) {self.holdout_cost_before:.5g} -> "
+                         f"{self.holdout_cost_after:.5g}.")
+            lines += ["", "| channel | held-out fit % before | after |", "|---|---|---|"]
+            for c in self.channels:
+                lines.append(f"| {c} | {self.holdout_fit_percent_before[c]:.1f} | "
+                             f"{self.holdout_fit_percent_after[c]:.1f} |")
+        rows = [(r, k, v) for r, idx in self.holdout_indices.items() for k, v in idx.items()]
+        if rows:
+            lines += ["", "| record | index | measured | before | after |",
+                      "|---|---|---|---|---|"]
+            fmt = lambda x: "-" if x is None else f"{x:.2f}"
+            lines += [f"| {r} | {k} | {fmt(v['measured'])} | {fmt(v['before'])} | "
+                      f"{fmt(v['after'])} |" for r, k, v in rows]
+        return "\n".join(lines) + "\n"
+
+
+def _plain(x):
+    """Python floats, lists and dicts for JSON."""
+    if isinstance(x, dict):
+        return {str(k): _plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_plain(v) for v in x]
+    if hasattr(x, "item") and getattr(x, "ndim", 1) == 0:
+        return x.item()
+    return x

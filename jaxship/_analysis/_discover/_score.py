@@ -1,0 +1,120 @@
+"""Score (Lagrange-multiplier) tests of candidate effects at the current fit.
+
+For candidate k with parameters $\\beta_k$ (zero: absent) and the fitted parameters
+$\\theta$, let $e$ be the weighted residuals at the fit and $J_\\theta$, $J_k$ their
+sensitivities. Projecting out what the fitted parameters can already do,
+$\\tilde J_k = (I - QQ^T)J_k$ with $Q$ an orthonormal basis of $J_\\theta$'s columns,
+the score is $g_k = \\tilde J_k^Te$ and (Rao 1948; for least squares e.g. Seber & Wild
+1989, sec. 5.9)
+
+$$S_k = g_k^T(\\hat\\sigma^2\\tilde J_k^T\\tilde J_k)^{-1}g_k \\sim \\chi^2_{\\dim\\beta_k},
+\\qquad \\hat\\sigma^2 = e^Te/(N - p),$$
+
+when nothing is missing and the residuals are white; $\\frac12 g_k^T(\\tilde J_k^T
+\\tilde J_k)^{-1}g_k$ is the cost decrease one Gauss-Newton step in $\\beta_k$ predicts.
+Residuals coloured by waves or gusts make $S_k$ far too large, so the decision uses
+the robust form $S_k^{rob} = g_k^TV_k^{-1}g_k$ with $V_k$ the variance of the score
+sum that allows correlated residuals, computed from the residuals after one
+Gauss-Newton step in $\beta_k$, $e - \tilde J_k(\tilde J_k^T\tilde J_k)^{-1}g_k$ (under the
+null the step is small and nothing changes; under the alternative the effect's own
+signal would otherwise count as noise, and the statistic could not grow with the
+effect's size): clustered by prediction window when there are
+at least `MIN_CLUSTERS` windows (Liang & Zeger 1986; windows restart from
+measurements, so they are nearly independent), else the Bartlett (Newey-West) long-run
+variance of the per-sample scores in time with Andrews' bandwidth (as
+`jaxship.hac_covariance`).
+
+Candidates that the data cannot tell apart have (nearly) the same projected column
+space: their largest canonical correlation (cosine of the smallest principal angle,
+Bjorck & Golub 1973) is near 1.
+"""
+
+import dataclasses
+
+import numpy as np
+
+from ..._foundation._covariance import _auto_lags, bartlett_long_run
+
+
+MIN_CLUSTERS = 20  # prediction windows needed for the window-clustered score variance
+
+
+@dataclasses.dataclass(frozen=True)
+class Score:
+    """A candidate's score test: `statistic` (robust, the one decisions use),
+    `naive` (assuming white residuals), `dof` (its number of parameters),
+    `predicted_decrease` (cost decrease of one Gauss-Newton step), `step` that
+    Gauss-Newton step in the candidate's parameters, `basis` (N, dof)
+    an orthonormal basis of its projected sensitivities (for the equivalence test)
+    and `inflation` = naive / robust (how much correlated residuals inflate the
+    naive statistic; 1 for white residuals)."""
+
+    statistic: float
+    naive: float
+    dof: int
+    predicted_decrease: float
+    step: np.ndarray
+    basis: np.ndarray
+    inflation: float
+
+
+def _orthonormal(a, rtol=1e-10):
+    """An orthonormal basis of the columns of `a` (dropping dependent ones)."""
+    if a.shape[1] == 0:
+        return a
+    u, s, _ = np.linalg.svd(a, full_matrices=False)
+    return u[:, s > rtol * max(s[0], 1e-300)]
+
+
+def _score_variance(contributions, sens):
+    """Variance of the score sum under correlated residuals (see the module text),
+    from scores centred on their mean: a missing effect adds the same systematic
+    score to every window, which would otherwise count as variance and hide it."""
+    windows = np.unique(sens.window)
+    if windows.size >= MIN_CLUSTERS:
+        _, cluster = np.unique(sens.window, return_inverse=True)
+        sums = np.zeros((windows.size, contributions.shape[1]))
+        np.add.at(sums, cluster, contributions)
+        sums -= sums.mean(axis=0)
+        return sums.T @ sums * windows.size / (windows.size - 1)
+    num_e = int(sens.experiment.max()) + 1
+    series = np.zeros((num_e, sens.num_samples, contributions.shape[1]))
+    np.add.at(series, (sens.experiment, sens.sample), contributions)
+    valid = np.zeros((num_e, sens.num_samples), bool)
+    valid[sens.experiment, sens.sample] = True
+    series = np.where(valid[..., None], series - series[valid].mean(axis=0), 0.0)
+    return bartlett_long_run(series, _auto_lags(series, valid))
+
+
+def score_tests(sens, fitted, candidates) -> dict:
+    """`Score` of every candidate. `sens`: `Sensitivities` with columns for the fitted
+    parameter names `fitted` and for each candidate's names; `candidates`: `{id:
+    (names, ...)}`."""
+    column = {n: i for i, n in enumerate(sens.names)}
+    e = sens.residuals
+    q = _orthonormal(sens.jacobian[:, [column[n] for n in fitted]])
+    sigma2 = float(e @ e) / max(e.size - q.shape[1], 1)
+    out = {}
+    for key, names in candidates.items():
+        jk = sens.jacobian[:, [column[n] for n in names]]
+        jt = jk - q @ (q.T @ jk)
+        g = jt.T @ e
+        a = jt.T @ jt
+        a_inv = np.linalg.pinv(a, rcond=1e-12)
+        decrease = 0.5 * float(g @ a_inv @ g)
+        naive = 2.0 * decrease / sigma2
+        v = _score_variance(jt * (e - jt @ (a_inv @ g))[:, None], sens)
+        robust = float(g @ np.linalg.pinv(v, rcond=1e-12) @ g)
+        out[key] = Score(statistic=robust, naive=naive, dof=len(names),
+                         predicted_decrease=decrease, step=-(a_inv @ g),
+                         basis=_orthonormal(jt),
+                         inflation=naive / robust if robust > 0 else 1.0)
+    return out
+
+
+def canonical_correlation(a: Score, b: Score) -> float:
+    """The largest canonical correlation of two candidates' projected sensitivities
+    (1: one can mimic the other on these data)."""
+    if a.basis.shape[1] == 0 or b.basis.shape[1] == 0:
+        return 0.0
+    return float(np.linalg.svd(a.basis.T @ b.basis, compute_uv=False)[0])

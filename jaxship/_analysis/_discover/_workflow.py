@@ -1,0 +1,223 @@
+"""`discover`: from disagreement between a fitted model and measured data to a named,
+fitted, verified model term (or the answer that nothing is missing).
+
+One iteration (design: ../shared/reference/discovery-design.md, sec. 4):
+
+1. every applicable catalogue effect is added at zero and scored at the current fit
+   with one forward-mode Jacobian (`score_tests`: robust score statistics);
+2. candidates the data cannot tell apart (canonical correlation of their projected
+   sensitivities above `equivalence`) form a class; the best-scoring member of each
+   of the `top` best classes is refitted with Levenberg-Marquardt from the current
+   fit (warm start);
+3. a candidate is accepted only if all of these hold: its robust score and its
+   likelihood ratio (divided by the score's inflation by correlated residuals)
+   exceed the chi-square quantile at `alpha / (m K)` (Bonferroni over the m
+   candidates and K = `max_effects` iterations); its robust confidence interval at
+   the same level excludes zero; its estimate lies in the parameter's plausible
+   range; and the held-out cost falls;
+4. the best accepted candidate (largest likelihood ratio) joins the model, which
+   becomes the base of the next iteration, until nothing passes.
+"""
+
+import dataclasses
+import math
+
+from scipy import stats
+
+from ..._estimate._fit import PredictionError, fit
+from ..._estimate._sensitivity import sensitivities
+from ..._estimate._windows import as_dataset
+from ..._foundation._params import default_free, parameter_fields, rebuild
+from ..._models._effects import augment
+from ._catalogue import DISCOVERY_CATALOGUE, applicable
+from ._holdout import holdout_check, holdout_indices
+from ._report import DiscoveryReport
+from ._score import canonical_correlation, score_tests
+
+
+def _split(model):
+    """(base, effects) of a model with or without effects."""
+    if hasattr(model, "effects") and hasattr(model, "base"):
+        return model.base, tuple(model.effects)
+    return model, ()
+
+
+def _free_names(entry, effect) -> tuple[str, ...]:
+    fields = parameter_fields(effect)
+    return tuple(f"{entry.id}.{k}" for k, info in fields.items() if info.free)
+
+
+def _parameters(result, names) -> dict:
+    """`{name: {"value", "std", "unit"}}` with the robust standard error."""
+    index = {n: i for i, n in enumerate(result.names)}
+    fields = parameter_fields(result.model)
+    out = {}
+    for n in names:
+        i = index[n]
+        std = float(result.parameters.std_robust[i])
+        out[n] = {"value": float(result.values[i]), "std": std, "unit": fields[n].unit}
+    return out
+
+
+def _in_range(result, names) -> bool:
+    fields = parameter_fields(result.model)
+    values = dict(zip(result.names, result.values))
+    return all(fields[n].lower - 1e-12 <= values[n] <= fields[n].upper + 1e-12 for n in names)
+
+
+def _points_outside(model, names, step) -> bool:
+    """Whether the score's Gauss-Newton step from zero leaves a parameter's plausible
+    range (a one-sided parameter asked to go negative: no evidence for the effect)."""
+    fields = parameter_fields(model)
+    return any(fields[n].lower == 0.0 and d < 0 for n, d in zip(names, step))
+
+
+def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
+             estimator: PredictionError = PredictionError(horizon=60.0, initial="estimate"),
+             free=None,
+             max_effects: int = 3, alpha: float = 0.01, top: int = 3,
+             equivalence: float = 0.98, progress=None) -> DiscoveryReport:
+    """Find, name and add the effects missing from `model`.
+
+    **Arguments:**
+
+    - `model`: a vessel or steering model (start values of the base fit).
+    - `train`: the records the model is fitted and scored on (`Experiment`s or a
+      `Dataset`); `holdout`: records of other manoeuvres, used only to check that an
+      effect improves predictions (output error) and to report the gap closed.
+    - `catalogue`: the candidate effects (`jaxship.DISCOVERY_CATALOGUE`).
+    - `estimator`: the prediction-error loss of every fit and score (default: 60 s
+      windows, so that the window-clustered score variance holds for coloured
+      residuals, each starting from an estimated correction of the measured r and psi,
+      so that the noise of a start sample does not run through its window); `free`:
+      the base parameters fitted (default the model's).
+    - `max_effects`: most effects added; `alpha`: family-wise false-alarm rate over
+      candidates and iterations; `top`: classes refitted per iteration;
+      `equivalence`: canonical correlation above which candidates are one class.
+    - `progress`: a callable taking a message string (the CLI's progress bar).
+
+    **Returns:** a `DiscoveryReport`.
+    """
+    say = progress or (lambda message: None)
+    free = tuple(default_free(model) if free is None else free)
+    data = as_dataset(train)
+    if not estimator.wind and model.wind_loads and all(
+            {"wind_speed", "wind_dir"} <= set(c) for c in data.experiment_channels):
+        estimator = dataclasses.replace(estimator, wind=True)  # replay the logged wind
+    say("fitting the base model")
+    base_fit = fit(model, train, estimator=estimator, free=free)
+    channels = tuple(base_fit.metrics)
+    current, theta, cost = base_fit, free, base_fit.cost
+    before = holdout_check(base_fit.model, holdout, channels) if holdout else None
+    held_cost = before["cost"] if holdout else None
+    accepted, rejected, first_scores = [], [], None
+    for iteration in range(max_effects):
+        base, effects = _split(current.model)
+        done = {e.id for e in effects}
+        candidates = applicable(base, data, catalogue, exclude=done)
+        if not candidates:
+            break
+        names = {c.id: _free_names(c, e) for c, e, _ in candidates}
+        probes = {f"{c.id}.{k}": v for c, _, pr in candidates for k, v in pr.items()}
+        scored = augment(base, *effects, *(e for _, e, _ in candidates))
+        say(f"iteration {iteration + 1}: scoring {len(candidates)} candidates")
+        sens = sensitivities(scored, train, estimator, theta + sum(names.values(), ()),
+                             probes, start_offsets=current.start_offsets)
+        nuisance = tuple(n for n in sens.names if n.startswith("start["))
+        scores = score_tests(sens, theta + nuisance, names)
+        m = len(candidates) * max_effects
+        level = alpha / m
+        threshold = lambda dof: float(stats.chi2.isf(level, dof))
+        sigma2 = 2 * sens.cost / max(sens.residuals.size - len(theta) - len(nuisance), 1)
+        ranked = sorted(scores, key=lambda k: -scores[k].statistic)
+        if first_scores is None:
+            first_scores = {k: _score_dict(scores[k], threshold) for k in ranked}
+        classes = {k: [j for j in ranked if j != k and canonical_correlation(
+            scores[k], scores[j]) > equivalence] for k in ranked}
+        chosen = []
+        for k in ranked:
+            if len(chosen) < top and not any(k in classes[c] for c in chosen):
+                chosen.append(k)
+        entry = {c.id: (c, e, pr) for c, e, pr in candidates}
+        passed = []
+        for k in chosen:
+            c, effect, probe = entry[k]
+            s = scores[k]
+            why = []
+            if s.statistic <= threshold(s.dof) or _points_outside(scored, names[k], s.step):
+                why = (f"score {s.statistic:.3g} below the threshold {threshold(s.dof):.3g}"
+                       if s.statistic <= threshold(s.dof) else
+                       "its score points out of the plausible range (a negative lag, rate "
+                       "or area)")
+                rejected.append({"id": k, "name": c.name, "score": s.statistic,
+                                 "iteration": iteration + 1, "why": [why]})
+                continue
+            say(f"iteration {iteration + 1}: refitting with {k}")
+            start = augment(base, *effects, effect)
+            for field, value in probe.items():
+                start = _set(start, f"{k}.{field}", value)
+            trial = fit(start, train, estimator=estimator, free=theta + names[k])
+            lr = 2 * (cost - trial.cost) / sigma2
+            lr_robust = lr / max(s.inflation, 1.0)
+            z = float(stats.norm.isf(level / 2))
+            params = _parameters(trial, names[k])
+            if not trial.success:
+                why.append(f"the refit did not converge ({trial.message})")
+            if lr_robust <= threshold(s.dof):
+                why.append(f"likelihood ratio {lr_robust:.3g} (robust) below the threshold "
+                           f"{threshold(s.dof):.3g}")
+            if not all(abs(p["value"]) > z * p["std"] for p in params.values()):
+                why.append("its confidence interval includes zero")
+            if not _in_range(trial, names[k]):
+                why.append("its estimate lies outside the plausible range")
+            after = holdout_check(trial.model, holdout, channels) if holdout else None
+            if holdout and not after["cost"] < held_cost:
+                why.append(f"the held-out cost does not fall ({held_cost:.4g} -> "
+                           f"{after['cost']:.4g})")
+            record = {"id": k, "name": c.name, "iteration": iteration + 1,
+                      "parameters": params, "score": s.statistic,
+                      "score_naive": s.naive, "likelihood_ratio": lr_robust,
+                      "p_value": float(stats.chi2.sf(lr_robust, s.dof)),
+                      "delta_bic": _delta_bic(cost, trial.cost, sens.residuals.size, s.dof),
+                      "equivalent_to": [{"id": j, "separate": entry[j][0].separate}
+                                        for j in classes[k]],
+                      "holdout_cost": after["cost"] if holdout else None}
+            if why:
+                rejected.append({**record, "why": why})
+            else:
+                passed.append((record, trial))
+        if not passed:
+            break
+        record, trial = max(passed, key=lambda pair: pair[0]["likelihood_ratio"])
+        accepted.append(record)
+        say(f"accepted {record['id']}")
+        current, theta, cost = trial, theta + names[record["id"]], trial.cost
+        held_cost = record["holdout_cost"] if holdout else None
+    after = holdout_check(current.model, holdout, channels) if holdout else None
+    return DiscoveryReport(
+        verdict="missing_effect" if accepted else "nothing_missing", effects=accepted,
+        rejected=rejected, scores=first_scores or {}, model_before=base_fit.model,
+        model_after=current.model, train_cost_before=base_fit.cost,
+        train_cost_after=current.cost,
+        holdout_cost_before=before["cost"] if holdout else None,
+        holdout_cost_after=after["cost"] if holdout else None,
+        holdout_fit_percent_before=before["fit_percent"] if holdout else None,
+        holdout_fit_percent_after=after["fit_percent"] if holdout else None,
+        holdout_indices=holdout_indices(holdout, before["predictions"],
+                                        after["predictions"]) if holdout else {},
+        alpha=alpha, channels=channels)
+
+
+def _set(model, name, value):
+    return rebuild(model, (name,), (float(value),))
+
+
+def _delta_bic(cost0, cost1, n, dof) -> float:
+    """$\\Delta BIC = N\\ln(V_1/V_0) + k\\ln N$ (Gaussian errors, unknown variance;
+    negative favours the effect)."""
+    return float(n * math.log(max(cost1, 1e-300) / max(cost0, 1e-300)) + dof * math.log(n))
+
+
+def _score_dict(s, threshold) -> dict:
+    return {"score": s.statistic, "score_naive": s.naive, "dof": s.dof,
+            "threshold": threshold(s.dof), "predicted_decrease": s.predicted_decrease}

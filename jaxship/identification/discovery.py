@@ -1,0 +1,86 @@
+"""`jaxship discover`: identify a registered model on training records, run
+`jaxship.discover` against held-out records, and write `discovery.json`,
+`report.md` and figures."""
+
+import json
+import pathlib
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+import jaxship as js
+
+from .data import read_experiments
+from .registry import get_model_entry
+from .workflow import identify
+
+
+def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
+                  max_effects: int = 3, alpha: float = 0.01, progress=None):
+    """Read the records, fit `model` (as `jaxship identify` does, for start values),
+    run discovery and write `out/discovery.json`, `out/report.md` and
+    `out/figures/`. Returns the `DiscoveryReport`."""
+    say = progress or (lambda message: None)
+    get_model_entry(model)  # an unknown model fails before any file is read
+    if max_effects < 1:
+        raise ValueError(f"--max-effects must be at least 1, got {max_effects}.")
+    if not 0 < alpha < 1:
+        raise ValueError(f"--alpha must be between 0 and 1, got {alpha}.")
+    train = read_experiments(train_paths, role="training")
+    holdout = read_experiments(holdout_paths, role="held-out") if holdout_paths else None
+    say(f"start values: identify {model} on {len(train)} training records")
+    start = identify(train, model=model).fit.model
+    report = js.discover(start, train, holdout, max_effects=max_effects, alpha=alpha,
+                         progress=say)
+    out.mkdir(parents=True, exist_ok=True)
+    figures = save_discovery_figures(report, train, holdout, out / "figures")
+    text = report.to_markdown()
+    text += "\n## Figures\n\n" + "\n".join(f"![{p.stem}](figures/{p.name})" for p in figures)
+    _write(out / "discovery.json", json.dumps(report.to_dict(), indent=2) + "\n")
+    _write(out / "report.md", text + "\n")
+    return report
+
+
+def _write(path: pathlib.Path, text: str):
+    """Write through a temporary file and rename: never half a file."""
+    temporary = path.with_name(f".{path.name}.tmp")
+    temporary.write_text(text)
+    temporary.replace(path)
+
+
+def save_discovery_figures(report, train, holdout, folder: pathlib.Path) -> list[pathlib.Path]:
+    """Residuals before and after on the held-out records (or the training records)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    records = holdout if holdout else train
+    channels = tuple(report.channels)
+    estimator = js.PredictionError(horizon=None, channels=channels)
+    before = js.predict(report.model_before, records, estimator=estimator)
+    after = js.predict(report.model_after, records, estimator=estimator)
+    data = js.Dataset.from_experiments(records) if isinstance(records, list) else records
+    paths = []
+    for i, name in enumerate(data.names):
+        n = int(data.lengths[i])
+        t = np.asarray(data.t[i, :n])
+        fig, axes = plt.subplots(len(channels), 1, figsize=(8, 2.4 * len(channels)),
+                                 sharex=True, squeeze=False)
+        for ax, c in zip(axes[:, 0], channels):
+            measured = np.asarray(getattr(data, c)[i, :n])
+            scale = np.rad2deg(1.0) if c in ("psi", "r") else 1.0
+            unit = {"psi": "deg", "r": "deg/s"}.get(c, "m/s")
+            for label, p, style in (("before", before, "C3"), ("after", after, "C2")):
+                hit = p.predicted[i, :n]
+                ax.plot(t[hit], scale * (measured - p.predictions[c][i, :n])[hit], style,
+                        lw=1, label=f"{label} (fit {p.metrics[c].fit_per_experiment[i]:.1f} %)")
+            ax.axhline(0.0, color="0.5", lw=0.5)
+            ax.set_ylabel(f"{c} residual [{unit}]")
+            ax.legend(loc="upper left", fontsize=8, frameon=False)
+        axes[-1, 0].set_xlabel("time [s]")
+        added = ", ".join(report.named) or "nothing"
+        axes[0, 0].set_title(f"{name}: measured minus simulated, before and after adding "
+                             f"{added}", fontsize=9)
+        fig.tight_layout()
+        path = folder / f"residuals_{i:02d}.png"
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        paths.append(path)
+    return paths

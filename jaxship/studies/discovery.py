@@ -1,0 +1,86 @@
+"""Hidden-effect data for `jaxship.discover`: the records its tests, its Monte-Carlo
+benchmark and its notebook use.
+
+A truth model (a steering model with or without effects) is run through 10/10 and
+20/20 zig-zags to both sides (training) and +-20 deg turning circles (held out), with
+a rudder rate limit of 2.3 deg/s, integrated more finely than any fit (0.02 s control
+steps against one RK4 step per 0.5 s sample) and with the rudder logged at the sample
+rate, as a real log would be. Measurement noise: heading 0.1 deg, yaw rate 0.05 deg/s.
+Optionally a slowly varying yaw moment that is not in any log: an Ornstein-Uhlenbeck
+equivalent rudder angle (20 s correlation time), the kind of disturbance waves and
+gusts cause, which colours the residuals without being physics to name.
+"""
+
+import time
+
+import numpy as np
+
+import jaxship as js
+
+
+DEG = np.pi / 180
+FINE = js.Simulator(max_step=0.02)
+TRAIN = tuple((a, s) for a in (10, 20) for s in (1, -1))  # zig-zag angle [deg], side
+HOLDOUT = (20, -20)  # turning-circle rudder angles [deg]
+
+
+def disturbance(t, std, seed, correlation_time=20.0) -> np.ndarray:
+    """An Ornstein-Uhlenbeck series at the times `t` (uniform), standard deviation
+    `std` and correlation time [s]: exact discretisation $w_k = a w_{k-1} +
+    \\sqrt{1 - a^2}\\,\\sigma\\xi_k$, $a = e^{-\\Delta t/\\tau}$, from zero."""
+    rng = np.random.default_rng(seed)
+    a = np.exp(-(t[1] - t[0]) / correlation_time)
+    w = np.zeros(t.size)
+    for k in range(1, t.size):
+        w[k] = a * w[k - 1] + np.sqrt(1 - a * a) * std * rng.normal()
+    return w
+
+
+def record(truth, manoeuvre, name, rng, *, disturbance_std=0.0, noise=(0.1, 0.05)):
+    """One noisy record of `truth` through `manoeuvre` (see the module text)."""
+    out = js.steer_manoeuvre(truth, manoeuvre, simulator=FINE, rudder_rate=2.3 * DEG)
+    t, delta = np.asarray(out.t), np.asarray(out.delta)
+    psi, r = np.asarray(out.psi), np.asarray(out.r)
+    if disturbance_std:
+        w = disturbance(t, disturbance_std, int(rng.integers(2**31)))
+        out = js.simulate_steering(truth, delta + w, float(t[1] - t[0]), substeps=25)
+        psi, r = np.asarray(out.psi), np.asarray(out.r)
+    return js.Experiment(t, delta, psi=psi + rng.normal(0, noise[0] * DEG, t.size),
+                         r=r + rng.normal(0, noise[1] * DEG, t.size), name=name)
+
+
+def hidden_effect_records(truth, seed, *, disturbance_std=0.0):
+    """`(train, holdout)` records of `truth` (see the module text)."""
+    rng = np.random.default_rng(seed)
+    train = [record(truth, js.ZigZag(a * DEG, s * a * DEG, duration=400.0, dt=0.5),
+                    f"zigzag {a}/{a} {'starboard' if s > 0 else 'port'}", rng,
+                    disturbance_std=disturbance_std) for a, s in TRAIN]
+    holdout = [record(truth, js.Turn(a * DEG, duration=300.0, dt=0.5), f"turn {a:+d}", rng,
+                      disturbance_std=disturbance_std) for a in HOLDOUT]
+    return train, holdout
+
+
+def run_case(effects, seed, *, base=None, disturbance_std=0.0, **options):
+    """Discovery on records of `base` (default Nomoto 1, K = 0.06 1/s, T = 25 s) with
+    `effects` hidden; returns `(report, seconds)`."""
+    base = js.Nomoto1(K=0.06, T=25.0) if base is None else base
+    truth = js.augment(base, *effects) if effects else base
+    train, holdout = hidden_effect_records(truth, seed, disturbance_std=disturbance_std)
+    start = js.Nomoto1(K=0.05, T=20.0) if isinstance(base, js.Nomoto1) else base
+    began = time.perf_counter()
+    report = js.discover(start, train, holdout, **options)
+    return report, time.perf_counter() - began
+
+
+def outcome(report, hidden_ids) -> str:
+    """`"correct"` (every hidden effect named or in a named class, nothing else),
+    `"missed"` (something hidden not named, nothing wrong named), `"wrong"` (a
+    named effect whose class holds no hidden one) or `"nothing"` (null data,
+    nothing named)."""
+    classes = report.names_or_classes()
+    if any(not (c & set(hidden_ids)) for c in classes):
+        return "wrong"
+    if not hidden_ids:
+        return "nothing"
+    found = {h for h in hidden_ids if any(h in c for c in classes)}
+    return "correct" if found == set(hidden_ids) else "missed"
