@@ -3,8 +3,11 @@
 import argparse
 import importlib.metadata
 import json
+import math
+import os
 import pathlib
 import sys
+import tempfile
 import warnings
 
 import jax
@@ -14,10 +17,19 @@ from tqdm.auto import tqdm
 
 matplotlib.use("Agg")  # the command writes files; it never opens a window
 
+import matplotlib.pyplot as plt  # noqa: E402
+
 from ._models._vessel.catalogue import VESSELS, get_vessel  # noqa: E402
 from ._trials import simulate_to_folder  # noqa: E402
-from .identification import MODELS, get_model_entry, identify, read_experiments  # noqa: E402
-from .plotting import save_identification_figures  # noqa: E402
+from .identification import (  # noqa: E402
+    MODELS,
+    get_model_entry,
+    identify,
+    read_experiments,
+    read_result,
+)
+from .plotting import plot_autopilot, save_identification_figures  # noqa: E402
+from .studies import autopilot as autopilot_study  # noqa: E402
 from .studies.reproduce import reproduce  # noqa: E402
 
 
@@ -73,11 +85,33 @@ def main(argv=None) -> int:
     ident.add_argument("--no-figures", action="store_true", help="write result.json only")
     ident.add_argument("--quiet", action="store_true", help="no progress bar")
 
+    auto = sub.add_parser(
+        "autopilot", help="design a heading autopilot from an identified model and run it",
+        description="Design a PID heading autopilot with reference feed-forward from the model "
+        "of an `identify` result (pole placement, thesis eq. 5.1-5.7), run it on a vessel "
+        "preset from straight runs at each --rpm or --speed with feed-forward (pid+ff), "
+        "without (pid) and, with --tune, with gains tuned on the vessel (tuned); writes "
+        "autopilot.json, report.md and figures/ into --out.")
+    auto.add_argument("--model", required=True, type=pathlib.Path,
+                      help="result.json written by `jaxship identify`")
+    auto.add_argument("--vessel", required=True, help="the vessel steered (see `jaxship "
+                      "vessels`)")
+    auto.add_argument("--rpm", nargs="+", default=None, help="propeller rates of the runs")
+    auto.add_argument("--speed", nargs="+", default=None, help="approach speeds [m/s]")
+    auto.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
+    auto.add_argument("--step", default="45", help="heading step [deg] at 100 s (default 45)")
+    auto.add_argument("--tune", action="store_true",
+                      help="also tune the gains on the vessel at the given rpm/speeds")
+    auto.add_argument("--natural-frequency", default="0.5",
+                      help="the controller's omega_n [rad/s] (default 0.5)")
+    auto.add_argument("--damping", default="1.0", help="the controller's zeta (default 1.0)")
+    auto.add_argument("--quiet", action="store_true", help="no progress bar")
+
     args = parser.parse_args(argv)
     jax.config.update("jax_enable_x64", True)
     try:
         commands = {"vessels": _vessels, "simulate": _simulate, "reproduce": _reproduce,
-                    "identify": _identify}
+                    "identify": _identify, "autopilot": _autopilot}
         return commands[args.command](args)
     except ValueError as error:
         print(f"jaxship: error: {error}", file=sys.stderr)
@@ -174,6 +208,132 @@ def _identify(args) -> int:
     for message in dict.fromkeys(str(w.message) for w in caught):
         print(f"jaxship: warning: {message}", file=sys.stderr)
     print(f"wrote {args.out}/" + f", {args.out}/".join(written))
+    return 0
+
+
+def _numbers(option, texts) -> list[float]:
+    values = []
+    for text in texts:
+        try:
+            value = float(text)
+        except ValueError:
+            raise ValueError(f"{option} {text!r}: not a number.") from None
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{option} {text!r}: must be a positive number.")
+        values.append(value)
+    return values
+
+
+def _check_out(out: pathlib.Path):
+    """`ValueError` unless `out` is (or can be made) a folder we can write into;
+    writes nothing that stays."""
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out} is a file, not a folder.")
+    parent = out
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise ValueError(f"--out {out}: {parent} is a file, not a folder.")
+    try:
+        with tempfile.TemporaryFile(dir=parent):
+            pass
+    except OSError as error:
+        raise ValueError(f"--out {out}: cannot write in {parent} "
+                         f"({error.strerror or error}).") from None
+
+
+def _replace(path: pathlib.Path, write):
+    """Write `path` through a temporary file in its folder (`write(temporary path)`),
+    then rename it into place."""
+    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(handle)
+    umask = os.umask(0)
+    os.umask(umask)
+    try:
+        write(pathlib.Path(temporary))
+        os.chmod(temporary, 0o666 & ~umask)  # as an ordinary new file (mkstemp makes 0600)
+        os.replace(temporary, path)
+    except BaseException:
+        pathlib.Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def _point_name(row, by_rpm) -> str:
+    return f"{row['rpm']:g}rpm" if by_rpm else f"{row['speed']:g}mps"
+
+
+def _autopilot(args) -> int:
+    # every check before the long work; nothing is written until the runs are done
+    if (args.rpm is None) == (args.speed is None):
+        raise ValueError("give --rpm or --speed (one of them).")
+    by_rpm = args.rpm is not None
+    values = _numbers("--rpm" if by_rpm else "--speed", args.rpm if by_rpm else args.speed)
+    try:
+        step = float(args.step)
+        design = autopilot_study.Design(step=step,
+                                        natural_frequency=float(args.natural_frequency),
+                                        damping=float(args.damping))
+    except ValueError:
+        raise ValueError("--step, --natural-frequency and --damping take numbers.") from None
+    design.check()
+    vessel = get_vessel(args.vessel)
+    model, report = read_result(args.model)
+    _check_out(args.out)
+
+    bar = tqdm(total=2 + 2 * int(args.tune), desc="autopilot", unit="stage", leave=False,
+               file=sys.stderr, disable=args.quiet)
+    started = []
+
+    def progress(message):  # a stage starts: the one before it is done
+        if started:
+            bar.update()
+        started.append(message)
+        bar.set_postfix_str(message)
+
+    kw = {"rpm": values} if by_rpm else {"speeds": values}
+    evaluation = autopilot_study.evaluate(model, vessel, design=design, tune=args.tune,
+                                          progress=progress, **kw)
+    bar.update(bar.total - bar.n)
+    bar.close()
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "figures").mkdir(exist_ok=True)
+    names = list(evaluation.runs)
+    loops = [evaluation.runs[n] for n in names]
+    figures = []
+    for j, row in enumerate(evaluation.rows[:len(values)]):
+        point = _point_name(row, by_rpm)
+        fig = plot_autopilot(
+            loops[0], index=j, others=loops[1:], labels=names,
+            max_angle=float(vessel.rudder.max_angle),
+            window=(design.step_time - 10.0, design.duration),
+            title=f"{report['model']} autopilot on {args.vessel} at {row['rpm']:.0f} rpm, "
+            f"{row['speed']:.3g} m/s")
+        name = f"figures/heading_{point}.png"
+        _replace(args.out / name, lambda p, fig=fig: fig.savefig(p, dpi=100, format="png"))
+        plt.close(fig)
+        figures.append(name)
+    result = {
+        "model": {"file": str(args.model), "name": report["model"],
+                  "class": type(model).__name__,
+                  "parameters": {k: e["value"] for k, e in report["parameters"].items()}},
+        "vessel": args.vessel,
+        **evaluation.to_dict(),
+        "figures": figures,
+    }
+    _replace(args.out / "autopilot.json",
+             lambda p: p.write_text(json.dumps(result, indent=2) + "\n"))
+    parameters = ", ".join(f"{k} = {float(v):.4g}"
+                           for k, v in result["model"]["parameters"].items())
+    page = autopilot_study.evaluation_report(
+        evaluation, title=f"Heading autopilot: {report['model']} on {args.vessel}",
+        model_text=f"Model: {report['model']} ({type(model).__name__}) from `{args.model}`: "
+        f"{parameters}.", figures=figures)
+    _replace(args.out / "report.md", lambda p: p.write_text(page))
+    print(autopilot_study.gains_table(evaluation.gains()))
+    print(autopilot_study.runs_table(evaluation.rows))
+    print(f"wrote {args.out}/autopilot.json, {args.out}/report.md, {args.out}/figures/ "
+          f"({len(figures)} figures)")
     return 0
 
 

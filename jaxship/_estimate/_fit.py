@@ -32,7 +32,7 @@ from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
 from .._foundation._sharding import sharded_vmap
 from .._foundation._validate import validate
 from .._simulation._simulate import Simulator, integrate, replay_policy
-from ._lm import LevenbergMarquardt, solve_least_squares
+from ._lm import LevenbergMarquardt, blockwise_jacfwd, solve_least_squares, value_and_jacfwd
 from ._result import ConvergenceWarning, FitResult, IdentifiabilityWarning
 from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_data, to_timeline
 
@@ -177,9 +177,11 @@ def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
         p = transform.to_physical(p)
         return p if offsets is None else jnp.concatenate([p, jnp.reshape(offsets, (-1,))])
 
+    jacobian = value_and_jacfwd if offset_scale is None else blockwise_jacfwd(
+        len(transform.names), windows.start.r.shape)  # each window's start corrections
     z, result, steps, q, residual, jac = solve_least_squares(
         _residual_fn, solver, z0, (model, transform, windows, offset_scale), max_steps,
-        physical)
+        physical, jacobian)
     pred = windows.targets - residual / windows.weights[:, None, None, None]
     return z, result, steps, q[: len(transform.names)], pred, jac
 

@@ -20,6 +20,8 @@ custom JVP that computes the full forward-mode Jacobian once and multiplies by i
 so linearising costs one `jacfwd` and materialising one small matrix product.
 """
 
+import math
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -82,9 +84,37 @@ def value_and_jacfwd(f, z):
     return jax.vmap(lambda t: jax.jvp(f, (z,), (t,)), out_axes=(None, -1))(basis)
 
 
+def blockwise_jacfwd(num_params: int, blocks: tuple[int, ...]):
+    """A `value_and_jacfwd` for residuals `(..., *blocks, L)` whose last inputs are
+    per-block nuisance parameters, k for each of the B = `prod(blocks)` blocks in
+    block order (`z = (p, n_1, ..., n_B)`, each `n_b` of length k), where block b's
+    nuisance parameters move block b's residuals only (the start corrections of
+    prediction windows). Their columns have disjoint row supports, so one JVP seeded
+    with the j-th nuisance parameter of every block gives all B of those columns at
+    once (Curtis, Powell & Reid 1974): `num_params + k` JVPs instead of
+    `num_params + k B`."""
+    count = int(math.prod(blocks))
+
+    def value_and_jac(f, z):
+        k = (z.shape[0] - num_params) // count
+        seeds = jnp.zeros((k, z.shape[0]), dtype=z.dtype)
+        for j in range(k):
+            seeds = seeds.at[j, num_params + j::k].set(1.0)
+        basis = jnp.concatenate([jnp.eye(num_params, z.shape[0], dtype=z.dtype), seeds])
+        value, cols = jax.vmap(lambda t: jax.jvp(f, (z,), (t,)), out_axes=(None, -1))(basis)
+        lead = value.ndim - len(blocks) - 1  # axes before the blocks (e.g. channels)
+        # spread each seeded column back onto its own block: (..., *blocks, L, B, k)
+        eye = jnp.eye(count, dtype=z.dtype).reshape((1,) * lead + blocks + (1, count, 1))
+        spread = (cols[..., num_params:][..., None, :] * eye).reshape(value.shape
+                                                                      + (count * k,))
+        return value, jnp.concatenate([cols[..., :num_params], spread], axis=-1)
+
+    return value_and_jac
+
+
 @eqx.filter_custom_jvp
-def _value_and_jacobian(z, fn, args):
-    return value_and_jacfwd(lambda x: fn(x, args), z)
+def _value_and_jacobian(z, fn, args, jacobian):
+    return jacobian(lambda x: fn(x, args), z)
 
 
 @_value_and_jacobian.def_jvp
@@ -93,22 +123,24 @@ def _value_and_jacobian_jvp(primals, tangents):
     return (value, jac), (jac @ tangents[0], jnp.zeros_like(jac))
 
 
-def stored_jacobian(fn):
+def stored_jacobian(fn, jacobian=value_and_jacfwd):
     """`fn(z, args)` turned into `(f, J)`, $J$ from `value_and_jacfwd`, with a custom
     JVP $\\dot f = J \\dot z$ (see the module docstring): as a residual function with
     `has_aux=True` the solver's linearisation costs one `jacfwd` and $J$ comes back
     as the auxiliary output. (`args` is an explicit input of the custom JVP, not a
     closure: optimistix closure-converts the residual function.)"""
-    return lambda z, args: _value_and_jacobian(z, fn, args)
+    return lambda z, args: _value_and_jacobian(z, fn, args, jacobian)
 
 
-def solve_least_squares(fn, solver, z0, args, max_steps, to_physical):
+def solve_least_squares(fn, solver, z0, args, max_steps, to_physical,
+                        jacobian=value_and_jacfwd):
     """Minimise $\\frac12\\|f(z)\\|^2$, `f = fn(z, args)`; return `(z, result, num_steps,
     q, residuals, J_q)` at the solution, with $q$ = `to_physical(z)` (an elementwise
     map) and $J_q = \\partial f / \\partial q$ (..., d). With a Gauss-Newton solver the
     residuals and Jacobian are those of its last accepted step (no second compilation
-    of the forward pass); other solvers evaluate them once more. Call under jit."""
-    fn = stored_jacobian(fn)
+    of the forward pass); other solvers evaluate them once more. `jacobian(f, z)`
+    computes `(f, J)` (default `value_and_jacfwd`; `blockwise_jacfwd`). Call under jit."""
+    fn = stored_jacobian(fn, jacobian)
     sol = optx.least_squares(fn, solver, z0, args=args, options=dict(jac="fwd"),
                              has_aux=True, max_steps=max_steps, throw=False)
     info = getattr(sol.state, "f_info", None)

@@ -12,13 +12,13 @@ to a probe value $\\beta_p$.
 import dataclasses
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
 import numpy as np
 
 from .._foundation._params import get_path, rebuild
 from .._simulation._simulate import _as_arrays as as_arrays
 from ._fit import _prepare, _residuals
+from ._lm import blockwise_jacfwd, value_and_jacfwd
 
 
 @dataclasses.dataclass(frozen=True)
@@ -58,7 +58,9 @@ def _evaluate(q, model, names, windows, shape):
 @eqx.filter_jit
 def _residual_jacobian(q, model, names, windows, shape):
     f = lambda x: _evaluate(x, model, names, windows, shape)
-    return f(q), jax.jacfwd(f)(q)
+    if shape is None:
+        return value_and_jacfwd(f, q)
+    return blockwise_jacfwd(len(names), shape[:-1])(f, q)  # each window's own offsets
 
 
 _residuals_at = eqx.filter_jit(_evaluate)

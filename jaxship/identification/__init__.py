@@ -13,7 +13,11 @@ from .registry import (
     get_model_entry as get_model_entry,
     model_key as model_key,
 )
-from .result import IdentificationResult as IdentificationResult
+from .result import (
+    IdentificationResult as IdentificationResult,
+    model_from_report as model_from_report,
+    read_result as read_result,
+)
 from .simulation import (
     simulate_armax_records as simulate_armax_records,
     simulate_records as simulate_records,

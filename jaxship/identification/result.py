@@ -1,17 +1,24 @@
 """`IdentificationResult`: the report of `identify` (fitted model, start, assessments on
-the training and held-out records, notes), as text (`summary`) and JSON (`to_json`)."""
+the training and held-out records, notes), as text (`summary`) and JSON (`to_json`);
+`model_from_report` and `read_result` rebuild the fitted model from that JSON."""
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import math
+import pathlib
+import re
 
+import equinox as eqx
 import numpy as np
 
 import jaxship as js
 
+from .._foundation._params import parameter_fields
 from .._foundation._validate import _to_plain
 from .assessment import Assessment
+from .registry import model_key
 
 
 @dataclasses.dataclass(frozen=True)
@@ -102,6 +109,7 @@ class IdentificationResult:
             "start": {"method": self.start_method, "parameters": start},
             "parameters": parameters,
             "frozen": fitted["frozen"],
+            "constants": _constants(self.model),
             "fit": {k: fitted[k] for k in ("success", "result", "num_steps", "cost",
                                           "window_samples", "weights")},
             "train": self.train.to_dict(),
@@ -121,3 +129,114 @@ class IdentificationResult:
     def to_json(self, indent: int | None = 2) -> str:
         """`to_dict` as JSON text (non-finite numbers as "inf"/"-inf"/null)."""
         return json.dumps(self.to_dict(), indent=indent)
+
+
+def _constants(model) -> dict:
+    """The scalar fields of a steering model that are not parameters (reference scales
+    such as `RossAutopilot`'s L, U_0, n_0; the sway-yaw models' length, speed,
+    draught): with `parameters` and `frozen` they rebuild the model."""
+    if not isinstance(model, js.AbstractSteeringModel):
+        return {}
+    names = parameter_fields(model)
+    out = {}
+    for field in dataclasses.fields(model):
+        value = getattr(model, field.name, None)
+        if field.name in names or isinstance(value, bool) or np.ndim(value) != 0:
+            continue
+        if isinstance(value, (int, float, np.number, np.ndarray)) or hasattr(value, "dtype"):
+            out[field.name] = _to_plain(float(value))
+    return out
+
+
+# "RossAutopilot reference scales (frozen): L = 1.2 m, U0 = 1.1 m/s, n0 = 6.1 rev/s" (start_ross)
+_ROSS_SCALES = re.compile(r"L = (\S+) m, U0 = (\S+) m/s, n0 = (\S+) rev/s")
+
+
+def _number(name, value) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"parameter {name} is {value!r}, not a number.") from None
+    if not math.isfinite(number):
+        raise ValueError(f"parameter {name} is {value!r}, not a finite number.")
+    return number
+
+
+def model_from_report(report: dict):
+    """The fitted model of an `identify` report (`IdentificationResult.to_dict()`, i.e.
+    the parsed `result.json` of `jaxship identify`): a steering model rebuilt from its
+    class name, `parameters` (values), `frozen` and `constants`, or a vessel preset
+    with its estimated and frozen coefficients. Reports written before `constants`
+    existed rebuild `RossAutopilot` from the reference-scale note of its start.
+
+    **Raises** `ValueError` (one line) for a report without `model` and `parameters`,
+    non-numeric values, an ARMAX model (discrete, no yaw equation to design on) or a
+    model with effects."""
+    if not isinstance(report, dict) or not isinstance(report.get("parameters"), dict) or \
+            "model" not in report:
+        raise ValueError("not an identify result: no 'model' and 'parameters' (write one "
+                         "with `jaxship identify`).")
+    try:
+        name = model_key(report["model"])
+    except ValueError:
+        raise ValueError(f"unknown model {report['model']!r} in the identify result.") from None
+    values = {}
+    for key, entry in report["parameters"].items():
+        values[key] = _number(key, entry.get("value") if isinstance(entry, dict) else entry)
+    for key, value in (report.get("frozen") or {}).items():
+        values[key] = _number(key, value)
+    if any("." in key for key in values):
+        raise ValueError(f"the {name} result has effect parameters "
+                         f"({', '.join(k for k in values if '.' in k)}); models with effects "
+                         "cannot be rebuilt from result.json.")
+    if name == "armax":
+        raise ValueError("armax is a discrete model of the yaw rate: it has no yaw equation "
+                         "to design an autopilot on; identify a steering model.")
+    if name in js.VESSELS:
+        model = js.vessel(name)
+        known = parameter_fields(model)
+        unknown = [k for k in values if k not in known]
+        if unknown:
+            raise ValueError(f"the {name} preset has no coefficient {unknown[0]!r}.")
+        return eqx.tree_at(lambda m: tuple(getattr(m, k) for k in values), model,
+                           tuple(values.values()))
+    cls = getattr(js, str(report.get("model_class", "")), None)
+    if not (isinstance(cls, type) and issubclass(cls, js.AbstractSteeringModel)):
+        raise ValueError(f"unknown model class {report.get('model_class')!r} in the identify "
+                         "result.")
+    constants = report.get("constants")
+    if constants is None and cls is js.RossAutopilot:
+        found = [_ROSS_SCALES.search(str(note)) for note in report.get("notes", ())]
+        found = [m for m in found if m]
+        if not found:
+            raise ValueError("the RossAutopilot result has no reference scales ('constants'); "
+                             "re-run `jaxship identify` to write them.")
+        constants = dict(zip(("length", "speed", "rate"), found[0].groups()))
+    constants = {k: _number(k, v) for k, v in (constants or {}).items()}
+    try:
+        return cls(**constants, **values)
+    except TypeError as error:
+        raise ValueError(f"cannot rebuild {cls.__name__} from the identify result: "
+                         f"{error}.") from None
+
+
+def read_result(path) -> tuple[object, dict]:
+    """`(model, report)` from the `result.json` of `jaxship identify` at `path`
+    (see `model_from_report`). **Raises** `ValueError` (one line) when the file is
+    missing or unreadable, not JSON, or not an identify result."""
+    path = pathlib.Path(path)
+    if path.is_dir():
+        path = path / "result.json"
+    try:
+        text = path.read_text()
+    except OSError as error:
+        raise ValueError(f"cannot read {path}: {error.strerror or error}.") from None
+    try:
+        report = json.loads(text)
+    except json.JSONDecodeError as error:
+        raise ValueError(f"{path} is not valid JSON ({error.msg}, line {error.lineno}).") \
+            from None
+    try:
+        return model_from_report(report), report
+    except ValueError as error:
+        raise ValueError(f"{path}: {error}") from None

@@ -135,6 +135,7 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
 
     **Returns:** an `IdentificationResult`; `to_json()` gives `model`,
     `parameters` (`{name: {value, std, unit, relative_std, start}}`, SI), `frozen`,
+    `constants` (fixed non-parameter fields: `model_from_report` rebuilds the model),
     `fit` (optimiser result), `train` (the fit criterion), `train_simulation` and
     `validation` (output error; None without held-out data), each with
     `channels: {psi|r|u|v: {loss, fpe, aic, bic, fit_percent,

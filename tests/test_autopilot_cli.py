@@ -1,0 +1,261 @@
+"""`jaxship autopilot` (thesis ch. 5 on one identified model): the command end to end on a
+Nomoto model identified from a simulated zig-zag of the thesis vessel, its bad-input
+errors, the loader of `identify` results, the autopilot figure, and (slow) the
+chapter-5 study and the `--tune` option."""
+
+import json
+import math
+import os
+import pathlib
+
+import jax.numpy as jnp
+import matplotlib
+import numpy as np
+import pytest
+
+import jaxship as js
+from jaxship.cli import main
+from jaxship.identification import model_from_report, read_result
+from jaxship.plotting import plot_autopilot
+from jaxship.studies import autopilot as study
+
+
+matplotlib.use("Agg")
+
+RUN_KEYS = ("controller", "rpm", "speed", "sum_abs_error_deg", "rms_error_deg",
+            "max_overshoot_deg", "settling_time_s", "mean_abs_rudder_deg",
+            "rudder_travel_deg", "time_rate_limited_s")
+
+
+@pytest.fixture(scope="module")
+def identified(tmp_path_factory):
+    """`jaxship identify` of a Nomoto 1 model on a 20/20 zig-zag of the thesis vessel at
+    400 rpm: the result.json path."""
+    root = tmp_path_factory.mktemp("identified")
+    assert main(["simulate", "--vessel", "thesis", "--manoeuvre", "zigzag:20/20", "--rpm",
+                 "400", "--out", str(root / "trial")]) == 0
+    assert main(["identify", str(root / "trial" / "trial.csv"), "--model", "nomoto1",
+                 "--out", str(root / "fit"), "--no-figures", "--quiet"]) == 0
+    return root / "fit" / "result.json"
+
+
+@pytest.fixture(scope="module")
+def written(identified, tmp_path_factory):
+    """`jaxship autopilot` at 300 and 500 rpm (neither used for the fit)."""
+    out = tmp_path_factory.mktemp("autopilot") / "run"
+    code = main(["autopilot", "--model", str(identified), "--vessel", "thesis", "--rpm", "300",
+                 "500", "--out", str(out), "--quiet"])
+    assert code == 0
+    return out
+
+
+def test_autopilot_writes_gains_runs_report_and_figures(written):
+    result = json.loads((written / "autopilot.json").read_text())
+    assert result["model"]["class"] == "Nomoto1" and result["vessel"] == "thesis"
+    assert set(result["gains"]) == {"pid+ff", "pid"}
+    for gains in result["gains"].values():
+        assert all(math.isfinite(gains[k]) and gains[k] > 0 for k in ("kp", "ki", "kd"))
+    assert result["gains"]["pid+ff"]["feedforward"] == "Nomoto1"
+    assert result["gains"]["pid"]["feedforward"] is None
+    runs = result["runs"]
+    assert [(r["controller"], r["rpm"]) for r in runs] == [
+        ("pid+ff", 300.0), ("pid+ff", 500.0), ("pid", 300.0), ("pid", 500.0)]
+    for run in runs:
+        assert set(RUN_KEYS) <= set(run) and run["success"]
+        assert all(math.isfinite(run[k]) for k in RUN_KEYS[1:])
+    assert runs[0]["speed"] < runs[1]["speed"]  # 300 rpm is slower than 500 rpm
+    # feed-forward from the identified model beats feedback only at rpm not fitted on
+    by = {(r["controller"], r["rpm"]): r["sum_abs_error_deg"] for r in runs}
+    for rpm in (300.0, 500.0):
+        assert by["pid+ff", rpm] < by["pid", rpm]
+    # the thesis' rudder limits, and the design's numbers
+    assert result["design"]["max_rudder_deg"] == 45.0
+    assert result["design"]["max_rudder_rate_deg_s"] == 15.0
+    assert result["design"]["window_s"] == [100.0, 200.0]
+    assert result["design"]["sample_interval"] == 1.0
+    # report and figures; no temporary files left behind
+    report = (written / "report.md").read_text()
+    assert "| pid+ff | 300 |" in report and "K_p" in report
+    for figure in result["figures"]:
+        assert f"]({figure})" in report
+        assert (written / figure).stat().st_size > 20_000
+    assert sorted(p.name for p in (written / "figures").iterdir()) == [
+        "heading_300rpm.png", "heading_500rpm.png"]
+    assert not [p for p in written.rglob("*") if p.name.endswith(".tmp")]
+
+
+def test_autopilot_by_speed_with_a_port_step(identified, tmp_path):
+    out = tmp_path / "speed"
+    assert main(["autopilot", "--model", str(identified), "--vessel", "thesis", "--speed",
+                 "1.1", "--step", "-30", "--out", str(out), "--quiet"]) == 0
+    result = json.loads((out / "autopilot.json").read_text())
+    assert result["design"]["step"] == -30.0
+    assert [r["speed"] for r in result["runs"]] == [1.1, 1.1]
+    assert all(300 < r["rpm"] < 400 for r in result["runs"])
+    assert all(r["sum_abs_error_deg"] < 200 for r in result["runs"])
+    assert (out / "figures" / "heading_1.1mps.png").exists()
+
+
+def _bad_cases(tmp_path, identified):
+    bad_json = tmp_path / "bad.json"
+    bad_json.write_text("{not json")
+    other_json = tmp_path / "other.json"
+    other_json.write_text('{"model": "nomoto1"}')
+    armax = tmp_path / "armax.json"
+    armax.write_text(json.dumps({"model": "armax", "model_class": "ARMAXModel",
+                                 "parameters": {"a1": {"value": -1.0}}}))
+    a_file = tmp_path / "a_file"
+    a_file.write_text("keep")
+    model = ["--model", str(identified)]
+    out = ["--out", str(tmp_path / "out")]
+    return [
+        (model + ["--vessel", "nope", "--rpm", "300"] + out, "Unknown vessel"),
+        (model + ["--vessel", "thesis", "--rpm", "-300"] + out, "positive"),
+        (model + ["--vessel", "thesis", "--speed", "0"] + out, "positive"),
+        (model + ["--vessel", "thesis", "--rpm", "fast"] + out, "not a number"),
+        (model + ["--vessel", "thesis", "--rpm", "300", "--speed", "1.0"] + out, "one of them"),
+        (model + ["--vessel", "thesis"] + out, "one of them"),
+        (model + ["--vessel", "thesis", "--rpm", "300", "--step", "0"] + out, "step"),
+        (["--model", str(tmp_path / "missing.json"), "--vessel", "thesis", "--rpm", "300"] + out,
+         "cannot read"),
+        (["--model", str(bad_json), "--vessel", "thesis", "--rpm", "300"] + out,
+         "not valid JSON"),
+        (["--model", str(other_json), "--vessel", "thesis", "--rpm", "300"] + out,
+         "not an identify result"),
+        (["--model", str(armax), "--vessel", "thesis", "--rpm", "300"] + out, "armax"),
+        (model + ["--vessel", "mariner", "--rpm", "60"] + out, "no propeller"),
+        (model + ["--vessel", "thesis", "--rpm", "300", "--out", str(a_file)], "is a file"),
+        (model + ["--vessel", "thesis", "--rpm", "300", "--out", str(a_file / "sub")],
+         "is a file"),
+    ]
+
+
+def test_bad_input_is_one_line_a_non_zero_exit_and_writes_nothing(identified, tmp_path,
+                                                                  capsys):
+    capsys.readouterr()
+    for args, message in _bad_cases(tmp_path, identified):
+        before = sorted(p.name for p in tmp_path.rglob("*"))
+        assert main(["autopilot", *args, "--quiet"]) == 2, args
+        captured = capsys.readouterr()
+        err = captured.err.strip()
+        assert err.startswith("jaxship: error:") and "\n" not in err, (args, err)
+        assert message in err, (args, err)
+        assert captured.out == ""
+        assert sorted(p.name for p in tmp_path.rglob("*")) == before, args
+    assert (tmp_path / "a_file").read_text() == "keep"
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc") or os.name != "posix", reason="needs /proc")
+def test_an_unwritable_output_folder_is_refused_before_the_runs(identified, capsys):
+    code = main(["autopilot", "--model", str(identified), "--vessel", "thesis", "--rpm", "300",
+                 "--out", "/proc/jaxship-autopilot-test", "--quiet"])
+    assert code == 2
+    assert "cannot write" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------------------ the loader
+
+
+def test_the_loader_rebuilds_the_fitted_model(identified):
+    model, report = read_result(identified)
+    assert isinstance(model, js.Nomoto1)
+    assert float(model.K) == report["parameters"]["K"]["value"]
+    assert float(model.T) == report["parameters"]["T"]["value"]
+    assert read_result(identified.parent)[0] == model  # the folder works too
+
+
+def test_the_loader_rebuilds_ross_with_its_reference_scales():
+    values = dict(n_ur=-0.9, n_delta=-0.7, n_rrr=0.1)
+    report = {"model": "ross-autopilot", "model_class": "RossAutopilot",
+              "parameters": {k: {"value": v} for k, v in values.items()},
+              "frozen": {"n_delta_nn": 0.0}, "constants": {"length": 4.0, "speed": 1.5,
+                                                           "rate": 8.0}}
+    model = model_from_report(report)
+    assert isinstance(model, js.RossAutopilot)
+    assert (model.length, model.speed, model.rate, model.n_rrr) == (4.0, 1.5, 8.0, 0.1)
+    # results written before "constants": the reference scales from the start's note
+    del report["constants"]
+    report["notes"] = ["RossAutopilot reference scales (frozen): L = 4 m, U0 = 1.5 m/s, n0 = 8 "
+                       "rev/s; the estimates are ..."]
+    assert model_from_report(report) == model
+    report["notes"] = []
+    with pytest.raises(ValueError, match="reference scales"):
+        model_from_report(report)
+
+
+def test_the_loader_rebuilds_a_vessel_preset_with_its_estimates():
+    vessel = js.vessel("thesis")
+    report = {"model": "thesis", "model_class": "RossVessel",
+              "parameters": {"n_ur": {"value": 2 * float(vessel.n_ur)}}, "frozen": {}}
+    model = model_from_report(report)
+    assert isinstance(model, js.RossVessel) and float(model.n_ur) == 2 * float(vessel.n_ur)
+    report["parameters"]["n_ur"]["value"] = None
+    with pytest.raises(ValueError, match="not a number"):
+        model_from_report(report)
+
+
+# ------------------------------------------------------------------------------ the figure
+
+
+def _record(steps=2, points=3):
+    t = np.arange(0.0, 20.01, 0.5)
+    ordered = np.where(t >= 5.0, 0.5, 0.0)
+    shape = lambda x: jnp.broadcast_to(jnp.asarray(x), (steps, points, t.size))
+    return js.ClosedLoop(t=jnp.asarray(t), psi=shape(0.9 * ordered), psi_d=shape(ordered),
+                         psi_ref=shape(ordered), r=shape(0 * t), r_d=shape(0 * t),
+                         delta=shape(0.1 * ordered), delta_c=shape(0.1 * ordered),
+                         speed=jnp.ones(points), max_rate=jnp.ones(steps),
+                         control_period=jnp.ones(steps), success=jnp.ones((steps, points), bool))
+
+
+def test_plot_autopilot_draws_heading_error_rudder_with_limits_and_outside_legends():
+    fig = plot_autopilot(_record(), index=1, others=[_record(1)], labels=["a", "b", "c"],
+                         max_angle=np.deg2rad(45.0), window=(0.0, 20.0), title="t")
+    heading, error, rudder = fig.axes[:3]
+    assert len(heading.get_lines()) == 2 + 3  # ordered, desired, three actual headings
+    assert np.isclose(np.max(error.get_lines()[0].get_ydata()), np.rad2deg(0.05))
+    assert sorted({line.get_ydata()[0] for line in rudder.get_lines()
+                   if line.get_linestyle() == "--"}) == [-45.0, 45.0]
+    fig.canvas.draw()
+    for ax in (heading, error, rudder):  # each legend lies right of its axes
+        legend = ax.get_legend().get_window_extent()
+        assert legend.x0 >= ax.get_window_extent().x1
+    matplotlib.pyplot.close(fig)
+    with pytest.raises(ValueError, match="labels"):
+        plot_autopilot(_record(), labels=["only one"])
+
+
+# ------------------------------------------------------------------------------ slow tier
+
+
+@pytest.mark.slow
+def test_tune_adds_a_tuned_controller_that_tracks_better(identified, tmp_path):
+    out = tmp_path / "tuned"
+    assert main(["autopilot", "--model", str(identified), "--vessel", "thesis", "--rpm", "300",
+                 "500", "--out", str(out), "--tune", "--quiet"]) == 0
+    result = json.loads((out / "autopilot.json").read_text())
+    tuned = result["gains"]["tuned"]
+    assert tuned["objective_after"] < tuned["objective_before"]
+    by = {(r["controller"], r["rpm"]): r["rms_error_deg"] for r in result["runs"]}
+    assert all(by["tuned", rpm] < by["pid+ff", rpm] for rpm in (300.0, 500.0))
+
+
+@pytest.mark.slow
+def test_chapter_5_study_has_every_table_row(tmp_path):
+    result = study.autopilot_study(quick=True)
+    table = result["table"]
+    ff = [r for r in table if r["controller"] == "pid+ff"]
+    fb = [r for r in table if r["controller"] == "pid"]
+    assert len(ff) == 12 and len(fb) == 12  # Tables 5.2-5.7 at 300 and 400 rpm, both
+    assert {(r["model"], r["family"], r["rpm"]) for r in ff} == {
+        (m, f, rpm) for m in ("nomoto", "ross") for f in study.FAMILIES for rpm in (300.0, 400.0)}
+    assert all(r["thesis"] is not None for r in ff) and all(r["thesis"] is None for r in fb)
+    assert all(r["success"] and math.isfinite(r["sum_abs_error_deg"]) for r in table)
+    assert len(result["reference"]) == 4
+    assert set(result["goals"]) == {"feedforward", "ross_vs_nomoto"}
+    section = study.report_section(result)
+    for number in ("5.2", "5.3", "5.4", "5.5", "5.6", "5.7"):
+        assert f"| {number} |" in section
+    assert "sampled every 1 s over 100-200 s" in section
+    json.dumps(study.to_json(result))  # JSON-ready
+    pathlib.Path(tmp_path / "section.md").write_text(section)
