@@ -28,6 +28,7 @@ from .identification import (  # noqa: E402
     read_experiments,
     read_result,
 )
+from .identification.discovery import run_discovery  # noqa: E402
 from .plotting import plot_autopilot, save_identification_figures  # noqa: E402
 from .studies import autopilot as autopilot_study  # noqa: E402
 from .studies.reproduce import reproduce  # noqa: E402
@@ -107,11 +108,29 @@ def main(argv=None) -> int:
     auto.add_argument("--damping", default="1.0", help="the controller's zeta (default 1.0)")
     auto.add_argument("--quiet", action="store_true", help="no progress bar")
 
+    disc = sub.add_parser(
+        "discover", help="find, name and add the effect a model is missing",
+        description="Fit a registered model to the training records (as `identify` does), "
+        "score the catalogue of physically named effects at the fit, add those that pass "
+        "calibrated tests and improve the held-out records, and report; writes "
+        "discovery.json, report.md and figures/ into --out.")
+    disc.add_argument("train", nargs="+", type=pathlib.Path,
+                      help="training records: trial CSV or measurement files, or folders")
+    disc.add_argument("--holdout", nargs="+", type=pathlib.Path, default=None, metavar="TEST",
+                      help="held-out records (other manoeuvres) the effects must improve")
+    disc.add_argument("--model", required=True, help="a registered model (see `jaxship "
+                      "identify --help`)")
+    disc.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
+    disc.add_argument("--max-effects", type=int, default=3, help="most effects added (3)")
+    disc.add_argument("--alpha", type=float, default=0.01,
+                      help="family-wise false-alarm rate (0.01)")
+    disc.add_argument("--quiet", action="store_true", help="no progress messages")
+
     args = parser.parse_args(argv)
     jax.config.update("jax_enable_x64", True)
     try:
         commands = {"vessels": _vessels, "simulate": _simulate, "reproduce": _reproduce,
-                    "identify": _identify, "autopilot": _autopilot}
+                    "identify": _identify, "autopilot": _autopilot, "discover": _discover}
         return commands[args.command](args)
     except ValueError as error:
         print(f"jaxship: error: {error}", file=sys.stderr)
@@ -260,6 +279,19 @@ def _replace(path: pathlib.Path, write):
 
 def _point_name(row, by_rpm) -> str:
     return f"{row['rpm']:g}rpm" if by_rpm else f"{row['speed']:g}mps"
+
+
+def _discover(args) -> int:
+    _check_out(args.out)  # before any long work
+    say = (lambda message: None) if args.quiet else (
+        lambda message: tqdm.write(f"jaxship: {message} ...", file=sys.stderr))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the report says what matters
+        report = run_discovery(args.train, args.holdout, model=args.model, out=args.out,
+                               max_effects=args.max_effects, alpha=args.alpha, progress=say)
+    print(report.to_markdown())
+    print(f"wrote {args.out}/discovery.json, {args.out}/report.md, {args.out}/figures/")
+    return 0
 
 
 def _autopilot(args) -> int:

@@ -7,11 +7,14 @@ step per 0.5 s sample), with a rate-limited rudder logged at the sample rate, as
 log would be. Training: 10/10 and 20/20 zig-zags to both sides; held out: +-20 deg
 turning circles (another manoeuvre type)."""
 
+import json
+
 import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship.studies.discovery import run_case
+from jaxship.cli import main
+from jaxship.studies.discovery import hidden_effect_records, record, run_case
 
 
 DEG = np.pi / 180
@@ -74,7 +77,7 @@ def test_two_effects_at_once_are_both_named_and_nothing_else():
 @pytest.mark.slow
 @pytest.mark.parametrize("effect", [
     js.RudderLag(time_constant=2.0), js.RudderDelay(delay=1.5),
-    js.RudderRateLimit(inverse_rate=1 / (1.0 * DEG)), js.YawRateSensorBias(bias=0.05 * DEG),
+    js.RudderRateLimit(inverse_rate=1 / (1.0 * DEG)), js.YawRateSensorBias(bias=0.15 * DEG),
     js.YawMomentBias(n0=K * 0.5 * DEG),
 ], ids=lambda e: e.id)
 def test_every_steering_effect_is_named_or_its_class(effect):
@@ -82,3 +85,61 @@ def test_every_steering_effect_is_named_or_its_class(effect):
     assert report.effects, report.to_markdown()
     assert effect.id in report.names_or_classes()[0], report.to_markdown()
     assert report.holdout_cost_after <= report.holdout_cost_before
+
+
+def test_the_discover_command(tmp_path, capsys):
+    """`jaxship discover` on trial CSVs with a hidden cubic damping: discovery.json has the
+    documented keys, report.md and the figures are written."""
+    truth = js.augment(js.Nomoto1(K=K, T=25.0), js.YawCubicDamping(beta=300.0))
+    train, holdout = hidden_effect_records(truth, 4)
+    holdout.append(record(truth, js.ZigZag(25 * DEG, 25 * DEG, duration=300.0, dt=0.5),
+                          "zz25", np.random.default_rng(9)))
+    paths = {}
+    for role, records in (("train", train), ("holdout", holdout)):
+        paths[role] = []
+        for i, e in enumerate(records):
+            path = tmp_path / f"{role}{i}.csv"
+            js.write_trial_csv(path, e)
+            paths[role].append(str(path))
+    out = tmp_path / "out"
+    code = main(["discover", *paths["train"], "--holdout", *paths["holdout"], "--model",
+                 "nomoto1", "--out", str(out), "--quiet"])
+    assert code == 0
+    result = json.loads((out / "discovery.json").read_text())
+    assert result["verdict"] == "missing_effect"
+    assert result["effects"][0]["id"] == "yaw_cubic_damping"
+    for key in ("parameters", "score", "likelihood_ratio", "p_value", "delta_bic",
+                "equivalent_to"):
+        assert key in result["effects"][0]
+    for key in ("rejected", "train_cost_before", "train_cost_after", "holdout_cost_before",
+                "holdout_cost_after", "holdout_fit_percent_before",
+                "holdout_fit_percent_after", "holdout_indices"):
+        assert key in result
+    assert result["holdout_cost_after"] < result["holdout_cost_before"]
+    assert set(result["holdout_indices"]) == {"holdout0", "holdout1", "holdout2"}
+    zigzag = result["holdout_indices"]["holdout2"]  # turns need u, v for a track
+    error = lambda when: sum(abs(o[when] - o["measured"]) for o in zigzag.values())
+    assert set(zigzag) == {"overshoot_1_deg", "overshoot_2_deg"}
+    assert error("after") < 0.5 * error("before")  # measured 19.2, 21.7 deg
+    assert (out / "report.md").read_text().startswith("# Discovery report")
+    assert list((out / "figures").glob("*.png"))
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--model", "nope"], "nope"),
+    (["--model", "nomoto1", "--max-effects", "0"], "--max-effects"),
+])
+def test_the_discover_command_rejects_bad_input_before_work(tmp_path, capsys, args, message):
+    record = tmp_path / "a.csv"
+    js.write_trial_csv(record, hidden_effect_records(js.Nomoto1(K=K, T=25.0), 0)[0][0])
+    out = tmp_path / "out"
+    assert main(["discover", str(record), "--out", str(out), *args]) == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_the_discover_command_refuses_an_output_file(tmp_path, capsys):
+    target = tmp_path / "taken"
+    target.write_text("x")
+    assert main(["discover", str(target), "--model", "nomoto1", "--out", str(target)]) == 2
+    assert "is a file" in capsys.readouterr().err

@@ -21,10 +21,12 @@ One iteration (design: ../shared/reference/discovery-design.md, sec. 4):
 
 import dataclasses
 import math
+import warnings
 
 from scipy import stats
 
 from ..._estimate._fit import PredictionError, fit
+from ..._estimate._result import ConvergenceWarning, IdentifiabilityWarning
 from ..._estimate._sensitivity import sensitivities
 from ..._estimate._windows import as_dataset
 from ..._foundation._params import default_free, parameter_fields, rebuild
@@ -72,6 +74,14 @@ def _points_outside(model, names, step) -> bool:
     return any(fields[n].lower == 0.0 and d < 0 for n, d in zip(names, step))
 
 
+def _quiet_fit(*args, **kwargs):
+    """`fit` without its identifiability and convergence warnings: every candidate's
+    refit is judged by the report's gates, which say why one is rejected."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", (IdentifiabilityWarning, ConvergenceWarning))
+        return fit(*args, **kwargs)
+
+
 def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
              estimator: PredictionError = PredictionError(horizon=60.0, initial="estimate"),
              free=None,
@@ -105,7 +115,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             {"wind_speed", "wind_dir"} <= set(c) for c in data.experiment_channels):
         estimator = dataclasses.replace(estimator, wind=True)  # replay the logged wind
     say("fitting the base model")
-    base_fit = fit(model, train, estimator=estimator, free=free)
+    base_fit = _quiet_fit(model, train, estimator=estimator, free=free)
     channels = tuple(base_fit.metrics)
     current, theta, cost = base_fit, free, base_fit.cost
     before = holdout_check(base_fit.model, holdout, channels) if holdout else None
@@ -156,7 +166,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             start = augment(base, *effects, effect)
             for field, value in probe.items():
                 start = _set(start, f"{k}.{field}", value)
-            trial = fit(start, train, estimator=estimator, free=theta + names[k])
+            trial = _quiet_fit(start, train, estimator=estimator, free=theta + names[k])
             lr = 2 * (cost - trial.cost) / sigma2
             lr_robust = lr / max(s.inflation, 1.0)
             z = float(stats.norm.isf(level / 2))
