@@ -9,6 +9,8 @@ import dataclasses
 import json
 import pathlib
 
+import jax
+import jax.numpy as jnp
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -18,7 +20,7 @@ from ._models import _manoeuvres as man
 from ._models._vessel._base import straight_run, surge_force
 from ._simulation._readers import write_trial_csv
 from ._simulation._simulate import Simulator, simulate
-from .plotting import plot_trajectory
+from .plotting import plot_imo_criteria, plot_spiral, plot_trajectory
 
 
 SPEC_HELP = (
@@ -62,9 +64,43 @@ class TrialSpec:
             raise ValueError(
                 f"Manoeuvre {text!r} takes {expected[kind]} value(s); use one of: {SPEC_HELP}."
             )
-        if kind == "zigzag" and values[1] <= 0:
-            raise ValueError(f"Manoeuvre {text!r}: the heading change must be positive.")
-        return cls(kind, values)
+        for value in values:
+            if not np.isfinite(value):
+                raise ValueError(f"Manoeuvre {text!r}: values must be finite numbers in degrees, "
+                                 f"got {value:g}.")
+        spec = cls(kind, values)
+        for angle in spec.rudder_angles:
+            if abs(angle) > 90:
+                raise ValueError(f"Manoeuvre {text!r}: the rudder angle {angle:g} deg is beyond "
+                                 "90 deg; give a rudder angle in degrees within the vessel's "
+                                 "limit (e.g. 35).")
+        if kind == "zigzag" and values[0] == 0:
+            raise ValueError(f"Manoeuvre {text!r}: the rudder angle must not be 0 (e.g. "
+                             "zigzag:20/20, or zigzag:-20/20 to port first).")
+        if kind == "zigzag" and not 0 < values[1] < 180:
+            raise ValueError(f"Manoeuvre {text!r}: the heading change must be positive and below "
+                             "180 deg (e.g. zigzag:20/20).")
+        if kind in ("pullout", "3211") and values and values[0] == 0:
+            raise ValueError(f"Manoeuvre {text!r}: the rudder angle must not be 0.")
+        if kind == "prbs" and values and values[0] <= 0:
+            raise ValueError(f"Manoeuvre {text!r}: the amplitude must be positive (the sequence "
+                             "takes both signs).")
+        if kind == "heading-steps" and not 0 < values[0] <= 180:
+            raise ValueError(f"Manoeuvre {text!r}: the heading amplitude must be positive and at "
+                             "most 180 deg (the steps take both signs).")
+        return spec
+
+    @property
+    def rudder_angles(self) -> tuple[float, ...]:
+        """The rudder angles [deg] the spec orders (its own or the defaults), for checks
+        against a vessel's rudder limit; heading values are not included."""
+        if self.kind in ("turn", "zigzag"):
+            return self.values[:1]
+        if self.kind == "pullout":
+            return self.values or (20.0,)
+        if self.kind in ("prbs", "3211"):
+            return self.values or (10.0,)
+        return ()
 
 
 def build_manoeuvre(spec: TrialSpec, vessel, x0, *, duration=None, dt=None):
@@ -80,13 +116,9 @@ def build_manoeuvre(spec: TrialSpec, vessel, x0, *, duration=None, dt=None):
     if spec.kind == "zigzag":
         return man.ZigZag(rad(v[0]), rad(v[1]), duration=pick(35 * tau), dt=dt)
     if spec.kind == "spiral":
-        return man.spiral(hold=30 * tau, dt=dt)
+        return direct_spiral(_whole(30 * tau, dt), dt=dt)
     if spec.kind == "reverse-spiral":
-        levels = np.deg2rad(np.array([0.5, 0.3, 0.15, 0.05, -0.05, -0.15, -0.3, -0.5])) * 60 / tau
-        hold = 30 * tau
-        return man.ReverseSpiral(
-            levels / 60, hold, kp=tau, ki=0.2, duration=hold * len(levels), dt=dt
-        )
+        return reverse_spiral(vessel, x0, hold=_whole(30 * tau, dt), dt=dt)
     if spec.kind == "pullout":
         angle = rad(v[0]) if v else rad(20.0)
         return man.pull_out(
@@ -97,7 +129,7 @@ def build_manoeuvre(spec: TrialSpec, vessel, x0, *, duration=None, dt=None):
             raise ValueError(
                 f"{type(vessel).__name__} has no propeller model: a stop cannot be simulated."
             )
-        return man.Stop(-abs(float(x0.n)), duration=pick(80 * tau), dt=dt)
+        return man.Stop(-abs(float(x0.n)), duration=pick(80 * tau), dt=dt, until_stopped=True)
     if spec.kind == "prbs":
         amp = rad(v[0]) if v else rad(10.0)
         return man.prbs(amp, bit_time=2 * tau, duration=pick(100 * tau), dt=dt)
@@ -107,7 +139,7 @@ def build_manoeuvre(spec: TrialSpec, vessel, x0, *, duration=None, dt=None):
     if spec.kind == "thesis":
         return man.thesis_manoeuvre(dt=dt)
     if spec.kind == "heading-steps":
-        return man.HeadingPerturbations(
+        return man.heading_perturbations(
             rad(v[0]),
             period=20 * tau,
             kp=2.0,
@@ -117,6 +149,107 @@ def build_manoeuvre(spec: TrialSpec, vessel, x0, *, duration=None, dt=None):
             dt=dt,
         )
     raise AssertionError(spec.kind)
+
+
+# direct spiral levels [deg]: 25 deg to either side in 5 deg steps, finer near midships
+# where the loop of a course-unstable ship lies (MSC/Circ.1053 app. 4 2.1.5)
+SPIRAL_LEVELS_DEG = (25.0, 20.0, 15.0, 10.0, 5.0, 2.0, 1.0, 0.0)
+# reverse spiral levels: fractions of the steady yaw rate at the direct spiral's largest
+# rudder angle, from starboard to port; the small ones fall inside the loop of an
+# unstable ship (the S-shaped part of Bech's delta(r) curve)
+REVERSE_SPIRAL_FRACTIONS = (0.8, 0.55, 0.35, 0.2, 0.1, 0.03)
+
+
+def _whole(duration, dt):
+    """`duration` [s] rounded to a whole number (at least one) of sample intervals `dt`."""
+    return float(max(1, round(duration / dt)) * dt)
+
+
+def direct_spiral(hold, *, dt, levels_deg=SPIRAL_LEVELS_DEG, n=None):
+    """Direct (Dieudonne) spiral (MSC/Circ.1053 app. 4 2.1; ITTC 7.5-04-02-01 2.2.4):
+    the rudder at each of `levels_deg` to starboard, down through midships to the
+    same angles to port and back, each held `hold` [s]; returns a `Schedule`."""
+    side = np.asarray(levels_deg, dtype=float)
+    side = side[side > 0]
+    down = np.deg2rad(np.concatenate([side, [0.0], -side[::-1]]))
+    levels = np.concatenate([down, down[::-1][1:]])
+    edges = hold * np.arange(levels.size + 1)
+    times = np.repeat(edges, 2)[1:-1]
+    return man.Schedule(times, np.repeat(levels, 2), duration=float(edges[-1]), dt=dt, n=n)
+
+
+def linear_yaw(vessel, x0):
+    """First-order Nomoto model $r/\\delta = K/(1 + T s)$ of `vessel` about the state `x0`,
+    as `(b, a)` with $b = K/T$ [1/s^2] and $a = 1/T$ [1/s] ($\\dot r = -a r + b \\delta$;
+    $a < 0$: course-unstable).
+
+    The sway-yaw equations linearised about `x0` (the Jacobian of the loads, solved with
+    the mass matrix) give $r/\\delta = K (1 + T_3 s)/((1 + T_1 s)(1 + T_2 s))$; Nomoto's
+    first-order model keeps $K$ and $T = T_1 + T_2 - T_3$ (Nomoto et al. 1957; Fossen
+    2021 sec. 7.2). With $b$ and $a$ written without dividing by the determinant they
+    stay finite for a marginally stable ship. A vessel without sway dynamics (the sway
+    row is zero) gives the yaw equation alone.
+    """
+    u0, v0, r0, d0, n0 = (float(getattr(x0, k)) for k in ("u", "v", "r", "delta", "n"))
+    loads = lambda z: vessel.loads(0.0, z[0], z[1], z[2], z[3], n0)
+    jac = np.asarray(jax.jacfwd(loads)(jnp.array([u0, v0, r0, d0])), dtype=float)
+    mass = np.asarray(vessel.mass_matrix(), dtype=float)
+    system = np.linalg.solve(mass, jac)
+    a2, b2 = system[1:, 1:3], system[1:, 3]
+    trace, det = np.trace(a2), np.linalg.det(a2)
+    c0 = a2[1, 0] * b2[0] - a2[0, 0] * b2[1]  # K det
+    denominator = -trace * c0 - b2[1] * det  # K det T
+    scale = abs(trace * c0) + abs(b2[1] * det)
+    if scale > 0 and abs(denominator) > 1e-9 * scale:
+        return float(c0 * c0 / denominator), float(det * c0 / denominator)
+    return float(b2[1]), float(-a2[1, 1])  # no sway coupling: the yaw equation
+
+
+def yaw_rate_gains(b, a, bandwidth, damping=0.8):
+    """PI gains `(kp, ki)` of `ReverseSpiral` that place the closed-loop poles of the
+    first-order yaw model $\\dot r = -a r + b \\delta$ at natural frequency
+    `bandwidth` [rad/s] and relative damping `damping`:
+    $s^2 + (a + b k_p) s + b k_i = s^2 + 2\\zeta\\omega s + \\omega^2$. The frequency is
+    raised to $a/\\zeta$ for a ship whose own yaw damping is faster, so $k_p > 0$."""
+    if not b > 0:
+        raise ValueError(f"the rudder must turn the ship to starboard (b = {b:g} 1/s^2).")
+    omega = max(float(bandwidth), float(a) / damping)
+    return (2 * damping * omega - a) / b, omega**2 / b
+
+
+def reverse_spiral(vessel, x0, *, hold, dt, max_angle=np.deg2rad(25.0),
+                   fractions=REVERSE_SPIRAL_FRACTIONS):
+    """Bech's reverse spiral (MSC/Circ.1053 app. 4 2.2; Bech 1968) for `vessel` from `x0`.
+
+    The yaw-rate levels are `fractions` (to starboard, then the same to port) of the
+    steady yaw rate the vessel reaches at `max_angle` of rudder (the smaller of the two
+    sides, from a simulated turn to each side), so that they span the direct spiral's
+    range and reach into an unstable ship's loop; the PI gains come from the vessel's
+    linearised yaw dynamics (`linear_yaw`, `yaw_rate_gains`, closed-loop bandwidth
+    U/(2L)), so that every level is reached within its `hold` [s].
+    """
+    speed = float(np.hypot(x0.u, x0.v)) or float(vessel.nominal_speed)
+    tau = float(vessel.length) / speed
+    turn = _whole(20 * tau, dt)
+    angles = np.array([0.0, max_angle, max_angle, -max_angle])
+    both = simulate(vessel, man.Schedule(np.array([0.0, 0.0, turn, turn]), angles,
+                                         duration=2 * turn, dt=dt), x0)
+    t, r = np.asarray(both.t), np.asarray(both.state.r)
+    ends = np.array([turn, 2 * turn])
+    steady = np.abs(np.interp(ends, t, r))
+    drift = np.abs(np.interp(ends, t, r) - np.interp(ends - 0.25 * turn, t, r))
+    if not (bool(both.success) and np.all(np.isfinite(steady)) and np.min(steady) > 0
+            and np.all(drift <= 0.02 * steady)):
+        raise ValueError(
+            f"{type(vessel).__name__}: no steady turn at {np.rad2deg(max_angle):g} deg of "
+            "rudder to size the reverse spiral's yaw-rate levels."
+        )
+    side = np.asarray(fractions, dtype=float) * float(np.min(steady))
+    rates = np.concatenate([side, -side[::-1]])  # from starboard to port
+    kp, ki = yaw_rate_gains(*linear_yaw(vessel, x0), bandwidth=0.5 / tau)
+    limit = float(vessel.rudder.max_angle)
+    return man.ReverseSpiral(rates, hold, kp=kp, ki=ki, duration=hold * rates.size, dt=dt,
+                             max_angle=limit)
 
 
 def _default_dt(tau):
@@ -145,6 +278,8 @@ def run_trial(vessel, spec, *, speed=None, rpm=None, duration=None, dt=None, sub
     manoeuvre = build_manoeuvre(spec, vessel, x0, duration=duration, dt=dt)
     simulator = Simulator(substeps=substeps)
     traj = simulate(vessel, manoeuvre, x0, simulator=simulator)
+    if spec.kind == "stop" and duration is None and bool(traj.success):
+        traj = _cut_at_stop(traj)
     while spec.kind == "turn" and duration is None and spec.values[0] != 0:
         if abs(float(traj.state.psi[-1] - traj.state.psi[0])) >= np.deg2rad(540):
             break
@@ -155,6 +290,22 @@ def run_trial(vessel, spec, *, speed=None, rpm=None, duration=None, dt=None, sub
         )
         traj = simulate(vessel, manoeuvre, x0, simulator=simulator)
     return manoeuvre, traj
+
+
+def _cut_at_stop(traj):
+    """The stopping trial ends with the ship stopped in the water (ITTC 7.5-04-02-01
+    2.2.7): keep the samples up to the stop and a tenth of the time to stop after it
+    (the ship lying stopped); the whole run if it did not stop."""
+    try:
+        stop = ix.stopping_indices(traj)
+    except ValueError:
+        return traj
+    t = np.asarray(traj.t)
+    end = stop.execute_time + 1.1 * stop.time_to_stop
+    keep = min(t.size, int(np.searchsorted(t, end)) + 2)
+    size = t.size
+    return jax.tree.map(lambda a: a[:keep] if np.ndim(a) and np.shape(a)[0] == size else a,
+                        traj)
 
 
 def trial_indices(spec, manoeuvre, traj) -> dict:
@@ -172,10 +323,12 @@ def trial_indices(spec, manoeuvre, traj) -> dict:
     if spec.kind == "spiral":
         hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
         curve = ix.spiral_curve(traj, hold=hold)
-        return base | curve.to_dict() | {"loop_width_deg": float(np.rad2deg(ix.loop_width(curve)))}
+        return base | curve.to_dict() | curve.loop.to_dict()
     if spec.kind == "reverse-spiral":
-        curve = ix.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
-        return base | curve.to_dict() | {"loop_width_deg": float(np.rad2deg(ix.loop_width(curve)))}
+        curve = _reverse_curve(manoeuvre, traj)
+        ordered = np.asarray(manoeuvre.rates, dtype=float)[: curve.r.size]
+        return (base | curve.to_dict() | {"r_ordered_deg_s": np.rad2deg(ordered).tolist()}
+                | curve.loop.to_dict())
     if spec.kind == "pullout":
         return base | ix.pull_out_indices(traj).to_dict()
     if spec.kind == "stop":
@@ -183,10 +336,63 @@ def trial_indices(spec, manoeuvre, traj) -> dict:
     return base
 
 
+def _reverse_curve(manoeuvre, traj):
+    return ix.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
+
+
+def _spiral_curve(spec, manoeuvre, traj):
+    if spec.kind == "spiral":
+        hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
+        return ix.spiral_curve(traj, hold=hold)
+    return _reverse_curve(manoeuvre, traj)
+
+
+def _trial_marks(spec, manoeuvre, traj):
+    """The indices drawn on the trial figure: turning, zig-zag or stopping."""
+    try:
+        if spec.kind == "turn" and spec.values[0] != 0:
+            return ix.turning_indices(traj)
+        if spec.kind == "zigzag":
+            return ix.zigzag_indices(traj, manoeuvre.heading)
+        if spec.kind == "stop":
+            return ix.stopping_indices(traj)
+    except ValueError:  # the run is too short for them: the figure goes without
+        return None
+    return None
+
+
+def trial_criteria(spec, vessel, traj, marks) -> list:
+    """The IMO MSC.137(76) 5.3 criteria that the trial `spec` checks (a 35 deg turn,
+    a 10/10 or 20/20 zig-zag, the stop), as `CriterionRow`s; [] for the others."""
+    spec = TrialSpec.parse(spec) if isinstance(spec, str) else spec
+    if marks is None:
+        return []
+    angle = abs(spec.values[0]) if spec.values else None
+    kwargs = {}
+    if spec.kind == "turn" and angle == 35:
+        kwargs["turning35"] = marks
+    elif spec.kind == "zigzag" and angle == spec.values[1] == 10:
+        if len(marks.overshoots) < 2:
+            return []
+        kwargs["zigzag10"] = marks
+    elif spec.kind == "zigzag" and angle == spec.values[1] == 20:
+        kwargs["zigzag20"] = marks
+    elif spec.kind == "stop":
+        kwargs["stopping"] = marks
+    if not kwargs:
+        return []
+    speed = float(np.hypot(traj.state.u[0], traj.state.v[0]))
+    return ix.imo_criteria(float(vessel.length), speed, **kwargs)
+
+
 def simulate_to_folder(
     vessel, spec, out, *, speed=None, rpm=None, duration=None, dt=None, title=""
 ) -> dict:
-    """Run `spec` on `vessel` and write `trial.csv`, `indices.json` and `trial.png` to `out`."""
+    """Run `spec` on `vessel` and write `trial.csv`, `indices.json` and `trial.png` to `out`,
+    with `spiral.png` (the r-delta curve) for a spiral and `imo_criteria.png` (and the
+    rows under "imo_criteria" in `indices.json`) for a trial that an IMO criterion
+    checks."""
+    spec = TrialSpec.parse(spec) if isinstance(spec, str) else spec
     manoeuvre, traj = run_trial(vessel, spec, speed=speed, rpm=rpm, duration=duration, dt=dt)
     if not bool(traj.success):
         raise ValueError(
@@ -199,10 +405,31 @@ def simulate_to_folder(
         k: (None if isinstance(v, float) and not np.isfinite(v) else v)
         for k, v in trial_indices(spec, manoeuvre, traj).items()
     }
+    marks = _trial_marks(spec, manoeuvre, traj)
+    criteria = trial_criteria(spec, vessel, traj, marks)
+    if criteria:
+        indices["imo_criteria"] = [row.to_dict() for row in criteria]
     (out / "indices.json").write_text(json.dumps(indices, indent=2) + "\n")
-    fig = plot_trajectory(
-        traj, length=float(vessel.length), title=title or str(spec), labels=[title or str(spec)]
-    )
+    name = title or _spec_text(spec)
+    fig = plot_trajectory(traj, length=float(vessel.length), title=name, labels=[name],
+                          indices=marks)
     fig.savefig(out / "trial.png", dpi=110)
     plt.close(fig)
+    if spec.kind in ("spiral", "reverse-spiral"):
+        curve = _spiral_curve(spec, manoeuvre, traj)
+        ordered = manoeuvre.rates if spec.kind == "reverse-spiral" else None
+        fig = plot_spiral(curve, title=f"{name}: steady yaw rate against rudder angle",
+                          ordered=ordered)
+        fig.savefig(out / "spiral.png", dpi=110)
+        plt.close(fig)
+    if criteria:
+        fig = plot_imo_criteria(criteria, title=f"{name}: IMO MSC.137(76) criteria")
+        fig.savefig(out / "imo_criteria.png", dpi=110)
+        plt.close(fig)
     return indices
+
+
+def _spec_text(spec) -> str:
+    """The spec as written: `turn:35`, `zigzag:10/10`, `spiral`."""
+    values = "/".join(f"{v:g}" for v in spec.values)
+    return f"{spec.kind}:{values}" if values else spec.kind

@@ -1,11 +1,13 @@
 """The `jaxship` command: a thin layer over the public API (float64 is enabled here)."""
 
 import argparse
+import contextlib
 import importlib.metadata
 import json
 import math
 import os
 import pathlib
+import shutil
 import sys
 import tempfile
 import warnings
@@ -19,8 +21,10 @@ matplotlib.use("Agg")  # the command writes files; it never opens a window
 
 import matplotlib.pyplot as plt  # noqa: E402
 
+from ._estimate._result import ConvergenceWarning  # noqa: E402
+from ._models._vessel._base import surge_force  # noqa: E402
 from ._models._vessel.catalogue import VESSELS, get_vessel  # noqa: E402
-from ._trials import simulate_to_folder  # noqa: E402
+from ._trials import TrialSpec, simulate_to_folder  # noqa: E402
 from .identification import (  # noqa: E402
     MODELS,
     get_model_entry,
@@ -29,13 +33,24 @@ from .identification import (  # noqa: E402
     read_result,
 )
 from .identification.discovery import run_discovery  # noqa: E402
+from .identification.workflow import FitDivergedError  # noqa: E402
 from .plotting import plot_autopilot, save_identification_figures  # noqa: E402
 from .studies import autopilot as autopilot_study  # noqa: E402
 from .studies.reproduce import reproduce  # noqa: E402
 
 
+EXIT_STATUS = """exit status: 0 done; 2 bad input (arguments, records, an --out that cannot be
+written: one line on stderr, nothing written); 1 a file-system failure while writing;
+3 the fit did not converge, ended on a parameter bound (results written, the reason on
+stderr) or diverged (nothing written); 130 interrupted."""
+
+# the most samples `simulate` integrates (10 million samples hold gigabytes)
+MAX_SAMPLES = 5_000_000
+
+
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="jaxship", description=__doc__)
+    parser = argparse.ArgumentParser(prog="jaxship", description=__doc__, epilog=EXIT_STATUS,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version",
                         version=f"jaxship {importlib.metadata.version('jaxship')}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -128,13 +143,27 @@ def main(argv=None) -> int:
 
     args = parser.parse_args(argv)
     jax.config.update("jax_enable_x64", True)
+    commands = {"vessels": _vessels, "simulate": _simulate, "reproduce": _reproduce,
+                "identify": _identify, "autopilot": _autopilot, "discover": _discover}
     try:
-        commands = {"vessels": _vessels, "simulate": _simulate, "reproduce": _reproduce,
-                    "identify": _identify, "autopilot": _autopilot, "discover": _discover}
         return commands[args.command](args)
+    except FitDivergedError as error:
+        print(f"jaxship: error: {_one_line(error)}", file=sys.stderr)
+        return 3
     except ValueError as error:
-        print(f"jaxship: error: {error}", file=sys.stderr)
+        print(f"jaxship: error: {_one_line(error)}", file=sys.stderr)
         return 2
+    except OSError as error:  # the file system failed under us (disk full, a folder removed)
+        where = f"{error.filename}: " if error.filename else ""
+        print(f"jaxship: error: {where}{error.strerror or error}.", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("jaxship: interrupted.", file=sys.stderr)
+        return 130
+
+
+def _one_line(error) -> str:
+    return " ".join(str(error).split())
 
 
 def _vessels(args) -> int:
@@ -145,23 +174,56 @@ def _vessels(args) -> int:
 
 
 def _simulate(args) -> int:
+    # every check before the simulation; the files appear in --out only when all are written
     vessel = get_vessel(args.vessel)
-    indices = simulate_to_folder(
-        vessel,
-        args.manoeuvre,
-        args.out,
-        speed=args.speed,
-        rpm=args.rpm,
-        duration=args.duration,
-        dt=args.dt,
-        title=f"{args.vessel} {args.manoeuvre}",
-    )
+    spec = TrialSpec.parse(args.manoeuvre)
+    speed, rpm = _positive("--speed", args.speed), _positive("--rpm", args.rpm)
+    duration, dt = _positive("--duration", args.duration), _positive("--dt", args.dt)
+    limit = math.degrees(float(vessel.rudder.max_angle))
+    for angle in spec.rudder_angles:
+        if abs(angle) > limit * (1 + 1e-12):
+            raise ValueError(f"--manoeuvre {args.manoeuvre}: the rudder angle {angle:g} deg is "
+                             f"beyond the rudder limit of {args.vessel} ({limit:g} deg); give "
+                             f"at most {limit:g}.")
+    nominal = float(vessel.nominal_speed)
+    if speed is not None and speed > 10 * nominal:
+        raise ValueError(f"--speed {speed:g} m/s: more than 10 times the service speed of "
+                         f"{args.vessel} ({nominal:.3g} m/s); give an approach speed in m/s.")
+    if rpm is not None and float(surge_force(vessel, nominal, 1.0)
+                                 - surge_force(vessel, nominal, 0.0)) == 0.0:
+        raise ValueError(f"--rpm: {args.vessel} has no propeller model, so the propeller rate "
+                         "does nothing; give --speed instead.")
+    tau = float(vessel.length) / (speed or nominal)  # the time scale L/U [s]
+    if dt is not None and dt > tau:
+        raise ValueError(f"--dt {dt:g} s is longer than the time scale L/U = {tau:.3g} s of "
+                         f"{args.vessel}, which the simulation could not resolve; give at most "
+                         f"{tau:.3g} s (the default is about L/U / 20).")
+    # a pull-out turns for 30 L/U before the release; a 3211 sequence lasts 7 L/U
+    least = {"pullout": 30 * tau, "3211": 7 * tau}.get(spec.kind, 0.0)
+    if duration is not None and duration <= least:
+        raise ValueError(f"--duration {duration:g} s: a {spec.kind} needs more than "
+                         f"{least:.4g} s on {args.vessel}; give a longer --duration or none.")
+    if duration is not None and dt is not None and duration < 2 * dt:
+        raise ValueError(f"--duration {duration:g} s is shorter than two samples of --dt "
+                         f"{dt:g} s.")
+    samples = (duration or 100 * tau) / (dt or tau / 20)
+    if samples > MAX_SAMPLES:
+        raise ValueError(f"--duration/--dt: {samples:.3g} samples ({duration or 100 * tau:.4g} s "
+                         f"at {dt or tau / 20:.3g} s), more than {MAX_SAMPLES:.0e}; give a "
+                         "larger --dt or a shorter --duration.")
+    _check_out(args.out)
+    with _staging(args.out) as stage:
+        indices = simulate_to_folder(vessel, spec, stage, speed=speed, rpm=rpm,
+                                     duration=duration, dt=dt,
+                                     title=f"{args.vessel} {args.manoeuvre}")
+        written = sorted(p.name for p in stage.iterdir())
     print(json.dumps(indices, indent=2))
-    print(f"wrote {args.out}/trial.csv, indices.json, trial.png")
+    print(f"wrote {args.out}/" + f", {args.out}/".join(written))
     return 0
 
 
 def _reproduce(args) -> int:
+    _check_out(args.out)
     reproduce(args.out, quick=args.quick, progress=True)
     return 0
 
@@ -170,10 +232,13 @@ def _horizon(text):
     if text is None or text.strip().lower() in ("none", "oe", "output-error"):
         return None
     try:
-        return float(text)
+        value = float(text)
     except ValueError:
-        raise ValueError(f"--horizon {text!r}: give seconds (e.g. 10), 0 (equation error) or "
-                         "'none' (output error).") from None
+        value = math.nan
+    if not (math.isfinite(value) and value >= 0):
+        raise ValueError(f"--horizon {text!r}: the horizon must be a non-negative number of "
+                         "seconds (e.g. 10; 0: equation error) or 'none' (output error).")
+    return value
 
 
 class _ProgressBar:
@@ -204,8 +269,13 @@ class _ProgressBar:
 
 
 def _identify(args) -> int:
+    # every check before the fit; the files appear in --out only when all are written
     get_model_entry(args.model)  # unknown models fail before reading any file
     horizon = _horizon(args.horizon)
+    if args.max_steps < 1:
+        raise ValueError(f"--max-steps {args.max_steps}: give a positive number of optimiser "
+                         "steps (default 256).")
+    _check_out(args.out)
     train = read_experiments(args.train, role="training")
     held_out = None if args.validate is None else read_experiments(args.validate,
                                                                    role="validation")
@@ -215,19 +285,37 @@ def _identify(args) -> int:
         result = identify(train, model=args.model, horizon=horizon, validate=held_out,
                           rudder=args.rudder, channels=args.channels, initial=args.initial,
                           max_steps=args.max_steps, progress=bar)
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "result.json").write_text(result.to_json() + "\n")
     written = ["result.json"]
-    if not args.no_figures:
-        paths = save_identification_figures(result, args.out / "figures")
-        written.append(f"figures/ ({len(paths)} figures)")
-    print(result.summary())
+    with _staging(args.out) as stage:
+        if not args.no_figures:
+            paths = save_identification_figures(result, stage / "figures")
+            written.append(f"figures/ ({len(paths)} figures)")
+        (stage / "result.json").write_text(result.to_json() + "\n")
+    head, *lines = result.summary().splitlines()
+    if not result.fit.success:  # the optimiser's own words are on stderr, in plain ones
+        head = (f"{result.model_name}: {type(result.model).__name__}, NOT converged (stopped "
+                f"after {result.fit.num_steps} steps)")
+    print("\n".join([head, *lines]))
     for note in result.notes:
         print(f"note: {note}")
+    failed = False
+    for w in caught:
+        failed = failed or issubclass(w.category, ConvergenceWarning)
     for message in dict.fromkeys(str(w.message) for w in caught):
-        print(f"jaxship: warning: {message}", file=sys.stderr)
+        print(f"jaxship: warning: {_one_line(message)}", file=sys.stderr)
     print(f"wrote {args.out}/" + f", {args.out}/".join(written))
+    if failed:
+        print("jaxship: the fit did not converge properly (see the warnings above); the "
+              "results were written for inspection.", file=sys.stderr)
+        return 3
     return 0
+
+
+def _positive(option, value):
+    """`value` (a float or None) checked: finite and positive."""
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{option} {value:g}: must be a positive number.")
+    return value
 
 
 def _numbers(option, texts) -> list[float]:
@@ -247,7 +335,8 @@ def _check_out(out: pathlib.Path):
     """`ValueError` unless `out` is (or can be made) a folder we can write into;
     writes nothing that stays."""
     if out.exists() and not out.is_dir():
-        raise ValueError(f"--out {out} is a file, not a folder.")
+        raise ValueError(f"--out {out} is a file, not a folder; give a folder (it is made if "
+                         "need be).")
     parent = out
     while not parent.exists():
         parent = parent.parent
@@ -275,6 +364,31 @@ def _replace(path: pathlib.Path, write):
     except BaseException:
         pathlib.Path(temporary).unlink(missing_ok=True)
         raise
+
+
+@contextlib.contextmanager
+def _staging(out: pathlib.Path):
+    """A temporary folder inside `out` (made if need be) to write results into: when the
+    block ends, each of its folders replaces the one of that name in `out` and each file
+    is renamed into `out` (folders first, files in name order); after an error nothing is
+    moved, the temporary folder is removed, and so is `out` if it was made here and is
+    empty."""
+    made = [folder for folder in (out, *out.parents) if not folder.exists()]
+    out.mkdir(parents=True, exist_ok=True)
+    stage = pathlib.Path(tempfile.mkdtemp(dir=out, prefix=".jaxship."))
+    try:
+        yield stage
+        entries = sorted(stage.iterdir(), key=lambda p: (not p.is_dir(), p.name))
+        for entry in entries:
+            target = out / entry.name
+            if entry.is_dir() and target.is_dir():
+                os.replace(target, stage / f".old.{entry.name}")
+            os.replace(entry, target)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+        for folder in made:  # innermost first; each only while empty
+            with contextlib.suppress(OSError):
+                folder.rmdir()
 
 
 def _point_name(row, by_rpm) -> str:

@@ -5,6 +5,7 @@ import pathlib
 
 import nbformat as nbf
 
+
 HERE = pathlib.Path(__file__).parent
 SETUP = "import jax\njax.config.update('jax_enable_x64', True)\nimport numpy as np\n"
 

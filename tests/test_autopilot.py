@@ -286,3 +286,20 @@ def test_gradient_tuning_beats_pole_placement_on_and_off_the_tuning_speeds():
         before, after = (float(js.tracking_objective(
             js.closed_loop(vessel, a, rpm=[rpm], **kw), 0.1)) for a in (start, tuned.autopilot))
         assert after < 0.5 * before
+
+
+def test_a_wave_filter_calms_the_rudder_in_waves():
+    """A fast yaw disturbance (3 s correlation): behind a 2 s first-order wave filter the
+    PID works the rudder less (measured: travel 121 -> 91 deg over 200 s) for a larger
+    heading error (RMS 2.27 -> 2.86 deg): the trade a wave filter makes."""
+    vessel = js.vessel("thesis")
+    sea = js.YawDisturbance(rudder_std=5 * DEG, time_constant=3.0, sample_interval=0.5, seed=1)
+    plain = js.design_autopilot(vessel, natural_frequency=0.5, steps=js.HeadingSteps((), ()))
+    filtered = js.design_autopilot(vessel, natural_frequency=0.5, wave_filter=2.0,
+                                   steps=js.HeadingSteps((), ()))
+    runs = [js.closed_loop_metrics(js.closed_loop(vessel, a, duration=200.0, dt=0.5,
+                                                  disturbance=sea)) for a in (plain, filtered)]
+    travel = [float(m.rudder_travel[0, 0]) for m in runs]
+    error = [float(m.rms_error[0, 0]) for m in runs]
+    assert travel[1] < 0.85 * travel[0], travel
+    assert error[0] < error[1] < 1.5 * error[0], error

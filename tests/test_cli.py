@@ -1,12 +1,18 @@
-"""The `jaxship` command: listing, simulating to a folder, errors."""
+"""The `jaxship` command: listing, simulating to a folder, errors; robustness (issue 13):
+bad input on every command is one line and a non-zero exit before any long work, results
+are written whole or not at all, fits that do not converge say so and exit with 3."""
 
 import json
+import types
 
 import numpy as np
+import optimistix as optx
 import pytest
 
 import jaxship as js
+from jaxship._foundation._params import parameter_fields, resolve_free
 from jaxship.cli import main
+from jaxship.identification.workflow import FitDivergedError, _convergence_problems
 
 
 def test_vessels_lists_every_preset_with_source(capsys):
@@ -71,3 +77,329 @@ def test_version(capsys):
         main(["--version"])
     assert stop.value.code == 0
     assert capsys.readouterr().out.strip() == f"jaxship {js.__version__}"
+
+
+# -- robustness (issue 13): bad input is one line on stderr, a non-zero exit status, no
+# traceback and nothing written; --out is checked before any long work; results are
+# written through a temporary folder and renamed, never half
+
+
+def _record(path, *, psi=True, seed=0, num=400, dt=0.5):
+    """A trial CSV of Nomoto1(K=0.06, T=25) driven by random rudder steps."""
+    rng = np.random.default_rng(seed)
+    delta = np.repeat(np.where(rng.random(num // 20) < 0.5, -1.0, 1.0) * np.deg2rad(10), 20)
+    tr = js.simulate_steering(js.Nomoto1(K=0.06, T=25.0), delta, dt, psi0=0.1)
+    channels = {"psi": np.asarray(tr.psi)} if psi else {}
+    js.write_trial_csv(path, js.Experiment(np.asarray(tr.t), delta, r=np.asarray(tr.r),
+                                           name=path.stem, **channels))
+    return str(path)
+
+
+def _error_line(capsys):
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("jaxship: error: "), captured.err
+    assert "Traceback" not in captured.err
+    return lines[0]
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--manoeuvre", "turn:35", "--dt", "-1"], "--dt -1: must be a positive number"),
+    (["--manoeuvre", "turn:35", "--dt", "0"], "--dt 0: must be a positive number"),
+    (["--manoeuvre", "turn:35", "--dt", "nan"], "--dt nan: must be a positive number"),
+    (["--manoeuvre", "turn:35", "--dt", "1000"], "longer than the time scale L/U = 20.9 s"),
+    (["--manoeuvre", "turn:35", "--dt", "1e-9"], "samples"),
+    (["--manoeuvre", "turn:35", "--duration", "-5"], "--duration -5: must be a positive"),
+    (["--manoeuvre", "turn:35", "--duration", "inf"], "--duration inf: must be a positive"),
+    (["--manoeuvre", "turn:35", "--dt", "2", "--duration", "3"], "shorter than two samples"),
+    (["--manoeuvre", "turn:35", "--speed", "-1"], "--speed -1: must be a positive number"),
+    (["--manoeuvre", "turn:35", "--speed", "0"], "--speed 0: must be a positive number"),
+    (["--manoeuvre", "turn:35", "--speed", "1e6"], "more than 10 times the service speed"),
+    (["--manoeuvre", "turn:35", "--rpm", "-1"], "--rpm -1: must be a positive number"),
+    (["--manoeuvre", "turn:35", "--rpm", "100"], "mariner has no propeller model"),
+    (["--manoeuvre", "turn:400"], "rudder angle 400 deg is beyond 90 deg"),
+    (["--manoeuvre", "turn:45"], "beyond the rudder limit of mariner (40 deg)"),
+    (["--manoeuvre", "turn:nan"], "values must be finite numbers in degrees"),
+    (["--manoeuvre", "turn:-inf"], "values must be finite numbers in degrees"),
+    (["--manoeuvre", "zigzag:0/10"], "the rudder angle must not be 0"),
+    (["--manoeuvre", "zigzag:10/400"], "heading change must be positive and below 180"),
+    (["--manoeuvre", "prbs:-5"], "the amplitude must be positive"),
+    (["--manoeuvre", "heading-steps:-5"], "heading amplitude must be positive"),
+    (["--manoeuvre", "pullout:20", "--duration", "5"], "a pullout needs more than"),
+])
+def test_simulate_rejects_nonsense_before_simulating(tmp_path, capsys, args, message):
+    out = tmp_path / "a" / "b"
+    assert main(["simulate", "--vessel", "mariner", *args, "--out", str(out)]) == 2
+    assert message in _error_line(capsys)
+    assert not (tmp_path / "a").exists()
+
+
+def test_simulate_failure_leaves_the_output_folder_untouched(tmp_path, capsys):
+    """A run that fails after the simulation (too short for turning indices) writes
+    nothing: a new folder is removed again, an old one keeps its files, no temporary
+    files are left."""
+    args = ["simulate", "--vessel", "mariner", "--manoeuvre", "turn:35", "--duration", "40"]
+    assert main([*args, "--out", str(tmp_path / "new")]) == 2
+    assert "simulate longer" in _error_line(capsys)
+    assert not (tmp_path / "new").exists()
+    old = tmp_path / "old"
+    old.mkdir()
+    (old / "trial.csv").write_text("earlier run\n")
+    assert main([*args, "--out", str(old)]) == 2
+    capsys.readouterr()
+    assert sorted(p.name for p in old.iterdir()) == ["trial.csv"]
+    assert (old / "trial.csv").read_text() == "earlier run\n"
+
+
+def test_simulate_replaces_earlier_results_whole(tmp_path, capsys):
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "trial.csv").write_text("earlier run\n")
+    (out / "notes.txt").write_text("mine\n")
+    assert main(["simulate", "--vessel", "mariner", "--manoeuvre", "zigzag:10/10", "--out",
+                 str(out)]) == 0
+    assert "wrote" in capsys.readouterr().out
+    names = {p.name for p in out.iterdir()}
+    assert {"indices.json", "notes.txt", "trial.csv", "trial.png"} <= names
+    assert not [name for name in names if name.startswith(".")]  # no temporary files left
+    assert js.read_trial_csv(out / "trial.csv").num_samples > 100
+    again = tmp_path / "again"  # same inputs, same numbers
+    assert main(["simulate", "--vessel", "mariner", "--manoeuvre", "zigzag:10/10", "--out",
+                 str(again)]) == 0
+    capsys.readouterr()
+    for name in ("trial.csv", "indices.json"):
+        assert (again / name).read_text() == (out / name).read_text()
+
+
+@pytest.fixture(scope="module")
+def record(tmp_path_factory):
+    return _record(tmp_path_factory.mktemp("records") / "zz.csv")
+
+
+@pytest.fixture(scope="module")
+def fitted(record, tmp_path_factory):
+    """The result.json of `identify` on `record`."""
+    out = tmp_path_factory.mktemp("fitted")
+    assert main(["identify", record, "--model", "nomoto1", "--out", str(out), "--no-figures",
+                 "--quiet"]) == 0
+    return str(out / "result.json")
+
+
+def _command(name, record, fitted, out):
+    """Each command with valid arguments but --out."""
+    return {
+        "simulate": ["simulate", "--vessel", "mariner", "--manoeuvre", "turn:35"],
+        "identify": ["identify", record, "--model", "nomoto1"],
+        "discover": ["discover", record, "--model", "nomoto1"],
+        "autopilot": ["autopilot", "--model", fitted, "--vessel", "mariner", "--speed", "5"],
+        "reproduce": ["reproduce", "--quick"],
+    }[name] + ["--out", str(out)]
+
+
+COMMANDS = ("simulate", "identify", "discover", "autopilot", "reproduce")
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_out_that_is_a_file_is_refused_first(command, record, fitted, tmp_path, capsys,
+                                             monkeypatch):
+    """An --out that is a file, lies under a file or cannot be written is one line, exit
+    2, before any record is read or anything simulated or fitted."""
+    def no_work(*args, **kwargs):
+        raise AssertionError("long work started before --out was checked")
+
+    for name in ("simulate_to_folder", "identify", "read_experiments", "run_discovery",
+                 "reproduce", "autopilot_study.evaluate"):
+        monkeypatch.setattr(f"jaxship.cli.{name}", no_work)
+    target = tmp_path / "taken"
+    target.write_text("a file\n")
+    assert main(_command(command, record, fitted, target)) == 2
+    assert f"--out {target} is a file, not a folder" in _error_line(capsys)
+    assert main(_command(command, record, fitted, target / "sub")) == 2
+    assert f"{target} is a file, not a folder" in _error_line(capsys)
+    assert target.read_text() == "a file\n"
+
+    def refuse(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr("jaxship.cli.tempfile.TemporaryFile", refuse)
+    assert main(_command(command, record, fitted, tmp_path / "new")) == 2
+    line = _error_line(capsys)
+    assert f"--out {tmp_path / 'new'}: cannot write in {tmp_path} (Permission denied)" in line
+    assert not (tmp_path / "new").exists()
+
+
+def test_identify_checks_out_before_reading_records(tmp_path, capsys):
+    target = tmp_path / "taken"
+    target.write_text("x")
+    assert main(["identify", str(tmp_path / "missing.csv"), "--model", "nomoto1", "--out",
+                 str(target)]) == 2
+    assert "is a file, not a folder" in _error_line(capsys)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--max-steps", "0"], "--max-steps 0: give a positive number"),
+    (["--max-steps", "-3"], "--max-steps -3: give a positive number"),
+    (["--horizon", "nan"], "--horizon 'nan': the horizon must be a non-negative"),
+    (["--horizon", "inf"], "--horizon 'inf': the horizon must be a non-negative"),
+])
+def test_identify_rejects_nonsense_numbers(record, tmp_path, capsys, args, message):
+    assert main(["identify", record, "--model", "nomoto1", *args, "--out",
+                 str(tmp_path / "out")]) == 2
+    assert message in _error_line(capsys)
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("name, content, message", [
+    ("empty.csv", "", "the file is empty"),
+    ("semicolons.csv", "t [s];delta [deg];psi [deg]\n0;0;0\n1;0;0\n",
+     "separated by semicolons, not commas"),
+    ("latin1.csv", "t [s],delta [deg],psi [deg]\n0,0,0\n1,0,0\xe9\n", "line 3 is not UTF-8"),
+    ("nonnumber.csv", "t [s],delta [deg],psi [deg]\n0,0,0\n1,zero,0\n",
+     "column 'delta [deg]', row 2 (line 3): cannot read 'zero' as a number"),
+    ("dup.csv", "t [s],delta [deg],psi [deg]\n0,0,0\n0,0,0\n", "strictly increasing"),
+    ("unit.csv", "t [s],delta [grad],psi [deg]\n0,0,0\n1,0,0\n", "unknown unit 'grad'"),
+])
+@pytest.mark.parametrize("command", ["identify", "discover"])
+def test_bad_records_are_one_line(tmp_path, capsys, command, name, content, message):
+    path = tmp_path / name
+    path.write_bytes(content.encode("latin-1"))
+    assert main([command, str(path), "--model", "nomoto1", "--out", str(tmp_path / "o")]) == 2
+    line = _error_line(capsys)
+    assert str(path) in line and message in line
+    assert not (tmp_path / "o").exists()
+
+
+def test_identify_not_converged_exit_3_plain_sentence(record, tmp_path, capsys):
+    """The step limit: exit 3, a plain sentence (not the optimiser's root-find text), the
+    results written for inspection with the sentence in result.json."""
+    out = tmp_path / "fit"
+    code = main(["identify", record, "--model", "nomoto1", "--max-steps", "1", "--out",
+                 str(out), "--no-figures", "--quiet"])
+    captured = capsys.readouterr()
+    assert code == 3
+    assert "the fit stopped at the step limit (1) before converging" in captured.err
+    assert "NOT converged (stopped after 1 steps)" in captured.out
+    assert "root-find" not in captured.out + captured.err
+    result = json.loads((out / "result.json").read_text())
+    assert not result["fit"]["success"]
+    assert any("step limit (1)" in w for w in result["warnings"])
+    assert sorted(p.name for p in out.iterdir()) == ["result.json"]  # no temporary files
+
+
+def test_identify_flags_one_per_line(tmp_path, capsys):
+    """Without excitation every identifiability flag is its own warning line."""
+    t = 0.5 * np.arange(200)
+    path = tmp_path / "straight.csv"
+    js.write_trial_csv(path, js.Experiment(t, np.zeros_like(t), psi=np.full_like(t, 0.1),
+                                           r=np.zeros_like(t)))
+    out = tmp_path / "fit"
+    assert main(["identify", str(path), "--model", "nomoto1", "--out", str(out),
+                 "--no-figures", "--quiet"]) == 0
+    err = capsys.readouterr().err
+    flags = json.loads((out / "result.json").read_text())["identifiability"]["flags"]
+    assert len(flags) >= 2
+    lines = err.strip().splitlines()
+    for flag in flags:
+        assert sum(flag in line for line in lines) == 1
+    for line in lines:
+        assert sum(flag in line for flag in flags) <= 1
+
+
+def test_identify_says_when_psi_is_derived(tmp_path, capsys):
+    """A record without psi: the note says psi is integrated from r and the default fit
+    uses r alone."""
+    path = _record(tmp_path / "yawrate.csv", psi=False)
+    out = tmp_path / "fit"
+    assert main(["identify", path, "--model", "nomoto1", "--out", str(out), "--no-figures",
+                 "--quiet"]) == 0
+    stdout = capsys.readouterr().out
+    assert ("note: psi is not measured in the training record yawrate: it is integrated from "
+            "the measured r") in stdout
+    assert "psi is not fitted (channels r)" in stdout
+    result = json.loads((out / "result.json").read_text())
+    assert result["options"]["channels"] == ["r"]
+    np.testing.assert_allclose([result["parameters"][k]["value"] for k in ("K", "T")],
+                               [0.06, 25.0], rtol=1e-6)
+
+
+def test_identify_is_repeatable(record, tmp_path, capsys):
+    """Same inputs, same numbers: two runs write the same result.json, byte for byte."""
+    texts = []
+    for name in ("a", "b"):
+        assert main(["identify", record, "--model", "nomoto1", "--out", str(tmp_path / name),
+                     "--no-figures", "--quiet"]) == 0
+        texts.append((tmp_path / name / "result.json").read_text())
+    capsys.readouterr()
+    assert texts[0] == texts[1]
+
+
+def test_identify_replaces_figures_whole(record, tmp_path, capsys):
+    out = tmp_path / "fit"
+    (out / "figures").mkdir(parents=True)
+    (out / "figures" / "stale.png").write_bytes(b"old")
+    assert main(["identify", record, "--model", "nomoto1", "--out", str(out), "--quiet"]) == 0
+    capsys.readouterr()
+    figures = sorted(p.name for p in (out / "figures").iterdir())
+    assert "stale.png" not in figures and "correlation.png" in figures
+    assert sorted(p.name for p in out.iterdir()) == ["figures", "result.json"]
+
+
+def test_exit_status_of_diverged_fits_file_system_errors_and_interrupts(
+        record, tmp_path, capsys, monkeypatch):
+    def diverge(*args, **kwargs):
+        raise FitDivergedError("the fit of nomoto1 diverged: the model's outputs became "
+                               "non-finite")
+
+    monkeypatch.setattr("jaxship.cli.identify", diverge)
+    out = tmp_path / "fit"
+    assert main(["identify", record, "--model", "nomoto1", "--out", str(out)]) == 3
+    assert "diverged" in _error_line(capsys)
+    assert not out.exists()
+
+    def disk_full(*args, **kwargs):
+        raise OSError(28, "No space left on device", str(tmp_path / "run" / "trial.png"))
+
+    monkeypatch.setattr("jaxship.cli.simulate_to_folder", disk_full)
+    args = ["simulate", "--vessel", "mariner", "--manoeuvre", "turn:35", "--out",
+            str(tmp_path / "run")]
+    assert main(args) == 1
+    assert "No space left on device" in _error_line(capsys)
+    assert not (tmp_path / "run").exists()
+
+    def interrupt(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("jaxship.cli.simulate_to_folder", interrupt)
+    assert main(args) == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert not (tmp_path / "run").exists()
+
+
+def test_an_estimate_on_its_bound_is_a_convergence_problem():
+    """T of Nomoto1 is bounded below by 0: an estimate that ends there is said plainly
+    (and is a ConvergenceWarning, so `jaxship identify` exits with status 3)."""
+    def fake(T, success=True):
+        return types.SimpleNamespace(
+            success=success, result=optx.RESULTS.successful, num_steps=12, message="",
+            names=("K", "T"), values=np.array([0.06, T]))
+
+    start, entry = js.Nomoto1(K=0.05, T=20.0), types.SimpleNamespace(fit=None)
+    assert _convergence_problems(fake(25.0), 256, start, entry) == []
+    problems = _convergence_problems(fake(1e-7), 256, start, entry)
+    assert len(problems) == 1
+    assert problems[0].startswith("T = 1e-07 s ended on its lower bound 0 s")
+    assert _convergence_problems(fake(1e-7), 256, start,
+                                 types.SimpleNamespace(fit=lambda *a: None)) == []
+
+
+@pytest.mark.parametrize("preset", ["kvlcc2", "esso_osaka"])
+def test_mmg_coefficients_have_units(preset):
+    """The unit column of `identify` for the MMG presets: primed coefficients are "-",
+    dimensional ones carry their SI unit."""
+    fields = parameter_fields(js.vessel(preset))
+    assert all(info.unit for info in fields.values()), [k for k, i in fields.items()
+                                                        if not i.unit]
+    assert fields["y_v"].unit == "-" and fields["length"].unit == "m"
+    assert fields["rho"].unit == "kg/m^3"
+    assert {spec.unit for spec in resolve_free(js.vessel(preset))} == {"-"}
+    assert all(not info.unit for info in parameter_fields(js.vessel("mariner")).values())

@@ -72,7 +72,7 @@ CONTROLLERS = {
     "schedule": js.multi_step_3211(10 * DEG, 3.0, settle=10.0, dt=0.5),
     "reverse_spiral": js.ReverseSpiral(rates=np.array([0.002, -0.002]), hold=20.0, kp=20.0,
                                        ki=0.5, duration=40.0, dt=0.5),
-    "heading_perturbations": js.HeadingPerturbations(5 * DEG, 30.0, kp=2.0, ki=0.01, kd=20.0,
+    "heading_perturbations": js.heading_perturbations(5 * DEG, 30.0, kp=2.0, ki=0.01, kd=20.0,
                                              duration=40.0, dt=0.5),
     "stop": js.Stop(-0.5, duration=40.0, dt=0.5),
     "heading_autopilot": js.Controlled(
@@ -232,7 +232,7 @@ def test_controller_gains_are_differentiable_and_vmappable():
     x0 = js.straight_run(vessel)
 
     def final_error(kp):
-        pilot = js.HeadingPerturbations(5 * DEG, 120.0, kp=kp, ki=0.0, kd=30.0, duration=60.0,
+        pilot = js.heading_perturbations(5 * DEG, 120.0, kp=kp, ki=0.0, kd=30.0, duration=60.0,
                                     dt=0.5)
         return js.simulate(vessel, pilot, x0).state.psi[-1] - 5 * DEG
 

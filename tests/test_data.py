@@ -18,6 +18,7 @@ from jaxship import (
     write_trial_csv,
 )
 from jaxship._simulation._data import CHANNELS
+from jaxship.identification import read_experiments
 
 
 def synthetic_experiment(num=201, dt=0.1, t0=5.0):
@@ -478,3 +479,193 @@ def test_read_measured_unknown_format(tmp_path):
     trial = tmp_path / "trial.csv"
     trial.write_text(GOOD)
     assert read_measured(trial).num_samples == 3
+
+
+# --- robustness of every reader (issue 13): one line naming the file and what to do -------
+
+ESSO_HEADER = ("t [s],x_position_mid [m],u_velo [m/s],y_position_mid [m],vm_velo [m/s],"
+               "psi_hat [rad],r_angvelo [rad/s],n_prop [rps],delta_rudder [rad]")
+
+
+def esso_text(rows=5, header=ESSO_HEADER, edit=None, sep=","):
+    lines = [header.replace(",", sep)]
+    for k in range(rows):
+        cells = [f"{0.1 * k:.1f}", "1.0", "0.5", "2.0", "0.0", f"{0.01 * k}", "0.01", "10.0",
+                 "0.1"]
+        if edit:
+            cells = edit(k, cells)
+        lines.append(sep.join(cells))
+    return "\n".join(lines) + "\n"
+
+
+def hsva_text(rows=5, edit=None, sep=" "):
+    lines = [" HSVA, experimental data CPMC", " KVLCC2", " Z10/10", " Time series of motions"]
+    for k in range(rows):
+        cells = [f"{0.05 * k:.6f}", "2.9", "-0.001", "-0.04", "1.17", "-0.002", "-0.03",
+                 "-0.003", "0.0", "10.2", "40.5", "1.01"]
+        if edit:
+            cells = edit(k, cells)
+        lines.append(sep.join(cells))
+    return "\n".join(lines) + "\n"
+
+
+def marin_text(rows=5, edit=None, sep="\t"):
+    lines = ["MARIN(Maritime Research Institute Netherlands)", "Turning test for KVLCC2"]
+    for k in range(rows):
+        cells = [f"{k * 0.13526:.2E}",
+                 "0.00E+00", "-1.00E-02", "-2.39E-01", "1.54E-01", "8.01E+00", "6.65E-02",
+                 "-1.95E-02", "1.99E-02", "-8.52E-01", "9.14E+01"]
+        if edit:
+            cells = edit(k, cells)
+        lines.append(sep.join(cells))
+    return "\n".join(lines) + "\n"
+
+
+def cell(row, col, value):
+    return lambda k, cells: cells[:col] + [value] + cells[col + 1:] if k == row else cells
+
+
+def repeat(row):  # row `row` repeats the one before
+    state = {}
+
+    def edit(k, cells):
+        if k == row - 1:
+            state["cells"] = cells
+        return state["cells"] if k == row else cells
+    return edit
+
+
+READER_CASES = {
+    # trial CSV through read_measured (the commands' reader)
+    "trial: empty": ("x.csv", b"", read_measured, r"x\.csv: the file is empty"),
+    "trial: blank lines": ("x.csv", b"\n \n\n", read_measured, r"x\.csv: the file is empty"),
+    "trial: semicolons": ("x.csv", b"t [s];delta [deg];psi [deg]\n0;0;0\n", read_measured,
+                          r"x\.csv: header row \(line 1\): the columns are separated by "
+                          r"semicolons, not commas; save the file as comma-separated CSV"),
+    "trial: tabs": ("x.csv", b"t [s]\tdelta [deg]\tpsi [deg]\n0\t0\t0\n", read_trial_csv,
+                    r"separated by tabs, not commas"),
+    "trial: latin-1": ("x.csv", "t [s],delta [deg],psi [deg]\n0,0,0\n0.1,0,1é\n".encode(
+        "latin-1"), read_measured, r"x\.csv: line 3 is not UTF-8 text \(byte 0xe9\)"),
+    "trial: header only": ("x.csv", b"t [s],delta [deg],psi [deg]\n", read_measured,
+                           r"x\.csv: needs at least two data rows, got 0"),
+    "trial: decimal commas": ("x.csv", b"t [s],delta [deg],psi [deg]\n0,0,0\n0,1,0,2,0\n",
+                              read_measured, r"row 2 \(line 3\) has 5 fields but the header "
+                                             r"has 3 columns"),
+    # Esso Osaka
+    "esso: header only": ("e.csv", (ESSO_HEADER + "\n").encode(), read_measured,
+                          r"e\.csv: needs at least two data rows"),
+    "esso: semicolons": ("e.csv", esso_text(sep=";").encode(), read_measured,
+                         r"e\.csv: header row \(line 1\): the columns are separated by semi"),
+    "esso: missing column": ("e.csv", esso_text(header=ESSO_HEADER.replace(
+        "r_angvelo", "r_angvel")).encode(), read_esso_osaka,
+        r"e\.csv: column 'r_angvel \[rad/s\]' \(header row, line 1\): unknown Esso Osaka"),
+    "esso: unit": ("e.csv", esso_text(header=ESSO_HEADER.replace("psi_hat [rad]",
+                                                                  "psi_hat [deg]")).encode(),
+                   read_measured, r"column 'psi_hat \[deg\]'.*unit 'deg', expected 'rad'"),
+    "esso: nan": ("e.csv", esso_text(edit=cell(2, 5, "nan")).encode(), read_measured,
+                  r"e\.csv: column 'psi_hat \[rad\]', row 3 \(line 4\): value 'nan' is not "
+                  r"finite"),
+    "esso: text": ("e.csv", esso_text(edit=cell(3, 6, "n/a")).encode(), read_measured,
+                   r"column 'r_angvelo \[rad/s\]', row 4 \(line 5\): cannot read 'n/a'"),
+    "esso: repeated time": ("e.csv", esso_text(edit=repeat(3)).encode(), read_measured,
+                            r"row 4 \(line 5\): time 0\.2 is not greater than the previous"),
+    # HSVA
+    "hsva: empty": ("h.dat", b"", read_hsva_kvlcc2, r"h\.dat: the file is empty; expected an "
+                                                    r"HSVA file"),
+    "hsva: not hsva": ("h.dat", b"hello\n1 2 3\n", read_hsva_kvlcc2,
+                       r"h\.dat: not an HSVA file \(line 1 names HSVA\) \(line 1 is 'hello'\)"),
+    "hsva: header only": ("h.dat", hsva_text(rows=0).encode(), read_measured,
+                          r"h\.dat: needs at least two data rows, got 0"),
+    "hsva: commas": ("h.dat", hsva_text(sep=",").encode(), read_measured,
+                     r"h\.dat: row 1 \(line 5\) has 1 fields but an HSVA record has 12 "
+                     r"numbers separated by spaces"),
+    "hsva: missing column": ("h.dat", hsva_text(edit=lambda k, c: c[:11]).encode(),
+                             read_measured, r"has 11 fields but an HSVA record has 12"),
+    "hsva: nan": ("h.dat", hsva_text(edit=cell(1, 3, "NaN")).encode(), read_measured,
+                  r"h\.dat: column 'column 4', row 2 \(line 6\): value 'NaN' is not finite"),
+    "hsva: text": ("h.dat", hsva_text(edit=cell(1, 3, "x")).encode(), read_measured,
+                   r"column 'column 4', row 2 \(line 6\): cannot read 'x' as a number"),
+    "hsva: decreasing time": ("h.dat", hsva_text(edit=cell(3, 0, "0.01")).encode(),
+                              read_measured, r"row 4 \(line 8\): time 0\.01 is not greater"),
+    "hsva: undecodable": ("h.dat", hsva_text().encode() + b"\x81\n", read_hsva_kvlcc2,
+                          r"h\.dat: line 10 is not CP1252 text \(byte 0x81\)"),
+    # MARIN
+    "marin: empty": ("m.dat", b"", read_marin_kvlcc2, r"m\.dat: the file is empty; expected a "
+                                                      r"MARIN file"),
+    "marin: header only": ("m.dat", marin_text(rows=0).encode(), read_measured,
+                           r"m\.dat: needs at least two data rows, got 0"),
+    "marin: spaces": ("m.dat", marin_text(sep=" ").encode(), read_measured,
+                      r"m\.dat: row 1 \(line 3\) has 1 fields but a MARIN record has 11 numbers "
+                      r"separated by tabs"),
+    "marin: missing column": ("m.dat", marin_text(edit=lambda k, c: c[:10]).encode(),
+                              read_measured, r"has 10 fields but a MARIN record has 11"),
+    "marin: nan": ("m.dat", marin_text(edit=cell(2, 4, "nan")).encode(), read_measured,
+                   r"m\.dat: column 'column 5', row 3 \(line 5\): value 'nan' is not finite"),
+    "marin: text": ("m.dat", marin_text(edit=cell(2, 4, "--")).encode(), read_measured,
+                    r"column 'column 5', row 3 \(line 5\): cannot read '--' as a number"),
+    "marin: repeated row": ("m.dat", marin_text(edit=repeat(3)).encode(), read_measured,
+                            r"m\.dat: column 1 \(time\), row 4 \(line 6\): printed time .* "
+                            r"\(a row repeated, missing or out of order"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(READER_CASES))
+def test_every_reader_gives_one_line_errors(tmp_path, case):
+    name, content, reader, message = READER_CASES[case]
+    path = tmp_path / name
+    path.write_bytes(content)
+    with pytest.raises(ValueError, match=message) as error:
+        reader(path)
+    text = str(error.value)
+    assert "\n" not in text and str(path) in text
+
+
+@pytest.mark.parametrize("reader", [read_measured, read_trial_csv, read_esso_osaka,
+                                    read_hsva_kvlcc2, read_marin_kvlcc2])
+def test_readers_refuse_folders_and_missing_files(tmp_path, reader):
+    with pytest.raises(ValueError, match=r"is a folder; pass one measurement file"):
+        reader(tmp_path)
+    with pytest.raises(ValueError, match=r"nope\.csv: (no such file|cannot read the file)"):
+        reader(tmp_path / "nope.csv")
+
+
+def test_marin_rejects_a_nonsense_sample_interval(tmp_path):
+    path = tmp_path / "m.dat"
+    path.write_text(marin_text())
+    assert read_marin_kvlcc2(path).num_samples == 5
+    with pytest.raises(ValueError, match=r"`dt` must be a positive number of seconds"):
+        read_marin_kvlcc2(path, dt=-0.1)
+
+
+def test_rows_are_read_in_chunks_with_the_right_row_numbers(tmp_path, monkeypatch):
+    """A file longer than a chunk reads the same as in one piece; a bad cell in a later
+    chunk is reported at its own row and line; empty rows inside the data are errors and
+    trailing ones are dropped, across chunk boundaries too."""
+    rows = [f"{0.1 * k!r},{float(np.sin(k))!r},{float(np.cos(k))!r}" for k in range(23)]
+    path = tmp_path / "long.csv"
+    path.write_text("t [s],delta [rad],psi [rad]\n" + "\n".join(rows) + "\n,,\n,,\n")
+    whole = read_trial_csv(path)
+    monkeypatch.setattr("jaxship._simulation._readers._CHUNK", 4)
+    assert_channels_equal(read_trial_csv(path), whole, rtol=0)
+    assert whole.num_samples == 23
+    bad = rows[:17] + [rows[17].replace(",", ",oops", 1)] + rows[18:]
+    path.write_text("t [s],delta [rad],psi [rad]\n" + "\n".join(bad) + "\n")
+    with pytest.raises(ValueError, match=r"column 'delta \[rad\]', row 18 \(line 19\): "
+                                         r"cannot read 'oops"):
+        read_trial_csv(path)
+    gap = rows[:9] + [",,"] + rows[9:]
+    path.write_text("t [s],delta [rad],psi [rad]\n" + "\n".join(gap) + "\n")
+    with pytest.raises(ValueError, match=r"column 't \[s\]', row 10 \(line 11\): empty value"):
+        read_trial_csv(path)
+
+
+def test_a_folder_with_a_record_in_the_wrong_dialect_says_so(tmp_path):
+    """A semicolon-separated record in a folder is read (and refused with the reason),
+    not skipped in silence; other tables are still skipped."""
+    (tmp_path / "a.csv").write_text(GOOD)
+    (tmp_path / "open_water.csv").write_text("J,Kt\n0,0.3\n")
+    assert [e.name for e in read_experiments([tmp_path])] == ["a"]
+    (tmp_path / "b.csv").write_text(GOOD.replace(",", ";"))
+    with pytest.raises(ValueError, match=r"b\.csv: header row \(line 1\): the columns are "
+                                         r"separated by semicolons"):
+        read_experiments([tmp_path])

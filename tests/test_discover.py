@@ -77,7 +77,7 @@ def test_two_effects_at_once_are_both_named_and_nothing_else():
 @pytest.mark.slow
 @pytest.mark.parametrize("effect", [
     js.RudderLag(time_constant=2.0), js.RudderDelay(delay=1.5),
-    js.RudderRateLimit(inverse_rate=1 / (1.0 * DEG)), js.YawRateSensorBias(bias=0.15 * DEG),
+    js.RudderRateLimit(inverse_rate=1 / (1.0 * DEG)), js.YawRateSensorBias(bias=0.05 * DEG),
     js.YawMomentBias(n0=K * 0.5 * DEG),
 ], ids=lambda e: e.id)
 def test_every_steering_effect_is_named_or_its_class(effect):

@@ -282,11 +282,26 @@ def test_loop_width_of_cubic_spiral_curves(b1):
         previous = cubic_branch(d, b1, previous)
         rates.append(previous)
     direct = SpiralCurve(delta=levels, r=np.array(rates))
+    assert direct.direct and not reverse.direct
     if b1 > 0:
         assert loop_width(direct) == 0.0
-    else:  # resolved to the rudder step: between width - 2 steps and the width
-        assert true_width - 0.2 <= direct.loop_width <= true_width
-        assert direct.loop_width == pytest.approx(0.6)
+        assert direct.loop.height == 0.0 and reverse.loop.height == 0.0
+    else:
+        # resolved to the rudder step: the levels -0.3 ... 0.3 have two branches, the
+        # edges lie between them and the next levels, +-0.4
+        loop = direct.loop
+        np.testing.assert_allclose(loop.inside, np.arange(-3, 4) / 10, atol=1e-12)
+        assert loop.width_low == pytest.approx(0.6) and loop.width_high == pytest.approx(0.8)
+        assert loop.width_low <= true_width <= loop.width_high
+        assert direct.loop_width == pytest.approx(0.7)  # edges half-way
+        assert abs(loop.width - true_width) <= 0.1  # within half a step on each side
+        # height: the branches at zero rudder, r = +-1
+        assert loop.height == pytest.approx(2.0, abs=1e-9)
+        # the reverse spiral's S-curve: height between the outer branches at the middle
+        # of the loop (delta = 0: r = -1 ... +1)
+        assert reverse.loop.height == pytest.approx(2.0, abs=1e-9)
+        np.testing.assert_allclose(reverse.loop.edges, [-true_width / 2, true_width / 2],
+                                   atol=1e-12)
 
 
 def test_spiral_curve_reads_the_end_of_each_hold():
@@ -326,6 +341,75 @@ def test_reverse_spiral_curve_averages_the_settled_part():
     curve = reverse_spiral_curve(t=t, r=r, delta=delta, rates=rates, hold=hold)
     np.testing.assert_allclose(curve.delta, np.array([3.0, -1.0, 2.0]) * DEG, atol=1e-12)
     np.testing.assert_allclose(curve.r, rates, atol=1e-8)
+
+
+# issue 13: the KVLCC2 direct spiral (5 deg steps) read r = +0.094 and -1.158 deg/s at
+# zero rudder on its two branches, and its loop width came out 0.0
+KVLCC2_LEVELS = np.concatenate([np.arange(25, -26, -5), np.arange(-20, 26, 5)]) * DEG
+KVLCC2_R = np.array([2.935, 2.748, 2.507, 2.180, 1.676, 0.094, -2.095, -2.478, -2.741, -2.939,
+                     -3.091, -2.939, -2.741, -2.478, -2.094, -1.158, 1.678, 2.182, 2.508,
+                     2.749, 2.935]) * DEG
+
+
+def test_loop_of_a_direct_spiral_whose_branches_differ_at_zero_rudder():
+    curve = SpiralCurve(delta=KVLCC2_LEVELS, r=KVLCC2_R)
+    loop = curve.loop
+    assert loop.inside == (0.0,)  # two steady rates at zero rudder, one at +-5 deg
+    assert loop_width(curve) > 0
+    # the edges lie between 0 and the next levels: width between 0 and 10 deg, 5 estimated
+    assert loop.width_low == 0.0 and loop.width_high == pytest.approx(10 * DEG)
+    assert loop.width == pytest.approx(5 * DEG)
+    np.testing.assert_allclose(loop.edges, [-2.5 * DEG, 2.5 * DEG])
+    assert loop.height == pytest.approx((0.094 + 1.158) * DEG)
+    shown = loop.to_dict()
+    assert shown["loop_width_deg"] == pytest.approx(5.0)
+    assert shown["loop_height_deg_s"] == pytest.approx(1.252)
+    # branches in the order run, sharing the turning level
+    down, up = curve.branches()
+    np.testing.assert_array_equal(down, np.arange(11))
+    np.testing.assert_array_equal(up, np.arange(10, 21))
+    # lag that holds too short leave between the branches is not a loop
+    stable = SpiralCurve(delta=KVLCC2_LEVELS, r=np.where(KVLCC2_R == -1.158 * DEG, 0.0,
+                                                         KVLCC2_R) + 0.05 * DEG)
+    assert stable.loop.width == 0.0 and stable.loop.inside == ()
+
+
+def test_spiral_curves_count_a_last_hold_that_is_not_a_whole_number_of_samples():
+    # 30 L/U of the KVLCC2 (178.1 s) sampled every 0.2 s: the run ends 0.1 s before the
+    # 21st hold does, which was dropped
+    hold, dt, count = 178.1170453, 0.2, 21
+    t = np.arange(0.0, round(hold * count / dt) * dt + dt / 2, dt)
+    assert t[-1] < hold * count
+    k = np.minimum((t // hold).astype(int), count - 1)
+    levels = np.linspace(0.3, -0.3, count)
+    delta, r = levels[k], 0.01 * levels[k]
+    curve = spiral_curve(t=t, r=r, delta=delta, hold=hold)
+    assert curve.r.size == count and curve.kind == "direct"
+    np.testing.assert_allclose(curve.delta, levels)
+    rates = 0.01 * levels
+    reverse = reverse_spiral_curve(t=t, r=r, delta=delta, rates=rates, hold=hold)
+    assert reverse.r.size == count and reverse.kind == "reverse"
+    # (a level's edge between two samples is interpolated: within 1 % of a step)
+    np.testing.assert_allclose(reverse.r, rates, atol=0.01 * 0.0003)
+
+
+def test_kvlcc2_direct_spiral_shows_its_loop():
+    # the simulated trial (`jaxship simulate --manoeuvre spiral`): finer steps near
+    # midships; the loop of this MMG model lies between about 0 and 0.5 deg of rudder
+    vessel = js.vessel("kvlcc2")
+    manoeuvre, traj = js.run_trial(vessel, "spiral")
+    indices = js.trial_indices("spiral", manoeuvre, traj)
+    hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
+    curve = spiral_curve(traj, hold=hold)
+    assert curve.r.size == 29 and len(indices["r_deg_s"]) == 29  # every level
+    at_zero = curve.r[np.abs(curve.delta) < 1e-12]
+    assert at_zero.size == 2 and at_zero[0] > -0.1 * DEG and at_zero[1] < -1.0 * DEG
+    loop = curve.loop
+    assert loop.inside == (0.0,)
+    assert loop.width_low <= np.deg2rad(0.5) <= loop.width_high  # brackets the true width
+    assert loop.width == pytest.approx(1.0 * DEG, rel=1e-6)
+    assert indices["loop_width_deg"] == pytest.approx(1.0, rel=1e-6)
+    assert indices["loop_height_deg_s"] > 1.0
 
 
 # --------------------------------------------------------------------------- pull-out

@@ -9,6 +9,7 @@ from helpers import linear_test_vessel
 
 import jaxship as js
 from jaxship._analysis._indices import reverse_spiral_curve
+from jaxship._trials import linear_yaw, yaw_rate_gains
 
 
 AT_SAMPLES = js.Simulator(max_step=math.inf)  # controllers act at the output samples
@@ -147,6 +148,23 @@ def test_stop_orders_astern_at_execute(vessel, x0):
     assert traj.state.n[-1] < 0 and traj.state.u[-1] < traj.state.u[0]
 
 
+def test_stop_ends_the_astern_order_when_the_ship_has_stopped(vessel, x0):
+    # ITTC 7.5-04-02-01 2.2.7: the stopping trial ends with the ship stopped in the
+    # water; the propeller then goes back to zero instead of driving it astern
+    traj = js.simulate(vessel, js.Stop(-1.2, duration=600.0, dt=0.5, execute=20.0), x0)
+    t, u = np.asarray(traj.t), np.asarray(traj.state.u)
+    order = np.asarray(traj.command.n)
+    stopped = int(np.argmax((t >= 20.0) & (u <= 0.0)))
+    assert 100.0 < t[stopped] < 300.0
+    np.testing.assert_array_equal(order[(t >= 20.0) & (t < t[stopped] - 0.5)], -1.2)
+    np.testing.assert_array_equal(order[t > t[stopped]], 0.0)  # latched, whatever u does
+    assert np.max(-u[t > t[stopped]]) < 0.05 * x0.u  # it does not make way astern
+    astern = js.simulate(vessel, js.Stop(-1.2, duration=600.0, dt=0.5, execute=20.0,
+                                         until_stopped=False), x0)
+    np.testing.assert_array_equal(np.asarray(astern.command.n)[t >= 20.0], -1.2)
+    assert astern.state.u[-1] < -0.5 * x0.u  # the old behaviour: full astern to the end
+
+
 def test_replay_reproduces_a_closed_loop_run_and_pads(vessel, x0):
     # the zig-zag logic acting at the samples (one control step per sample), so that the
     # sampled commands are all it ordered
@@ -217,23 +235,105 @@ def test_reverse_spiral_reaches_the_yaw_rate_levels(vessel, x0):
 
 def test_heading_perturbations_track_the_square_wave(vessel, x0):
     A, period, dt = 10 * DEG, 600.0, 0.5
-    pd = js.HeadingPerturbations(A, period, kp=2.0, ki=0.0, kd=100.0, duration=1200.0, dt=dt)
+    pd = js.heading_perturbations(A, period, kp=2.0, ki=0.0, kd=100.0, duration=1200.0, dt=dt)
     traj = js.simulate(vessel, pd, js.straight_state(x0.u, x0.n, psi=1.0))
     t, psi = np.asarray(traj.t), np.asarray(traj.state.psi)
     for k in range(1, 5):  # at the end of each half period, heading within 0.1 deg of the ref
         i = np.searchsorted(t, k * period / 2) - 1
         reference = 1.0 + A * (1 if k % 2 else -1)
         assert abs(psi[i] - reference) < 0.1 * DEG, (k, (psi[i] - reference) / DEG)
-    # the rudder law, recomputed from the sampled states (PID with anti-windup clip)
+    # the rudder law, recomputed from the sampled states (HeadingAutopilot's PID with
+    # conditional-integration anti-windup)
     kp, ki, kd = 2.0, 0.005, 60.0
-    pid = js.HeadingPerturbations(A, period, kp=kp, ki=ki, kd=kd, duration=600.0, dt=dt)
+    pid = js.heading_perturbations(A, period, kp=kp, ki=ki, kd=kd, duration=600.0, dt=dt)
     traj = js.simulate(vessel, pid, x0, simulator=AT_SAMPLES)
     t, psi = np.asarray(traj.t), np.asarray(traj.state.psi)
     r, order = np.asarray(traj.state.r), np.asarray(traj.command.delta)
     reference = np.where(np.floor(2 * t / period) % 2 == 0, A, -A)
-    integral, limit, expected = 0.0, 35 * DEG / ki, []
+    integral, expected = 0.0, []
     for e, rk in zip(reference - psi, r):
-        integral = np.clip(integral + e * dt, -limit, limit)
+        wanted = kp * e + ki * (integral + e * dt) - kd * rk
+        delta = np.clip(wanted, -35 * DEG, 35 * DEG)
+        if not (wanted != delta and (wanted - delta) * ki * e > 0):  # not winding up
+            integral += e * dt
         expected.append(np.clip(kp * e + ki * integral - kd * rk, -35 * DEG, 35 * DEG))
     np.testing.assert_allclose(order, expected, atol=1e-12)
     assert np.any(np.abs(order) == 35 * DEG)  # the limit is exercised
+
+
+# ------------------------------------------------------------ trials of `jaxship simulate`
+
+
+def _direct_range(vessel, x0, tau, dt):
+    """Steady yaw rates [rad/s] at +-25 deg of rudder (the direct spiral's extremes)."""
+    turn = 20 * tau
+    both = js.simulate(vessel, js.Schedule(np.array([0.0, 0.0, turn, turn]),
+                                           np.array([0.0, 25.0, 25.0, -25.0]) * DEG,
+                                           duration=2 * turn, dt=dt), x0)
+    t, r = np.asarray(both.t), np.asarray(both.state.r)
+    return float(np.interp(turn, t, r)), float(r[-1])
+
+
+@pytest.mark.parametrize("name", ["mariner", "kvlcc2"])
+def test_reverse_spiral_trial_reaches_every_level_across_the_direct_range(name):
+    # issue 13: the levels were +-0.5/tau deg/s (+-0.025 deg/s for the Mariner, +-0.09
+    # for the KVLCC2, against +-0.6 and +-3 in the direct spiral) and the last one was
+    # dropped (7 of 8 reported)
+    vessel = js.vessel(name)
+    manoeuvre, traj = js.run_trial(vessel, "reverse-spiral")
+    assert isinstance(manoeuvre, js.ReverseSpiral)
+    curve = js.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
+    ordered = np.asarray(manoeuvre.rates)
+    assert curve.r.size == ordered.size == 12  # every level reported
+    assert np.all(np.diff(ordered) < 0)  # from starboard to port
+    np.testing.assert_array_less(np.abs(curve.r - ordered), 0.1 * np.abs(ordered))
+    x0 = js.straight_run(vessel)
+    tau = float(vessel.length / vessel.nominal_speed)
+    r_port_max, r_stbd_max = _direct_range(vessel, x0, tau, float(manoeuvre.dt))
+    assert np.ptp(curve.r) >= 0.5 * (r_port_max - r_stbd_max)
+    assert np.all(np.abs(np.asarray(traj.command.delta)) <= vessel.rudder.max_angle + 1e-12)
+    indices = js.trial_indices("reverse-spiral", manoeuvre, traj)
+    assert len(indices["r_deg_s"]) == 12
+    if name == "kvlcc2":  # course-unstable: the S-curve has a loop between its branches
+        assert curve.loop.width > np.deg2rad(0.1) and curve.loop.height > np.deg2rad(0.5)
+    else:
+        assert curve.loop.width == 0.0
+
+
+def test_linear_yaw_and_gains_place_the_poles():
+    vessel = js.vessel("mariner")
+    x0 = js.straight_run(vessel)
+    b, a = linear_yaw(vessel, x0)
+    assert b > 0 and a > 0  # course-stable: the rudder turns it to starboard, yaw damped
+    kp, ki = yaw_rate_gains(b, a, bandwidth=0.05, damping=0.8)
+    roots = np.roots([1.0, a + b * kp, b * ki])
+    np.testing.assert_allclose(np.abs(roots), 0.05, rtol=1e-9)
+    np.testing.assert_allclose(-roots.real / np.abs(roots), 0.8, rtol=1e-9)
+    # the marginally unstable KVLCC2 (one pole at +4e-4 1/s): finite, a < 0
+    kv = js.vessel("kvlcc2")
+    b2, a2 = linear_yaw(kv, js.straight_run(kv))
+    assert np.isfinite(b2) and b2 > 0 and a2 < 0
+
+
+def test_crash_stop_trial_ends_when_the_ship_has_stopped():
+    # issue 13: the KVLCC2 kept going full astern after it had stopped and spun at
+    # -4 deg/s to a heading of -1534 deg
+    vessel = js.vessel("kvlcc2")
+    manoeuvre, traj = js.run_trial(vessel, "stop")
+    ind = js.stopping_indices(traj)
+    t = np.asarray(traj.t)
+    assert t[-1] <= ind.execute_time + 1.1 * ind.time_to_stop + 3 * float(manoeuvre.dt)
+    after = t >= ind.execute_time + ind.time_to_stop
+    assert np.count_nonzero(after) >= 3
+    assert np.max(np.abs(np.asarray(traj.state.r))) < 0.05 * DEG
+    assert np.max(np.abs(np.asarray(traj.state.psi))) < 1.0 * DEG
+    np.testing.assert_array_equal(np.asarray(traj.command.n)[after][1:], 0.0)
+    # run for the whole default duration: it stays stopped (no astern run, no spin)
+    long = js.simulate(vessel, manoeuvre, js.straight_run(vessel))
+    t, u = np.asarray(long.t), np.asarray(long.state.u)
+    stopped = t >= ind.execute_time + ind.time_to_stop
+    assert t[-1] > 5 * ind.time_to_stop
+    assert np.max(np.abs(np.asarray(long.state.r)[stopped])) < 0.05 * DEG
+    assert np.max(np.abs(np.asarray(long.state.psi))) < 1.0 * DEG
+    assert np.max(np.abs(u[stopped])) < 0.05 * float(vessel.nominal_speed)
+

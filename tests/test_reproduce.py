@@ -1,21 +1,24 @@
-"""`jaxship reproduce --quick`: the thesis pipeline end to end on the built-in vessel."""
+"""`jaxship reproduce`: the thesis pipeline end to end on the built-in vessel, written up
+as `report.md` with the thesis' numbers beside ours."""
 
 import json
+import re
 
 import pytest
 
 from jaxship.cli import main
-from jaxship.studies.reproduce import reproduce
+from jaxship.studies import reproduce as rp
+from jaxship.studies.thesis import THESIS_FIT
 
 
-def test_quick_reproduce_writes_trials_and_matches_thesis_ranges(tmp_path):
-    reproduce(tmp_path, quick=True, identification=False)
+def test_quick_trials_match_thesis_ranges_and_open_the_report(tmp_path):
+    results = rp.reproduce(tmp_path, quick=True, identification=False, discover=False)
     summary = json.loads((tmp_path / "indices.json").read_text())
-    assert set(summary) >= {"turn40_500rpm", "zigzag40-40_500rpm", "thesis_500rpm"}
+    assert summary == results["indices"]
+    assert set(summary) == {"turn40_200rpm", "zigzag40-40_200rpm", "thesis_200rpm",
+                            "turn40_500rpm", "zigzag40-40_500rpm", "thesis_500rpm"}
     for name in summary:
         assert (tmp_path / "trials" / f"{name}.csv").stat().st_size > 0
-    assert list((tmp_path / "figures").glob("*.png"))
-    assert "| trial |" in (tmp_path / "summary.md").read_text()
     # thesis section 4.1 (figs. 4.3, 4.5, 4.7): 1.2-1.6 m/s at 500 rpm (fig. 4.7, with the
     # 45 deg step: from 0.8 m/s) and yaw rates of several deg/s, at most about 10 deg/s, at
     # 40-45 deg rudder. The lower speed bound was 1.1 m/s while the rudder stalled at 33 deg;
@@ -32,14 +35,73 @@ def test_quick_reproduce_writes_trials_and_matches_thesis_ranges(tmp_path):
     assert abs(slow["tactical_diameter_m"] / fast["tactical_diameter_m"] - 1) < 0.2
     assert summary["zigzag40-40_500rpm"]["overshoot_1_deg"] > 0
 
+    report = (tmp_path / "report.md").read_text()
+    assert report.startswith("# jaxship reproduce")
+    assert "**Table 1. Manoeuvring indices" in report
+    assert "| thesis: yaw-rate axis [deg/s] | thesis: speed axis [m/s] |" in report
+    row = next(line for line in report.splitlines() if line.startswith("| turn40_500rpm |"))
+    assert "fig. 4.3" in row and "fig. 4.8" in row  # the thesis values where it states them
+    _assert_figures_exist(tmp_path, report, at_least=4)
+    assert "A.3x" not in report and "## Left out" in report
+    run = json.loads((tmp_path / "run.json").read_text())
+    assert run["quick"] and run["seconds"] > 0 and set(run["stages_seconds"]) == {"trials"}
+
+
+def test_every_large_fit_difference_gets_a_sentence():
+    for case, models in THESIS_FIT.items():
+        for model, families in models.items():
+            for family, paper in families.items():
+                for ours in (paper - 20.0, paper - 2.0, paper + 2.0, paper + 20.0):
+                    row = dict(case=case, model=model, family=family, fit=ours, thesis=paper)
+                    sentence = rp._explanation(row)
+                    if abs(ours - paper) < rp.LARGE:
+                        assert sentence is None
+                    else:
+                        assert sentence and sentence.endswith("."), (case, model, family, ours)
+
+
+def _assert_figures_exist(folder, report, at_least):
+    paths = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", report)
+    assert len(paths) >= at_least
+    for path in paths:
+        assert not path.startswith("/") and (folder / path).stat().st_size > 0, path
+
 
 @pytest.mark.slow
-def test_quick_reproduce_command_identifies_the_steering_models(tmp_path, capsys):
+def test_quick_reproduce_command_writes_the_report(tmp_path, capsys):
     assert main(["reproduce", "--quick", "--out", str(tmp_path)]) == 0
-    study = json.loads((tmp_path / "identification.json").read_text())
-    rows = {(r["case"], r["model"], r["family"]): r for r in study["table"]}
-    assert len(rows) == 18  # single / merged x three models x three families
-    # the Ross model explains the single 40 deg / 500 rpm records better than Nomoto
-    for family in ("turning", "zigzag", "thesis"):
-        assert rows["single", "ross", family]["fit"] > rows["single", "nomoto", family]["fit"]
-    assert "Steering models identified" in (tmp_path / "summary.md").read_text()
+    report = (tmp_path / "report.md").read_text()
+    for heading in ("## Trials (thesis sec. 4.1)", "## Steering models identified (thesis "
+                    "chapter 4)", "## Heading autopilot (thesis chapter 5)",
+                    "## Discovery of a hidden effect", "## Left out"):
+        assert heading in report, heading
+    _assert_figures_exist(tmp_path, report, at_least=10)
+    data = {name: json.loads((tmp_path / f"{name}.json").read_text())
+            for name in ("indices", "identification", "autopilot", "discovery", "run")}
+
+    # chapter 4: the merged fits (quick) with the thesis' legend values and figures named
+    assert "| thesis fit % | thesis source |" in report and "fig. 4.22 legend" in report
+    rows = {(r["model"], r["family"]): r for r in data["identification"]["table"]}
+    assert len(rows) == 6 and {r["case"] for r in rows.values()} == {"merged"}
+    for (model, family), row in rows.items():
+        assert row["thesis"] == THESIS_FIT["merged"][model][family]
+        assert row["thesis_figure"] in report
+    for family in ("turning", "zigzag", "thesis"):  # Ross follows the speed change
+        assert rows["ross", family]["fit"] > rows["nomoto", family]["fit"]
+    # merged Ross on the turning circles: 61 % in the thesis, far above here, explained
+    assert "merged Ross autopilot, turning circles" in report
+
+    # chapter 5: Tables 5.2-5.7 with the thesis' two rows beside ours
+    assert "| ours 300 | thesis 300 | ours 400 | thesis 400 |" in report
+    for table in ("5.2", "5.3", "5.4", "5.5", "5.6", "5.7"):
+        assert f"| {table} |" in report and f"**Table {table}**" in report
+    ff = [r for r in data["autopilot"]["table"] if r["controller"] == "pid+ff"]
+    assert len(ff) == 12 and all(r["thesis"] is not None for r in ff)
+
+    # discovery: the hidden cubic yaw damping is named and the held-out cost falls
+    disc = data["discovery"]
+    assert [e["id"] for e in disc["effects"]] == ["yaw_cubic_damping"]
+    assert disc["holdout_cost_after"] < disc["holdout_cost_before"]
+    assert "**Named: yaw_cubic_damping**" in report
+    assert data["run"]["quick"] and set(data["run"]["stages_seconds"]) >= {
+        "trials", "identification", "autopilot", "discovery"}

@@ -69,7 +69,7 @@ def design_autopilot(model, *, bandwidth=None, natural_frequency=None, damping=1
                      feedforward=True, reference: ReferenceModel = ReferenceModel(),
                      steps: HeadingSteps = HeadingSteps(), max_angle=None, max_rate=None,
                      interval=0.1, speed=None, n=None, subtract_damping=True,
-                     anti_windup=True) -> HeadingAutopilot:
+                     anti_windup=True, wave_filter=None) -> HeadingAutopilot:
     """A `HeadingAutopilot` for `model` (an identified steering model or a vessel) by
     pole placement (thesis eq. 5.3-5.5; Fossen 2011, sec. 12.2):
 
@@ -86,7 +86,7 @@ def design_autopilot(model, *, bandwidth=None, natural_frequency=None, damping=1
     `feedforward`: True (invert `model` itself), False/None, or another model (or
     a `Feedforward`) to invert. `max_angle`, `max_rate` [rad, rad/s]: default the
     vessel's servo limits, else 35 deg and no rate limit. `reference`, `steps`,
-    `interval`, `anti_windup`: as `HeadingAutopilot`.
+    `interval`, `anti_windup`, `wave_filter`: as `HeadingAutopilot`.
     """
     if (bandwidth is None) == (natural_frequency is None):
         raise ValueError("give exactly one of `bandwidth` and `natural_frequency` [rad/s].")
@@ -107,7 +107,8 @@ def design_autopilot(model, *, bandwidth=None, natural_frequency=None, damping=1
         max_rate = servo.max_rate if servo is not None else float("inf")
     return HeadingAutopilot(kp=kp, ki=w / 10 * kp, kd=kd, reference=reference, steps=steps,
                             feedforward=feedforward, max_angle=max_angle, max_rate=max_rate,
-                            interval=interval, anti_windup=anti_windup)
+                            interval=interval, anti_windup=anti_windup,
+                            wave_filter=wave_filter)
 
 
 class TunedAutopilot(eqx.Module):

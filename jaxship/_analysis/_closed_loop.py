@@ -33,7 +33,7 @@ class YawDisturbance(eqx.Module):
     $\\sigma$ = `rudder_std` [rad] expressed as the rudder angle whose yaw moment it
     equals at the vessel's nominal straight run, time constant `time_constant` [s],
     held over `sample_interval` [s], drawn from `seed` (NumPy). Vessels only; added
-    with `RecordedDisturbance` through `augment`. No wave filter is modelled."""
+    with `RecordedDisturbance` through `augment` (see `HeadingAutopilot.wave_filter`)."""
 
     rudder_std: float = float(np.deg2rad(2.0))
     time_constant: float = 30.0

@@ -82,8 +82,9 @@ class Free:
 def parameter_fields(model) -> dict[str, ParameterInfo]:
     """The estimable fields of `model` with their metadata, in field order: the fields
     declared with `param`, or, for a vessel (whose coefficient tables are plain
-    floats), every scalar float field, free when named in its `free_by_default`; for a
-    model with effects, the base's and each effect's as `"<effect id>.<field>"`."""
+    floats), every scalar float field, free when named in its `free_by_default`, with
+    its unit from the class's `units` mapping if it has one; for a model with effects,
+    the base's and each effect's as `"<effect id>.<field>"`."""
     if hasattr(model, "lookup"):  # a model with effects: the base's and "<id>.<field>"
         out = dict(parameter_fields(model.base))
         for effect in model.effects:
@@ -92,14 +93,14 @@ def parameter_fields(model) -> dict[str, ParameterInfo]:
     fields = {f.name: f.metadata[_KEY] for f in dataclasses.fields(model) if _KEY in f.metadata}
     if fields or not hasattr(model, "free_by_default"):
         return fields
-    default = model.free_by_default
+    default, units = model.free_by_default, getattr(model, "units", {})
     out = {}
     for f in dataclasses.fields(model):
         value = getattr(model, f.name, None)
         if isinstance(value, bool) or not (isinstance(value, (int, float, np.number)) or (
                 isinstance(value, (np.ndarray, jax.Array)) and np.ndim(value) == 0)):
             continue
-        out[f.name] = ParameterInfo(free=f.name in default)
+        out[f.name] = ParameterInfo(free=f.name in default, unit=units.get(f.name, ""))
     return out
 
 

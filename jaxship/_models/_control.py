@@ -9,6 +9,8 @@ $\\tau_N = \\tau_{FF} - K_p\\tilde\\psi - K_d\\tilde r - K_i\\int\\tilde\\psi$ w
 errors the other way round, $\\tilde\\psi = \\psi - \\psi_d$: the same law).
 """
 
+import abc
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -17,7 +19,6 @@ from jaxtyping import Array, ArrayLike
 
 from .._foundation._kinematics import ssa
 from .._foundation._state import Command, ShipState
-from ._manoeuvres import AbstractController
 from ._steering._base import AbstractSteeringModel, AuxInputs
 from ._vessel._base import AbstractVessel, inverse3
 
@@ -26,6 +27,24 @@ def _floats(x):
     """Numbers and sequences as float NumPy arrays (cast to JAX's default float when
     traced); JAX arrays and tracers as they are."""
     return x if isinstance(x, jax.Array) else np.asarray(x, dtype=float)
+
+
+
+class AbstractController(eqx.Module):
+    """The controller seam. `init(x0)` gives the controller's memory (a pytree) at the
+    initial state; `command(t, state, memory, h)` the `Command` for the control step
+    $[t, t + h]$ and the new memory. The simulator calls it at every control step
+    (`Simulator.max_step`, 0.1 s by default, whatever the output interval) and carries
+    the memory in its scan state, so a closed loop is differentiable (tune gains by
+    gradient) and vmappable (over gains, speeds, seeds)."""
+
+    @abc.abstractmethod
+    def init(self, x0):
+        """The controller's memory at the initial `ShipState` `x0`."""
+
+    @abc.abstractmethod
+    def command(self, t, state, memory, h):
+        """The command for the control step `[t, t + h]` and the new memory."""
 
 
 class ReferenceModel(eqx.Module):
@@ -158,6 +177,7 @@ class AutopilotMemory(eqx.Module):
     command: Array
     next_update: Array
     origin: Array
+    filtered: Array  # the wave filter's (psi, r) estimate [rad, rad/s]
 
 
 class HeadingAutopilot(AbstractController):
@@ -185,19 +205,26 @@ class HeadingAutopilot(AbstractController):
     integrator exactly the pole-placement design when nothing saturates, and handles
     the rate limit as well as the angle limit.
 
+    **Wave filter.** With `wave_filter` $= T_f$ [s] the PID sees the measured heading
+    and yaw rate through a first-order low pass, $\\dot{\\hat x} = (x - \\hat x)/T_f$
+    (exact discretisation every control step), so that wave-frequency yaw motion does
+    not drive the rudder (Fossen 2011, sec. 11.3, in its simplest form; $T_f$ well
+    below the closed-loop time constant and above the wave periods).
+
     The gains `kp` [-], `ki` [1/s], `kd` [s] are arrays: differentiable and vmappable.
     """
 
     kp: ArrayLike  # K_p [rad rudder / rad heading]
     ki: ArrayLike  # K_i [1/s]
     kd: ArrayLike  # K_d [s]
-    reference: ReferenceModel = ReferenceModel()
+    reference: ReferenceModel | None = ReferenceModel()  # None: track the steps as they are
     steps: HeadingSteps = HeadingSteps()
     feedforward: Feedforward | None = None
     max_angle: ArrayLike = float(np.deg2rad(35.0))  # delta_max [rad]
     max_rate: ArrayLike = float("inf")  # delta_dot_max [rad/s]
     interval: ArrayLike = 0.1  # control interval [s]
     anti_windup: bool = eqx.field(static=True, default=True)
+    wave_filter: ArrayLike | None = None  # T_f [s] of the wave filter; None: none
 
     def __check_init__(self):
         for name in ("max_angle", "max_rate", "interval"):
@@ -210,14 +237,25 @@ class HeadingAutopilot(AbstractController):
         zero = jnp.zeros_like(psi0)
         return AutopilotMemory(reference=jnp.stack([psi0, zero, zero]), integral=zero,
                                command=zero + x0.delta, next_update=zero - jnp.inf,
-                               origin=psi0)
+                               origin=psi0, filtered=jnp.stack([psi0, zero + x0.r]))
 
     def command(self, t, state: ShipState, memory: AutopilotMemory, h):
+        psi_ref = memory.origin + self.steps(t + 0.5 * h)
+        if self.reference is None:  # the ordered heading itself, at rest
+            memory = eqx.tree_at(lambda m: m.reference, memory,
+                                 jnp.stack([psi_ref, 0.0 * psi_ref, 0.0 * psi_ref]))
         psi_d, r_d, a_d = memory.reference[0], memory.reference[1], memory.reference[2]
         period = jnp.maximum(self.interval, h)
         update = t >= memory.next_update - 0.5 * h
-        error = ssa(psi_d - state.psi)
-        fixed = self.kp * error + self.kd * (r_d - state.r)  # all but the integral term
+        psi, r = state.psi, state.r
+        filtered = memory.filtered
+        if self.wave_filter is not None:  # first-order low pass, exact over the step
+            a = jnp.exp(-h / self.wave_filter)
+            filtered = jnp.stack([memory.filtered[0] + (1 - a) * ssa(psi - memory.filtered[0]),
+                                  a * memory.filtered[1] + (1 - a) * r])
+            psi, r = filtered[0], filtered[1]
+        error = ssa(psi_d - psi)
+        fixed = self.kp * error + self.kd * (r_d - r)  # all but the integral term
         if self.feedforward is not None:
             fixed = fixed + jnp.clip(self.feedforward(r_d, a_d, state, self.max_angle),
                                            -self.max_angle, self.max_angle)
@@ -238,12 +276,13 @@ class HeadingAutopilot(AbstractController):
         scheduled = jnp.where(jnp.isfinite(memory.next_update),
                               jnp.maximum(memory.next_update + self.interval, t + 0.5 * h),
                               t + self.interval)
-        psi_ref = memory.origin + self.steps(t + 0.5 * h)
         memory = AutopilotMemory(
-            reference=self.reference.step(memory.reference, psi_ref, h),
+            reference=memory.reference if self.reference is None
+            else self.reference.step(memory.reference, psi_ref, h),
             integral=jnp.where(update, integral, memory.integral),
             command=jnp.where(update, delta, memory.command),
             next_update=jnp.where(update, scheduled, memory.next_update),
             origin=memory.origin,
+            filtered=filtered,
         )
         return Command(memory.command, state.n), memory

@@ -16,25 +16,8 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import ArrayLike
 
-from .._foundation._kinematics import ssa
 from .._foundation._state import Command
-
-
-class AbstractController(eqx.Module):
-    """The controller seam. `init(x0)` gives the controller's memory (a pytree) at the
-    initial state; `command(t, state, memory, h)` the `Command` for the control step
-    $[t, t + h]$ and the new memory. The simulator calls it at every control step
-    (`Simulator.max_step`, 0.1 s by default, whatever the output interval) and carries
-    the memory in its scan state, so a closed loop is differentiable (tune gains by
-    gradient) and vmappable (over gains, speeds, seeds)."""
-
-    @abc.abstractmethod
-    def init(self, x0):
-        """The controller's memory at the initial `ShipState` `x0`."""
-
-    @abc.abstractmethod
-    def command(self, t, state, memory, h):
-        """The command for the control step `[t, t + h]` and the new memory."""
+from ._control import AbstractController, HeadingAutopilot, HeadingSteps
 
 
 class AbstractManoeuvre(AbstractController):
@@ -283,7 +266,15 @@ def thesis_manoeuvre(
 
 
 class Stop(AbstractTrial):
-    """Crash stop (ITTC 2.2.7): propeller to `astern_n` [rev/s] at `execute`, rudder midships."""
+    """Crash stop (ITTC 7.5-04-02-01 2.2.7; IMO MSC.137(76) 4.2.4): propeller to
+    `astern_n` [rev/s] at `execute`, rudder midships.
+
+    The trial ends when the ship is stopped in the water (the surge velocity through
+    the water falls to zero): with `until_stopped` (the default) the propeller is
+    then ordered to zero, so that the ship is not driven astern (and, with a
+    single-screw ship's asymmetric astern forces, into a turn) for the rest of the
+    run; the stop is latched in the controller memory. `until_stopped=False` keeps
+    the astern order to the end (the astern run after a stop)."""
 
     astern_n: ArrayLike  # n_astern [rev/s], negative
     duration: ArrayLike
@@ -292,22 +283,43 @@ class Stop(AbstractTrial):
     start: ArrayLike = 0.0
     n: ArrayLike | None = None
     num_samples: int | None = eqx.field(static=True, default=None)
+    until_stopped: bool = eqx.field(static=True, default=True)
 
     def init_memory(self, x0):
-        return None
+        return jnp.zeros_like(jnp.asarray(x0.u, dtype=float))  # 1 once stopped
 
     def rudder(self, tau, state, psi0, memory, h):
         return jnp.zeros_like(tau), memory
+
+    def command(self, t, state, memory, h):
+        """Astern from `execute` until the surge velocity reaches zero (then stop)."""
+        n0, psi0, stopped = memory
+        tau = t - self.start
+        ordered = tau >= self.execute
+        if self.until_stopped:
+            stopped = jnp.where(ordered & (state.u <= 0.0), 1.0, stopped)
+        ahead = n0 if self.n is None else self.n
+        astern = jnp.where(stopped > 0, 0.0, self.astern_n)
+        n = jnp.where(ordered, astern, ahead)
+        return Command(jnp.zeros_like(tau), n), (n0, psi0, stopped)
 
     def propeller(self, tau, n):
         return jnp.where(tau >= self.execute, self.astern_n, n)
 
 
 class ReverseSpiral(AbstractTrial):
-    """Bech's reverse spiral: a yaw-rate controller holds each rate in `rates` [rad/s]
-    for `hold` s; the mean rudder needed gives the delta(r) curve (MSC/Circ.1053 app. 4).
+    """Bech's reverse spiral (Bech 1968, "The reversed spiral test as applied to large
+    ships", Shipping World and Shipbuilder; MSC/Circ.1053 app. 4 2.2): a yaw-rate
+    controller holds each rate in `rates` [rad/s] for `hold` s; the mean rudder needed
+    gives the delta(r) curve, S-shaped through an unstable ship's loop, which the
+    direct spiral cannot hold.
 
-    Rudder law (PI on yaw rate): $\\delta_c = k_p e + k_i \\int e\\,dt$, $e = r_{ref} - r$.
+    Rudder law (PI on yaw rate): $\\delta_c = k_p e + k_i \\int e\\,dt$, $e = r_{ref} - r$,
+    clipped to `max_angle` with the integral bounded to it. On the first-order model
+    $\\dot r = -a r + b\\delta$ the closed loop is
+    $s^2 + (a + b k_p)s + b k_i$; `jaxship simulate` places its poles from the
+    vessel's linearised yaw dynamics and sizes the rates from its steady turn at the
+    direct spiral's largest rudder angle (`jaxship._trials.reverse_spiral`).
     """
 
     rates: ArrayLike  # r_ref levels [rad/s]
@@ -337,40 +349,22 @@ class ReverseSpiral(AbstractTrial):
         return delta, integral
 
 
-class HeadingPerturbations(AbstractTrial):
-    """Heading-reference perturbations under a PID heading controller (the closed-loop
-    identification experiments of Astrom & Kallstrom 1979, sec. 4).
-
-    Reference: initial heading plus a square wave of `amplitude` [rad] and `period`
-    [s]. Rudder law: $\\delta_c = k_p e + k_i \\int e\\,dt - k_d r$ with
-    $e = \\mathrm{ssa}(\\psi_{ref} - \\psi)$.
-    """
-
-    amplitude: ArrayLike
-    period: ArrayLike
-    kp: ArrayLike  # [-]
-    ki: ArrayLike  # [1/s]
-    kd: ArrayLike  # [s]
-    duration: ArrayLike
-    dt: ArrayLike = 0.1
-    start: ArrayLike = 0.0
-    max_angle: ArrayLike = np.deg2rad(35)
-    n: ArrayLike | None = None
-    num_samples: int | None = eqx.field(static=True, default=None)
-
-    def init_memory(self, x0):
-        return jnp.zeros_like(jnp.asarray(x0.psi, dtype=float))
-
-    def reference(self, tau, psi0):
-        phase = jnp.floor(2 * tau / self.period) % 2
-        return psi0 + self.amplitude * (1 - 2 * phase)
-
-    def rudder(self, tau, state, psi0, integral, h):
-        error = ssa(self.reference(tau, psi0) - state.psi)
-        limit = self.max_angle / jnp.maximum(self.ki, 1e-12)
-        integral = jnp.clip(integral + error * h, -limit, limit)
-        delta = self.kp * error + self.ki * integral - self.kd * state.r
-        return jnp.clip(delta, -self.max_angle, self.max_angle), integral
+def heading_perturbations(amplitude, period, kp, ki, kd, duration, *, dt=0.1,
+                          max_angle=np.deg2rad(35)) -> Controlled:
+    """Heading-reference perturbations under the heading autopilot (the closed-loop
+    identification experiments of Astrom & Kallstrom 1979, sec. 4): the ordered
+    heading is the initial one plus a square wave of `amplitude` [rad] and `period`
+    [s], taken without a reference model; the rudder law is `HeadingAutopilot`'s PID,
+    $\\delta_c = k_p e + k_i\\int e\\,dt - k_d r$, $e = \\mathrm{ssa}(\\psi_{ref} - \\psi)$,
+    with `kp` [-], `ki` [1/s], `kd` [s], clipped to `max_angle` [rad] with
+    conditional-integration anti-windup. Returns the manoeuvre (`Controlled`)."""
+    count = int(np.ceil(float(duration) / (0.5 * float(period)))) + 1
+    times = 0.5 * float(period) * np.arange(count)
+    headings = float(amplitude) * (1.0 - 2.0 * (np.arange(count) % 2))
+    pilot = HeadingAutopilot(kp=kp, ki=ki, kd=kd, reference=None,
+                             steps=HeadingSteps(tuple(times), tuple(headings)),
+                             max_angle=max_angle)
+    return Controlled(pilot, duration=duration, dt=dt)
 
 
 class Replay(AbstractTrial):

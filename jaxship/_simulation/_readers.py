@@ -27,6 +27,7 @@ non-finite cell anywhere else is an error. Unknown column names are an error unl
 """
 
 import csv
+import itertools
 import math
 import os
 import re
@@ -83,55 +84,161 @@ def _from_si(value: np.ndarray, unit: str) -> np.ndarray:
 # ---------------------------------------------------------------------------------------
 # CSV parsing shared by the trial format and the Esso Osaka files
 
+_CHUNK = 1024  # rows converted at a time: small, so that the rows die young (cheap GC)
+_DELIMITERS = {";": "semicolons", "\t": "tabs", "|": "vertical bars"}
+
+
+def _open_text(path: Path, encoding: str):
+    """`path` opened for reading text; a missing, unreadable or folder path is a
+    one-line `ValueError`."""
+    if path.is_dir():
+        raise ValueError(f"{path} is a folder; pass one measurement file.")
+    try:
+        return open(path, newline="", encoding=encoding)
+    except OSError as error:
+        raise ValueError(f"{path}: cannot read the file ({error.strerror or error}).") from None
+
+
+def _not_text(path: Path, encoding: str) -> ValueError:
+    """The error for a file that is not `encoding` text, naming the first bad line."""
+    try:
+        data = path.read_bytes()
+        data.decode(encoding)
+    except UnicodeDecodeError as error:
+        line = data.count(b"\n", 0, error.start) + 1
+        return ValueError(f"{path}: line {line} is not {encoding.split('-sig')[0].upper()} text "
+                          f"(byte 0x{data[error.start]:02x}); save the file as UTF-8 or ASCII "
+                          "text.")
+    except OSError as error:
+        return ValueError(f"{path}: cannot read the file ({error.strerror or error}).")
+    return ValueError(f"{path}: not {encoding} text; save the file as UTF-8 or ASCII text.")
+
+
+def _csv_records(path: Path, encoding: str):
+    """Yield `(line, fields)` for every CSV record of `path` (blank lines give no
+    fields); decoding and CSV errors become one-line `ValueError`s naming the line."""
+    with _open_text(path, encoding) as f:
+        reader = csv.reader(f)
+        try:
+            for fields in reader:
+                yield reader.line_num, fields
+        except UnicodeDecodeError:
+            raise _not_text(path, encoding) from None
+        except csv.Error as error:
+            raise ValueError(f"{path}: line {reader.line_num + 1}: not a readable CSV record "
+                             f"({error}).") from None
+
+
+def _data_records(records):
+    """The data records after the header: blank lines skipped, and records with only
+    empty cells kept only when a record with a value follows (so trailing empty rows of
+    spreadsheet exports are dropped, and an empty row inside the data is an error)."""
+    pending = []
+    for record in records:
+        fields = record[1]
+        if not fields:
+            continue
+        if not any(map(str.strip, fields)):
+            pending.append(record)
+            continue
+        if pending:
+            yield from pending
+            pending.clear()
+        yield record
+
+
+def _check_delimiter(path, line, header):
+    """A header of one field holding semicolons or tabs: the file is not comma-separated."""
+    if len(header) == 1:
+        for delimiter, name in _DELIMITERS.items():
+            if delimiter in header[0]:
+                raise ValueError(
+                    f"{path}: header row (line {line}): the columns are separated by {name}, "
+                    "not commas; save the file as comma-separated CSV (decimal points, not "
+                    "commas)."
+                )
+
 
 def _read_csv(path: Path, encoding: str = "utf-8-sig"):
-    """Header fields, header line number and the data records `(line, fields)`;
-    blank lines are skipped and so are trailing records with only empty cells."""
-    with open(path, newline="", encoding=encoding) as f:
-        reader = csv.reader(f)
-        header, header_line, records = None, 0, []
-        for fields in reader:
-            if not fields or (header is None and all(not s.strip() for s in fields)):
-                continue
-            if header is None:
-                header, header_line = [s.strip() for s in fields], reader.line_num
-            else:
-                records.append((reader.line_num, fields))
-    if header is None:
-        raise ValueError(f"{path}: the file is empty; expected a header row.")
-    while records and all(not s.strip() for s in records[-1][1]):
-        records.pop()
-    return header, header_line, records
+    """Header fields, header line number and an iterator of the data records
+    `(line, fields)` (see `_data_records`); records before the header with only empty
+    cells are skipped."""
+    records = _csv_records(path, encoding)
+    for line, fields in records:
+        if any(map(str.strip, fields)):
+            header = [s.strip() for s in fields]
+            _check_delimiter(path, line, header)
+            return header, line, _data_records(records)
+    raise ValueError(f"{path}: the file is empty; expected a header row such as "
+                     "'t [s],delta [deg],psi [deg]'.")
 
 
-def _parse_numbers(path, headers, records) -> np.ndarray:
-    """Float table of `records`, with an error naming file, column and row on bad cells."""
+def _parse_numbers(path, headers, records, layout=None) -> tuple[np.ndarray, list[int]]:
+    """Float table of the `(line, fields)` `records` (any iterable; converted in chunks)
+    and the line number of each row; an error names the file, column and row of the
+    first bad cell. `layout`: the expected layout, for a row with the wrong number of
+    fields (default: the header's column count)."""
     ncol = len(headers)
-    data = np.empty((len(records), ncol))
-    for k, (line, fields) in enumerate(records):
+    layout = layout or f"the header has {ncol} columns"
+    blocks, lines, chunk = [], [], []
+
+    def convert():
+        try:
+            block = np.array([fields for _, fields in chunk], dtype=np.float64)
+            good = bool(np.isfinite(block).all())
+        except ValueError:
+            good = False
+        if not good:  # find the bad cell (or parse what numpy would not, as float() does)
+            block = _checked_block(path, headers, chunk, len(lines) - len(chunk))
+        blocks.append(block)
+        chunk.clear()
+
+    for line, fields in records:
         if len(fields) != ncol:
             raise ValueError(
-                f"{path}: row {k + 1} (line {line}) has {len(fields)} fields but the header "
-                f"has {ncol} columns."
+                f"{path}: row {len(lines) + 1} (line {line}) has {len(fields)} fields but "
+                f"{layout}."
             )
+        lines.append(line)
+        chunk.append((line, fields))
+        if len(chunk) == _CHUNK:
+            convert()
+    if chunk:
+        convert()
+    data = np.concatenate(blocks) if blocks else np.empty((0, ncol))
+    return data, lines
+
+
+def _checked_block(path, headers, chunk, offset) -> np.ndarray:
+    """The float table of `chunk` (whose first row is row `offset + 1`) read cell by
+    cell, with the error for its first empty, unreadable or non-finite cell."""
+    block = np.empty((len(chunk), len(headers)))
+    for k, (line, fields) in enumerate(chunk):
         for j, text in enumerate(fields):
-            where = f"{path}: column '{headers[j]}', row {k + 1} (line {line})"
-            if not text.strip():
-                raise ValueError(f"{where}: empty value.")
             try:
                 value = float(text)
             except ValueError:
-                raise ValueError(f"{where}: cannot read {text!r} as a number.") from None
-            if not math.isfinite(value):
-                raise ValueError(f"{where}: value {text.strip()!r} is not finite (NaN and "
-                                 "infinite values are not allowed).")
-            data[k, j] = value
-    return data
+                value = None
+            if value is not None and math.isfinite(value):
+                block[k, j] = value
+                continue
+            where = f"{path}: column '{headers[j]}', row {offset + k + 1} (line {line})"
+            if not text.strip():
+                raise ValueError(f"{where}: empty value.")
+            if value is None:
+                raise ValueError(f"{where}: cannot read {text!r} as a number.")
+            raise ValueError(f"{where}: value {text.strip()!r} is not finite (NaN and "
+                             "infinite values are not allowed).")
+    return block
+
+
+def _check_rows(path, count):
+    if count < 2:
+        raise ValueError(f"{path}: needs at least two data rows, got {count}.")
 
 
 def _check_time(path, header, t, lines, require_uniform, rtol):
-    if t.shape[0] < 2:
-        raise ValueError(f"{path}: needs at least two data rows, got {t.shape[0]}.")
+    _check_rows(path, t.shape[0])
     steps = np.diff(t)
     bad = np.nonzero(steps <= 0)[0]
     if bad.size:
@@ -212,8 +319,7 @@ def read_trial_csv(path, *, require_uniform: bool = False, allow_unknown: bool =
             f"{path}: header row (line {header_line}): missing required column 'psi' or 'r' "
             "(at least one of heading and yaw rate is needed)."
         )
-    data = _parse_numbers(path, headers, records)
-    lines = [line for line, _ in records]
+    data, lines = _parse_numbers(path, headers, records)
     j_t = columns["t"][0]
     _check_time(path, headers[j_t], data[:, j_t], lines, require_uniform, rtol)
     values = {key: _to_si(data[:, j], unit) for key, (j, unit) in columns.items()}
@@ -231,7 +337,8 @@ def write_trial_csv(path, data, units: str = "display") -> None:
     `units="display"`: degrees, deg/s and rpm; `units="si"`: radians, rad/s and rev/s
     (times in s, lengths in m and speeds in m/s either way). Values are written with
     `repr`, the shortest text that reads back to the same float, so a write-read round
-    trip is exact up to the unit conversion (a few ulp for degrees and rpm).
+    trip is exact up to the unit conversion (a few ulp for degrees and rpm). A value
+    too large to write in display units (above about 3e306 rad) is a `ValueError`.
 
     An experiment's measured `channels` are written (derived and zero-filled ones are
     not, so reading back recomputes them identically); a trajectory's valid samples are
@@ -250,7 +357,16 @@ def write_trial_csv(path, data, units: str = "display") -> None:
     for key in keys:
         si = next(u for u, f in _UNITS[key].items() if f == 1.0)
         unit_of[key] = _DISPLAY_UNITS.get(si, si) if units == "display" else si
-    columns = [_from_si(np.asarray(getattr(data, k), dtype=np.float64), unit_of[k]) for k in keys]
+    with np.errstate(over="ignore"):  # an overflow is the error below, not a warning
+        columns = [_from_si(np.asarray(getattr(data, k), dtype=np.float64), unit_of[k])
+                   for k in keys]
+    for key, column in zip(keys, columns):
+        bad = np.nonzero(~np.isfinite(column))[0]
+        if bad.size:  # finite in SI (an Experiment is) but too large in display units
+            raise ValueError(
+                f"channel {key!r} sample {bad[0]} is {float(getattr(data, key)[bad[0]])!r} in SI, "
+                f"which is not finite in {unit_of[key]}; write it with units='si'."
+            )
     with open(path, "w", newline="", encoding="utf-8") as f:
         writer = csv.writer(f, lineterminator="\n")
         writer.writerow([f"{k} [{unit_of[k]}]" for k in keys])
@@ -336,8 +452,7 @@ def read_esso_osaka(path) -> Experiment:
                 f"{path}: header row (line {header_line}): missing required column "
                 f"'{key} [{_ESSO_COLUMNS[key][1]}]'."
             )
-    data = _parse_numbers(path, headers, records)
-    lines = [line for line, _ in records]
+    data, lines = _parse_numbers(path, headers, records)
     _check_time(path, headers[columns["t"]], data[:, columns["t"]], lines, False, 0.0)
     values = {_ESSO_COLUMNS[k][0]: data[:, j] for k, j in columns.items()}
     values["psi"] = np.unwrap(values["psi"])  # wrapped to [-pi, pi] in the files
@@ -358,19 +473,40 @@ def _body_velocity(ue, ve, psi):
     return ue * c + ve * s, -ue * s + ve * c
 
 
-def _numeric_lines(path, lines, first_line, ncol, split):
-    """Float table of whitespace- or tab-separated `lines` (line numbers from
-    `first_line`), blank lines skipped; errors name the file, column and row."""
-    rows, numbers = [], []
-    for offset, text in enumerate(lines):
-        fields = [s for s in split(text)]
-        if all(not s.strip() for s in fields):
-            continue
-        numbers.append(first_line + offset)
-        rows.append(fields)
+def _text_lines(path: Path, encoding: str):
+    """Yield the lines of the text file `path` without their line ends; unreadable
+    files and undecodable bytes are one-line `ValueError`s."""
+    with _open_text(path, encoding) as f:
+        try:
+            for line in f:
+                yield line.rstrip("\r\n")
+        except UnicodeDecodeError:
+            raise _not_text(path, encoding) from None
+
+
+def _numeric_lines(path, lines, first_line, ncol, split, layout):
+    """Float table of whitespace- or tab-separated `lines` (an iterable, line numbers
+    from `first_line`), blank lines skipped, and the line number of each row; errors
+    name the file, column and row (`layout`: the expected columns, in words)."""
+    def records():
+        for offset, text in enumerate(lines):
+            fields = split(text)
+            if not any(map(str.strip, fields)):
+                continue
+            yield first_line + offset, fields
+
     headers = [f"column {j + 1}" for j in range(ncol)]
-    table = _parse_numbers(path, headers, list(zip(numbers, rows)))
-    return table, numbers
+    return _parse_numbers(path, headers, records(), layout)
+
+
+def _head(path, lines, count, test, what):
+    """The first `count` lines of the iterator `lines`, checked by `test` on line 1."""
+    head = list(itertools.islice(lines, count))
+    if not head or not "".join(head).strip():
+        raise ValueError(f"{path}: the file is empty; expected {what}.")
+    if not test(head[0]):
+        raise ValueError(f"{path}: not {what} (line 1 is {head[0].strip()[:40]!r}).")
+    return head
 
 
 def read_hsva_kvlcc2(path) -> Experiment:
@@ -384,10 +520,13 @@ def read_hsva_kvlcc2(path) -> Experiment:
     (positive turns to starboard). Thrust and torque go to `extra`.
     """
     path = Path(path)
-    text = path.read_text(encoding="cp1252").splitlines()
-    if not text or "HSVA" not in text[0]:
-        raise ValueError(f"{path}: not an HSVA file (line 1 should name HSVA).")
-    table, lines = _numeric_lines(path, text[4:], 5, 12, str.split)
+    lines = _text_lines(path, "cp1252")
+    text = _head(path, lines, 4, lambda line: "HSVA" in line,
+                 "an HSVA file (line 1 names HSVA)")
+    table, lines = _numeric_lines(
+        path, lines, len(text) + 1, 12, str.split,
+        "an HSVA record has 12 numbers separated by spaces (t, x0, y0, psi, dx0/dt, dy0/dt, "
+        "r, -, delta, n, thrust, torque)")
     t, x, y, psi_deg, ue, ve, r_deg, _, delta_deg, n, thrust, torque = table.T
     _check_time(path, "column 1", t, lines, False, 0.0)
     psi = np.deg2rad(psi_deg)
@@ -422,10 +561,16 @@ def read_marin_kvlcc2(path, *, model_scale: bool = False, dt: float = MARIN_DT
     velocities and times / sqrt(lambda), yaw/roll rates and n * sqrt(lambda).
     """
     path = Path(path)
-    text = path.read_text(encoding="latin-1").splitlines()
-    if not text or not text[0].startswith("MARIN"):
-        raise ValueError(f"{path}: not a MARIN file (line 1 should start with 'MARIN').")
-    table, lines = _numeric_lines(path, text[2:], 3, 11, lambda s: s.split("\t"))
+    if not (math.isfinite(dt) and dt > 0):
+        raise ValueError(f"`dt` must be a positive number of seconds, got {dt}.")
+    lines = _text_lines(path, "latin-1")
+    text = _head(path, lines, 2, lambda line: line.startswith("MARIN"),
+                 "a MARIN file (line 1 starts with 'MARIN')")
+    table, lines = _numeric_lines(
+        path, lines, len(text) + 1, 11, lambda s: s.split("\t"),
+        "a MARIN record has 11 numbers separated by tabs (t, x0, y0, phi, psi, dx0/dt, "
+        "dy0/dt, p, r, delta, n)")
+    _check_rows(path, table.shape[0])
     t_printed, x, y, phi, psi_deg, ue, ve, p, r_deg, delta_deg, rpm = table.T
     t = dt * np.arange(table.shape[0])
     quantum = 10.0 ** (np.floor(np.log10(np.maximum(np.abs(t_printed), 1e-300))) - 2)
@@ -434,7 +579,8 @@ def read_marin_kvlcc2(path, *, model_scale: bool = False, dt: float = MARIN_DT
         k = int(np.nonzero(off[1:])[0][0]) + 1
         raise ValueError(
             f"{path}: column 1 (time), row {k + 1} (line {lines[k]}): printed time "
-            f"{t_printed[k]} s does not match the reconstructed {t[k]:.3f} s = {k} * {dt} s."
+            f"{t_printed[k]} s does not match the reconstructed {t[k]:.3f} s = {k} * {dt} s "
+            "(a row repeated, missing or out of order, or another sample interval `dt`)."
         )
     psi = np.deg2rad(psi_deg)
     u, v = _body_velocity(ue, ve, psi)
@@ -470,8 +616,17 @@ def read_measured(path, **kwargs) -> Experiment:
         raise ValueError(f"{path} is a folder; pass one measurement file.")
     if not path.exists():
         raise ValueError(f"{path}: no such file.")
-    with open(path, "rb") as f:
-        first = f.readline(4096).decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
+    try:
+        with open(path, "rb") as f:
+            first, number = b"", 0
+            while not first.strip():  # the first line with something on it
+                first, number = f.readline(4096), number + 1
+                if not first:
+                    raise ValueError(f"{path}: the file is empty; expected a measurement file "
+                                     "(trial CSV, Esso Osaka CSV, HSVA or MARIN .dat).")
+    except OSError as error:
+        raise ValueError(f"{path}: cannot read the file ({error.strerror or error}).") from None
+    first = first.decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
     suffix = path.suffix.lower()
     if first.startswith("MARIN"):
         return read_marin_kvlcc2(path, **kwargs)
@@ -483,6 +638,8 @@ def read_measured(path, **kwargs) -> Experiment:
             return read_esso_osaka(path, **kwargs)
         if "t" in names:
             return read_trial_csv(path, **kwargs)
+    if "[" in first and "," not in first:
+        _check_delimiter(path, number, [first])
     raise ValueError(
         f"{path}: unknown measurement format (first line {first[:60]!r}); supported: trial "
         "CSV ('t [s],delta [deg],...'), Esso Osaka FRT CSV, HSVA and MARIN KVLCC2 .dat files."

@@ -42,15 +42,24 @@ def source(e: js.Experiment) -> str:
 def is_measurement_file(path: Path) -> bool:
     """Whether `read_measured` recognises the format of `path` (the same test of the
     first line: MARIN or HSVA .dat, Esso Osaka CSV, trial CSV with a `t` column), so
-    that a folder scan skips other files without reading them."""
-    with open(path, "rb") as f:
-        first = f.readline(4096).decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
+    that a folder scan skips other files without reading them; a header of
+    `name [unit]` columns separated by semicolons or tabs counts too, so that
+    `read_measured` rejects it with the reason."""
+    try:
+        with open(path, "rb") as f:
+            first = f.readline(4096).decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
+    except OSError as error:
+        raise ValueError(f"{path}: cannot read the file ({error.strerror or error}).") from None
     if first.startswith(("MARIN", "HSVA")):
         return True
     if path.suffix.lower() == ".csv" or ("[" in first and "," in first):
         names = {_HEADER.match(s).group(1) if _HEADER.match(s) else s for s in first.split(",")}
-        return bool(names & {"t", "psi_hat", "delta_rudder"})
-    return False
+        if names & {"t", "psi_hat", "delta_rudder"}:
+            return True
+    # a header of `name [unit]` columns separated by semicolons or tabs: a record in the
+    # wrong CSV dialect, read so that `read_measured` says so (not skipped in silence)
+    fields = re.split(r"[;\t]", first)
+    return len(fields) > 1 and "," not in first and any(_HEADER.match(f) for f in fields)
 
 
 def _renamed(e: js.Experiment, name: str) -> js.Experiment:

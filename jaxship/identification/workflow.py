@@ -23,10 +23,11 @@ from collections.abc import Callable
 
 import jax
 import numpy as np
+import optimistix as optx
 
 import jaxship as js
 
-from .._foundation._params import parameter_fields
+from .._foundation._params import parameter_fields, resolve_free
 from .assessment import assess
 from .data import as_experiments, check_experiments, valid_samples
 from .registry import MODELS, model_key
@@ -54,6 +55,11 @@ class Progress:
     total: int | None = None
     cost: float | None = None
     done: bool = False
+
+
+class FitDivergedError(ValueError):
+    """`identify`'s fit diverged: the model's outputs became non-finite from every start
+    tried (the `jaxship identify` command exits with status 3)."""
 
 
 # The host-side receivers of the optimiser's step reports. The solver's verbose hook
@@ -148,10 +154,17 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     or channels, missing files, a missing rudder column, a missing u or v the model
     needs (`ross-autopilot`, vessel presets; u for the sway-yaw models), non-finite
     values or non-uniform sampling; for `armax`, more than one training record.
+    `FitDivergedError` (a `ValueError`) when the fit diverged from every start tried.
 
-    **Warns:** `IdentifiabilityWarning` when the estimates are flagged (e.g. no
-    excitation: the fit still returns, with infinite standard errors), and
-    `ConvergenceWarning` when the optimiser did not converge.
+    **Warns:** one `IdentifiabilityWarning` per flag of the estimates (e.g. no
+    excitation: the fit still returns, with infinite standard errors), and a
+    `ConvergenceWarning`, in a plain sentence, when the optimiser stopped without
+    converging (the step limit, divergence) or an estimate ended on a bound of its
+    parameter; those sentences are also the result's `warnings`, with the flags.
+
+    Records without a measured psi (or r) are filled by `Experiment` (psi integrated
+    from r, r differenced from psi); a note says so, and with the default `channels`
+    such a channel is not fitted when every training record lacks it.
     """
     name = model_key(model)
     entry = MODELS[name]
@@ -192,6 +205,7 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
             channels = tuple(c for c in channels if c not in constant)
             notes.append(f"the measured {', '.join(constant)} is constant in the training "
                          f"records: not fitted (channels {', '.join(channels)}).")
+    channels = _derived_notes(train_exps, held_out, channels, default_channels, notes)
 
     report = progress if progress is not None else (lambda event: None)
     solver = js.LevenbergMarquardt(rtol=1e-9, atol=1e-9, verbose=_verbose_hook)
@@ -254,17 +268,18 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
         method = "neutral fallback (the fit from the regression start diverged)"
         outcome, why = attempt(start)
     if outcome is None:
-        raise ValueError(
+        raise FitDivergedError(
             f"the fit of {name} diverged: the model's outputs became non-finite ({why}) from "
             f"the start {_values_text(start)}; try a finite --horizon, --initial measured or "
             "another model."
         )
     result, got = outcome
-    for w in got:
-        if issubclass(w.category, (js.IdentifiabilityWarning, js.ConvergenceWarning)):
-            caught.append(str(w.message))
-        else:
+    for w in got:  # the fit's own convergence and identifiability texts are replaced below
+        if not issubclass(w.category, (js.IdentifiabilityWarning, js.ConvergenceWarning)):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    problems = _convergence_problems(result, int(max_steps), start, entry)
+    caught.extend(problems)
+    caught.extend(result.flags)
 
     d = len(result.names)
     simulate = entry.simulate or simulate_records
@@ -308,10 +323,78 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
                  "initial": initial, "max_steps": int(max_steps), "substeps": int(substeps)},
         notes=tuple(notes), warnings=tuple(caught),
     )
-    if not result.success:
-        warnings.warn(f"identify {name}: the optimiser stopped without converging "
-                      f"({result.message}).", js.ConvergenceWarning, stacklevel=2)
-    if result.flags:
-        warnings.warn(f"identify {name}: " + " ".join(result.flags), js.IdentifiabilityWarning,
-                      stacklevel=2)
+    for problem in problems:
+        warnings.warn(f"identify {name}: {problem}", js.ConvergenceWarning, stacklevel=2)
+    for flag in result.flags:  # one warning per flag: one line each
+        warnings.warn(f"identify {name}: {flag}", js.IdentifiabilityWarning, stacklevel=2)
     return out
+
+
+def _derived_notes(train, held_out, channels, default_channels, notes) -> tuple[str, ...]:
+    """Notes on the psi or r that records lack and `Experiment` derived (psi integrated
+    from r, r differenced from psi); a default fitted channel derived in every training
+    record is dropped from the fit (it repeats the other channel, with the integration
+    or differencing error). Returns the fitted channels."""
+    how = {"psi": "integrated from the measured r (psi = 0 at the start)",
+           "r": "differenced from the measured psi"}
+    for c in ("psi", "r"):
+        for role, records in (("training", train), ("validation", held_out or [])):
+            derived = [e.name for e in records if c in e.derived]
+            if not derived:
+                continue
+            names = ", ".join(derived[:5]) + (f" and {len(derived) - 5} more"
+                                              if len(derived) > 5 else "")
+            plural = "s" if len(derived) > 1 else ""
+            text = (f"{c} is not measured in the {role} record{plural} {names}: it is "
+                    f"{how[c]}, so their {c} fit % compares the model with that derived "
+                    f"{c}, not with a measurement")
+            if (role == "training" and default_channels and c in channels
+                    and len(channels) > 1 and len(derived) == len(records)):
+                channels = tuple(k for k in channels if k != c)
+                text += f"; {c} is not fitted (channels {', '.join(channels)})"
+            notes.append(text + ".")
+    return channels
+
+
+def _convergence_problems(result, max_steps: int, start, entry) -> list[str]:
+    """Plain sentences for a fit that stopped without converging or whose estimates
+    sit on a bound of their parameter (empty when neither)."""
+    problems = []
+    if not result.success:
+        code = result.result
+        if code in (optx.RESULTS.nonlinear_max_steps_reached, optx.RESULTS.max_steps_reached) \
+                or int(result.num_steps) >= max_steps:
+            problems.append(f"the fit stopped at the step limit ({max_steps}) before "
+                            "converging; the estimates are those of the last step, not an "
+                            "optimum: raise --max-steps or check the data and the model.")
+        elif code == optx.RESULTS.nonlinear_divergence:
+            problems.append(f"the fit diverged after {int(result.num_steps)} steps (the "
+                            "optimiser's steps grew without bound); the estimates mean "
+                            "nothing: try a finite --horizon, --initial measured or another "
+                            "model.")
+        elif code == optx.RESULTS.singular:
+            problems.append(f"the fit stopped after {int(result.num_steps)} steps: the "
+                            "optimiser's linear solve failed (a singular Jacobian: some "
+                            "parameters do not change the outputs); see the identifiability "
+                            "flags.")
+        else:
+            problems.append(f"the fit stopped after {int(result.num_steps)} steps without "
+                            f"converging ({result.message.splitlines()[0]}).")
+    if entry.fit is None:  # `jaxship.fit` with the default free set: the bounds it used
+        values = dict(zip(result.names, np.asarray(result.values, dtype=np.float64)))
+        for spec in resolve_free(start):
+            value = values.get(spec.name)
+            if value is None:
+                continue
+            span = spec.upper - spec.lower if math.isfinite(spec.upper - spec.lower) else \
+                spec.scale
+            tol = 1e-4 * (span if span > 0 else 1.0)
+            for side, bound in (("lower", spec.lower), ("upper", spec.upper)):
+                if math.isfinite(bound) and abs(value - bound) <= tol:
+                    unit = f" {spec.unit}" if spec.unit and spec.unit != "-" else ""
+                    problems.append(
+                        f"{spec.name} = {value:.4g}{unit} ended on its {side} bound "
+                        f"{bound:g}{unit}: the data pull it beyond the bound, so the fit is "
+                        "not a proper optimum and its standard error means nothing; check the "
+                        "model choice and the data.")
+    return problems

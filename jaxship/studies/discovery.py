@@ -45,6 +45,7 @@ def record(truth, manoeuvre, name, rng, *, disturbance_std=0.0, noise=(0.1, 0.05
         w = disturbance(t, disturbance_std, int(rng.integers(2**31)))
         out = js.simulate_steering(truth, delta + w, float(t[1] - t[0]), substeps=25)
         psi, r = np.asarray(out.psi), np.asarray(out.r)
+    psi, r = np.asarray(truth.measure("psi", psi)), np.asarray(truth.measure("r", r))  # sensors
     return js.Experiment(t, delta, psi=psi + rng.normal(0, noise[0] * DEG, t.size),
                          r=r + rng.normal(0, noise[1] * DEG, t.size), name=name)
 
@@ -84,3 +85,30 @@ def outcome(report, hidden_ids) -> str:
         return "nothing"
     found = {h for h in hidden_ids if any(h in c for c in classes)}
     return "correct" if found == set(hidden_ids) else "missed"
+
+
+def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02)):
+    """`(train, holdout)` of a 3-DOF `truth` vessel (e.g. the Mariner with an effect):
+    10/10 and 20/20 zig-zags to both sides to train, +-35 deg turning circles and a
+    15/15 zig-zag held out, `duration` s at 2 Hz from the nominal straight run, with
+    the servo's rudder logged at the samples and noise on psi [deg], r [deg/s], u, v
+    [m/s] (positions, rudder and rpm exact): 8 channels per record."""
+    rng = np.random.default_rng(seed)
+    x0 = js.straight_run(truth)
+
+    def one(manoeuvre, name):
+        traj = js.simulate(truth, manoeuvre, x0, simulator=FINE)
+        e = js.Experiment.from_trajectory(traj, name=name)
+        scale = {"psi": noise[0] * DEG, "r": noise[1] * DEG, "u": noise[2], "v": noise[3]}
+        noisy = {c: getattr(e, c) + rng.normal(0, s, e.t.size) for c, s in scale.items()}
+        return js.Experiment(e.t, e.delta, psi=truth.measure("psi", noisy["psi"]),
+                             r=truth.measure("r", noisy["r"]), u=noisy["u"], v=noisy["v"],
+                             x=e.x, y=e.y, n=e.n, name=name)
+
+    train = [one(js.ZigZag(a * DEG, s * a * DEG, duration=duration, dt=0.5),
+                 f"zigzag {a}/{a} {'starboard' if s > 0 else 'port'}") for a, s in TRAIN]
+    holdout = [one(js.Turn(a * DEG, duration=duration, dt=0.5), f"turn {a:+d}")
+               for a in (35, -35)]
+    holdout.append(one(js.ZigZag(15 * DEG, 15 * DEG, duration=duration, dt=0.5),
+                       "zigzag 15/15"))
+    return train, holdout

@@ -119,36 +119,57 @@ def record_name(spec, rpm) -> str:
     return f"{spec}@{rpm:g}rpm"
 
 
-def thesis_experiments(vessel=None, *, families=None, settings: Settings = Settings()
-                       ) -> dict[str, js.Experiment]:
-    """Simulate the experiment design and return noisy records `{name: Experiment}`
-    (names `"turn:40@500rpm"`), sampled at `settings.dt` with the noise of
-    `settings.noise` added to psi, r, u, v and delta (n is exact)."""
+def simulate_design(vessel=None, *, families=None, settings: Settings = Settings(),
+                    progress=None) -> dict[str, tuple]:
+    """Simulate the experiment design without noise: `{record name: (family, spec, rpm,
+    manoeuvre, Trajectory)}` in the order of `families` (trials) and `RPMS`, at half the
+    sample interval `settings.dt` (the trials of `jaxship reproduce`). `progress`: a
+    callable taking the record name before each simulation, or None."""
     vessel = js.vessel("thesis") if vessel is None else vessel
     families = FAMILIES if families is None else families
-    rng = np.random.default_rng(settings.seed)
-    noise = dict(settings.noise)
     out = {}
     simulator = js.Simulator(substeps=2)
     for family, specs in families.items():
         for spec in specs:
             for rpm in RPMS:
+                if progress is not None:
+                    progress(record_name(spec, rpm))
                 x0 = js.initial_state(vessel, rpm=rpm)
-                traj = js.simulate(vessel, _manoeuvre(spec, vessel, x0, settings), x0,
-                                simulator=simulator)
+                manoeuvre = _manoeuvre(spec, vessel, x0, settings)
+                traj = js.simulate(vessel, manoeuvre, x0, simulator=simulator)
                 if not bool(traj.success):
                     raise RuntimeError(f"simulation of {spec} at {rpm:g} rpm failed")
-                exact = js.Experiment.from_trajectory(traj)
-                keep = slice(None, None, 2)
-                channels = {k: getattr(exact, k)[keep].copy() for k in
-                            ("t", "delta", "psi", "r", "u", "v", "n")}
-                for k, sigma in noise.items():
-                    channels[k] = channels[k] + sigma * rng.standard_normal(channels[k].shape)
-                name = record_name(spec, rpm)
-                out[name] = js.Experiment(name=name, metadata=(("family", family),
-                                                            ("spec", spec), ("rpm", rpm)),
-                                       **channels)
+                out[record_name(spec, rpm)] = (family, spec, rpm, manoeuvre, traj)
     return out
+
+
+def noisy_records(design: dict, settings: Settings = Settings()) -> dict[str, js.Experiment]:
+    """The records `{name: Experiment}` of a `simulate_design` result, sampled at
+    `settings.dt` with the noise of `settings.noise` (seed `settings.seed`) added to psi,
+    r, u, v and delta (n is exact)."""
+    rng = np.random.default_rng(settings.seed)
+    noise = dict(settings.noise)
+    out = {}
+    for name, (family, spec, rpm, _, traj) in design.items():
+        exact = js.Experiment.from_trajectory(traj)
+        keep = slice(None, None, 2)
+        channels = {k: getattr(exact, k)[keep].copy() for k in
+                    ("t", "delta", "psi", "r", "u", "v", "n")}
+        for k, sigma in noise.items():
+            channels[k] = channels[k] + sigma * rng.standard_normal(channels[k].shape)
+        out[name] = js.Experiment(name=name, metadata=(("family", family), ("spec", spec),
+                                                       ("rpm", rpm)), **channels)
+    return out
+
+
+def thesis_experiments(vessel=None, *, families=None, settings: Settings = Settings()
+                       ) -> dict[str, js.Experiment]:
+    """Simulate the experiment design and return noisy records `{name: Experiment}`
+    (names `"turn:40@500rpm"`), sampled at `settings.dt` with the noise of
+    `settings.noise` added to psi, r, u, v and delta (n is exact):
+    `noisy_records(simulate_design(...))`."""
+    return noisy_records(simulate_design(vessel, families=families, settings=settings),
+                         settings)
 
 
 def simulate_record(model, e: js.Experiment, substeps: int = 2) -> np.ndarray:
@@ -258,7 +279,8 @@ def identify(model_name, records, vessel, *, settings: Settings = Settings(), no
 
 
 def identification_study(vessel=None, *, quick=False, settings: Settings = Settings(),
-                         experiments=None, progress=None) -> dict:
+                         experiments=None, progress=None, families=None,
+                         models=MODELS, cases=("single", "merged")) -> dict:
     """Run the study; returns a JSON-ready dict with `table` rows
     `{case, model, family, fit, fit_family, per_record, thesis}` (simulation fit % of
     the yaw rate on the family's 40 deg / 500 rpm record, pooled over all records of
@@ -268,21 +290,25 @@ def identification_study(vessel=None, *, quick=False, settings: Settings = Setti
 
     `quick`: two trials per family instead of four (turn 10 and 40 deg, zig-zag
     10/10 and 40/40); `experiments`: records from `thesis_experiments` (simulated
-    if None); `progress`: a callable taking a message string, or None.
+    if None); `progress`: a callable taking a message string, or None; `families`
+    {family: trial specs} (default `FAMILIES`, or `QUICK_FAMILIES` if `quick`) and
+    `models` (a subset of `MODELS`, in order; "ross_speed_rudder" starts from "ross")
+    and `cases` ("single", "merged") narrow the study (`jaxship reproduce --quick`).
     """
     vessel = js.vessel("thesis") if vessel is None else vessel
-    families = QUICK_FAMILIES if quick else FAMILIES
+    if families is None:
+        families = QUICK_FAMILIES if quick else FAMILIES
     if experiments is None:
         experiments = thesis_experiments(vessel, families=families, settings=settings)
     say = progress or (lambda msg: None)
-    rows, params, models = [], {}, {}
-    for case in ("single", "merged"):
+    names, (rows, params, models) = tuple(models), ([], {}, {})
+    for case in cases:
         for family, specs in families.items():
             shown = experiments[record_name(SHOWN[family], 500.0)]
             family_records = [experiments[record_name(s, rpm)] for s in specs for rpm in RPMS]
             train = [shown] if case == "single" else family_records
             fitted = {}
-            for model_name in MODELS:
+            for model_name in names:
                 say(f"{case} {family}: {model_name}")
                 result = identify(model_name, train, vessel, settings=settings,
                                   nomoto=fitted.get("nomoto"), base=fitted.get("ross"))

@@ -23,11 +23,13 @@ from .criteria import (
 from .spiral import (
     PullOutIndices as PullOutIndices,
     SpiralCurve as SpiralCurve,
+    SpiralLoop as SpiralLoop,
     StoppingIndices as StoppingIndices,
     loop_width as loop_width,
     pull_out_indices as pull_out_indices,
     reverse_spiral_curve as reverse_spiral_curve,
     spiral_curve as spiral_curve,
+    spiral_loop as spiral_loop,
     stopping_indices as stopping_indices,
 )
 from .turning import (

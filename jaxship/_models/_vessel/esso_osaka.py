@@ -12,6 +12,8 @@ from the upstream code's structure; parameter values are those of the upstream f
 (copies in `shared/data/esso_osaka_frt/reference/`), hard-coded below.
 """
 
+from typing import ClassVar
+
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
@@ -93,6 +95,19 @@ class LowSpeedMMGVessel(AbstractVessel):
     # ahead, and the rudder's inflow and flow-straightening factors
     free_by_default = ("x_0f", "y_v", "y_r", "n_v", "n_r", "c_d", "c_ry", "c_rn", "epsilon",
                        "gamma_n", "gamma_p")
+    # units of the coefficients, for parameter tables (`parameter_fields`); "-": primed
+    # (non-dimensional) as in the source
+    units: ClassVar[dict[str, str]] = {
+        "length": "m", "nominal_speed": "m/s", "nominal_n": "rev/s", "frontal_wind_area": "m^2",
+        "lateral_wind_area": "m^2", "draft": "m", "propeller_diameter": "m",
+        "rudder_area": "m^2", "rho": "kg/m^3",
+        **dict.fromkeys((
+            "mass_nd", "x_g", "m_x", "m_y", "i_zz_j_zz", "x_0f", "x_0a", "x_vr", "y_v", "y_r",
+            "n_v", "n_r", "c_d", "c_ry", "c_rn", "pitch_ratio", "t_p", "w_p0", "tau_p", "c_p",
+            "x_p", "k_0", "k_1", "k_2", "c_3", "c_6", "c_7", "c_10", "j_syn", "j_syn0",
+            "rudder_aspect_ratio", "x_r", "t_r", "a_h", "x_h", "l_r", "k_x", "k_x_reverse",
+            "epsilon", "c_pr", "gamma_n", "gamma_p"), "-"),
+    }
 
     length: float  # L_pp [m]
     rudder: RudderServo

@@ -7,6 +7,8 @@ project notes `reference/vessel-models.md` sec. 2.2 (cross-checked there against
 `ShipMMG/shipmmg` and other public implementations).
 """
 
+from typing import ClassVar
+
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
@@ -88,6 +90,20 @@ class MMGVessel(AbstractVessel):
 
     # fitted by default: linear and cubic hull derivatives, resistance, rudder inflow factor
     free_by_default = ("r_0", "y_v", "y_r", "n_v", "n_r", "y_vvv", "n_rrr", "epsilon")
+    # units of the coefficients, for parameter tables (`parameter_fields`); "-": primed
+    # (non-dimensional) as in the paper
+    units: ClassVar[dict[str, str]] = {
+        "length": "m", "nominal_speed": "m/s", "nominal_n": "rev/s", "frontal_wind_area": "m^2",
+        "lateral_wind_area": "m^2", "draft": "m", "volume": "m^3", "x_g": "m",
+        "radius_of_gyration": "m", "propeller_diameter": "m", "rudder_area": "m^2",
+        "rudder_span": "m", "rho": "kg/m^3",
+        **dict.fromkeys((
+            "m_x", "m_y", "j_z", "r_0", "x_vv", "x_vr", "x_rr", "x_vvvv", "y_v", "y_r", "y_vvv",
+            "y_vvr", "y_vrr", "y_rrr", "n_v", "n_r", "n_vvv", "n_vvr", "n_vrr", "n_rrr", "t_p",
+            "w_p0", "k_0", "k_1", "k_2", "x_p", "c_1", "c_2_plus", "c_2_minus", "t_r", "a_h",
+            "x_h", "x_r", "f_alpha", "epsilon", "kappa", "l_r", "gamma_r_plus",
+            "gamma_r_minus"), "-"),
+    }
 
     length: float  # L_pp [m]
     rudder: RudderServo

@@ -1,0 +1,158 @@
+"""Property-based tests (hypothesis) of the trial CSV format and its readers, the unit
+and angle conversions and the smallest signed angle `ssa`: write-then-read gives the
+same numbers for arbitrary finite arrays in either unit system, the conversions invert
+each other to a few ulp, and time that is not strictly increasing is always rejected
+at the first offending row."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, assume, given, settings, strategies as st
+
+import jaxship as js
+from jaxship._simulation._readers import _UNITS, _from_si, _to_si
+
+
+SETTINGS = settings(max_examples=60, deadline=None, database=None,
+                    suppress_health_check=[HealthCheck.too_slow])
+OPTIONAL = ("psi", "r", "u", "v", "x", "y", "n", "delta_c", "wind_speed", "wind_dir")
+ANGLES = {"delta", "delta_c", "psi", "r", "wind_dir"}  # written in degrees in display units
+
+
+def finite(limit=1e12):
+    return st.floats(-limit, limit, allow_nan=False, allow_infinity=False)
+
+
+@st.composite
+def experiments(draw, limit=1e12, both=False):
+    """An `Experiment` with strictly increasing time and arbitrary finite values in a
+    random subset of the channels (psi or r among them; both with `both`, so that none is
+    derived: a derivative of values near the float limit overflows)."""
+    num = draw(st.integers(2, 25))
+    t0 = draw(finite(1e6))
+    steps = draw(st.lists(st.floats(1e-3, 1e3), min_size=num - 1, max_size=num - 1))
+    t = t0 + np.concatenate([[0.0], np.cumsum(steps)])
+    assume(np.all(np.diff(t) > 0))
+    chosen = draw(st.sets(st.sampled_from(OPTIONAL)))
+    chosen.update(("psi", "r") if both else (draw(st.sampled_from(("psi", "r"))),))
+    column = st.lists(finite(limit), min_size=num, max_size=num).map(np.array)
+    values = {key: draw(column) for key in ("delta", *sorted(chosen))}
+    return js.Experiment(t, name="prop", **values)
+
+
+def assert_close(read, written, key):
+    """Equal, to a few ulp where a unit conversion was applied (subnormals: absolutely)."""
+    np.testing.assert_allclose(read, written, rtol=4 * np.finfo(float).eps, atol=1e-300,
+                               err_msg=key)
+
+
+@SETTINGS
+@given(experiments(), st.sampled_from(["display", "si"]))
+def test_write_then_read_gives_the_same_numbers(tmp_path_factory, experiment, units):
+    path = tmp_path_factory.mktemp("roundtrip") / "trial.csv"
+    js.write_trial_csv(path, experiment, units=units)
+    back = js.read_trial_csv(path)
+    assert back.channels == experiment.channels and back.derived == experiment.derived
+    np.testing.assert_array_equal(back.t, experiment.t)  # seconds: written exactly
+    for key in experiment.channels:
+        written, read = getattr(experiment, key), getattr(back, key)
+        if units == "si" or (key not in ANGLES and key != "n"):
+            np.testing.assert_array_equal(read, written, err_msg=key)  # no conversion: exact
+        else:
+            assert_close(read, written, key)
+    # a derived channel is recomputed from the measured one read back: equal to the
+    # ulps of that one, amplified by the differencing (r) or summed (psi)
+    eps, scale = 8 * np.finfo(float).eps, {"r": "psi", "psi": "r"}
+    for key in experiment.derived:
+        source = np.max(np.abs(getattr(experiment, scale[key]))) + 1e-300
+        span = (1.0 / np.min(np.diff(experiment.t)) if key == "r"
+                else experiment.t[-1] - experiment.t[0])
+        np.testing.assert_allclose(getattr(back, key), getattr(experiment, key), rtol=0,
+                                   atol=eps * source * span * experiment.num_samples,
+                                   err_msg=key)
+
+
+@SETTINGS
+@given(experiments(limit=1e308, both=True))
+def test_huge_values_round_trip_or_are_refused_in_display_units(tmp_path_factory, experiment):
+    path = tmp_path_factory.mktemp("huge") / "trial.csv"
+    js.write_trial_csv(path, experiment, units="si")  # always writable in SI
+    assert js.read_trial_csv(path).channels == experiment.channels
+    try:
+        js.write_trial_csv(path, experiment, units="display")
+    except ValueError as error:
+        assert "not finite in" in str(error) and "units='si'" in str(error)
+    else:
+        back = js.read_trial_csv(path)
+        for key in experiment.channels:
+            assert_close(getattr(back, key), getattr(experiment, key), key)
+
+
+@given(st.floats(allow_nan=False, allow_infinity=False, min_value=-1e300, max_value=1e300))
+@settings(max_examples=300, deadline=None, database=None)
+def test_unit_conversions_invert_each_other(value):
+    x = np.array([value])
+    for unit in ("deg", "deg/s", "rpm"):
+        assert_close(_to_si(_from_si(x, unit), unit), x, unit)
+        assert np.sign(_to_si(x, unit)[0]) * np.sign(value) >= 0  # a subnormal may become 0
+    np.testing.assert_array_equal(_to_si(x, "deg"), np.deg2rad(x))
+    np.testing.assert_array_equal(_from_si(_to_si(x, "deg"), "deg"), np.rad2deg(np.deg2rad(x)))
+    for unit in ("s", "rad", "rad/s", "m/s", "m", "rps"):
+        np.testing.assert_array_equal(_to_si(x, unit), x)
+        np.testing.assert_array_equal(_from_si(x, unit), x)
+    for key, factors in _UNITS.items():  # the table's factors are what `_to_si` applies
+        for unit, factor in factors.items():
+            assert_close(_to_si(x, unit), x * factor, f"{key} [{unit}]")
+
+
+@given(st.floats(-1e6, 1e6, allow_nan=False))
+@settings(max_examples=300, deadline=None, database=None)
+def test_ssa_wraps_to_the_equivalent_angle_in_minus_pi_pi(angle):
+    wrapped = float(js.ssa(angle))
+    # [-pi, pi): an angle a rounding step below -pi can come out as +pi (the same angle)
+    assert -math.pi <= wrapped <= math.pi
+    turns = (angle - wrapped) / (2 * math.pi)
+    tol = 8 * np.finfo(float).eps * max(1.0, abs(angle))
+    assert abs(turns - round(turns)) * 2 * math.pi <= tol
+    assert abs(float(js.ssa(wrapped)) - wrapped) <= tol or abs(abs(wrapped) - math.pi) <= tol
+    if abs(angle) < math.pi - 1e-9:
+        assert abs(wrapped - angle) <= 4 * np.finfo(float).eps * math.pi
+    if abs(wrapped) < math.pi - 1e-6:
+        assert abs(float(js.ssa(-angle)) + wrapped) <= tol
+
+
+@st.composite
+def bad_times(draw):
+    """Strictly increasing times made non-increasing by a shuffle or a repeated sample;
+    the first row whose time is not greater than the one before."""
+    num = draw(st.integers(3, 30))
+    steps = draw(st.lists(st.floats(1e-3, 100.0), min_size=num - 1, max_size=num - 1))
+    t = np.concatenate([[draw(finite(1e4))], np.cumsum(steps)])
+    t = np.cumsum(t)
+    assume(np.all(np.diff(t) > 0))
+    if draw(st.booleans()):
+        order = np.array(draw(st.permutations(range(num))))
+        assume(np.any(order != np.arange(num)))
+        t = t[order]
+    else:
+        i = draw(st.integers(1, num - 1))
+        t[i] = t[i - 1]
+    first = int(np.nonzero(np.diff(t) <= 0)[0][0]) + 1  # 0-based index of the bad row
+    return t, first
+
+
+@SETTINGS
+@given(bad_times())
+def test_reader_rejects_shuffled_or_repeated_time(tmp_path_factory, case):
+    t, first = case
+    path = tmp_path_factory.mktemp("time") / "trial.csv"
+    rows = "".join(f"{value!r},0.0,{k!r}\n" for k, value in enumerate(t.tolist()))
+    path.write_text("t [s],delta [deg],psi [deg]\n" + rows)
+    with pytest.raises(ValueError, match=rf"column 't \[s\]', row {first + 1} \(line "
+                                         rf"{first + 2}\): time .* time must be strictly "
+                                         "increasing") as error:
+        js.read_trial_csv(path)
+    assert "\n" not in str(error.value)
+    with pytest.raises(ValueError, match="strictly increasing"):
+        js.read_measured(path)
