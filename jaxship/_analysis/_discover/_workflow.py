@@ -15,8 +15,8 @@ One iteration (design: ../shared/reference/discovery-design.md, sec. 4):
    candidates and K = `max_effects` iterations); its robust confidence interval at
    the same level excludes zero; its estimate lies in the parameter's plausible
    range; and the held-out cost falls;
-4. the best accepted candidate (largest likelihood ratio) joins the model, which
-   becomes the base of the next iteration, until nothing passes.
+4. of the candidates that pass, the one that lowers the cost most joins the model,
+   which becomes the base of the next iteration, until nothing passes.
 """
 
 import dataclasses
@@ -198,7 +198,9 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                 passed.append((record, trial))
         if not passed:
             break
-        record, trial = max(passed, key=lambda pair: pair[0]["likelihood_ratio"])
+        # of those that pass, the one that explains most (the largest cost decrease; the
+        # robust ratios gate, but their per-candidate inflation must not rank)
+        record, trial = min(passed, key=lambda pair: pair[1].cost)
         accepted.append(record)
         say(f"accepted {record['id']}")
         current, theta, cost = trial, theta + names[record["id"]], trial.cost
