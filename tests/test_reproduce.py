@@ -7,7 +7,7 @@ import re
 import pytest
 
 from jaxship.cli import main
-from jaxship.studies import reproduce as rp
+from jaxship.studies import reproduce as rp, reproduce_report
 from jaxship.studies.thesis import THESIS_FIT
 
 
@@ -53,8 +53,8 @@ def test_every_large_fit_difference_gets_a_sentence():
             for family, paper in families.items():
                 for ours in (paper - 20.0, paper - 2.0, paper + 2.0, paper + 20.0):
                     row = dict(case=case, model=model, family=family, fit=ours, thesis=paper)
-                    sentence = rp._explanation(row)
-                    if abs(ours - paper) < rp.LARGE:
+                    sentence = reproduce_report._explanation(row)
+                    if abs(ours - paper) < reproduce_report.LARGE:
                         assert sentence is None
                     else:
                         assert sentence and sentence.endswith("."), (case, model, family, ours)

@@ -1,0 +1,217 @@
+"""Identification figures: measured against model, residual tests, parameter
+correlation."""
+
+import textwrap
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from ._common import (
+    _REFERENCE_COLOR,
+    _legend_below,
+    _legend_beside,
+    _range,
+    _range_text,
+    _title,
+)
+
+
+_CHANNEL_AXES = {"psi": ("heading", "deg", 180 / np.pi), "r": ("yaw rate", "deg/s", 180 / np.pi),
+                 "u": ("surge velocity", "m/s", 1.0), "v": ("sway velocity", "m/s", 1.0)}
+
+
+def _channel_axes(channel):
+    return _CHANNEL_AXES.get(channel, (channel, "SI", 1.0))
+
+
+def _masked(values, mask):
+    return np.where(mask, np.asarray(values, dtype=np.float64), np.nan)
+
+
+def plot_comparison(assessment, index: int = 0, *, title: str = "", reference=None,
+                    reference_label: str = "reference"):
+    """Measured against model outputs of one record, with the fit % in the legend.
+
+    **Arguments:**
+
+    - `assessment`: a `jaxship.identification.Assessment` (or anything with `data`
+      (a `Dataset`), `rudder`, `predictions` {channel: (E, N)}, `mask` (E, N) and
+      `metrics` {channel: `ValidationReport`}).
+    - `index`: which record (experiment) of the assessment.
+    - `title`: the figure title.
+    - `reference`: `{channel: fit % or (low, high)}` of a reference (e.g. the thesis'
+      fit), written in that channel's legend next to the model's.
+
+    Each channel in `predictions` (heading and yaw rate in degrees) and the replayed
+    rudder, legends beside the axes. **Returns:** the matplotlib `Figure`.
+    """
+    reference = dict(reference or {})
+    ds = assessment.data
+    n = ds.lengths[index]
+    t = np.asarray(ds.t, dtype=np.float64)[index, :n]
+    channels = list(assessment.predictions)
+    fig, axes = plt.subplots(len(channels) + 1, 1, figsize=(11, 2.4 * (len(channels) + 1)),
+                             sharex=True, layout="constrained")
+    mask = np.asarray(assessment.mask)[index, :n]
+    for ax, c in zip(axes, channels):
+        label, unit, factor = _channel_axes(c)
+        measured = factor * np.asarray(getattr(ds, c), dtype=np.float64)[index, :n]
+        model = factor * _masked(assessment.predictions[c][index, :n], mask)
+        fit = assessment.metrics[c].fit_per_experiment[index] if c in assessment.metrics else None
+        ax.plot(t, measured, color="k", lw=1.0, label="measured")
+        text = "model" if fit is None or not np.isfinite(fit) else f"model, fit {fit:.1f} %"
+        ax.plot(t, model, color="tab:red", lw=1.2, label=text)
+        if c in reference:
+            low, high = _range(reference[c])
+            ax.plot([], [], color=_REFERENCE_COLOR, lw=3, alpha=0.6,
+                    label=f"{reference_label}: fit " + _range_text(low, high,
+                                                                    lambda v: f"{v:.1f} %"))
+        ax.set(ylabel=f"{label} [{unit}]")
+        _legend_beside(ax)
+    rudder = np.rad2deg(np.asarray(getattr(ds, assessment.rudder), dtype=np.float64)[index, :n])
+    axes[-1].step(t, rudder, where="post", color="tab:blue", lw=1.0,
+                  label=f"rudder ({assessment.rudder})")
+    axes[-1].set(ylabel="rudder [deg]", xlabel="time [s]")
+    _legend_beside(axes[-1])
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    _title(fig, title or f"{ds.names[index]}: measured and model", size=12.0)
+    return fig
+
+
+def _correlation_axes(ax, corr, label, dt=None):
+    """A correlation test's values against the lag (seconds when the sample interval
+    `dt` [s] is known), with its confidence band."""
+    lags = np.asarray(corr.lags, dtype=np.float64) * (1.0 if dt is None else float(dt))
+    ax.axhspan(-corr.band, corr.band, color="tab:blue", alpha=0.15, label="99 % band")
+    ax.vlines(lags, 0.0, corr.values, color="k", lw=1.2)
+    ax.plot(lags, corr.values, "o", color="k", ms=2.5)
+    ax.axhline(0.0, color="k", lw=0.5)
+    verdict = "passed" if corr.passed else "failed"
+    ax.set(xlabel="lag [samples]" if dt is None else "lag [s]",
+           title=textwrap.fill(f"{label}: test {verdict} ({corr.statistic:.3g} vs "
+                               f"{corr.threshold:.3g})", 60))
+    ax.title.set_fontsize("small")
+
+
+def _sample_interval(ds):
+    """The sample interval [s] of a `Dataset` (its first record's median step)."""
+    t = np.asarray(ds.t, dtype=np.float64)[0, : ds.lengths[0]]
+    return float(np.median(np.diff(t))) if t.size > 1 else None
+
+
+def plot_residuals(assessment, *, title: str = ""):
+    """Prediction errors and their correlation tests, one row per output channel
+    (like MATLAB's `resid`): the residuals over time (each record), their
+    autocorrelation and their cross-correlation with the rudder against the lag in
+    seconds, with the 99 % confidence bands of `jaxship._foundation._validate`
+    (Ljung 1999, sec. 16.6).
+
+    **Arguments:** `assessment` as in `plot_comparison`; `title`.
+    **Returns:** the matplotlib `Figure`.
+    """
+    ds = assessment.data
+    dt = _sample_interval(ds)
+    channels = list(assessment.metrics)
+    fig, axes = plt.subplots(len(channels), 3, figsize=(15, 3.4 * len(channels)),
+                             squeeze=False, layout="constrained")
+    for row, c in zip(axes, channels):
+        label, unit, factor = _channel_axes(c)
+        measured = np.asarray(getattr(ds, c), dtype=np.float64)
+        mask = np.asarray(assessment.mask)
+        error = factor * _masked(measured - assessment.predictions[c], mask)
+        for i, name in enumerate(ds.names):
+            n = ds.lengths[i]
+            row[0].plot(np.asarray(ds.t)[i, :n], error[i, :n], lw=0.8, label=name)
+        row[0].set(xlabel="time [s]", ylabel=f"{label} error [{unit}]")
+        report = assessment.metrics[c]
+        _correlation_axes(row[1], report.autocorrelation, f"{c} residual autocorrelation", dt)
+        if report.cross_correlation is not None:
+            _correlation_axes(row[2], report.cross_correlation,
+                              f"{c} residual x {assessment.rudder} cross-correlation", dt)
+        else:
+            row[2].axis("off")
+        for ax in row:
+            ax.grid(True, alpha=0.3)
+    if len(ds.names) <= 8:
+        _legend_below(fig, [axes[0, 0]], ncols=4)
+    kind = "prediction" if assessment.kind == "prediction" else "simulation"
+    _title(fig, title or f"{kind} errors")
+    return fig
+
+
+def plot_parameter_correlation(names, correlation, *, title: str = "parameter correlation"):
+    """Heat map of the estimates' correlation matrix (-1 blue to +1 red), with the
+    values written in the cells; undetermined entries (NaN) are grey.
+    **Returns:** the matplotlib `Figure`."""
+    corr = np.asarray(correlation, dtype=np.float64)
+    d = len(names)
+    fig, ax = plt.subplots(figsize=(max(1.2 * d + 2.5, 6.0), 1.0 * d + 2.0),
+                           layout="constrained")
+    cmap = plt.get_cmap("RdBu_r").with_extremes(bad="0.8")
+    image = ax.imshow(np.ma.masked_invalid(corr), vmin=-1, vmax=1, cmap=cmap)
+    for i in range(d):
+        for j in range(d):
+            text = "n/a" if not np.isfinite(corr[i, j]) else f"{corr[i, j]:+.2f}"
+            ax.text(j, i, text, ha="center", va="center", fontsize="small",
+                    color="w" if np.isfinite(corr[i, j]) and abs(corr[i, j]) > 0.6 else "k")
+    ax.set_xticks(range(d), names, rotation=45, ha="right")
+    ax.set_yticks(range(d), names)
+    fig.colorbar(image, ax=ax, shrink=0.8, label="correlation")
+    _title(fig, title, size=12.0)
+    return fig
+
+
+def _file_part(name: str) -> str:
+    keep = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in str(name))
+    return keep.strip("._")[:60] or "record"
+
+
+def save_identification_figures(result, folder, *, dpi: int = 100) -> list:
+    """Write the figures of a `jaxship.IdentificationResult` into `folder`
+    and return their paths:
+
+    - `fit_train_NN_NAME.png`, `fit_validation_NN_NAME.png`: measured vs simulated
+      model (output error from the measured start) per record, fit % in the legend;
+    - `residuals_train.png`: the fit criterion's prediction errors with their
+      autocorrelation and rudder cross-correlation tests; `residuals_validation.png`:
+      the same for the simulation errors on the held-out records;
+    - `correlation.png`: the parameter correlation heat map.
+    """
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+
+    def save(fig, name):
+        path = folder / name
+        fig.savefig(path, dpi=dpi)
+        plt.close(fig)
+        written.append(path)
+
+    model = type(result.model).__name__
+    blocks = [("train", result.train_simulation)]
+    if result.validation is not None:
+        blocks.append(("validation", result.validation))
+    for label, block in blocks:
+        for i, name in enumerate(block.names):
+            save(plot_comparison(block, i, title=f"{model} on {label} record {name} "
+                                                 "(simulation from the measured start)"),
+                 f"fit_{label}_{i:02d}_{_file_part(name)}.png")
+    horizon = result.train.horizon
+    what = "simulation" if horizon is None else f"{horizon:g} s prediction"
+    save(plot_residuals(result.train, title=f"{model}: {what} errors on the training records"),
+         "residuals_train.png")
+    if result.validation is not None:
+        save(plot_residuals(result.validation,
+                            title=f"{model}: simulation errors on the validation records"),
+             "residuals_validation.png")
+    report = result.fit.parameters
+    save(plot_parameter_correlation(report.names, report.correlation,
+                                    title=f"{model}: correlation of the estimates"),
+         "correlation.png")
+    return written
+
+
+# ---------------------------------------------------------------------------------------
+# heading autopilot (`jaxship autopilot`, thesis figs. 5.1-5.6)

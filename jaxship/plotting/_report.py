@@ -1,0 +1,140 @@
+"""Figures of the `jaxship reproduce` report: trials, fits and tracking next to what
+the thesis states."""
+
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+
+def _thesis_marks(ax, bands=(), lines=()):
+    """Shade the `bands` [(low, high, label)] and draw the `lines` [(value, label)]: what
+    a thesis figure states (its axis range or a reported value), not a thesis curve."""
+    for low, high, label in bands:
+        ax.axhspan(low, high, facecolor="none", edgecolor="tab:orange", hatch="//", lw=0.0,
+                   alpha=0.6, label=label)
+    for value, label in lines:
+        ax.axhline(value, color="tab:orange", ls="--", lw=1.2, label=label)
+
+
+def plot_trial_vs_thesis(traj, *, bands=None, lines=None, track_note="", title="",
+                         label="jaxship"):
+    """A trial (track, heading and rudder, yaw rate, speed) with what the thesis states
+    about the same trial drawn over it.
+
+    **Arguments:**
+
+    - `traj`: a `Trajectory` (`t`, `state.x/y/psi/delta/r`, `speed`).
+    - `bands`: `{panel: [(low, high, label)]}`, panels `"heading"` [deg], `"yaw_rate"`
+      [deg/s] and `"speed"` [m/s]: hatched ranges, e.g. the tick range of a thesis
+      figure's axis (the thesis prints no curve values).
+    - `lines`: `{panel: [(value, label)]}`: dashed lines, e.g. a peak value the thesis
+      text reports.
+    - `track_note`: a text written into the track axes (e.g. the extent of the
+      thesis' track plot, whose origin is unknown).
+    - `title`, `label`: the figure title and the legend label of the trajectory.
+
+    **Returns:** the matplotlib `Figure`.
+    """
+    bands, lines = bands or {}, lines or {}
+    s = traj.state
+    t = np.asarray(traj.t, dtype=np.float64)
+    fig = plt.figure(figsize=(11, 7), constrained_layout=True)
+    grid = fig.add_gridspec(3, 2, width_ratios=[1, 1.4])
+    track = fig.add_subplot(grid[:, 0])
+    axes = {k: fig.add_subplot(grid[i, 1]) for i, k in enumerate(("heading", "yaw_rate",
+                                                                   "speed"))}
+    track.plot(np.asarray(s.y), np.asarray(s.x), label=label)
+    track.set(xlabel="east [m]", ylabel="north [m]", title="track")
+    track.set_aspect("equal", adjustable="datalim")
+    if track_note:
+        track.text(0.02, 0.02, track_note, transform=track.transAxes, fontsize="small",
+                   va="bottom", wrap=True, bbox=dict(facecolor="white", alpha=0.8, lw=0.0))
+    axes["heading"].plot(t, np.rad2deg(np.asarray(s.psi)), label=f"{label} heading")
+    axes["heading"].plot(t, np.rad2deg(np.asarray(s.delta)), "--", label=f"{label} rudder")
+    axes["yaw_rate"].plot(t, np.rad2deg(np.asarray(s.r)), label=label)
+    axes["speed"].plot(t, np.asarray(traj.speed), label=label)
+    units = {"heading": "heading, rudder [deg]", "yaw_rate": "yaw rate [deg/s]",
+             "speed": "speed [m/s]"}
+    for key, ax in axes.items():
+        _thesis_marks(ax, bands.get(key, ()), lines.get(key, ()))
+        ax.set(ylabel=units[key])
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+                  fontsize="small")
+        ax.grid(True, alpha=0.3)
+    axes["speed"].set(xlabel="time [s]")
+    track.grid(True, alpha=0.3)
+    fig.suptitle(title)
+    return fig
+
+
+def plot_model_outputs(t, measured, panels, *, ylabel="yaw rate [deg/s]", title="",
+                       measured_label="measured"):
+    """One measured signal against model outputs, one axes per group of models.
+
+    **Arguments:**
+
+    - `t` [s], `measured`: the record (display units, e.g. deg/s); `t` may be one
+      array or a list of arrays, one per panel (then `measured` is a list too).
+    - `panels`: `{panel title: [(label, values)]}`: the model outputs drawn over the
+      measured signal in each axes (same length as `t`; NaN where not predicted).
+    - `ylabel`, `title`, `measured_label`: labels.
+
+    **Returns:** the matplotlib `Figure`.
+    """
+    names = list(panels)
+    many = isinstance(t, (list, tuple))
+    fig, axes = plt.subplots(len(names), 1, figsize=(10, 3.0 * len(names)), squeeze=False,
+                             sharex=not many, constrained_layout=True)
+    for i, (ax, name) in enumerate(zip(axes[:, 0], names)):
+        ti = np.asarray(t[i] if many else t, dtype=np.float64)
+        yi = np.asarray(measured[i] if many else measured, dtype=np.float64)
+        ax.plot(ti, yi, color="k", lw=0.8, label=measured_label)
+        for label, values in panels[name]:
+            ax.plot(ti, np.asarray(values, dtype=np.float64), lw=1.3, label=label)
+        ax.set(ylabel=ylabel, title=name)
+        ax.title.set_fontsize("medium")
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="best", fontsize="small")
+    axes[-1, 0].set(xlabel="time [s]")
+    fig.suptitle(title)
+    return fig
+
+
+def plot_heading_tracking(t, desired, runs, *, window=None, bands=None, title=""):
+    """Closed-loop heading runs of several autopilots on the same order: heading
+    (desired and actual), error (desired minus actual) and rudder, over time.
+
+    **Arguments:**
+
+    - `t` [s], `desired` [deg]: the reference model's heading.
+    - `runs`: `[(label, heading [deg], rudder [deg])]`, one per autopilot.
+    - `window`: (start, end) [s] of the time axis.
+    - `bands`: `{"heading" | "error" | "rudder": [(low, high, label)]}`: hatched
+      ranges, e.g. a thesis figure's axis range.
+    - `title`: the figure title.
+
+    **Returns:** the matplotlib `Figure`.
+    """
+    bands = bands or {}
+    t = np.asarray(t, dtype=np.float64)
+    desired = np.asarray(desired, dtype=np.float64)
+    fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True, constrained_layout=True)
+    heading, error, rudder = axes
+    heading.plot(t, desired, "k--", lw=1.4, label="desired (reference model)")
+    for label, psi, delta in runs:
+        (line,) = heading.plot(t, np.asarray(psi, dtype=np.float64), lw=1.2, label=label)
+        error.plot(t, desired - np.asarray(psi, dtype=np.float64), color=line.get_color(),
+                   lw=1.2, label=label)
+        rudder.plot(t, np.asarray(delta, dtype=np.float64), color=line.get_color(), lw=1.2,
+                    label=label)
+    for key, ax in (("heading", heading), ("error", error), ("rudder", rudder)):
+        _thesis_marks(ax, bands.get(key, ()))
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+                  fontsize="small")
+    heading.set(ylabel="heading [deg]", title=title)
+    error.set(ylabel="heading error\ndesired - actual [deg]")
+    rudder.set(ylabel="rudder [deg]", xlabel="time [s]")
+    if window is not None:
+        rudder.set_xlim(*window)
+    return fig
