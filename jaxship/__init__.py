@@ -157,13 +157,15 @@ from ._models._vessel.ross import RossVessel as RossVessel
 from ._models._vessel.sway_yaw import SwayYawVessel as SwayYawVessel
 from ._simulation._batch import simulate_batch as simulate_batch, stack as stack
 from ._simulation._data import Dataset as Dataset, Experiment as Experiment
-from ._simulation._readers import (
+from ._simulation._measured import (
     read_esso_osaka as read_esso_osaka,
     read_hsva_kvlcc2 as read_hsva_kvlcc2,
     read_marin_kvlcc2 as read_marin_kvlcc2,
     read_measured as read_measured,
-    read_trial_csv as read_trial_csv,
     shared_data_dir as shared_data_dir,
+)
+from ._simulation._readers import (
+    read_trial_csv as read_trial_csv,
     write_trial_csv as write_trial_csv,
 )
 from ._simulation._simulate import RK4 as RK4, Simulator as Simulator, simulate as simulate

@@ -20,7 +20,7 @@ import jaxship as js
 from jaxship._analysis._indices import turning_indices, zigzag_indices
 from jaxship._models._vessel.esso_osaka import LowSpeedMMGVessel, cross_flow_integrals, esso_osaka
 from jaxship._models._vessel.mmg import MMGVessel, kvlcc2
-from jaxship._simulation._readers import read_esso_osaka, shared_data_dir
+from jaxship._simulation._measured import read_esso_osaka, shared_data_dir
 
 
 DEG = np.pi / 180

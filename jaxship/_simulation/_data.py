@@ -4,7 +4,8 @@ readers in `jaxship._simulation._readers`).
 Inside the library every channel is SI with angles in radians and propeller rates in
 rev/s, in our sign convention (positive rudder angle turns the ship to starboard,
 $r > 0$; x north / forward, y east / starboard, heading from x towards y). Degrees,
-rpm and the sign conventions of the sources live only in `jaxship._simulation._readers`.
+rpm and the sign conventions of the sources live only in the readers
+(`jaxship._simulation._readers` and `_measured`).
 """
 
 from collections.abc import Sequence
