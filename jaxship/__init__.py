@@ -86,6 +86,7 @@ from ._models._control import (
     HeadingAutopilot as HeadingAutopilot,
     HeadingSteps as HeadingSteps,
     ReferenceModel as ReferenceModel,
+    YawRateLevels as YawRateLevels,
 )
 from ._models._effects import (
     AbstractEffect as AbstractEffect,

@@ -206,15 +206,17 @@ def linear_yaw(vessel, x0):
 
 
 def yaw_rate_gains(b, a, bandwidth, damping=0.8):
-    """PI gains `(kp, ki)` of `ReverseSpiral` that place the closed-loop poles of the
-    first-order yaw model $\\dot r = -a r + b \\delta$ at natural frequency
-    `bandwidth` [rad/s] and relative damping `damping`:
-    $s^2 + (a + b k_p) s + b k_i = s^2 + 2\\zeta\\omega s + \\omega^2$. The frequency is
-    raised to $a/\\zeta$ for a ship whose own yaw damping is faster, so $k_p > 0$."""
+    """Heading-autopilot gains `(kp, kd)` of `ReverseSpiral` (no integral) that place
+    the closed-loop poles of the first-order yaw model $\\dot r = -a r + b\\delta$ at
+    natural frequency `bandwidth` [rad/s] and relative damping `damping`: with
+    $\\delta = K_p\\tilde\\psi + K_d\\tilde r$ and $\\dot{\\tilde\\psi} = \\tilde r$,
+    $s^2 + (a + b K_d) s + b K_p = s^2 + 2\\zeta\\omega s + \\omega^2$ (thesis eq.
+    5.3-5.5 with $m = 1/b$, $d = a/b$). The frequency is raised to $a/\\zeta$ for a ship
+    whose own yaw damping is faster, so $K_d > 0$."""
     if not b > 0:
         raise ValueError(f"the rudder must turn the ship to starboard (b = {b:g} 1/s^2).")
     omega = max(float(bandwidth), float(a) / damping)
-    return (2 * damping * omega - a) / b, omega**2 / b
+    return omega**2 / b, (2 * damping * omega - a) / b
 
 
 def reverse_spiral(vessel, x0, *, hold, dt, max_angle=np.deg2rad(25.0),
@@ -226,7 +228,8 @@ def reverse_spiral(vessel, x0, *, hold, dt, max_angle=np.deg2rad(25.0),
     sides, from a simulated turn to each side), so that they span the direct spiral's
     range and reach into an unstable ship's loop; the PI gains come from the vessel's
     linearised yaw dynamics (`linear_yaw`, `yaw_rate_gains`, closed-loop bandwidth
-    U/(2L)), so that every level is reached within its `hold` [s].
+    U/(2L)), so that every level is reached within its `hold` [s]; the heading
+    autopilot flies the levels (`ReverseSpiral`).
     """
     speed = float(np.hypot(x0.u, x0.v)) or float(vessel.nominal_speed)
     tau = float(vessel.length) / speed
@@ -246,9 +249,9 @@ def reverse_spiral(vessel, x0, *, hold, dt, max_angle=np.deg2rad(25.0),
         )
     side = np.asarray(fractions, dtype=float) * float(np.min(steady))
     rates = np.concatenate([side, -side[::-1]])  # from starboard to port
-    kp, ki = yaw_rate_gains(*linear_yaw(vessel, x0), bandwidth=0.5 / tau)
+    kp, kd = yaw_rate_gains(*linear_yaw(vessel, x0), bandwidth=0.5 / tau)
     limit = float(vessel.rudder.max_angle)
-    return man.ReverseSpiral(rates, hold, kp=kp, ki=ki, duration=hold * rates.size, dt=dt,
+    return man.ReverseSpiral(rates, hold, kp=kp, kd=kd, duration=hold * rates.size, dt=dt,
                              max_angle=limit)
 
 

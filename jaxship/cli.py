@@ -1,13 +1,10 @@
 """The `jaxship` command: a thin layer over the public API (float64 is enabled here)."""
 
 import argparse
-import contextlib
 import importlib.metadata
 import json
 import math
-import os
 import pathlib
-import shutil
 import sys
 import tempfile
 import warnings
@@ -22,6 +19,7 @@ matplotlib.use("Agg")  # the command writes files; it never opens a window
 import matplotlib.pyplot as plt  # noqa: E402
 
 from ._estimate._result import ConvergenceWarning  # noqa: E402
+from ._foundation._files import staged_folder, write_whole  # noqa: E402
 from ._models._vessel._base import surge_force  # noqa: E402
 from ._models._vessel.catalogue import VESSELS, get_vessel  # noqa: E402
 from ._trials import TrialSpec, simulate_to_folder  # noqa: E402
@@ -212,7 +210,7 @@ def _simulate(args) -> int:
                          f"at {dt or tau / 20:.3g} s), more than {MAX_SAMPLES:.0e}; give a "
                          "larger --dt or a shorter --duration.")
     _check_out(args.out)
-    with _staging(args.out) as stage:
+    with staged_folder(args.out) as stage:
         indices = simulate_to_folder(vessel, spec, stage, speed=speed, rpm=rpm,
                                      duration=duration, dt=dt,
                                      title=f"{args.vessel} {args.manoeuvre}")
@@ -286,7 +284,7 @@ def _identify(args) -> int:
                           rudder=args.rudder, channels=args.channels, initial=args.initial,
                           max_steps=args.max_steps, progress=bar)
     written = ["result.json"]
-    with _staging(args.out) as stage:
+    with staged_folder(args.out) as stage:
         if not args.no_figures:
             paths = save_identification_figures(result, stage / "figures")
             written.append(f"figures/ ({len(paths)} figures)")
@@ -348,47 +346,6 @@ def _check_out(out: pathlib.Path):
     except OSError as error:
         raise ValueError(f"--out {out}: cannot write in {parent} "
                          f"({error.strerror or error}).") from None
-
-
-def _replace(path: pathlib.Path, write):
-    """Write `path` through a temporary file in its folder (`write(temporary path)`),
-    then rename it into place."""
-    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(handle)
-    umask = os.umask(0)
-    os.umask(umask)
-    try:
-        write(pathlib.Path(temporary))
-        os.chmod(temporary, 0o666 & ~umask)  # as an ordinary new file (mkstemp makes 0600)
-        os.replace(temporary, path)
-    except BaseException:
-        pathlib.Path(temporary).unlink(missing_ok=True)
-        raise
-
-
-@contextlib.contextmanager
-def _staging(out: pathlib.Path):
-    """A temporary folder inside `out` (made if need be) to write results into: when the
-    block ends, each of its folders replaces the one of that name in `out` and each file
-    is renamed into `out` (folders first, files in name order); after an error nothing is
-    moved, the temporary folder is removed, and so is `out` if it was made here and is
-    empty."""
-    made = [folder for folder in (out, *out.parents) if not folder.exists()]
-    out.mkdir(parents=True, exist_ok=True)
-    stage = pathlib.Path(tempfile.mkdtemp(dir=out, prefix=".jaxship."))
-    try:
-        yield stage
-        entries = sorted(stage.iterdir(), key=lambda p: (not p.is_dir(), p.name))
-        for entry in entries:
-            target = out / entry.name
-            if entry.is_dir() and target.is_dir():
-                os.replace(target, stage / f".old.{entry.name}")
-            os.replace(entry, target)
-    finally:
-        shutil.rmtree(stage, ignore_errors=True)
-        for folder in made:  # innermost first; each only while empty
-            with contextlib.suppress(OSError):
-                folder.rmdir()
 
 
 def _point_name(row, by_rpm) -> str:
@@ -456,7 +413,7 @@ def _autopilot(args) -> int:
             title=f"{report['model']} autopilot on {args.vessel} at {row['rpm']:.0f} rpm, "
             f"{row['speed']:.3g} m/s")
         name = f"figures/heading_{point}.png"
-        _replace(args.out / name, lambda p, fig=fig: fig.savefig(p, dpi=100, format="png"))
+        write_whole(args.out / name, lambda p, fig=fig: fig.savefig(p, dpi=100, format="png"))
         plt.close(fig)
         figures.append(name)
     result = {
@@ -467,7 +424,7 @@ def _autopilot(args) -> int:
         **evaluation.to_dict(),
         "figures": figures,
     }
-    _replace(args.out / "autopilot.json",
+    write_whole(args.out / "autopilot.json",
              lambda p: p.write_text(json.dumps(result, indent=2) + "\n"))
     parameters = ", ".join(f"{k} = {float(v):.4g}"
                            for k, v in result["model"]["parameters"].items())
@@ -475,7 +432,7 @@ def _autopilot(args) -> int:
         evaluation, title=f"Heading autopilot: {report['model']} on {args.vessel}",
         model_text=f"Model: {report['model']} ({type(model).__name__}) from `{args.model}`: "
         f"{parameters}.", figures=figures)
-    _replace(args.out / "report.md", lambda p: p.write_text(page))
+    write_whole(args.out / "report.md", lambda p: p.write_text(page))
     print(autopilot_study.gains_table(evaluation.gains()))
     print(autopilot_study.runs_table(evaluation.rows))
     print(f"wrote {args.out}/autopilot.json, {args.out}/report.md, {args.out}/figures/ "

@@ -106,6 +106,8 @@ def _bad_cases(tmp_path, identified):
                                  "parameters": {"a1": {"value": -1.0}}}))
     a_file = tmp_path / "a_file"
     a_file.write_text("keep")
+    latin1 = tmp_path / "latin1.json"
+    latin1.write_bytes('{"model": "nomoto1", "note": "Kr\u00e5ke"}'.encode("latin-1"))
     model = ["--model", str(identified)]
     out = ["--out", str(tmp_path / "out")]
     return [
@@ -122,6 +124,8 @@ def _bad_cases(tmp_path, identified):
          "not valid JSON"),
         (["--model", str(other_json), "--vessel", "thesis", "--rpm", "300"] + out,
          "not an identify result"),
+        (["--model", str(latin1), "--vessel", "thesis", "--rpm", "300"] + out,
+         "not a text file"),
         (["--model", str(armax), "--vessel", "thesis", "--rpm", "300"] + out, "armax"),
         (model + ["--vessel", "mariner", "--rpm", "60"] + out, "no propeller"),
         (model + ["--vessel", "thesis", "--rpm", "300", "--out", str(a_file)], "is a file"),

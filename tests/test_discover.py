@@ -143,3 +143,27 @@ def test_the_discover_command_refuses_an_output_file(tmp_path, capsys):
     target.write_text("x")
     assert main(["discover", str(target), "--model", "nomoto1", "--out", str(target)]) == 2
     assert "is a file" in capsys.readouterr().err
+
+
+def test_an_interrupted_discover_command_leaves_the_earlier_results(tmp_path, capsys,
+                                                                      monkeypatch):
+    # issue 13: results are written to a temporary folder and renamed, never half
+    import jaxship.identification.discovery as command
+
+    record = tmp_path / "a.csv"
+    js.write_trial_csv(record, hidden_effect_records(js.Nomoto1(K=K, T=25.0), 0)[0][0])
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "report.md").write_text("earlier\n")
+
+    def half_written(report, train, holdout, folder):
+        folder.mkdir(parents=True)
+        (folder / "residuals.png").write_bytes(b"partial")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(js, "discover", lambda *args, **kwargs: None)
+    monkeypatch.setattr(command, "save_discovery_figures", half_written)
+    assert main(["discover", str(record), "--model", "nomoto1", "--out", str(out),
+                 "--quiet"]) == 130
+    assert sorted(p.name for p in out.iterdir()) == ["report.md"]
+    assert (out / "report.md").read_text() == "earlier\n"

@@ -245,6 +245,9 @@ def test_non_convergence_warns():
         res = fit(Nomoto1(K=0.03, T=10.0), NOMOTO1_DATA,
                   estimator=PredictionError(horizon=None, max_steps=2))
     assert not res.success
+    # issue 13: in a fit's words, not optimistix's ("Try increasing `max_steps`.")
+    assert res.message.startswith("stopped at the maximum number of steps")
+    assert "`max_steps`" not in res.summary() and res.message in res.summary()
 
 
 def test_result_serialises_and_summarises():

@@ -220,7 +220,7 @@ def test_zigzag_switches_when_the_heading_passes_the_switch_angle(vessel, x0, an
 
 def test_reverse_spiral_reaches_the_yaw_rate_levels(vessel, x0):
     rates = np.array([0.3, 0.1, -0.1, -0.3]) * DEG
-    m = js.ReverseSpiral(rates, 400.0, kp=50.0, ki=2.0, duration=1600.0, dt=0.5)
+    m = js.ReverseSpiral(rates, 400.0, kp=2.0, kd=50.0, duration=1600.0, dt=0.5)
     traj = js.simulate(vessel, m, x0)
     t, r = np.asarray(traj.t), np.asarray(traj.state.r)
     ends = np.searchsorted(t, 400.0 * np.arange(1, 5))
@@ -231,6 +231,31 @@ def test_reverse_spiral_reaches_the_yaw_rate_levels(vessel, x0):
     # the mean rudder of the last level holds that rate in an open-loop steady turn
     turn = js.simulate(vessel, js.Turn(curve.delta[-1], duration=1500.0, dt=0.5), x0)
     np.testing.assert_allclose(turn.state.r[-1], rates[-1], rtol=2e-2)
+
+
+def test_reverse_spiral_is_flown_by_the_heading_autopilot(vessel, x0):
+    # issue 12: the heading autopilot tracks a heading turning at each level's rate;
+    # the rudder law recomputed from the samples (PID on heading and yaw rate)
+    rates, hold, dt = np.array([0.2, -0.3]) * DEG, 100.0, 0.5
+    levels = js.YawRateLevels(rates, hold)
+    t = np.array([0.0, 50.0, 100.0, 150.0, 250.0])
+    np.testing.assert_allclose(levels(t), np.array([0, 50, 100, 100 - 1.5 * 50,
+                                                    100 - 1.5 * 150]) * 0.2 * DEG, atol=1e-15)
+    kp, kd, ki = 1.5, 40.0, 0.004
+    m = js.ReverseSpiral(rates, hold, kp=kp, kd=kd, ki=ki, duration=2 * hold, dt=dt,
+                         start=10.0)
+    assert isinstance(m.autopilot, js.HeadingAutopilot)
+    traj = js.simulate(vessel, m, x0, simulator=AT_SAMPLES)
+    tau = np.asarray(traj.t) - 10.0
+    psi, r = np.asarray(traj.state.psi), np.asarray(traj.state.r)
+    psi_ref = float(x0.psi) + np.asarray(levels(tau + dt / 2))
+    r_ref = np.asarray(levels.rate(tau + dt / 2))
+    integral, expected = 0.0, []
+    for e, er in zip(psi_ref - psi, r_ref - r):
+        integral += e * dt  # the limit is not reached here
+        expected.append(kp * e + kd * er + ki * integral)
+    np.testing.assert_allclose(np.asarray(traj.command.delta), expected, atol=1e-12)
+    assert np.max(np.abs(expected)) < 35 * DEG
 
 
 def test_heading_perturbations_track_the_square_wave(vessel, x0):
@@ -305,8 +330,8 @@ def test_linear_yaw_and_gains_place_the_poles():
     x0 = js.straight_run(vessel)
     b, a = linear_yaw(vessel, x0)
     assert b > 0 and a > 0  # course-stable: the rudder turns it to starboard, yaw damped
-    kp, ki = yaw_rate_gains(b, a, bandwidth=0.05, damping=0.8)
-    roots = np.roots([1.0, a + b * kp, b * ki])
+    kp, kd = yaw_rate_gains(b, a, bandwidth=0.05, damping=0.8)
+    roots = np.roots([1.0, a + b * kd, b * kp])
     np.testing.assert_allclose(np.abs(roots), 0.05, rtol=1e-9)
     np.testing.assert_allclose(-roots.real / np.abs(roots), 0.8, rtol=1e-9)
     # the marginally unstable KVLCC2 (one pole at +4e-4 1/s): finite, a < 0

@@ -105,3 +105,48 @@ def test_quick_reproduce_command_writes_the_report(tmp_path, capsys):
     assert "**Named: yaw_cubic_damping**" in report
     assert data["run"]["quick"] and set(data["run"]["stages_seconds"]) >= {
         "trials", "identification", "autopilot", "discovery"}
+
+
+def test_a_failed_reproduce_leaves_the_earlier_report(tmp_path, monkeypatch):
+    # issue 13: reproduce writes into a temporary folder; nothing moves after an error
+    import jaxship.studies.reproduce as job
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "report.md").write_text("earlier\n")
+
+    def failing(vessel, families, folder, progress):
+        (folder / "trials" / "turn.csv").write_text("t\n0\n")
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(job, "_trials", failing)
+    with pytest.raises(RuntimeError, match="disk full"):
+        job.reproduce(out, quick=True, parallel=False, discover=False)
+    assert sorted(p.name for p in out.iterdir()) == ["report.md"]
+    assert (out / "report.md").read_text() == "earlier\n"
+
+
+def test_a_failed_fit_in_the_study_leaves_the_others(monkeypatch):
+    # issue 13: in the batch of chapter-4 fits, one that fails is reported and the others
+    # are returned; its autopilot is skipped
+    from jaxship.studies import autopilot, thesis
+
+    families = {"turning": ("turn:40",), "zigzag": ("zigzag:40/40",)}
+    real = thesis.identify
+
+    def zigzag_fails(model_name, records, *args, **kwargs):
+        if any("zigzag" in e.name for e in records):
+            raise RuntimeError("every start of the nomoto fit diverged")
+        return real(model_name, records, *args, **kwargs)
+
+    monkeypatch.setattr(thesis, "identify", zigzag_fails)
+    study = thesis.identification_study(families=families, models=("nomoto",),
+                                        cases=("merged",))
+    rows = {r["family"]: r for r in study["table"]}
+    assert rows["zigzag"]["success"] is False and "diverged" in rows["zigzag"]["error"]
+    assert rows["zigzag"]["fit"] is None and study["models"]["merged/nomoto/zigzag"] is None
+    assert rows["turning"]["success"] and rows["turning"]["fit"] is not None
+    assert study["parameters"]["merged/nomoto/turning"]["K"] > 0  # -67.6 %: as in fig. 4.20
+    closed = autopilot.autopilot_study(identification=study, models=("nomoto",),
+                                       rpms=(300.0,))
+    assert {r["family"] for r in closed["table"]} == {"turning"}

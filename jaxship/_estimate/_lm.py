@@ -74,7 +74,25 @@ class SolverOutcome(eqx.Module):
 
     @property
     def message(self) -> str:
-        return "successful" if self.success else optx.RESULTS[self.result]
+        """In plain words: "successful", or why the optimiser stopped."""
+        if self.success:
+            return "successful"
+        for name, text in _PLAIN_RESULTS.items():
+            if self.result == getattr(optx.RESULTS, name, None):
+                return text
+        return optx.RESULTS[self.result].split("\n")[0]
+
+
+# the optimistix results a fit meets, in the words of a fit (not of a root-find)
+_PLAIN_RESULTS = {
+    "max_steps_reached": "stopped at the maximum number of steps before converging "
+                         "(raise max_steps, or start closer)",
+    "nonlinear_max_steps_reached": "stopped at the maximum number of steps before "
+                                   "converging (raise max_steps, or start closer)",
+    "nonlinear_divergence": "diverged",
+    "singular": "the least-squares step was singular or not finite (a parameter is not "
+                "identifiable on these data, or the simulation blew up)",
+}
 
 
 def value_and_jacfwd(f, z):

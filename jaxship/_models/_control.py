@@ -107,6 +107,34 @@ class HeadingSteps(eqx.Module):
         values = jnp.concatenate([jnp.zeros((1,)), jnp.asarray(self.headings, dtype=float)])
         return values[taken]
 
+    def rate(self, t: ArrayLike) -> Array:
+        """The yaw rate ordered at time `t`: zero between steps [rad/s]."""
+        return jnp.zeros_like(jnp.asarray(t, dtype=float))
+
+
+class YawRateLevels(eqx.Module):
+    """An ordered heading that turns at constant rates: `rates[k]` [rad/s] from
+    `k hold` to `(k + 1) hold` [s] (the last held after), so $\\psi_{ref}(t) = \\psi_0 +
+    \\int_0^t r_{ref}\\,dt$ and $r_{ref}$ is the ordered yaw rate (Bech's reverse spiral
+    flown by a heading autopilot; MSC/Circ.1053 app. 4 2.2)."""
+
+    rates: ArrayLike = eqx.field(converter=_floats)  # [rad/s]
+    hold: ArrayLike = eqx.field(converter=_floats)  # [s] per level
+
+    def rate(self, t: ArrayLike) -> Array:
+        """$r_{ref}(t)$ [rad/s]."""
+        rates = jnp.asarray(self.rates, dtype=float)
+        k = jnp.clip(jnp.floor(t / self.hold).astype(int), 0, rates.shape[0] - 1)
+        return rates[k]
+
+    def __call__(self, t: ArrayLike) -> Array:
+        """The heading change ordered at time `t` [s], $\\int_0^t r_{ref}\\,dt$ [rad]."""
+        rates = jnp.asarray(self.rates, dtype=float)
+        t = jnp.maximum(t, 0.0)
+        k = jnp.clip(jnp.floor(t / self.hold).astype(int), 0, rates.shape[0] - 1)
+        before = jnp.concatenate([jnp.zeros((1,)), jnp.cumsum(rates) * self.hold])
+        return before[k] + rates[k] * (t - k * self.hold)
+
 
 def yaw_acceleration(model, r: ArrayLike, delta: ArrayLike, state: ShipState) -> Array:
     """$\\dot r$ [rad/s^2] of `model` at yaw rate `r`, rudder angle `delta` and the
@@ -189,7 +217,9 @@ class HeadingAutopilot(AbstractController):
 
     with $(\\psi_d, r_d, \\dot r_d)$ from `reference` (eq. 5.7) driven by `steps`
     (relative to the initial heading), and $\\delta_{ff}$ from `feedforward` (None: no
-    feed-forward) clipped to `max_angle`.
+    feed-forward) clipped to `max_angle`. With `reference=None` the ordered heading is
+    tracked as it is, $(\\psi_d, r_d, \\dot r_d) = (\\psi_{ref}, r_{ref}, 0)$, where
+    `steps` may order a yaw rate too (`YawRateLevels`).
 
     **Sampling.** The controller updates at its own `interval` [s]: at the first
     control step whose start is within half a step of the scheduled time (a fixed grid,
@@ -218,7 +248,7 @@ class HeadingAutopilot(AbstractController):
     ki: ArrayLike  # K_i [1/s]
     kd: ArrayLike  # K_d [s]
     reference: ReferenceModel | None = ReferenceModel()  # None: track the steps as they are
-    steps: HeadingSteps = HeadingSteps()
+    steps: HeadingSteps | YawRateLevels = HeadingSteps()
     feedforward: Feedforward | None = None
     max_angle: ArrayLike = float(np.deg2rad(35.0))  # delta_max [rad]
     max_rate: ArrayLike = float("inf")  # delta_dot_max [rad/s]
@@ -241,9 +271,10 @@ class HeadingAutopilot(AbstractController):
 
     def command(self, t, state: ShipState, memory: AutopilotMemory, h):
         psi_ref = memory.origin + self.steps(t + 0.5 * h)
-        if self.reference is None:  # the ordered heading itself, at rest
+        if self.reference is None:  # the ordered heading and yaw rate themselves
+            r_ref = self.steps.rate(t + 0.5 * h) + 0.0 * psi_ref
             memory = eqx.tree_at(lambda m: m.reference, memory,
-                                 jnp.stack([psi_ref, 0.0 * psi_ref, 0.0 * psi_ref]))
+                                 jnp.stack([psi_ref, r_ref, 0.0 * psi_ref]))
         psi_d, r_d, a_d = memory.reference[0], memory.reference[1], memory.reference[2]
         period = jnp.maximum(self.interval, h)
         update = t >= memory.next_update - 0.5 * h

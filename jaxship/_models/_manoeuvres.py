@@ -17,7 +17,7 @@ import numpy as np
 from jaxtyping import ArrayLike
 
 from .._foundation._state import Command
-from ._control import AbstractController, HeadingAutopilot, HeadingSteps
+from ._control import AbstractController, HeadingAutopilot, HeadingSteps, YawRateLevels
 
 
 class AbstractManoeuvre(AbstractController):
@@ -307,46 +307,53 @@ class Stop(AbstractTrial):
         return jnp.where(tau >= self.execute, self.astern_n, n)
 
 
-class ReverseSpiral(AbstractTrial):
+class ReverseSpiral(AbstractManoeuvre):
     """Bech's reverse spiral (Bech 1968, "The reversed spiral test as applied to large
-    ships", Shipping World and Shipbuilder; MSC/Circ.1053 app. 4 2.2): a yaw-rate
-    controller holds each rate in `rates` [rad/s] for `hold` s; the mean rudder needed
+    ships", Shipping World and Shipbuilder; MSC/Circ.1053 app. 4 2.2): the heading
+    autopilot (`HeadingAutopilot`, no reference model) tracks a heading that turns at
+    each rate of `rates` [rad/s] for `hold` s (`YawRateLevels`); the mean rudder needed
     gives the delta(r) curve, S-shaped through an unstable ship's loop, which the
     direct spiral cannot hold.
 
-    Rudder law (PI on yaw rate): $\\delta_c = k_p e + k_i \\int e\\,dt$, $e = r_{ref} - r$,
-    clipped to `max_angle` with the integral bounded to it. On the first-order model
-    $\\dot r = -a r + b\\delta$ the closed loop is
-    $s^2 + (a + b k_p)s + b k_i$; `jaxship simulate` places its poles from the
-    vessel's linearised yaw dynamics and sizes the rates from its steady turn at the
-    direct spiral's largest rudder angle (`jaxship._trials.reverse_spiral`).
+    Rudder law: $\\delta_c = K_p\\tilde\\psi + K_d\\tilde r + K_i\\int\\tilde\\psi\\,dt$,
+    $\\tilde\\psi = \\psi_{ref} - \\psi$, $\\tilde r = r_{ref} - r$, clipped to
+    `max_angle` with conditional-integration anti-windup. Since
+    $\\tilde\\psi = \\int\\tilde r\\,dt$, with $K_i = 0$ it is a PI controller on the
+    yaw rate (gains $K_d$, $K_p$), the rate-of-turn controller of Bech's trial; on
+    $\\dot r = -a r + b\\delta$ its closed loop is $s^2 + (a + bK_d)s + bK_p$.
+    `jaxship simulate` places those poles from the vessel's linearised yaw dynamics
+    and sizes the rates from its steady turn at the direct spiral's largest rudder
+    angle (`jaxship._trials.reverse_spiral`).
     """
 
     rates: ArrayLike  # r_ref levels [rad/s]
     hold: ArrayLike  # [s] per level
-    kp: ArrayLike  # [s] (rad of rudder per rad/s of yaw-rate error)
-    ki: ArrayLike  # [-] (rad of rudder per rad of integrated error)
+    kp: ArrayLike  # K_p [rad rudder / rad heading]
+    kd: ArrayLike  # K_d [s]
     duration: ArrayLike
+    ki: ArrayLike = 0.0  # K_i [1/s]
     dt: ArrayLike = 0.1
     start: ArrayLike = 0.0
-    max_angle: ArrayLike = np.deg2rad(35)  # anti-windup limit of the controller [rad]
-    n: ArrayLike | None = None
+    max_angle: ArrayLike = float(np.deg2rad(35))  # rudder limit of the autopilot [rad]
+    n: None = None
     num_samples: int | None = eqx.field(static=True, default=None)
 
+    @property
+    def autopilot(self) -> HeadingAutopilot:
+        """The heading autopilot flying the levels (time from `start`)."""
+        return HeadingAutopilot(kp=self.kp, ki=self.ki, kd=self.kd, reference=None,
+                                steps=YawRateLevels(self.rates, self.hold),
+                                max_angle=self.max_angle)
+
     def reference(self, tau):
-        rates = jnp.asarray(self.rates)
-        k = jnp.clip(jnp.floor(tau / self.hold).astype(int), 0, rates.shape[0] - 1)
-        return rates[k]
+        """The ordered yaw rate [rad/s] at time `tau` since the start."""
+        return YawRateLevels(self.rates, self.hold).rate(tau)
 
-    def init_memory(self, x0):
-        return jnp.zeros_like(jnp.asarray(x0.r, dtype=float))
+    def init(self, x0):
+        return self.autopilot.init(x0)
 
-    def rudder(self, tau, state, psi0, integral, h):
-        error = self.reference(tau) - state.r
-        limit = self.max_angle / jnp.maximum(self.ki, 1e-12)
-        integral = jnp.clip(integral + error * h, -limit, limit)
-        delta = jnp.clip(self.kp * error + self.ki * integral, -self.max_angle, self.max_angle)
-        return delta, integral
+    def command(self, t, state, memory, h):
+        return self.autopilot.command(t - self.start, state, memory, h)
 
 
 def heading_perturbations(amplitude, period, kp, ki, kd, duration, *, dt=0.1,

@@ -10,6 +10,7 @@ import numpy as np
 
 import jaxship as js
 
+from .._foundation._files import staged_folder
 from .data import read_experiments
 from .registry import get_model_entry
 from .workflow import identify
@@ -32,20 +33,14 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
     start = identify(train, model=model).fit.model
     report = js.discover(start, train, holdout, max_effects=max_effects, alpha=alpha,
                          progress=say)
-    out.mkdir(parents=True, exist_ok=True)
-    figures = save_discovery_figures(report, train, holdout, out / "figures")
-    text = report.to_markdown()
-    text += "\n## Figures\n\n" + "\n".join(f"![{p.stem}](figures/{p.name})" for p in figures)
-    _write(out / "discovery.json", json.dumps(report.to_dict(), indent=2) + "\n")
-    _write(out / "report.md", text + "\n")
+    with staged_folder(pathlib.Path(out)) as stage:  # all or nothing
+        figures = save_discovery_figures(report, train, holdout, stage / "figures")
+        text = report.to_markdown()
+        text += "\n## Figures\n\n" + "\n".join(f"![{p.stem}](figures/{p.name})"
+                                                for p in figures)
+        (stage / "discovery.json").write_text(json.dumps(report.to_dict(), indent=2) + "\n")
+        (stage / "report.md").write_text(text + "\n")
     return report
-
-
-def _write(path: pathlib.Path, text: str):
-    """Write through a temporary file and rename: never half a file."""
-    temporary = path.with_name(f".{path.name}.tmp")
-    temporary.write_text(text)
-    temporary.replace(path)
 
 
 def save_discovery_figures(report, train, holdout, folder: pathlib.Path) -> list[pathlib.Path]:

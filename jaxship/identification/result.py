@@ -228,9 +228,12 @@ def read_result(path) -> tuple[object, dict]:
     if path.is_dir():
         path = path / "result.json"
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8")
     except OSError as error:
         raise ValueError(f"cannot read {path}: {error.strerror or error}.") from None
+    except UnicodeDecodeError as error:
+        raise ValueError(f"{path} is not a text file (byte {error.start} is not UTF-8); "
+                         "give the result.json that `jaxship identify` wrote.") from None
     try:
         report = json.loads(text)
     except json.JSONDecodeError as error:

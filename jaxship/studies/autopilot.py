@@ -419,8 +419,11 @@ def autopilot_study(vessel=None, *, identification=None, quick: bool = False,
     table, gains, evaluations = [], {}, {}
     for name in models:
         for family in FAMILIES:
+            model = identification["models"].get(f"merged/{name}/{family}")
+            if model is None:  # not identified, or its identification failed
+                say(f"closed loop: no {name} model from the merged {family}")
+                continue
             say(f"closed loop: {name} from the merged {family}")
-            model = identification["models"][f"merged/{name}/{family}"]
             ev = evaluate(model, vessel, rpm=rpms, design=design)
             evaluations[f"{name}/{family}"] = ev
             gains[f"{name}/{family}"] = ev.gains()

@@ -38,6 +38,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import jaxship as js
+from jaxship._foundation._files import staged_folder
 from jaxship.studies import autopilot, discovery, thesis
 from jaxship.studies.reproduce_report import (
     DISCOVERY_HIDDEN,
@@ -96,8 +97,21 @@ def reproduce(out, *, quick=False, progress=False, identification=True,
     the Nomoto and Ross models in chapter 4, one discovery iteration. `identification`,
     `closed_loop` (needs `identification`), `discover`: run those stages; `parallel`:
     the discovery and one family of chapter 4 in a second process alongside the rest.
-    `progress`: tqdm bars on stderr."""
+    `progress`: tqdm bars on stderr. Written whole: into a temporary folder inside
+    `out` whose entries replace those of `out` at the end (nothing after an error)."""
     out = pathlib.Path(out)
+    with staged_folder(out) as stage:
+        results = _run(stage, quick, progress, identification, closed_loop, discover,
+                       parallel)
+    if progress:
+        tqdm.write(f"wrote {out}/report.md ({results['run']['seconds']:.0f} s), beside it "
+                   + ", ".join(f"{k}.json" for k, v in results.items() if v is not None)
+                   + ", figures/*.png and trials/*.csv")
+    return results
+
+
+def _run(out, quick, progress, identification, closed_loop, discover, parallel) -> dict:
+    """`reproduce` into the folder `out`."""
     (out / "trials").mkdir(parents=True, exist_ok=True)
     (out / "figures").mkdir(exist_ok=True)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
@@ -178,10 +192,6 @@ def reproduce(out, *, quick=False, progress=False, identification=True,
     text = header(results["run"], quick, len(indices) // len(RPMS), stages)
     text += "\n".join(sections) + left_out(quick, identification, closed_loop, discover)
     (out / "report.md").write_text(text)
-    if progress:
-        tqdm.write(f"wrote {out}/report.md ({results['run']['seconds']:.0f} s), beside it "
-                   + ", ".join(f"{k}.json" for k, v in results.items() if v is not None)
-                   + ", figures/*.png and trials/*.csv")
     return results
 
 

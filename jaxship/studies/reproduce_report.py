@@ -272,7 +272,12 @@ def identification_section(study, experiments, out, quick):
         source = f"fig. {fig} legend" if fig else "not in the thesis"
         diff = (row["fit"] - row["thesis"]) if row["thesis"] is not None and row["fit"] \
             is not None else None
-        cell = lambda x: "diverges" if x is None else f"{x:.2f}"
+        cell = lambda x: ("fit failed" if row.get("error") else "diverges") if x is None \
+            else f"{x:.2f}"
+        if row.get("error"):
+            notes.append(f"- **{row['case']} {MODEL_NAMES[row['model']]}, "
+                         f"{FAMILY_NAMES[row['family']]}**: the fit failed ({row['error']}); "
+                         "the other fits went on.")
         lines.append(f"| {row['case']} | {MODEL_NAMES[row['model']]} | "
                      f"{FAMILY_NAMES[row['family']]} | {cell(row['fit'])} | "
                      f"{_cell(row['thesis'])} | {source} | "
@@ -320,6 +325,8 @@ def _fit_figure(study, experiments, family, path):
             if (row["case"], row["family"]) != (case, family):
                 continue
             model = study["models"][f"{case}/{row['model']}/{family}"]
+            if model is None:  # the fit failed (see the table)
+                continue
             with np.errstate(all="ignore"):
                 r = np.rad2deg(thesis.simulate_record(model, e))
             fig = THESIS_FIGURE.get((case, row["model"], family))

@@ -285,7 +285,9 @@ def identification_study(vessel=None, *, quick=False, settings: Settings = Setti
     `{case, model, family, fit, fit_family, per_record, thesis}` (simulation fit % of
     the yaw rate on the family's 40 deg / 500 rpm record, pooled over all records of
     the family at both rates (None where the model diverges), and the thesis'
-    number), the fitted `parameters` per `"case/model/family"`, the `noise`,
+    number; a fit that fails has `success` False and its `error`, and the others go
+    on), the fitted `parameters` per `"case/model/family"` (None where it failed), the
+    `noise`,
     the `settings` and the experiment `records`.
 
     `quick`: two trials per family instead of four (turn 10 and 40 deg, zig-zag
@@ -310,20 +312,29 @@ def identification_study(vessel=None, *, quick=False, settings: Settings = Setti
             fitted = {}
             for model_name in names:
                 say(f"{case} {family}: {model_name}")
-                result = identify(model_name, train, vessel, settings=settings,
-                                  nomoto=fitted.get("nomoto"), base=fitted.get("ross"))
+                key = f"{case}/{model_name}/{family}"
+                thesis_fit = THESIS_FIT[case].get(model_name, {}).get(family)
+                try:
+                    result = identify(model_name, train, vessel, settings=settings,
+                                      nomoto=fitted.get("nomoto"), base=fitted.get("ross"))
+                except (RuntimeError, ValueError) as error:  # the other fits go on
+                    say(f"{case} {family}: {model_name} failed: {error}")
+                    rows.append(dict(case=case, model=model_name, family=family, fit=None,
+                                     fit_family=None, thesis=thesis_fit, success=False,
+                                     per_record={e.name: None for e in family_records},
+                                     error=str(error)))
+                    params[key], models[key] = None, None
+                    continue
                 fitted[model_name] = result.model
                 fit_shown, _ = simulation_fit(result.model, [shown], settings.substeps)
                 fit_family, per = simulation_fit(result.model, family_records,
                                                  settings.substeps)
                 rows.append(dict(
                     case=case, model=model_name, family=family, fit=_finite(fit_shown),
-                    fit_family=_finite(fit_family),
-                    thesis=THESIS_FIT[case].get(model_name, {}).get(family),
+                    fit_family=_finite(fit_family), thesis=thesis_fit,
                     per_record={e.name: _finite(f) for e, f in zip(family_records, per)},
                     success=result.success,
                 ))
-                key = f"{case}/{model_name}/{family}"
                 params[key] = {n: float(v) for n, v in zip(result.names, result.values)}
                 models[key] = result.model
     return {"table": rows, "parameters": params, "models": models,
