@@ -24,6 +24,7 @@ from ._analysis._discover._catalogue import (
     DISCOVERY_CATALOGUE as DISCOVERY_CATALOGUE,
     Candidate as Candidate,
 )
+from ._analysis._discover._locate import locate_disagreement as locate_disagreement
 from ._analysis._discover._report import DiscoveryReport as DiscoveryReport
 from ._analysis._discover._workflow import discover as discover
 from ._analysis._indices import (

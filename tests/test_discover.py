@@ -53,6 +53,12 @@ def test_a_rudder_offset_is_named_with_its_class_and_the_gap_shrinks():
     expected = 0.5 * DEG if effect["id"] == "rudder_offset" else K * 0.5 * DEG
     assert abs(value["value"] - expected) < 4 * value["std"]
     assert report.holdout_cost_after < report.holdout_cost_before
+    # located: a heading residual of one sign whichever way the ship turns (a bias, not a
+    # term odd in r), gone after the offset is added
+    before, after = (report.disagreement[k]["sides"]["psi"] for k in ("before", "after"))
+    assert before["symmetric"] > 0.5 and abs(before["antisymmetric"]) < 0.3 * before["symmetric"]
+    assert abs(after["symmetric"]) < 0.5 * before["symmetric"], (before, after)
+    assert "## Where the base model disagrees" in report.to_markdown()
 
 
 def test_cubic_damping_is_named_and_closes_the_held_out_gap():
@@ -122,6 +128,9 @@ def test_the_discover_command(tmp_path, capsys):
     assert set(zigzag) == {"overshoot_1_deg", "overshoot_2_deg"}
     assert error("after") < 0.5 * error("before")  # measured 19.2, 21.7 deg
     assert (out / "report.md").read_text().startswith("# Discovery report")
+    located = result["disagreement"]["before"]
+    assert set(located) >= {"records", "windows", "regions", "sides", "correlations"}
+    assert set(located["records"]) == {"train0", "train1", "train2", "train3"}
     assert list((out / "figures").glob("*.png"))
 
 

@@ -20,7 +20,10 @@ class DiscoveryReport(eqx.Module):
     - `train_cost_*`, `holdout_cost_*` (half the sum of squared normalised
       residuals), `holdout_fit_percent_*` per channel, `holdout_indices` per
       held-out record `{index: {measured, before, after}}`;
-    - `alpha`: the family-wise false-alarm rate; `channels`: the fitted outputs.
+    - `alpha`: the family-wise false-alarm rate; `channels`: the fitted outputs;
+    - `disagreement`: where the simulated training records depart from the measured
+      ones, `{"before": ..., "after": ...}` (`jaxship.locate_disagreement`: by
+      record, time window, state region, turning side and correlated signal).
     """
 
     verdict: str
@@ -38,6 +41,7 @@ class DiscoveryReport(eqx.Module):
     holdout_indices: dict
     alpha: float
     channels: tuple
+    disagreement: dict
 
     @property
     def named(self) -> tuple[str, ...]:
@@ -53,7 +57,7 @@ class DiscoveryReport(eqx.Module):
         keys = ("verdict", "effects", "rejected", "scores", "train_cost_before",
                 "train_cost_after", "holdout_cost_before", "holdout_cost_after",
                 "holdout_fit_percent_before", "holdout_fit_percent_after",
-                "holdout_indices", "alpha")
+                "holdout_indices", "alpha", "disagreement")
         return _plain({k: getattr(self, k) for k in keys} | {"channels": list(self.channels)})
 
     def to_markdown(self) -> str:
@@ -79,6 +83,7 @@ class DiscoveryReport(eqx.Module):
             if best:
                 lines.append(f"The largest robust score was {best[1]['score']:.3g} "
                              f"({best[0]}), against a threshold of {best[1]['threshold']:.3g}.")
+        lines += _where(self.disagreement["before"], self.disagreement["after"])
         lines += ["", "## Candidates at the base fit", "",
                   "| candidate | robust score | naive score | threshold |", "|---|---|---|---|"]
         for k, s in sorted(self.scores.items(), key=lambda kv: -kv[1]["score"]):
@@ -105,6 +110,43 @@ class DiscoveryReport(eqx.Module):
             lines += [f"| {r} | {k} | {fmt(v['measured'])} | {fmt(v['before'])} | "
                       f"{fmt(v['after'])} |" for r, k, v in rows]
         return "\n".join(lines) + "\n"
+
+
+def _where(before: dict, after: dict) -> list[str]:
+    """The disagreement section: records, windows, regions, sides, correlations."""
+    lines = ["", "## Where the base model disagrees (training records, simulated)", "",
+             "Residuals in standard deviations of each measured channel; descriptive "
+             "(the tests below decide).", "",
+             "| record | channel | fit % before | after | worst 60 s window | its RMS / "
+             "record's |", "|---|---|---|---|---|---|"]
+    for name, per in before["records"].items():
+        w = before["windows"][name]
+        span = f"{w['start_s']:.0f}-{w['end_s']:.0f} s" if w else "-"
+        ratio = f"{w['rms'] / w['record_rms']:.2f}" if w and w["record_rms"] else "-"
+        for c, m in per.items():
+            lines.append(f"| {name} | {c} | {m['fit_percent']:.1f} | "
+                         f"{after['records'][name][c]['fit_percent']:.1f} | {span} | {ratio} |")
+    lines += ["", "| state region | samples % | squared residual % | ratio |",
+              "|---|---|---|---|"]
+    for k, v in before["regions"].items():
+        ratio = "-" if v["ratio"] is None else f"{v['ratio']:.2f}"
+        lines.append(f"| {k} ({before['regions_defined'][k]}) | {100 * v['fraction']:.0f} | "
+                     f"{100 * v['share']:.0f} | {ratio} |")
+    if before["sides"]:
+        lines += ["", "| channel | mean residual, starboard turning | port | symmetric "
+                  "(bias) | antisymmetric (odd in r) |", "|---|---|---|---|---|"]
+        for c, v in before["sides"].items():
+            lines.append(f"| {c} | {v['starboard']:+.2f} | {v['port']:+.2f} | "
+                         f"{v['symmetric']:+.2f} | {v['antisymmetric']:+.2f} |")
+    lines += ["", f"Signals the residuals follow (largest |correlation| over lags; 95 % band "
+              f"of independent series {before['band']:.3f}):", ""]
+    for c, corr in before["correlations"].items():
+        top = sorted(corr.items(), key=lambda kv: -kv[1])[:3]
+        lines.append(f"- {c}: " + ", ".join(f"{k} {v:.2f}" for k, v in top)
+                     + f"; autocorrelations outside the band: "
+                     f"{100 * before['whiteness'][c]:.0f} % before, "
+                     f"{100 * after['whiteness'][c]:.0f} % after")
+    return lines
 
 
 def _plain(x):

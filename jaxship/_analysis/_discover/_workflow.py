@@ -33,6 +33,7 @@ from ..._foundation._params import default_free, parameter_fields, rebuild
 from ..._models._effects import augment
 from ._catalogue import DISCOVERY_CATALOGUE, applicable
 from ._holdout import holdout_check, holdout_indices
+from ._locate import locate_disagreement
 from ._report import DiscoveryReport
 from ._score import canonical_correlation, score_tests
 
@@ -206,6 +207,9 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         current, theta, cost = trial, theta + names[record["id"]], trial.cost
         held_cost = record["holdout_cost"] if holdout else None
     after = holdout_check(current.model, holdout, channels) if holdout else None
+    say("locating the disagreement before and after")
+    disagreement = {"before": locate_disagreement(base_fit.model, train, channels),
+                    "after": locate_disagreement(current.model, train, channels)}
     return DiscoveryReport(
         verdict="missing_effect" if accepted else "nothing_missing", effects=accepted,
         rejected=rejected, scores=first_scores or {}, model_before=base_fit.model,
@@ -217,7 +221,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         holdout_fit_percent_after=after["fit_percent"] if holdout else None,
         holdout_indices=holdout_indices(holdout, before["predictions"],
                                         after["predictions"]) if holdout else {},
-        alpha=alpha, channels=channels)
+        alpha=alpha, channels=channels, disagreement=disagreement)
 
 
 def _set(model, name, value):

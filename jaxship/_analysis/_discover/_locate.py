@@ -1,0 +1,167 @@
+"""Where a fitted model disagrees with the records: output-error residuals broken down
+by record, time window, state region and turning side, and their correlation with the
+signals a missing effect would follow (the first step of the discovery workflow;
+Ljung 1999, sec. 16.6, residual analysis; Astrom & Kallstrom 1979, sec. 5)."""
+
+import numpy as np
+
+from ..._estimate._fit import PredictionError
+from ..._estimate._predict import predict
+from ..._estimate._windows import as_dataset
+
+
+# state regions, each a mask over samples from the measured signals (thresholds as
+# fractions of the record's own range, so the breakdown is scale-free)
+REGIONS = {
+    "large rudder": "rudder above half its largest angle",
+    "steady turn": "yaw rate above half its largest, yaw acceleration below a tenth of its "
+                   "largest",
+    "reversal": "rudder moving faster than a tenth of its largest rate",
+    "speed change": "surge acceleration above a fifth of its largest (needs u)",
+    "straight": "yaw rate below a tenth of its largest",
+}
+
+
+def _rate(x, dt):
+    return np.gradient(x, dt) if x.size > 2 else np.zeros_like(x)
+
+
+def _regions(delta, r, u, dt) -> dict[str, np.ndarray]:
+    big = lambda x, f: np.abs(x) > f * (np.max(np.abs(x)) or np.inf)
+    r_dot, d_dot = _rate(r, dt), _rate(delta, dt)
+    out = {"large rudder": big(delta, 0.5),
+           "steady turn": big(r, 0.5) & ~big(r_dot, 0.1),
+           "reversal": big(d_dot, 0.1),
+           "straight": ~big(r, 0.1)}
+    if u is not None:
+        out["speed change"] = big(_rate(u, dt), 0.2)
+    return out
+
+
+def _signals(ds, e, n) -> dict[str, np.ndarray]:
+    """The regressors a missing effect would follow, for record `e` (first `n` samples)."""
+    have = ds.experiment_channels[e]
+    get = lambda c: np.asarray(getattr(ds, c)[e, :n], dtype=float)
+    out = {"delta": get("delta"), "delta rate": _rate(get("delta"), float(ds.dt[e]))}
+    for c in ("r", "psi", "u", "v", "n"):
+        if c in have:
+            out[c] = get(c)
+    if "r" in out:
+        out["r|r|"] = out["r"] * np.abs(out["r"])
+        out["r^3"] = out["r"] ** 3
+    if "v" in out:
+        out["v|v|"] = out["v"] * np.abs(out["v"])
+    return out
+
+
+def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 60.0) -> dict:
+    """Output-error residuals $e = y - \\hat y$ of `model` simulated over `data` (the
+    records it was fitted to), each channel divided by the standard deviation of its
+    measured record, and where they live:
+
+    - `records`: per record and channel, fit % and residual RMS;
+    - `windows`: per record, the `window`-second stretch with the largest residual
+      RMS (start, end [s], RMS) against the record's RMS, over the channels other than
+      the heading (whose output error accumulates all earlier ones) where there are any;
+    - `regions`: per state region (`REGIONS`) the fraction of samples, the share of
+      the squared residual and their ratio (above 1: the errors gather there);
+    - `sides`: per channel the mean residual while turning to starboard (r > 0) and
+      to port, split into the symmetric part $(\\bar e_s + \\bar e_p)/2$ (a bias: a
+      rudder offset, a constant moment) and the antisymmetric part
+      $(\\bar e_s - \\bar e_p)/2$ (a term odd in r: damping, rudder gain), in residual
+      standard deviations;
+    - `correlations`: per channel the correlation of the residual with each signal of
+      `_signals` (largest over lags of up to 10 % of a record), against the 95 % band
+      $1.96/\\sqrt{N}$ of independent series; `whiteness`: the fraction of residual
+      autocorrelations (lags 1-25) outside that band.
+    """
+    ds = as_dataset(data)
+    channels = tuple(c for c in channels if all(c in h for h in ds.experiment_channels))
+    out = predict(model, ds, estimator=PredictionError(horizon=None, channels=channels))
+    fit = out.fit_per_experiment()
+    res, sig, reg = {c: [] for c in channels}, {}, {}
+    records, windows = {}, {}
+    for e, name in enumerate(ds.names):
+        n, dt = int(ds.lengths[e]), float(ds.dt[e])
+        hit = np.asarray(out.predicted[e, :n] & ds.mask[e, :n])
+        records[name], worst = {}, None
+        for c in channels:
+            y = np.asarray(getattr(ds, c)[e, :n], dtype=float)
+            err = np.where(hit, (y - out.predictions[c][e, :n]) / (np.std(y[hit]) or 1.0), 0.0)
+            res[c].append(err)
+            records[name][c] = {"fit_percent": float(fit[name][c]),
+                                "rms": float(np.sqrt(np.mean(err[hit] ** 2)))}
+        # the heading's output error integrates every earlier error: windows by the rest
+        local = [c for c in channels if c != "psi"] or list(channels)
+        total = sum(res[c][-1] ** 2 for c in local)
+        span = max(int(round(window / dt)), 1)
+        if n > span:
+            moving = np.convolve(total, np.ones(span) / span, mode="valid")
+            k = int(np.argmax(moving))
+            worst = {"start_s": float(ds.t[e, k]), "end_s": float(ds.t[e, k + span - 1]),
+                     "rms": float(np.sqrt(moving[k])),
+                     "record_rms": float(np.sqrt(np.mean(total)))}
+        windows[name] = worst
+        signals = _signals(ds, e, n)
+        for key, value in signals.items():
+            sig.setdefault(key, []).append(value)
+        u = signals.get("u")
+        for key, mask in _regions(signals["delta"], signals.get("r", np.zeros(n)), u,
+                                  dt).items():
+            reg.setdefault(key, []).append(mask & hit)
+    res = {c: np.concatenate(v) for c, v in res.items()}
+    total = sum(v**2 for v in res.values())
+    regions = {}
+    for key, masks in reg.items():
+        mask = np.concatenate(masks)
+        fraction = float(np.mean(mask))
+        share = float(np.sum(total[mask]) / (np.sum(total) or 1.0))
+        regions[key] = {"fraction": fraction, "share": share,
+                        "ratio": share / fraction if fraction > 0 else None}
+    sides = {}
+    if "r" in sig:
+        r = np.concatenate(sig["r"])
+        for c, e in res.items():
+            s, p, spread = e[r > 0], e[r < 0], float(np.std(e)) or 1.0
+            if s.size and p.size:
+                ms, mp = float(np.mean(s)), float(np.mean(p))
+                sides[c] = {"starboard": ms / spread, "port": mp / spread,
+                            "symmetric": 0.5 * (ms + mp) / spread,
+                            "antisymmetric": 0.5 * (ms - mp) / spread}
+    n_total = total.size
+    band = 1.96 / np.sqrt(n_total)
+    ends = np.cumsum([int(n) for n in ds.lengths])[:-1]
+    correlations, whiteness = {}, {}
+    for c, e in res.items():
+        per_record = np.split(e, ends)
+        correlations[c] = {k: _largest_correlation(per_record, sig[k], ds) for k in sig}
+        whiteness[c] = _outside_band(per_record, band)
+    return {"records": records, "windows": windows, "regions": regions, "sides": sides,
+            "correlations": correlations, "band": float(band), "whiteness": whiteness,
+            "regions_defined": {k: REGIONS[k] for k in regions}}
+
+
+def _largest_correlation(residuals, signals, ds) -> float:
+    """The largest |correlation| of residual and signal over lags 0..10 % of the
+    shortest record (signal leading), pooled over records."""
+    lags = max(1, min(int(n) for n in ds.lengths) // 10)
+    best = 0.0
+    for lag in range(lags + 1):
+        a = np.concatenate([e[lag:] for e in residuals])
+        b = np.concatenate([s[:s.size - lag] for s in signals])
+        b = b - np.mean(b)
+        denominator = np.sqrt(np.sum(a * a) * np.sum(b * b))
+        if denominator > 0:
+            best = max(best, abs(float(np.sum(a * b) / denominator)))
+    return best
+
+
+def _outside_band(residuals, band, lags=25) -> float:
+    """Fraction of the residual autocorrelations at lags 1..`lags` outside the band."""
+    outside = 0
+    for lag in range(1, lags + 1):
+        a = np.concatenate([e[lag:] for e in residuals])
+        b = np.concatenate([e[:e.size - lag] for e in residuals])
+        denominator = np.sqrt(np.sum(a * a) * np.sum(b * b))
+        outside += denominator > 0 and abs(float(np.sum(a * b) / denominator)) > band
+    return outside / lags

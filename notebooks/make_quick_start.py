@@ -1,0 +1,82 @@
+"""Write notebooks/quick_start.ipynb: a turning circle and a zig-zag of the Mariner with
+their indices, figures and the IMO MSC.137(76) check, through the public API.
+
+Run: python notebooks/make_quick_start.py (then execute the notebook).
+"""
+
+import pathlib
+
+import nbformat
+from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
+
+
+CELLS = [
+    new_markdown_cell("""# Quick start: a turning circle and a zig-zag
+
+`jaxship` simulates a 3-DOF (surge, sway, yaw) vessel as pure JAX functions. Here the Mariner
+class cargo ship (Chislett & Strom-Tejsen 1965, as in Fossen's MSS `mariner.m`; `js.vessel`
+lists the presets) sails the two trials every manoeuvring booklet has, a 35 deg turning
+circle and a 20/20 zig-zag, and the IMO MSC.137(76) criteria are checked on them.
+
+SI units and radians inside, degrees only at the edges; positive rudder turns the ship to
+starboard."""),
+    new_code_cell("""import jax
+import numpy as np
+from IPython.display import Markdown, display
+
+import jaxship as js
+from jaxship.plotting import plot_imo_criteria, plot_trajectory
+
+
+jax.config.update("jax_enable_x64", True)  # our choice here; jaxship never changes it
+
+ship = js.vessel("mariner")
+L, U = float(ship.length), float(ship.nominal_speed)
+print(f"Mariner: L = {L:.1f} m, approach speed U = {U:.2f} m/s ({U / 0.5144:.1f} kn)")"""),
+    new_markdown_cell("""## Turning circle, 35 deg to starboard
+
+`js.run_trial` builds the trial from its name (as `jaxship simulate --manoeuvre` does) and
+simulates it from the straight run at the approach speed; the turn runs until the ship has
+turned 540 deg (ITTC). `js.turning_indices` gives advance, transfer and tactical diameter."""),
+    new_code_cell("""manoeuvre, turn = js.run_trial(ship, "turn:35")
+turning = js.turning_indices(turn)
+tactical = turning.tactical_diameter
+print(f"advance {turning.advance:.0f} m = {turning.advance / L:.2f} L, "
+      f"transfer {turning.transfer:.0f} m, "
+      f"tactical diameter {tactical:.0f} m = {tactical / L:.2f} L")
+fig = plot_trajectory(turn, length=L, indices=turning, title="Mariner, 35 deg turning circle")"""),
+    new_markdown_cell("""## Zig-zag 20/20
+
+The rudder goes to 20 deg and is reversed each time the heading has changed by 20 deg; the
+overshoots are how far the heading swings past that before it turns back."""),
+    new_code_cell("""manoeuvre, zigzag = js.run_trial(ship, "zigzag:20/20")
+zz20 = js.zigzag_indices(zigzag, np.deg2rad(20))
+print("overshoots [deg]:", np.round(np.rad2deg(zz20.overshoots), 2))
+fig = plot_trajectory(zigzag, length=L, indices=zz20, title="Mariner, 20/20 zig-zag")"""),
+    new_markdown_cell("""## IMO criteria
+
+MSC.137(76) limits the 35 deg turn (advance 4.5 L, tactical diameter 5 L) and the zig-zag
+overshoots (the 10/10 limits depend on L/V)."""),
+    new_code_cell("""manoeuvre, zigzag10 = js.run_trial(ship, "zigzag:10/10")
+zz10 = js.zigzag_indices(zigzag10, np.deg2rad(10))
+rows = js.imo_criteria(L, U, turning35=turning, zigzag10=zz10, zigzag20=zz20)
+display(Markdown(js.format_table(rows)))
+fig = plot_imo_criteria(rows)"""),
+    new_markdown_cell("""The same from a shell: `jaxship simulate --vessel mariner --manoeuvre turn:35 --out
+out/turn35` writes the trial's CSV, its indices as JSON and these figures. Next:
+`identification` of a steering model from such records (`thesis_identification.ipynb`,
+`esso_osaka_identification.ipynb`), the heading autopilot (`autopilot.ipynb`) and what a
+model is missing (`discovery.ipynb`)."""),
+]
+
+
+def main():
+    path = pathlib.Path(__file__).with_name("quick_start.ipynb")
+    nb = new_notebook(cells=CELLS, metadata={"kernelspec": {"name": "python3",
+                                                            "display_name": "Python 3"}})
+    nbformat.write(nb, path)
+    print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    main()
