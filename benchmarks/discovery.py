@@ -38,6 +38,7 @@ SCENARIOS = {  # name: (hidden effects, coloured-disturbance std [rad], true val
                               {"rudder_offset.delta0": 0.3 * DEG,
                                "yaw_moment_bias.n0": K * 0.3 * DEG}),
     "rudder offset 0.3 deg, coloured": ((js.RudderOffset(delta0=0.3 * DEG),), 1.0 * DEG, {}),
+    "rudder offset 1 deg, coloured": ((js.RudderOffset(delta0=1.0 * DEG),), 1.0 * DEG, {}),
     "cubic yaw damping 300": ((js.YawCubicDamping(beta=300.0),), 0.0,
                               {"yaw_cubic_damping.beta": 300.0}),
     "rudder lag 1.5 s": ((js.RudderLag(time_constant=1.5),), 0.0,

@@ -112,6 +112,7 @@ from ._models._hydro_effects import (
     CrossflowDrag as CrossflowDrag,
     PropellerAsymmetry as PropellerAsymmetry,
     RudderStall as RudderStall,
+    SpeedDependentDamping as SpeedDependentDamping,
     SpeedDependentRudder as SpeedDependentRudder,
     SurgeTurnResistance as SurgeTurnResistance,
     UniformCurrent as UniformCurrent,

@@ -46,6 +46,8 @@ EFFECTS = {
     "crossflow_drag": (js.CrossflowDrag(), "coefficient", 0.04, ("vessel",)),
     "speed_dependent_rudder": (js.SpeedDependentRudder(nominal_speed=U0), "kappa", 0.5,
                                ("vessel", "steering")),
+    "speed_dependent_damping": (js.SpeedDependentDamping(nominal_speed=U0), "kappa", 1.0,
+                                ("steering",)),
     "rudder_stall": (js.RudderStall(), "c", 0.3, ("vessel", "steering")),
     "propeller_asymmetry": (js.PropellerAsymmetry(), "moment",
                             {"vessel": 1.4e6, "steering": 2.6e-4}, ("vessel", "steering")),
@@ -65,6 +67,7 @@ SHOWN_BY = {
     "current": {"track": True},
     "propeller_asymmetry": {"n": 1.5, "aux": {"n": 2.0 + 0.0 * _T}},
     "speed_dependent_rudder": {"aux": {"u": U0 * (0.85 + 0.15 * np.cos(2 * np.pi * _T / 80))}},
+    "speed_dependent_damping": {"aux": {"u": U0 * (0.85 + 0.15 * np.cos(2 * np.pi * _T / 80))}},
 }
 CONTROLLERS = {
     "turn": js.Turn(15 * DEG, duration=40.0, dt=0.5),

@@ -236,6 +236,27 @@ def test_speed_dependent_rudder_is_the_base_at_the_nominal_speed():
         js.simulate_steering(js.augment(base, js.SpeedDependentRudder(kappa=kappa)), delta, 1.0)
 
 
+def test_speed_dependent_damping_and_rudder_make_nomoto_speed_scaled():
+    """With both kappa = 1 at a constant speed $u = sU_0$, Nomoto 1 is Nomoto's
+    dimensionless model at that speed: $K = K's$, $T = T'/s$ (Nomoto 1957)."""
+    s = 0.7
+    scaled = js.augment(js.Nomoto1(K=K, T=T), js.SpeedDependentRudder(kappa=1.0, nominal_speed=U0),
+                        js.SpeedDependentDamping(kappa=1.0, nominal_speed=U0))
+    delta = step(200)
+    aux = js.AuxInputs(u=s * U0)
+    np.testing.assert_allclose(js.simulate_steering(scaled, delta, 1.0, aux=aux).r,
+                               js.simulate_steering(js.Nomoto1(K=K * s, T=T / s), delta, 1.0).r,
+                               rtol=1e-9, atol=1e-12)
+    base = js.Nomoto1(K=K, T=T)
+    np.testing.assert_allclose(  # the base model at the nominal speed (to rounding)
+        js.simulate_steering(js.augment(base, js.SpeedDependentDamping(kappa=1.0,
+                                                                       nominal_speed=U0)),
+                             delta, 1.0, aux=js.AuxInputs(u=U0)).r,
+        js.simulate_steering(base, delta, 1.0, aux=js.AuxInputs(u=U0)).r, rtol=1e-14, atol=0)
+    with pytest.raises(ValueError, match="nominal_speed"):
+        js.simulate_steering(js.augment(base, js.SpeedDependentDamping(kappa=1.0)), delta, 1.0)
+
+
 def test_rudder_stall_saturates_only_large_rudder_angles():
     """$\\delta' = \\delta - c\\delta^3$: monotonic to 46 deg at the upper bound; Nomoto 1
     turns at $K\\delta'$; on the Mariner at 0.6 deg the yaw moment changes by

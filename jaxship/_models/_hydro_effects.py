@@ -151,6 +151,28 @@ class SpeedDependentRudder(AbstractEffect):
         return self._gain(u, nominal) * share
 
 
+class SpeedDependentDamping(AbstractEffect):
+    """Yaw damping that scales with the surge speed (steering models): $-\\kappa(u/U_0 -
+    1)\\,r$ in the yaw equation, with u the measured `AuxInputs.u` and $U_0$
+    `nominal_speed` (the speed the model's time constants belong to). Nomoto's
+    dimensionless model, $K = K'U/L$ and $T = T'L/U$ (Nomoto 1957; Fossen 2021, sec.
+    7.1), gives $T\\dot r + s r = K s^2 \\delta$ with $s = u/U_0$, that is $T\\dot r + r =
+    K s^2\\delta - (s - 1) r$: this effect with $\\kappa = 1$ and `SpeedDependentRudder`
+    with $\\kappa = 1$ together make a Nomoto model speed-scaled. $\\kappa$ [-] for Nomoto
+    models ([1/s] for models written as $\\dot r = \\dots$); plausible $-1 \\le \\kappa
+    \\le 2$. Seen only where the speed changes."""
+
+    kappa: ArrayLike = param(0.0, lower=-1.0, upper=2.0, scale=0.5, unit="-")
+    nominal_speed: float | None = eqx.field(static=True, default=None)  # U_0 [m/s]
+    id: ClassVar[str] = "speed_dependent_damping"
+
+    def yaw_term(self, model, x, delta, aux):
+        if self.nominal_speed is None:
+            raise ValueError("SpeedDependentDamping needs `nominal_speed` [m/s], the speed "
+                             "the model's time constants belong to (e.g. the mean measured u).")
+        return -self.kappa * (aux.u / self.nominal_speed - 1.0) * model.output(x)
+
+
 class RudderStall(AbstractEffect):
     """Lift saturation of the rudder as a third-order term linear in its parameter:
     the hydrodynamics see $\\delta' = \\delta - c\\,\\delta^3$ [c in 1/rad^2] (the

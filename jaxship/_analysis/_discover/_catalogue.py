@@ -29,6 +29,7 @@ from ..._models._hydro_effects import (
     CrossflowDrag,
     PropellerAsymmetry,
     RudderStall,
+    SpeedDependentDamping,
     SpeedDependentRudder,
     SurgeTurnResistance,
     UniformCurrent,
@@ -75,6 +76,12 @@ def _speed_dependent_rudder(model, data):
         return SpeedDependentRudder()
     if _measured(data, "u"):  # a steering model sees the measured u
         return SpeedDependentRudder(nominal_speed=float(np.mean(data.u[data.mask])))
+    return None
+
+
+def _speed_dependent_damping(model, data):
+    if _is(model, "steering") and _measured(data, "u"):  # a vessel's damping scales already
+        return SpeedDependentDamping(nominal_speed=float(np.mean(data.u[data.mask])))
     return None
 
 
@@ -126,6 +133,9 @@ DISCOVERY_CATALOGUE = (
               _simple(YawCubicDamping, *BOTH), separate=STEADY_TURNS),
     Candidate("speed_dependent_rudder", "rudder force changing with inflow speed",
               _speed_dependent_rudder,
+              separate="turning circles (speed loss) or runs at several speeds"),
+    Candidate("speed_dependent_damping", "yaw damping scaling with speed (Nomoto's T = T'L/U)",
+              _speed_dependent_damping,
               separate="turning circles (speed loss) or runs at several speeds"),
     Candidate("rudder_stall", "rudder lift saturation (stall)", _simple(RudderStall, *BOTH),
               separate=STEADY_TURNS),
