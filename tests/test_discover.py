@@ -91,7 +91,7 @@ def test_two_effects_at_once_are_both_named_and_nothing_else():
     js.RudderLag(time_constant=2.0), js.RudderDelay(delay=1.5),
     js.RudderRateLimit(inverse_rate=1 / (1.0 * DEG)), js.YawRateSensorBias(bias=0.05 * DEG),
     js.YawMomentBias(n0=K * 0.5 * DEG), js.YawQuadraticDamping(beta=10.0),
-    js.RudderStall(c=0.5),  # at the plausible bound: c = 0.3 scores 9.4 < 12.9 (missed)
+    js.RudderStall(c=0.45),  # near the plausible bound 0.5: c = 0.3 scores 9.4 < 12.9
 ], ids=lambda e: e.id)
 def test_every_steering_effect_is_named_or_its_class(effect):
     report = run(effect, seed=6)

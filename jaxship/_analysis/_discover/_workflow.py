@@ -63,9 +63,17 @@ def _parameters(result, names) -> dict:
 
 
 def _in_range(result, names) -> bool:
+    """Every estimate strictly inside its plausible range: one pinned at a bound (within
+    1e-6 of the span) is where the data want it beyond the range."""
     fields = parameter_fields(result.model)
     values = dict(zip(result.names, result.values))
-    return all(fields[n].lower - 1e-12 <= values[n] <= fields[n].upper + 1e-12 for n in names)
+    inside = []
+    for n in names:
+        lower, upper = fields[n].lower, fields[n].upper
+        edge = 1e-6 * (upper - lower) if math.isfinite(upper - lower) else 0.0
+        inside.append(lower + edge < values[n] < upper - edge if edge else
+                      lower - 1e-12 <= values[n] <= upper + 1e-12)
+    return all(inside)
 
 
 def _points_outside(model, names, step) -> bool:
@@ -183,7 +191,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                 why.append("its confidence interval includes zero" if len(params) == 1 else
                            "every one of its confidence intervals includes zero")
             if not _in_range(trial, names[k]):
-                why.append("its estimate lies outside the plausible range")
+                why.append("its estimate lies at or beyond the edge of the plausible range")
             after = holdout_check(trial.model, holdout, channels) if holdout else None
             if holdout and not after["cost"] < held_cost:
                 why.append(f"the held-out cost does not fall ({held_cost:.4g} -> "
