@@ -67,19 +67,16 @@ class Design:
     """Numbers of the autopilot design and of the closed-loop runs.
 
     - `natural_frequency` $\\omega_n$ [rad/s], `damping` $\\zeta$ [-]: the PID's pole
-      placement (eq. 5.3-5.5; see the module docstring for the choice);
-      `subtract_damping`: Fossen's $K_d = 2\\zeta\\omega_n m - d$ (True) or the thesis'
-      printed $2\\zeta\\omega_n m$ (False);
-    - `reference_frequency` [rad/s], `reference_damping` [-]: the reference model
-      (Table 5.1: 0.2 rad/s, 1.0);
-    - `step` [deg] at `step_time` [s]: the ordered heading change (Table 5.1: 45 deg
-      at 100 s), relative to the initial heading; `duration` [s] of each run;
-    - `dt` [s]: output interval of the runs; `interval` [s]: the controller's update
-      interval (the control step is at most 0.1 s, `Simulator.max_step`);
+      placement (eq. 5.3-5.5; the module docstring says why); `subtract_damping`:
+      Fossen's $K_d = 2\\zeta\\omega_n m - d$ (True) or the thesis' $2\\zeta\\omega_n m$;
+    - `reference_frequency` [rad/s], `reference_damping` [-]: the reference model and
+      `step` [deg] at `step_time` [s], relative to the initial heading (Table 5.1: 0.2
+      rad/s, 1.0, 45 deg at 100 s); `duration` [s] of each run;
+    - `dt` [s]: output interval; `interval` [s]: the controller's update interval;
     - `sample_interval` [s]: sampling of the residual eq. 3.19 and the RMS error over
-      the window from `step_time` to `duration`;
+      `step_time` to `duration`;
     - `tune_dt` [s], `tune_steps`, `rudder_weight`: `tune_autopilot`'s output
-      interval, step limit and weight of the rudder command (`--tune`).
+      interval, step limit and rudder weight (`--tune`).
     """
 
     natural_frequency: float = 0.5
@@ -420,10 +417,10 @@ def autopilot_study(vessel=None, *, identification=None, quick: bool = False,
     for name in models:
         for family in FAMILIES:
             model = identification["models"].get(f"merged/{name}/{family}")
+            say(f"closed loop: {name} from the merged {family}" if model is not None else
+                f"closed loop: no {name} model from the merged {family}")
             if model is None:  # not identified, or its identification failed
-                say(f"closed loop: no {name} model from the merged {family}")
                 continue
-            say(f"closed loop: {name} from the merged {family}")
             ev = evaluate(model, vessel, rpm=rpms, design=design)
             evaluations[f"{name}/{family}"] = ev
             gains[f"{name}/{family}"] = ev.gains()
