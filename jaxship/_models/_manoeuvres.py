@@ -345,10 +345,6 @@ class ReverseSpiral(AbstractManoeuvre):
                                 steps=YawRateLevels(self.rates, self.hold),
                                 max_angle=self.max_angle)
 
-    def reference(self, tau):
-        """The ordered yaw rate [rad/s] at time `tau` since the start."""
-        return YawRateLevels(self.rates, self.hold).rate(tau)
-
     def init(self, x0):
         return self.autopilot.init(x0)
 

@@ -67,13 +67,13 @@ def _in_range(result, names) -> bool:
     1e-6 of the span) is where the data want it beyond the range."""
     fields = parameter_fields(result.model)
     values = dict(zip(result.names, result.values))
-    inside = []
-    for n in names:
+
+    def inside(n):
         lower, upper = fields[n].lower, fields[n].upper
-        edge = 1e-6 * (upper - lower) if math.isfinite(upper - lower) else 0.0
-        inside.append(lower + edge < values[n] < upper - edge if edge else
-                      lower - 1e-12 <= values[n] <= upper + 1e-12)
-    return all(inside)
+        edge = 1e-6 * (upper - lower) if math.isfinite(upper - lower) else -1e-12
+        return lower + edge < values[n] < upper - edge
+
+    return all(inside(n) for n in names)
 
 
 def _points_outside(model, names, step) -> bool:
