@@ -70,6 +70,7 @@ class DiscoveryReport(eqx.Module):
                       "cannot be told from |", "|---|---|---|---|---|---|---|---|---|---|"]
             for e in self.effects:
                 twins = "; ".join(f"{q['id']} ({q['separate']})" for q in e["equivalent_to"])
+                twins = twins.replace("|", "\\|")  # r|r| inside a table cell
                 for name, p in e["parameters"].items():
                     unit = p["unit"].replace("|", "or")
                     lines.append(f"| {e['name']} | `{name}` | {p['value']:.4g} | "
