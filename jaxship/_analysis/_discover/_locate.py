@@ -141,27 +141,24 @@ def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 6
             "regions_defined": {k: REGIONS[k] for k in regions}}
 
 
+def _lagged(residuals, signals, lag, centre) -> float:
+    """|correlation| of the residuals with the signals `lag` samples earlier, pooled
+    over records (the signals' mean removed when `centre`); 0 when either is zero."""
+    a = np.concatenate([e[lag:] for e in residuals])
+    b = np.concatenate([s[:s.size - lag] for s in signals])
+    b = b - np.mean(b) if centre else b
+    denominator = np.sqrt(np.sum(a * a) * np.sum(b * b))
+    return abs(float(np.sum(a * b) / denominator)) if denominator > 0 else 0.0
+
+
 def _largest_correlation(residuals, signals, ds) -> float:
     """The largest |correlation| of residual and signal over lags 0..10 % of the
     shortest record (signal leading), pooled over records."""
     lags = max(1, min(int(n) for n in ds.lengths) // 10)
-    best = 0.0
-    for lag in range(lags + 1):
-        a = np.concatenate([e[lag:] for e in residuals])
-        b = np.concatenate([s[:s.size - lag] for s in signals])
-        b = b - np.mean(b)
-        denominator = np.sqrt(np.sum(a * a) * np.sum(b * b))
-        if denominator > 0:
-            best = max(best, abs(float(np.sum(a * b) / denominator)))
-    return best
+    return max(_lagged(residuals, signals, lag, True) for lag in range(lags + 1))
 
 
 def _outside_band(residuals, band, lags=25) -> float:
     """Fraction of the residual autocorrelations at lags 1..`lags` outside the band."""
-    outside = 0
-    for lag in range(1, lags + 1):
-        a = np.concatenate([e[lag:] for e in residuals])
-        b = np.concatenate([e[:e.size - lag] for e in residuals])
-        denominator = np.sqrt(np.sum(a * a) * np.sum(b * b))
-        outside += denominator > 0 and abs(float(np.sum(a * b) / denominator)) > band
-    return outside / lags
+    return sum(_lagged(residuals, residuals, lag, False) > band
+               for lag in range(1, lags + 1)) / lags
