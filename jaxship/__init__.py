@@ -109,6 +109,7 @@ from ._models._effects import (
 from ._models._environment import Current as Current, Environment as Environment, Wind as Wind
 from ._models._hydro_effects import (
     AddedMassError as AddedMassError,
+    ApparentWind as ApparentWind,
     CrossflowDrag as CrossflowDrag,
     PropellerAsymmetry as PropellerAsymmetry,
     RudderStall as RudderStall,

@@ -90,8 +90,9 @@ def main(argv=None) -> int:
     ident.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
     ident.add_argument("--rudder", default="delta", help="replayed rudder: delta or delta_c")
     ident.add_argument("--channels", default=None,
-                       help="fitted outputs, e.g. psi,r or r (default: psi,r; psi,r,u,v for "
-                       "vessel presets; r for armax)")
+                       help="fitted outputs, e.g. psi,r or r, or psi,r,u,v,x,y to fit a "
+                       "vessel's track (default: psi,r; psi,r,u,v for vessel presets; r for "
+                       "armax)")
     ident.add_argument("--initial", default="auto",
                        help="window start states: measured, estimate or auto (default: "
                        "estimate for output error, else measured)")

@@ -177,6 +177,31 @@ def test_v_channel_for_steering_models_with_a_v_state():
         fit(start, data, estimator=PredictionError(channels=("r", "u")))
 
 
+def test_fitting_the_positions_recovers_a_current():
+    """x, y as outputs (GNSS positions, 1 m noise): the Mariner's zig-zags in a current
+    of (0.3, -0.2) m/s north, east give it within 3 robust standard errors; through-water
+    u, v, r, psi alone do not see it (the fit does not move from zero)."""
+    from jaxship.studies.discovery import vessel_records
+
+    truth = js.augment(js.vessel("mariner"), js.UniformCurrent(north=0.3, east=-0.2))
+    train, _ = vessel_records(truth, 0, duration=400.0)
+    start = js.augment(js.vessel("mariner"), js.UniformCurrent())
+    free = ("current.north", "current.east")
+    track = PredictionError(horizon=60.0, channels=("psi", "r", "u", "v", "x", "y"))
+    res = fit(start, train[:2], estimator=track, free=free)
+    assert set(res.metrics) == {"psi", "r", "u", "v", "x", "y"}
+    assert np.all(np.abs(res.values - [0.3, -0.2]) < 3 * res.parameters.std_robust), res.values
+    blind = quiet_fit(start, train[:2], estimator=PredictionError(horizon=60.0), free=free)
+    np.testing.assert_allclose(blind.values, 0.0, atol=1e-9)
+    with pytest.raises(ValueError, match="unknown output channel 'x' for Nomoto1"):
+        fit(js.Nomoto1(K=0.05, T=10.0), train[0],
+            estimator=PredictionError(channels=("psi", "x")))
+    no_xy = js.Experiment(train[0].t, train[0].delta, psi=train[0].psi, r=train[0].r,
+                          u=train[0].u, v=train[0].v, name="no_xy")
+    with pytest.raises(ValueError, match="'no_xy'.*'x' is fitted but was not measured"):
+        fit(start, no_xy, estimator=track, free=free)
+
+
 # -- bad data ---------------------------------------------------------------------------
 
 

@@ -70,9 +70,10 @@ class PredictionError(AbstractEstimator):
       rad/s). Both are unwrapped records, so the heading error is a plain
       difference (no angle wrapping, which would make output error periodic).
       `"u"` and `"v"` (surge and sway velocity, m/s; measured in every experiment)
-      are outputs of vessels and of steering models with a state of that name.
-      `None` (default): `("psi", "r")` for steering models, `("psi", "r", "u", "v")`
-      for vessels.
+      are outputs of vessels and of steering models with a state of that name;
+      `"x"` and `"y"` (earth-fixed position, m; measured, e.g. GNSS) of vessels,
+      whose windows then start from the measured position. `None` (default):
+      `("psi", "r")` for steering models, `("psi", "r", "u", "v")` for vessels.
     - `weights`: per-channel residual weights (dict or sequence); default
       1 / (standard deviation of the measured channel), which makes the residuals
       dimensionless.
@@ -318,7 +319,8 @@ def _prepare(model, dataset, estimator):
                              f"outputs are psi, r and its states.") from None
     check_data(ds, estimator.rudder, channels)
     if estimator.wind and not model.wind_loads:
-        raise ValueError(f"`wind=True` is for vessels; {type(model).__name__} has no wind "
+        raise ValueError(f"`wind=True` is for vessels and steering models with a wind "
+                         f"effect (jaxship.ApparentWind); {type(model).__name__} has no wind "
                          "loads.")
     servo = estimator.rudder == "delta_c"
     needed = list(model.start_channels) + (["delta"] if servo and model.has_servo else [])

@@ -22,8 +22,10 @@ from .._simulation._data import Dataset, Experiment
 
 
 # fittable outputs: heading and yaw rate for every model; surge and sway velocity for
-# vessels and for steering models with a state of that name (see `_fit._predict`)
-CHANNEL_NAMES = ("psi", "r", "u", "v")
+# vessels and for steering models with a state of that name (see `_fit._predict`);
+# the earth-fixed position for vessels (where a current or leeway shows)
+CHANNEL_NAMES = ("psi", "r", "u", "v", "x", "y")
+MEASURED_ONLY = ("u", "v", "x", "y")  # fitted only where measured (never derived)
 
 
 def as_dataset(data) -> Dataset:
@@ -63,11 +65,11 @@ def check_data(ds: Dataset, rudder: str, channels, *, rtol: float = 1e-6) -> Non
             raise ValueError(f"{where}: no measured rudder channel {rudder!r}; estimation "
                              "replays the recorded rudder.")
         for c in channels:
-            if c in ("u", "v") and c not in ds.experiment_channels[i]:
+            if c in MEASURED_ONLY and c not in ds.experiment_channels[i]:
                 raise ValueError(f"{where}: output channel {c!r} is fitted but was not "
                                  "measured; drop it from `channels` or use data with it.")
         t = np.asarray(ds.t)[i, :n]
-        for key in ("t", rudder, "psi", "r", "u", "v", "n"):
+        for key in dict.fromkeys(("t", rudder, "psi", "r", "u", "v", "n", *channels)):
             a = np.asarray(getattr(ds, key))[i, :n]
             bad = np.nonzero(~np.isfinite(a))[0]
             if bad.size:
@@ -92,7 +94,19 @@ def check_data(ds: Dataset, rudder: str, channels, *, rtol: float = 1e-6) -> Non
 # how each replayed signal is interpolated between samples (MATLAB's `InterSample`):
 # measured continuous signals linearly (first-order hold), commands held (zero-order)
 DEFAULT_HOLDS = {"delta": "foh", "delta_c": "zoh", "u": "foh", "v": "foh", "n": "foh",
-                 "wind_speed": "foh", "wind_dir": "zoh"}
+                 "wind_speed": "foh", "wind_dir": "zoh", "wind_u": "foh", "wind_v": "foh"}
+
+
+def apparent_wind(ds: Dataset) -> dict:
+    """The ship's velocity through the air in body axes, `{"wind_u", "wind_v"}` (E, N)
+    [m/s], from the logged true wind (speed, direction it comes from), the measured
+    heading and u, v: $(u, v) - R(\\psi)^T v_w$, $v_w = -V_w(\\cos\\beta_w,
+    \\sin\\beta_w)$ the air's earth-fixed velocity (Fossen 2021, eq. 10.6)."""
+    north = -np.asarray(ds.wind_speed) * np.cos(ds.wind_dir)
+    east = -np.asarray(ds.wind_speed) * np.sin(ds.wind_dir)
+    cos, sin = np.cos(ds.psi), np.sin(ds.psi)
+    return {"wind_u": np.asarray(ds.u) - (north * cos + east * sin),
+            "wind_v": np.asarray(ds.v) - (-north * sin + east * cos)}
 
 
 def resolve_holds(rudder: str, hold, names) -> tuple[tuple[str, str], ...]:
@@ -193,7 +207,8 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
     predictions back onto the samples: `target` (E, W, L) sample index, `mask`.
     `starts`: optional `{"r": (E, N), "psi": (E, N)}` start values of the windows in
     place of the measured ones (e.g. smoothed states); targets stay measured. `hold`:
-    see `resolve_holds`; `wind`: also replay the measured wind."""
+    see `resolve_holds`; `wind`: also replay the measured wind, and the apparent wind
+    it makes (`apparent_wind`) for steering models."""
     lengths = window_lengths(ds, horizon)
     num_exp, num = ds.num_experiments, ds.num_samples
     counts = [len(range(0, n - 1, L)) for n, L in zip(ds.lengths, lengths)]
@@ -213,8 +228,11 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
     rows = np.arange(num_exp)[:, None, None]
     rows2 = np.arange(num_exp)[:, None]
 
+    derived = apparent_wind(ds) if wind else {}
+
     def at(name, index, r):
-        return np.asarray(getattr(ds, name), dtype=np.float64)[r, index]
+        return np.asarray(derived[name] if name in derived else getattr(ds, name),
+                          dtype=np.float64)[r, index]
 
     def start_at(name, index, r):
         if starts is not None and name in starts:
@@ -227,7 +245,7 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
     rud = np.asarray(getattr(ds, rudder), dtype=np.float64)
     # integral of the replayed rudder from the first sample to sample k (trapezoidal for
     # a first-order hold, rectangles for a zero-order hold: exact for either)
-    names = ("delta", "u", "v", "n") + (("wind_speed", "wind_dir") if wind else ())
+    names = ("delta", "u", "v", "n") + (("wind_speed", "wind_dir", *derived) if wind else ())
     holds = resolve_holds(rudder, hold, names)
     if dict(holds)["delta"] == "foh":
         pieces = 0.5 * (rud[:, 1:] + rud[:, :-1])
@@ -247,9 +265,10 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
         psi_first=f(first("psi")),
         delta_integral=f(integral[rows2, start_index]),
         elapsed=f(start_index * dt_e[:, None]),
-        aux=AuxInputs(u=f(at("u", start_index, rows2)), v=f(at("v", start_index, rows2)),
-                      n=f(at("n", start_index, rows2))),
+        aux=AuxInputs(*(f(at(c, start_index, rows2)) if c in names else None
+                        for c in ("u", "v", "n", "wind_u", "wind_v"))),
         rudder_angle=f(at("delta", start_index, rows2)),
+        x=f(at("x", start_index, rows2)), y=f(at("y", start_index, rows2)),
     )
     records = {name: f(rud[rows, record_index] if name == "delta" else
                        at(name, record_index, rows)) for name in names}

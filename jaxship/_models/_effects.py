@@ -60,6 +60,7 @@ class AbstractEffect(eqx.Module):
 
     id: eqx.AbstractClassVar[str]
     state_names: ClassVar[tuple[str, ...]] = ()  # the effect's own states, if any
+    uses_wind: ClassVar[bool] = False  # reads the replayed wind (`AuxInputs.wind_u`, ...)
 
     def initial_state(self, delta) -> Array:
         """The effect's states in a steady state at rudder `delta` [rad]."""
@@ -457,6 +458,11 @@ class AugmentedSteering(_Augmented, AbstractSteeringModel):
 
     def __init__(self, base: AbstractSteeringModel, effects=()):
         self.base, self.effects = base, _check_effects(effects)
+
+    @property
+    def wind_loads(self) -> bool:
+        """Whether an effect reads the replayed wind (`jaxship.ApparentWind`)."""
+        return any(e.uses_wind for e in self.effects)
 
     @property
     def state_names(self):

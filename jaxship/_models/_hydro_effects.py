@@ -275,8 +275,9 @@ class UniformCurrent(AbstractEffect):
     relative wind (where wind acts on wind areas).
 
     Measured u, v in jaxship are through the water by convention (log, or the
-    simulation's): `fit` and `predict` compare psi, r, u, v, where a current does
-    not show; its score there is zero unless wind is replayed on wind areas. A
+    simulation's), where a current does not show: it is seen in the positions
+    (`PredictionError(channels=(..., "x", "y"))`, which `discover` fits where every
+    record logs them) or through wind on wind areas. A
     record whose u, v come from GPS (over ground) would need the current in the
     output map, $u_g = u + V_N\\cos\\psi + V_E\\sin\\psi$,
     $v_g = v - V_N\\sin\\psi + V_E\\cos\\psi$, and the window starts through the
@@ -315,3 +316,31 @@ class Windage(AbstractEffect):
 
     def wind_areas(self, frontal, lateral):
         return frontal + self.frontal_area, lateral + self.lateral_area
+
+
+class ApparentWind(AbstractEffect):
+    """Wind on a steering model, from the logged wind: the yaw term
+    $f_w = V_{rw}^2(c_2\\sin 2\\gamma + c_1\\sin\\gamma)
+    = 2c_2u_{rw}v_{rw} + c_1V_{rw}v_{rw}$ with $(u_{rw}, v_{rw})$ the apparent wind of
+    `AuxInputs` (the ship's velocity through the air), $V_{rw}$ its speed and
+    $\\gamma$ the angle it comes from off the bow. The $\\sin 2\\gamma$ shape is
+    Fossen's (2021, eq. 10.10) yaw coefficient; $\\sin\\gamma$ is the lateral force
+    (eq. 10.9) acting off midship (wind area ahead or aft of it), the first terms of
+    Isherwood's (1972) series. $c_1, c_2$ [rad s/m^2 for Nomoto models, whose yaw
+    term is a yaw rate; rad/m^2 for $\\dot r = \\dots$ models] scale with the
+    windage over the rudder's moment: no ship-independent range. It shows only with
+    `PredictionError(wind=True)` on records with `wind_speed` and `wind_dir`
+    (`jaxship.discover` replays them where logged); vessels have `Windage`.
+    Steering models only."""
+
+    c2: ArrayLike = param(0.0, scale=1e-3, unit="rad s/m^2 | rad/m^2")
+    c1: ArrayLike = param(0.0, scale=1e-3, unit="rad s/m^2 | rad/m^2")
+    id: ClassVar[str] = "wind"
+    uses_wind: ClassVar[bool] = True
+
+    def yaw_term(self, model, x, delta, aux):
+        if aux is None or aux.wind_u is None:  # no wind logged: calm
+            return 0.0 * self.c2
+        u, v = jnp.asarray(aux.wind_u, float), jnp.asarray(aux.wind_v, float)
+        return (2.0 * self.c2 * u + self.c1 * jnp.sqrt(u**2 + v**2)) * v
+

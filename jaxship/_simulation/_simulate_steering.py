@@ -78,7 +78,7 @@ def simulate_steering(
     - `state0`: initial model state (default `model.initial_state(0.0)`: at rest).
     - `psi0`: initial heading [rad].
     - `aux`: `AuxInputs` with leaves of shape `(N,)` (or scalars), for models that
-      use measured speeds; zeros by default.
+      use measured speeds (or the apparent wind); zeros (calm) by default.
     - `start`: time of sample 0 [s].
     - `hold`: `"foh"` (default: linear between samples, as a rudder angle moves and
       as `fit` replays a measured one) or `"zoh"` (`delta[k]` held over
@@ -101,7 +101,9 @@ def simulate_steering(
     aux = AuxInputs() if aux is None else aux
     aux = jax.tree.map(lambda a: jnp.broadcast_to(jnp.asarray(a, dtype=float), (num,)), aux)
     records = {"delta": delta, "u": aux.u, "v": aux.v, "n": aux.n}
-    holds = dict.fromkeys(INPUTS, hold)
+    records.update({k: getattr(aux, k) for k in ("wind_u", "wind_v")
+                    if getattr(aux, k) is not None})  # the apparent wind, where given
+    holds = dict.fromkeys(records, hold)
     steps = simulator.steps_per_sample(dt)
     return _simulate_steering(as_arrays(model), records, jnp.asarray(dt, float),
                               None if state0 is None else jnp.asarray(state0, float),

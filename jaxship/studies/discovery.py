@@ -61,6 +61,39 @@ def hidden_effect_records(truth, seed, *, disturbance_std=0.0):
     return train, holdout
 
 
+def wind_records(truth, seed, *, speed=7.0, wind=(15.0, 60.0 * DEG), noise=(0.1, 0.05)):
+    """`(train, holdout)` of a steering `truth` that feels the wind (`ApparentWind`):
+    10/10 zig-zags to starboard on four headings (N, E, S, W) to train, +-20 deg turns
+    held out, at a logged constant surge speed `speed` [m/s] (v = 0) in a steady true
+    wind `(speed [m/s], direction it comes from [rad])` that is logged. The wind the
+    ship feels follows the heading it steers, so each record is the fixed point of
+    replaying the logged rudder through `truth` (output error, 10 substeps per
+    sample, 8 passes) from the calm-water record turned to its heading."""
+    rng = np.random.default_rng(seed)
+    replay = js.PredictionError(horizon=None, wind=True, substeps=10)
+
+    def one(manoeuvre, heading, name):
+        calm = js.steer_manoeuvre(truth, manoeuvre, simulator=FINE, rudder_rate=2.3 * DEG)
+        t, delta = np.asarray(calm.t), np.asarray(calm.delta)
+        logged = dict(u=np.full(t.size, speed), v=np.zeros(t.size),
+                      wind_speed=np.full(t.size, wind[0]), wind_dir=np.full(t.size, wind[1]))
+        psi, r = np.asarray(calm.psi) + heading, np.asarray(calm.r)
+        for _ in range(8):
+            out = js.predict(truth, js.Experiment(t, delta, psi=psi, r=r, **logged),
+                             estimator=replay)
+            hit = np.asarray(out.predicted[0])
+            psi = np.where(hit, np.asarray(out.predictions["psi"][0]), psi)
+            r = np.where(hit, np.asarray(out.predictions["r"][0]), r)
+        return js.Experiment(t, delta, psi=psi + rng.normal(0, noise[0] * DEG, t.size),
+                             r=r + rng.normal(0, noise[1] * DEG, t.size), name=name, **logged)
+
+    train = [one(js.ZigZag(10 * DEG, 10 * DEG, duration=400.0, dt=0.5), h * DEG,
+                 f"zigzag 10/10 heading {h}") for h in (0, 90, 180, 270)]
+    holdout = [one(js.Turn(a * DEG, duration=300.0, dt=0.5), 0.0, f"turn {a:+d}")
+               for a in HOLDOUT]
+    return train, holdout
+
+
 def run_case(effects, seed, *, base=None, disturbance_std=0.0, **options):
     """Discovery on records of `base` (default Nomoto 1, K = 0.06 1/s, T = 25 s) with
     `effects` hidden; returns `(report, seconds)`."""
@@ -87,23 +120,25 @@ def outcome(report, hidden_ids) -> str:
     return "correct" if found == set(hidden_ids) else "missed"
 
 
-def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02)):
+def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02, 1.0)):
     """`(train, holdout)` of a 3-DOF `truth` vessel (e.g. the Mariner with an effect):
     10/10 and 20/20 zig-zags to both sides to train, +-35 deg turning circles and a
     15/15 zig-zag held out, `duration` s at 2 Hz from the nominal straight run, with
     the servo's rudder logged at the samples and noise on psi [deg], r [deg/s], u, v
-    [m/s] (positions, rudder and rpm exact): 8 channels per record."""
+    [m/s] and the positions x, y [m] (GNSS; rudder and rpm exact): 8 channels per
+    record."""
     rng = np.random.default_rng(seed)
     x0 = js.straight_run(truth)
 
     def one(manoeuvre, name):
         traj = js.simulate(truth, manoeuvre, x0, simulator=FINE)
         e = js.Experiment.from_trajectory(traj, name=name)
-        scale = {"psi": noise[0] * DEG, "r": noise[1] * DEG, "u": noise[2], "v": noise[3]}
+        scale = {"psi": noise[0] * DEG, "r": noise[1] * DEG, "u": noise[2], "v": noise[3],
+                 "x": noise[4], "y": noise[4]}
         noisy = {c: getattr(e, c) + rng.normal(0, s, e.t.size) for c, s in scale.items()}
         return js.Experiment(e.t, e.delta, psi=truth.measure("psi", noisy["psi"]),
                              r=truth.measure("r", noisy["r"]), u=noisy["u"], v=noisy["v"],
-                             x=e.x, y=e.y, n=e.n, name=name)
+                             x=noisy["x"], y=noisy["y"], n=e.n, name=name)
 
     train = [one(js.ZigZag(a * DEG, s * a * DEG, duration=duration, dt=0.5),
                  f"zigzag {a}/{a} {'starboard' if s > 0 else 'port'}") for a, s in TRAIN]

@@ -26,6 +26,7 @@ from ..._models._effects import (
 )
 from ..._models._hydro_effects import (
     AddedMassError,
+    ApparentWind,
     CrossflowDrag,
     PropellerAsymmetry,
     RudderStall,
@@ -89,9 +90,21 @@ def _propeller_asymmetry(model, data):
     return PropellerAsymmetry() if _is(model, "vessel") or _measured(data, "n") else None
 
 
-def _windage(model, data):
-    return Windage() if _is(model, "vessel") and _measured(data, "wind_speed",
-                                                           "wind_dir") else None
+def _wind(model, data):
+    """Windage on a vessel, the apparent wind's yaw term on a steering model (that
+    needs u and v to make the apparent wind), where the wind is logged."""
+    if not _measured(data, "wind_speed", "wind_dir"):
+        return None
+    if _is(model, "vessel"):
+        return Windage()
+    return ApparentWind() if _measured(data, "u", "v") else None
+
+
+def _wind_probes(model, data):
+    if _is(model, "vessel"):
+        return {"lateral_area": 0.05 * float(model.length) ** 2,
+                "frontal_area": 0.01 * float(model.length) ** 2}
+    return {}
 
 
 def _rate_probe(model, data):
@@ -120,10 +133,9 @@ DISCOVERY_CATALOGUE = (
     Candidate("sway_force_bias", "constant sway force", _simple(SwayForceBias, *VESSEL),
               separate="measured sway velocity on straight legs"),
     Candidate("current", "uniform current", _simple(UniformCurrent, *VESSEL),
-              separate="positions (GNSS track) or wind on the hull at several headings"),
-    Candidate("wind", "wind loads (windage the model lacks)", _windage,
-              probes=lambda model, data: {"lateral_area": 0.05 * float(model.length) ** 2,
-                                          "frontal_area": 0.01 * float(model.length) ** 2},
+              separate="GNSS tracks on several headings: a current drifts each the same "
+                       "earth-fixed way, a compass bias sets it off to one side of the heading"),
+    Candidate("wind", "wind loads (windage the model lacks)", _wind, probes=_wind_probes,
               separate="runs at several headings to the wind"),
     Candidate("crossflow_drag", "cross-flow drag of the hull", _simple(CrossflowDrag, *VESSEL),
               probes=lambda model, data: {"coefficient": 0.02}, separate=STEADY_TURNS),
@@ -154,7 +166,8 @@ DISCOVERY_CATALOGUE = (
               separate="the heading record: psi integrates the true r, not the reading"),
     Candidate("heading_sensor_bias", "heading (compass) bias",
               _simple(HeadingSensorBias, *BOTH),
-              separate="an external heading reference (GNSS course on a straight leg)"),
+              separate="an external heading reference (GNSS course on straight legs on "
+                       "several headings: a current's drift angle changes with heading)"),
 )
 
 

@@ -1,6 +1,6 @@
 """Held-out checks of a discovery: the cost and fit % of a model simulated over
-records it was not fitted to (output error), and the manoeuvre indices of each
-record, measured and predicted."""
+records it was not fitted to (output error; positions over windows), and the
+manoeuvre indices of each record, measured and predicted."""
 
 import numpy as np
 
@@ -10,21 +10,30 @@ from ..._estimate._windows import as_dataset
 from .._indices import turning_indices, zigzag_indices
 
 
-def holdout_check(model, holdout, channels) -> dict:
-    """Output-error predictions of `holdout` by `model`: `cost` (half the sum of
-    squared residuals, each channel divided by the standard deviation of its measured
-    record, so models compare on one scale), `fit_percent` per channel and the
-    predicted timelines `predictions` `{channel: (E, N)}`."""
+def holdout_check(model, holdout, channels, wind: bool = False, window=None) -> dict:
+    """Output-error predictions of `holdout` by `model` (with the logged wind replayed
+    if `wind`): `cost` (half the sum of squared residuals, each channel divided by the
+    standard deviation of its measured record, so models compare on one scale),
+    `fit_percent` per channel and the predicted timelines `predictions`
+    `{channel: (E, N)}`. Positions x, y are predicted over `window`-second stretches
+    from the measured state (None: whole records too): over a whole record a position
+    integrates every heading error before it, which the heading's own residual
+    already counts, while a window shows the drift a current or a heading bias makes."""
     ds = as_dataset(holdout)
-    out = predict(model, ds, estimator=PredictionError(horizon=None, channels=channels))
-    cost, filled = 0.0, {}
-    for c in channels:
-        measured = np.asarray(getattr(ds, c), dtype=np.float64)
-        hit = out.predicted & ds.mask
-        scale = float(np.std(measured[hit])) or 1.0
-        cost += 0.5 * float(np.sum(((measured - out.predictions[c])[hit] / scale) ** 2))
-        filled[c] = np.where(out.predicted, out.predictions[c], measured)  # the start sample
-    return {"cost": cost, "fit_percent": out.fit_percent(), "predictions": filled}
+    tracks = tuple(c for c in channels if c in ("x", "y") and window is not None)
+    parts = [(None, tuple(c for c in channels if c not in tracks)), (window, tracks)]
+    cost, fit, filled = 0.0, {}, {}
+    for horizon, group in (part for part in parts if part[1]):
+        out = predict(model, ds, estimator=PredictionError(horizon=horizon, channels=group,
+                                                           wind=wind))
+        fit.update(out.fit_percent())
+        for c in group:
+            measured = np.asarray(getattr(ds, c), dtype=np.float64)
+            hit = out.predicted & ds.mask
+            scale = float(np.std(measured[hit])) or 1.0
+            cost += 0.5 * float(np.sum(((measured - out.predictions[c])[hit] / scale) ** 2))
+            filled[c] = np.where(out.predicted, out.predictions[c], measured)  # start samples
+    return {"cost": cost, "fit_percent": fit, "predictions": filled}
 
 
 def _track(t, psi, u, v):

@@ -54,7 +54,8 @@ def _signals(ds, e, n) -> dict[str, np.ndarray]:
     return out
 
 
-def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 60.0) -> dict:
+def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 60.0,
+                        wind: bool = False) -> dict:
     """Output-error residuals $e = y - \\hat y$ of `model` simulated over `data` (the
     records it was fitted to), each channel divided by the standard deviation of its
     measured record, and where they live:
@@ -74,10 +75,13 @@ def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 6
       `_signals` (largest over lags of up to 10 % of a record), against the 95 % band
       $1.96/\\sqrt{N}$ of independent series; `whiteness`: the fraction of residual
       autocorrelations (lags 1-25) outside that band.
+
+    `wind`: replay the logged wind (for a model with wind loads).
     """
     ds = as_dataset(data)
     channels = tuple(c for c in channels if all(c in h for h in ds.experiment_channels))
-    out = predict(model, ds, estimator=PredictionError(horizon=None, channels=channels))
+    out = predict(model, ds, estimator=PredictionError(horizon=None, channels=channels,
+                                                       wind=wind))
     fit = out.fit_per_experiment()
     res, sig, reg = {c: [] for c in channels}, {}, {}
     records, windows = {}, {}

@@ -97,8 +97,9 @@ class DiscoveryReport(eqx.Module):
         lines += ["", "## The gap", "",
                   f"Training cost {self.train_cost_before:.5g} -> {self.train_cost_after:.5g}."]
         if self.holdout_cost_before is not None:
-            lines.append(f"Held-out cost (output error) {self.holdout_cost_before:.5g} -> "
-                         f"{self.holdout_cost_after:.5g}.")
+            track = "; positions over the fit's windows" if "x" in self.channels else ""
+            lines.append(f"Held-out cost (output error{track}) {self.holdout_cost_before:.5g} "
+                         f"-> {self.holdout_cost_after:.5g}.")
             lines += ["", "| channel | held-out fit % before | after |", "|---|---|---|"]
             for c in self.channels:
                 lines.append(f"| {c} | {self.holdout_fit_percent_before[c]:.1f} | "

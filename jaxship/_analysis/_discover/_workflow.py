@@ -83,6 +83,14 @@ def _points_outside(model, names, step) -> bool:
     return any(fields[n].lower == 0.0 and d < 0 for n, d in zip(names, step))
 
 
+def _has_output(model, channel) -> bool:
+    try:
+        model.channel_index(channel)
+    except ValueError:
+        return False
+    return True
+
+
 def _quiet_fit(*args, **kwargs):
     """`fit` without its identifiability and convergence warnings: every candidate's
     refit is judged by the report's gates, which say why one is rejected."""
@@ -109,7 +117,10 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
       windows, so that the window-clustered score variance holds for coloured
       residuals, each starting from an estimated correction of the measured r and psi,
       so that the noise of a start sample does not run through its window); `free`:
-      the base parameters fitted (default the model's).
+      the base parameters fitted (default the model's). Where every training record
+      logs the wind, models that feel it (vessels; steering models with the `wind`
+      candidate) replay it; a vessel on records that all log positions fits x and y
+      as well (where a current shows).
     - `max_effects`: most effects added; `alpha`: family-wise false-alarm rate over
       candidates and iterations; `top`: classes refitted per iteration;
       `equivalence`: canonical correlation above which candidates are one class.
@@ -120,14 +131,28 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
     say = progress or (lambda message: None)
     free = tuple(default_free(model) if free is None else free)
     data = as_dataset(train)
-    if not estimator.wind and model.wind_loads and all(
-            {"wind_speed", "wind_dir"} <= set(c) for c in data.experiment_channels):
-        estimator = dataclasses.replace(estimator, wind=True)  # replay the logged wind
+    held = as_dataset(holdout) if holdout else None
+    logs = lambda d, *names: all(set(names) <= set(c) for c in d.experiment_channels)
+    windy = estimator.wind or logs(data, "wind_speed", "wind_dir")
+    held_windy = held is not None and logs(held, "wind_speed", "wind_dir")
+    if (estimator.channels is None and _has_output(model, "x") and logs(data, "x", "y")
+            and (held is None or logs(held, "x", "y"))):
+        # a vessel on records with positions (GNSS) fits its track too: a current shows
+        estimator = dataclasses.replace(estimator, channels=model.default_channels + ("x", "y"))
+
+    def loss(m):
+        """The estimator for model `m`: the logged wind replayed where `m` feels it."""
+        return dataclasses.replace(estimator, wind=bool(windy and m.wind_loads))
+
+    def check(m):
+        return holdout_check(m, holdout, channels, wind=bool(held_windy and m.wind_loads),
+                             window=estimator.horizon)
+
     say("fitting the base model")
-    base_fit = _quiet_fit(model, train, estimator=estimator, free=free)
+    base_fit = _quiet_fit(model, train, estimator=loss(model), free=free)
     channels = tuple(base_fit.metrics)
     current, theta, cost = base_fit, free, base_fit.cost
-    before = holdout_check(base_fit.model, holdout, channels) if holdout else None
+    before = check(base_fit.model) if holdout else None
     held_cost = before["cost"] if holdout else None
     accepted, rejected, first_scores = [], [], None
     for iteration in range(max_effects):
@@ -140,7 +165,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         probes = {f"{c.id}.{k}": v for c, _, pr in candidates for k, v in pr.items()}
         scored = augment(base, *effects, *(e for _, e, _ in candidates))
         say(f"iteration {iteration + 1}: scoring {len(candidates)} candidates")
-        sens = sensitivities(scored, train, estimator, theta + sum(names.values(), ()),
+        sens = sensitivities(scored, train, loss(scored), theta + sum(names.values(), ()),
                              probes, start_offsets=current.start_offsets)
         nuisance = tuple(n for n in sens.names if n.startswith("start["))
         scores = score_tests(sens, theta + nuisance, names)
@@ -175,7 +200,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             start = augment(base, *effects, effect)
             for field, value in probe.items():
                 start = _set(start, f"{k}.{field}", value)
-            trial = _quiet_fit(start, train, estimator=estimator, free=theta + names[k])
+            trial = _quiet_fit(start, train, estimator=loss(start), free=theta + names[k])
             lr = 2 * (cost - trial.cost) / sigma2
             lr_robust = lr / max(s.inflation, 1.0)
             z = float(stats.norm.isf(level / 2))
@@ -192,7 +217,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                            "every one of its confidence intervals includes zero")
             if not _in_range(trial, names[k]):
                 why.append("its estimate lies at or beyond the edge of the plausible range")
-            after = holdout_check(trial.model, holdout, channels) if holdout else None
+            after = check(trial.model) if holdout else None
             if holdout and not after["cost"] < held_cost:
                 why.append(f"the held-out cost does not fall ({held_cost:.4g} -> "
                            f"{after['cost']:.4g})")
@@ -217,10 +242,11 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         say(f"accepted {record['id']}")
         current, theta, cost = trial, theta + names[record["id"]], trial.cost
         held_cost = record["holdout_cost"] if holdout else None
-    after = holdout_check(current.model, holdout, channels) if holdout else None
+    after = check(current.model) if holdout else None
     say("locating the disagreement before and after")
-    disagreement = {"before": locate_disagreement(base_fit.model, train, channels),
-                    "after": locate_disagreement(current.model, train, channels)}
+    disagreement = {label: locate_disagreement(r.model, train, channels,
+                                               wind=loss(r.model).wind)
+                    for label, r in (("before", base_fit), ("after", current))}
     return DiscoveryReport(
         verdict="missing_effect" if accepted else "nothing_missing", effects=accepted,
         rejected=rejected, scores=first_scores or {}, model_before=base_fit.model,

@@ -20,11 +20,17 @@ from jaxtyping import Array, ArrayLike
 class AuxInputs(eqx.Module):
     """Measured quantities a response model may use besides the rudder, at the time the
     model is evaluated: surge `u` and sway `v` velocity [m/s] at midship (through the
-    water) and the propeller rate `n` [rev/s]. Unused by the Nomoto models."""
+    water), the propeller rate `n` [rev/s] and, where wind is logged, the apparent
+    wind `wind_u`, `wind_v` [m/s]: the ship's velocity through the air in body axes,
+    so that the wind comes from $\\gamma = $ atan2(`wind_v`, `wind_u`) off the bow,
+    positive from starboard (`jaxship.Wind`'s convention). Unused by the Nomoto models;
+    effects use them (`jaxship.ApparentWind`)."""
 
     u: ArrayLike = 0.0
     v: ArrayLike = 0.0
     n: ArrayLike = 0.0
+    wind_u: ArrayLike | None = None  # None: not logged (no wind)
+    wind_v: ArrayLike | None = None
 
 
 class WindowStart(eqx.Module):
@@ -36,7 +42,7 @@ class WindowStart(eqx.Module):
     `delta_integral` $= \\int_{t_0}^{t_s}\\delta\\,dt$ [rad s] (exact for the
     replayed rudder, held or interpolated) and `elapsed` $= t_s - t_0$ [s];
     `rudder_angle`: the measured rudder angle at $t_s$ (where a servo replays the
-    command)."""
+    command); `x`, `y`: the measured position at $t_s$ (None: not given)."""
 
     r: ArrayLike
     psi: ArrayLike
@@ -47,6 +53,8 @@ class WindowStart(eqx.Module):
     elapsed: ArrayLike
     aux: AuxInputs
     rudder_angle: ArrayLike | None = None  # the measured rudder angle there [rad]
+    x: ArrayLike | None = None  # the measured earth-fixed position there [m], if any
+    y: ArrayLike | None = None
 
 
 class AbstractSteeringModel(eqx.Module):
@@ -126,11 +134,13 @@ class AbstractSteeringModel(eqx.Module):
     def replay_field(self, servo: bool = False):
         """`f(t, y, inputs)` $= (f(x, \\delta, a), h(x))$ with the replayed rudder
         `inputs["delta"]` (a command, with `servo`, is taken as the angle: a response
-        model has no servo) and the measured `inputs["u"]`, `["v"]`, `["n"]`."""
+        model has no servo) and the measured `inputs["u"]`, `["v"]`, `["n"]` (and the
+        apparent wind `["wind_u"]`, `["wind_v"]` where it is replayed)."""
 
         def field(t, y, inputs):
             x = y[:-1]
-            aux = AuxInputs(inputs["u"], inputs["v"], inputs["n"])
+            aux = AuxInputs(inputs["u"], inputs["v"], inputs["n"], inputs.get("wind_u"),
+                            inputs.get("wind_v"))
             return jnp.concatenate([self.rhs(x, inputs["delta"], aux),
                                     jnp.reshape(self.output(x), (1,))])
 

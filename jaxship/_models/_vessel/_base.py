@@ -77,7 +77,8 @@ class AbstractVessel(eqx.Module):
     # -- the model contract shared with steering models (replay of measured records) --
 
     def channel_index(self, channel: str) -> int:
-        """Where an output channel (`"psi"`, `"r"`, `"u"`, `"v"`) sits in the state vector."""
+        """Where an output channel (`"psi"`, `"r"`, `"u"`, `"v"`, `"x"`, `"y"`) sits in the
+        state vector."""
         return STATE_FIELDS.index(channel)
 
     def measure(self, channel: str, value):
@@ -87,13 +88,14 @@ class AbstractVessel(eqx.Module):
 
     def replay_state(self, start, servo: bool = False) -> Array:
         """The state vector at a window start (`WindowStart`) of a measured record:
-        $(u, v, r, 0, 0, \\psi, \\delta, n)$ measured; the positions do not enter the
-        loads. The rudder is the replayed angle, or with `servo` the measured angle
-        the servo starts from."""
+        $(u, v, r, x, y, \\psi, \\delta, n)$ measured (x, y zero where not given: they
+        do not enter the loads). The rudder is the replayed angle, or with
+        `servo` the measured angle the servo starts from."""
         zero = jnp.zeros_like(start.r)
         delta = start.rudder_angle if servo else start.delta
-        return jnp.stack([start.aux.u, start.aux.v, start.r, zero, zero, start.psi,
-                          delta + zero, start.aux.n + zero])
+        x, y = (zero, zero) if start.x is None else (start.x + zero, start.y + zero)
+        return jnp.stack([start.aux.u, start.aux.v, start.r, x, y, start.psi, delta + zero,
+                          start.aux.n + zero])
 
     def replay_field(self, servo: bool = False):
         """`f(t, y, inputs)`: the state derivative with the measured rudder angle and
