@@ -128,7 +128,11 @@ nb.cells = [
         "    kvlcc2 = js.discover(start, train, holdout)\n"
         "    print(f'{time.perf_counter() - t0:.0f} s')\n"
         "    text = kvlcc2.to_markdown()\n"
-        "    print(text[:text.index('## Where')] + text[text.index('## Rejected'):])"),
+        "    print(text[:text.index('## Where')] + text[text.index('## Rejected'):])\n"
+        "    print('Loads the base model lacks (mean; while turning to starboard, to port):')\n"
+        "    for name, v in kvlcc2.disagreement['before']['forces'].items():\n"
+        "        print(f\"  {name} [{v['unit']}]: {v['mean']:.3g}; {v['starboard']:.3g}, \"\n"
+        "              f\"{v['port']:.3g}\")"),
     nbf.v4.new_code_cell(
         "if HAVE['kvlcc2_simman2008_hsva'] and HAVE['kvlcc2_simman2008_marin']:\n"
         "    rows = [(r, v) for r, idx in kvlcc2.holdout_indices.items()\n"

@@ -8,6 +8,7 @@ import numpy as np
 from ..._estimate._fit import PredictionError
 from ..._estimate._predict import predict
 from ..._estimate._windows import as_dataset
+from ._forces import LOADS, residual_loads
 
 
 # state regions, each a mask over samples from the measured signals (thresholds as
@@ -75,6 +76,10 @@ def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 6
       `_signals` (largest over lags of up to 10 % of a record), against the 95 % band
       $1.96/\\sqrt{N}$ of independent series; `whiteness`: the fraction of residual
       autocorrelations (lags 1-25) outside that band.
+    - `forces` (vessels on records with u, v and r; else None): the residual loads X,
+      Y, N the model lacks (`residual_loads`: $M\\dot\\nu - \\tau$ from the smoothed
+      measured states), each with its mean and RMS [N, N m], its means while turning
+      to starboard and to port, and the signals it follows.
 
     `wind`: replay the logged wind (for a model with wind loads).
     """
@@ -140,9 +145,22 @@ def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 6
         per_record = np.split(e, ends)
         correlations[c] = {k: _largest_correlation(per_record, sig[k], ds) for k in sig}
         whiteness[c] = _outside_band(per_record, band)
+    loads = residual_loads(model, ds, wind=wind) if hasattr(model, "mass_matrix") else None
+    forces = None if loads is None else {
+        name: _describe_load(loads[name], sig, ds, unit) for name, unit in LOADS}
     return {"records": records, "windows": windows, "regions": regions, "sides": sides,
             "correlations": correlations, "band": float(band), "whiteness": whiteness,
-            "regions_defined": {k: REGIONS[k] for k in regions}}
+            "regions_defined": {k: REGIONS[k] for k in regions}, "forces": forces}
+
+
+def _describe_load(per_record, sig, ds, unit) -> dict:
+    """Mean and RMS of a residual load [its unit], its means while turning to starboard
+    and to port, and the signals it follows (as `correlations`)."""
+    a, r = np.concatenate(per_record), np.concatenate(sig["r"])
+    side = lambda m: float(np.mean(a[m])) if np.any(m) else None
+    return {"unit": unit, "mean": float(np.mean(a)), "rms": float(np.sqrt(np.mean(a**2))),
+            "starboard": side(r > 0), "port": side(r < 0),
+            "correlations": {k: _largest_correlation(per_record, sig[k], ds) for k in sig}}
 
 
 def _lagged(residuals, signals, lag, centre) -> float:

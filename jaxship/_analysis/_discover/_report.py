@@ -23,7 +23,8 @@ class DiscoveryReport(eqx.Module):
     - `alpha`: the family-wise false-alarm rate; `channels`: the fitted outputs;
     - `disagreement`: where the simulated training records depart from the measured
       ones, `{"before": ..., "after": ...}` (`jaxship.locate_disagreement`: by
-      record, time window, state region, turning side and correlated signal).
+      record, time window, state region, turning side and correlated signal; for a
+      vessel also the loads it lacks).
     """
 
     verdict: str
@@ -140,6 +141,17 @@ def _where(before: dict, after: dict) -> list[str]:
         for c, v in before["sides"].items():
             lines.append(f"| {c} | {v['starboard']:+.2f} | {v['port']:+.2f} | "
                          f"{v['symmetric']:+.2f} | {v['antisymmetric']:+.2f} |")
+    if before.get("forces"):
+        lines += ["", "Loads the model lacks, from the measured u, v, r and their smoothed "
+                  "derivatives (M dnu/dt - tau):", "",
+                  "| load | mean | RMS | mean, starboard turning | port | follows |",
+                  "|---|---|---|---|---|---|"]
+        fmt = lambda x: "-" if x is None else f"{x:.3g}"
+        for name, v in before["forces"].items():
+            top = sorted(v["correlations"].items(), key=lambda kv: -kv[1])[:2]
+            lines.append(f"| {name} [{v['unit']}] | {fmt(v['mean'])} | {fmt(v['rms'])} | "
+                         f"{fmt(v['starboard'])} | {fmt(v['port'])} | "
+                         + ", ".join(f"{k} {c:.2f}" for k, c in top) + " |")
     lines += ["", f"Signals the residuals follow (largest |correlation| over lags; 95 % band "
               f"of independent series {before['band']:.3f}):", ""]
     for c, corr in before["correlations"].items():
