@@ -112,6 +112,7 @@ from ._models._hydro_effects import (
     ApparentWind as ApparentWind,
     CrossflowDrag as CrossflowDrag,
     PropellerAsymmetry as PropellerAsymmetry,
+    PropellerRace as PropellerRace,
     RudderStall as RudderStall,
     SpeedDependentDamping as SpeedDependentDamping,
     SpeedDependentRudder as SpeedDependentRudder,

@@ -51,6 +51,7 @@ EFFECTS = {
     "rudder_stall": (js.RudderStall(), "c", 0.3, ("vessel", "steering")),
     "propeller_asymmetry": (js.PropellerAsymmetry(), "moment",
                             {"vessel": 1.4e6, "steering": 2.6e-4}, ("vessel", "steering")),
+    "propeller_race": (js.PropellerRace(), "gain", 2e-4, ("steering",)),
     "surge_turn_resistance": (js.SurgeTurnResistance(), "x_vr", 0.004, ("vessel",)),
     "added_mass_error": (js.AddedMassError(), "s_r", 0.2, ("vessel",)),
     "current": (js.UniformCurrent(), "north", 0.5, ("vessel",)),
@@ -66,6 +67,7 @@ SHOWN_BY = {
     "wind": {"environment": js.Environment(wind=js.Wind(15.0, np.deg2rad(60.0)))},
     "current": {"track": True},
     "propeller_asymmetry": {"n": 1.5, "aux": {"n": 2.0 + 0.0 * _T}},
+    "propeller_race": {"aux": {"n": 2.0 + 0.0 * _T}},
     "speed_dependent_rudder": {"aux": {"u": U0 * (0.85 + 0.15 * np.cos(2 * np.pi * _T / 80))}},
     "speed_dependent_damping": {"aux": {"u": U0 * (0.85 + 0.15 * np.cos(2 * np.pi * _T / 80))}},
 }

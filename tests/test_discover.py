@@ -17,6 +17,7 @@ from jaxship.cli import main
 from jaxship.studies.discovery import (
     hidden_effect_records,
     outcome,
+    race_records,
     record,
     run_case,
     vessel_records,
@@ -216,6 +217,19 @@ def test_wind_is_named_on_a_steering_model_with_logged_wind():
     assert outcome(report, ("wind",)) == "correct", report.to_markdown()
     c2 = report.effects[0]["parameters"]["wind.c2"]
     assert abs(c2["value"] - 3e-6) < 4 * c2["std"], c2
+    assert report.holdout_cost_after < report.holdout_cost_before
+
+
+def test_propeller_race_is_named_from_runs_at_two_rpm():
+    """Nomoto 1 whose rudder gain grows with the propeller rate squared (`race_records`:
+    zig-zags at 1 and 2 rev/s, turns at 1.5 held out): `propeller_race` is named, nothing
+    else, its gain within 4 robust standard errors, and the held-out cost falls."""
+    gain = 0.005  # K + b n^2: 0.065 at 1 rev/s, 0.08 at 2
+    train, holdout = race_records(K, 25.0, gain, 0)
+    report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout)
+    assert outcome(report, ("propeller_race",)) == "correct", report.to_markdown()
+    b = report.effects[0]["parameters"]["propeller_race.gain"]
+    assert abs(b["value"] - gain) < 4 * b["std"], b
     assert report.holdout_cost_after < report.holdout_cost_before
 
 

@@ -289,6 +289,18 @@ def test_propeller_asymmetry_on_nomoto1_turns_with_the_propeller_rate():
             K * 5 * DEG + a_p * n * abs(n), rel=1e-9)
 
 
+def test_propeller_race_on_nomoto1_adds_rudder_gain_with_rpm_squared():
+    """$T\\dot r + r = K\\delta + b n_+^2\\delta$: steady $r = (K + b n^2)\\delta$ ahead,
+    $K\\delta$ with the propeller astern (its race off the rudder) or stopped."""
+    b = 2e-4
+    model = js.augment(js.Nomoto1(K=K, T=T), js.PropellerRace(gain=b))
+    delta = 5 * DEG
+    assert steady_r(model, delta, js.AuxInputs(n=3.0)) == pytest.approx(
+        (K + b * 9.0) * delta, rel=1e-9)
+    for n in (0.0, -3.0):
+        assert steady_r(model, delta, js.AuxInputs(n=n)) == pytest.approx(K * delta, rel=1e-9)
+
+
 def test_added_mass_error_scales_the_mass_matrix():
     """$M_{22}(1 + s_v)$, $M_{33}(1 + s_r)$, the rest unchanged; the accelerations are
     $M^{-1}\\tau$ of that matrix."""

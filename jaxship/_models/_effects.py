@@ -22,7 +22,8 @@ default:
 - the yaw equation of a steering model, `yaw_term(model, x, delta, aux)`: a term $f$
   added to its right-hand side where the rudder's moment enters (for Nomoto
   $T\\dot r + r = K\\delta + f$ [rad/s]; for models written as $\\dot r = \\dots$,
-  [rad/s^2]); the model's `forcing(x)` says how it moves the state;
+  [rad/s^2]), `delta` the logged rudder (before the actuator path); the model's
+  `forcing(x)` says how it moves the state;
 - a vessel's mass matrix, `mass(M)`, its environment (current and wind) in the
   equations of motion, `environment(env)`, and its wind areas,
   `wind_areas(frontal, lateral)` [m^2]: each returns the corrected value;

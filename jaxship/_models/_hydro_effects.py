@@ -218,6 +218,32 @@ class PropellerAsymmetry(AbstractEffect):
         return self.moment * aux.n * jnp.abs(aux.n)
 
 
+class PropellerRace(AbstractEffect):
+    """The rudder's share of the propeller race, for steering models at low speed:
+    the rudder inflow is $u_R^2 \\approx u^2 + c\\,(nD)^2$ (the MMG rudder inflow of
+    Yasukawa & Yoshimura 2015, eq. 23, for a heavily loaded propeller, $u_P \\ll nD$;
+    Molland & Turnock 2007), so a rudder behind a turning propeller keeps a force
+    when the hull's speed does not give it one. A steering model whose rudder moment
+    scales with $u$ (or not at all) lacks the $n^2$ part: this effect adds
+    $b\\,n_+^2\\,\\delta$ to the yaw equation, with $n_+ = \\max(n, 0)$ the measured
+    `AuxInputs.n` [rev/s] (an astern propeller throws its race forward, off the
+    rudder) and $\\delta$ the logged rudder [for Nomoto models
+    $T\\dot r + r = K\\delta + b n_+^2\\delta$, $b$ in s; for models written as
+    $\\dot r = \\dots$, $b$ in -].
+
+    Family units, hence no bounds; physically $b > 0$. At one rpm it is a rudder gain
+    (confused with K): seen in runs at several rpm and at low or changing speed
+    (accelerations from rest, speed loss in turns, manoeuvres in a harbour).
+    Steering models only: vessels' rudder models carry the race already (MMG)."""
+
+    gain: ArrayLike = param(0.0, unit="s | -")
+    id: ClassVar[str] = "propeller_race"
+
+    def yaw_term(self, model, x, delta, aux):
+        n = jnp.maximum(jnp.asarray(aux.n, float), 0.0)
+        return self.gain * n**2 * delta
+
+
 class SurgeTurnResistance(AbstractEffect):
     """Added surge resistance in turns (Norrbin 1970; Ross 2008; MMG $X'_{vr}$ of
     Yasukawa & Yoshimura 2015): $X \\mathrel{+}= X_{vr}\\,vr$ with

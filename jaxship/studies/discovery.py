@@ -61,6 +61,27 @@ def hidden_effect_records(truth, seed, *, disturbance_std=0.0):
     return train, holdout
 
 
+def race_records(K, T, gain, seed, *, rpms=(1.0, 2.0)):
+    """`(train, holdout)` of Nomoto 1 ($K$ [1/s], $T$ [s]) whose rudder sits in the
+    propeller race (`PropellerRace(gain)`), with the propeller rate logged: 10/10 and
+    20/20 zig-zags to starboard at each rate of `rpms` [rev/s] to train, +-20 deg
+    turns at their mean rate held out. At a constant rate the race is a rudder gain,
+    so each record is Nomoto 1 with $K + b n^2$ (exact), run as `record` does."""
+    rng = np.random.default_rng(seed)
+
+    def one(manoeuvre, n, name):
+        out = record(js.Nomoto1(K=K + gain * n**2, T=T), manoeuvre, name, rng)
+        return js.Experiment(out.t, out.delta, psi=out.psi, r=out.r, n=np.full(out.t.size, n),
+                             name=name)
+
+    train = [one(js.ZigZag(a * DEG, a * DEG, duration=400.0, dt=0.5), n,
+                 f"zigzag {a}/{a} at {n} rev/s") for a in (10, 20) for n in rpms]
+    mean = float(np.mean(rpms))
+    holdout = [one(js.Turn(a * DEG, duration=300.0, dt=0.5), mean, f"turn {a:+d} at {mean} rev/s")
+               for a in HOLDOUT]
+    return train, holdout
+
+
 def wind_records(truth, seed, *, speed=7.0, wind=(15.0, 60.0 * DEG), noise=(0.1, 0.05)):
     """`(train, holdout)` of a steering `truth` that feels the wind (`ApparentWind`):
     10/10 zig-zags to starboard on four headings (N, E, S, W) to train, +-20 deg turns

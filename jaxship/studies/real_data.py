@@ -210,3 +210,60 @@ def identify_kvlcc2_hsva(root=None, *, factor: int = 4, train=HSVA_TRAIN, test=H
     est = js.PredictionError(horizon=None)
     models = _nomoto_models(train_runs, test_runs, est, (None,))
     return RealDataReport("KVLCC2 HSVA", models, tuple(train), tuple(test))
+
+
+ESSO_ZIGZAG_TEST = ("zigzag_31-Jul-2020_13_42_53", "turn_14-Oct-2020_15_06_53")
+
+
+def _trimmed(experiment: js.Experiment, seconds: float) -> js.Experiment:
+    keep = experiment.t >= experiment.t[0] + seconds
+    return js.Experiment(experiment.t[keep], name=experiment.name, metadata=experiment.metadata,
+                         **{c: getattr(experiment, c)[keep] for c in experiment.channels})
+
+
+def esso_osaka_zigzag_split(root=None, *, factor: int = 5, trim: float = 20.0):
+    """`(train, test)` of the Esso Osaka zig-zag split: the eight zig-zags other than
+    `zigzag_31-Jul-2020_13_42_53` to train; that zig-zag and `turn_14-Oct-2020_15_06_53`
+    (both of Wakita et al.'s test set) held out; the first `trim` seconds of each run
+    cut (the propeller spinning up from rest), decimated by `factor` (2 Hz)."""
+    folder = _root(root, "esso_osaka_frt")
+    read = lambda p: decimate(_trimmed(js.read_esso_osaka(p), trim), factor)
+    train = [read(p) for p in sorted(folder.glob("zigzag/*.csv"))
+             if p.stem not in ESSO_ZIGZAG_TEST]
+    return train, [read(next(folder.glob(f"*/{name}.csv"))) for name in ESSO_ZIGZAG_TEST]
+
+
+def esso_osaka_low_speed_steering(root=None, *, factor: int = 5) -> RealDataReport:
+    """Steering models of the Esso Osaka model at low speed, fitted by output error on
+    r over the zig-zag split (`esso_osaka_zigzag_split`) and validated by simulating
+    the held-out zig-zag and turn (psi, r):
+
+    - `speed-scaled Nomoto 1 + offset`: $T\\dot r + s r = K s^2(\\delta + \\delta_0)$,
+      $s = u/U_0$ with the measured u (Nomoto 1957), $U_0$ the mean training u;
+    - `+ race, wind, r|r|`: the same with the three low-speed terms it lacks, fitted
+      together: the propeller race on the rudder (`PropellerRace`, $b n^2\\delta$),
+      the logged apparent wind (`ApparentWind`) and quadratic yaw damping
+      (`YawQuadraticDamping`). At 0.1-0.5 m/s in 1-4 m/s of wind, the race and the
+      wind carry rudder and yaw moments of the size the hull's speed gives.
+    """
+    train, test = esso_osaka_zigzag_split(root, factor=factor)
+    nominal = float(sum(e.u.sum() for e in train) / sum(e.u.size for e in train))
+    base = js.augment(js.Nomoto1(K=0.3, T=10.0),
+                      js.SpeedDependentRudder(kappa=1.0, nominal_speed=nominal),
+                      js.SpeedDependentDamping(kappa=1.0, nominal_speed=nominal),
+                      js.RudderOffset())
+    free = ("K", "T", "rudder_offset.delta0")
+    est = js.PredictionError(horizon=None, channels=("r",), max_steps=400)
+    fit0 = _quiet_fit(base, train, estimator=est, free=free)
+    full = js.augment(fit0.model.base, *fit0.model.effects, js.PropellerRace(),
+                      js.ApparentWind(), js.YawQuadraticDamping())
+    windy = dataclasses.replace(est, wind=True)
+    fit1 = _quiet_fit(full, train, estimator=windy, free=free + (
+        "propeller_race.gain", "wind.c1", "wind.c2", "yaw_quadratic_damping.beta"))
+    shown = lambda e: dataclasses.replace(e, channels=("psi", "r"))
+    models = (Identified("speed-scaled Nomoto 1 + offset", fit0,
+                         _validate(fit0.model, test, shown(est), (None,))),
+              Identified("+ race, wind, r|r|", fit1,
+                         _validate(fit1.model, test, shown(windy), (None,))))
+    return RealDataReport("Esso Osaka FRT, zig-zag split", models,
+                          tuple(e.name for e in train), tuple(e.name for e in test))

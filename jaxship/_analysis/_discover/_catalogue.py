@@ -29,6 +29,7 @@ from ..._models._hydro_effects import (
     ApparentWind,
     CrossflowDrag,
     PropellerAsymmetry,
+    PropellerRace,
     RudderStall,
     SpeedDependentDamping,
     SpeedDependentRudder,
@@ -90,6 +91,11 @@ def _propeller_asymmetry(model, data):
     return PropellerAsymmetry() if _is(model, "vessel") or _measured(data, "n") else None
 
 
+def _propeller_race(model, data):
+    """Steering models only (a vessel's rudder model carries the race), where n is logged."""
+    return PropellerRace() if _is(model, "steering") and _measured(data, "n") else None
+
+
 def _wind(model, data):
     """Windage on a vessel, the apparent wind's yaw term on a steering model (that
     needs u and v to make the apparent wind), where the wind is logged."""
@@ -130,6 +136,10 @@ DISCOVERY_CATALOGUE = (
               _simple(YawMomentBias, *BOTH), separate=SPEEDS),
     Candidate("propeller_asymmetry", "propeller-induced yaw moment (single screw)",
               _propeller_asymmetry, separate=SPEEDS),
+    Candidate("propeller_race", "rudder in the propeller race (inflow from rpm)",
+              _propeller_race,
+              separate="runs at several rpm and at low or changing speed: the race's rudder "
+                       "force grows with rpm squared, a rudder gain does not"),
     Candidate("sway_force_bias", "constant sway force", _simple(SwayForceBias, *VESSEL),
               separate="measured sway velocity on straight legs"),
     Candidate("current", "uniform current", _simple(UniformCurrent, *VESSEL),
