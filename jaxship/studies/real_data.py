@@ -9,6 +9,8 @@
   `turn_14-Oct-2020_15_06_53` and `zigzag_31-Jul-2020_13_42_53` (the berthing test
   runs are left out: thruster use is not logged). Training set: every other random
   run (the consecutive segments of the 06-Aug run included, segment 3 excluded).
+  A second split for steering models at low speed (`esso_osaka_low_speed_steering`)
+  trains on eight zig-zags and holds out zig-zag 13_42_53 and turn 15_06_53.
 - **KVLCC2, HSVA** (SIMMAN 2008 free-running zig-zags, model scale): Nomoto 1 and 2
   identified by output error on some zig-zags and validated on the others.
 
