@@ -46,11 +46,13 @@ def decimate(experiment: js.Experiment, factor: int) -> js.Experiment:
     factor = int(factor)
     if factor < 1:
         raise ValueError(f"`factor` must be a positive integer, got {factor}.")
-    if factor == 1:
-        return experiment
-    kept = {c: getattr(experiment, c)[::factor] for c in experiment.channels}
-    return js.Experiment(experiment.t[::factor], name=experiment.name,
-                      metadata=experiment.metadata, **kept)
+    return experiment if factor == 1 else _samples(experiment, slice(None, None, factor))
+
+
+def _samples(experiment: js.Experiment, index) -> js.Experiment:
+    """The samples `index` (a slice or mask) of `experiment` (measured channels only)."""
+    return js.Experiment(experiment.t[index], name=experiment.name, metadata=experiment.metadata,
+                         **{c: getattr(experiment, c)[index] for c in experiment.channels})
 
 
 def _root(root, folder):
@@ -217,19 +219,16 @@ def identify_kvlcc2_hsva(root=None, *, factor: int = 4, train=HSVA_TRAIN, test=H
 ESSO_ZIGZAG_TEST = ("zigzag_31-Jul-2020_13_42_53", "turn_14-Oct-2020_15_06_53")
 
 
-def _trimmed(experiment: js.Experiment, seconds: float) -> js.Experiment:
-    keep = experiment.t >= experiment.t[0] + seconds
-    return js.Experiment(experiment.t[keep], name=experiment.name, metadata=experiment.metadata,
-                         **{c: getattr(experiment, c)[keep] for c in experiment.channels})
-
-
 def esso_osaka_zigzag_split(root=None, *, factor: int = 5, trim: float = 20.0):
     """`(train, test)` of the Esso Osaka zig-zag split: the eight zig-zags other than
     `zigzag_31-Jul-2020_13_42_53` to train; that zig-zag and `turn_14-Oct-2020_15_06_53`
     (both of Wakita et al.'s test set) held out; the first `trim` seconds of each run
     cut (the propeller spinning up from rest), decimated by `factor` (2 Hz)."""
     folder = _root(root, "esso_osaka_frt")
-    read = lambda p: decimate(_trimmed(js.read_esso_osaka(p), trim), factor)
+    def read(path):
+        run = js.read_esso_osaka(path)
+        return decimate(_samples(run, run.t >= run.t[0] + trim), factor)
+
     train = [read(p) for p in sorted(folder.glob("zigzag/*.csv"))
              if p.stem not in ESSO_ZIGZAG_TEST]
     return train, [read(next(folder.glob(f"*/{name}.csv"))) for name in ESSO_ZIGZAG_TEST]
