@@ -25,6 +25,7 @@ import dataclasses
 import warnings
 from pathlib import Path
 
+import numpy as np
 import optimistix as optx
 
 import jaxship as js
@@ -42,7 +43,7 @@ HSVA_TEST = ("HSVA_CPMC_KVLCC2_Z_10_10_S", "HSVA_CPMC_KVLCC2_Z_20_10_S",
 
 
 def decimate(experiment: js.Experiment, factor: int) -> js.Experiment:
-    """Every `factor`-th sample of `experiment` (measured channels only)."""
+    """Every `factor`-th sample of `experiment` (measured channels and `extra`)."""
     factor = int(factor)
     if factor < 1:
         raise ValueError(f"`factor` must be a positive integer, got {factor}.")
@@ -50,8 +51,12 @@ def decimate(experiment: js.Experiment, factor: int) -> js.Experiment:
 
 
 def _samples(experiment: js.Experiment, index) -> js.Experiment:
-    """The samples `index` (a slice or mask) of `experiment` (measured channels only)."""
+    """The samples `index` (a slice or mask) of `experiment`: its measured channels and
+    the `extra` signals logged at its samples."""
+    n = experiment.num_samples
+    extra = {k: a[index] if np.shape(a)[:1] == (n,) else a for k, a in experiment.extra.items()}
     return js.Experiment(experiment.t[index], name=experiment.name, metadata=experiment.metadata,
+                         extra=extra,
                          **{c: getattr(experiment, c)[index] for c in experiment.channels})
 
 
@@ -248,12 +253,7 @@ def esso_osaka_low_speed_steering(root=None, *, factor: int = 5) -> RealDataRepo
       wind carry rudder and yaw moments of the size the hull's speed gives.
     """
     train, test = esso_osaka_zigzag_split(root, factor=factor)
-    nominal = float(sum(e.u.sum() for e in train) / sum(e.u.size for e in train))
-    base = js.augment(js.Nomoto1(K=0.3, T=10.0),
-                      js.SpeedDependentRudder(kappa=1.0, nominal_speed=nominal),
-                      js.SpeedDependentDamping(kappa=1.0, nominal_speed=nominal),
-                      js.RudderOffset())
-    free = ("K", "T", "rudder_offset.delta0")
+    base, free = _speed_scaled_nomoto(train)
     est = js.PredictionError(horizon=None, channels=("r",), max_steps=400)
     fit0 = _quiet_fit(base, train, estimator=est, free=free)
     full = js.augment(fit0.model.base, *fit0.model.effects, js.PropellerRace(),
@@ -268,3 +268,24 @@ def esso_osaka_low_speed_steering(root=None, *, factor: int = 5) -> RealDataRepo
                          _validate(fit1.model, test, shown(windy), (None,))))
     return RealDataReport("Esso Osaka FRT, zig-zag split", models,
                           tuple(e.name for e in train), tuple(e.name for e in test))
+
+
+def _speed_scaled_nomoto(train):
+    """(the speed-scaled Nomoto 1 with a rudder offset, its free parameters) for the
+    training runs' mean speed (`esso_osaka_low_speed_steering`)."""
+    nominal = float(sum(e.u.sum() for e in train) / sum(e.u.size for e in train))
+    base = js.augment(js.Nomoto1(K=0.3, T=10.0),
+                      js.SpeedDependentRudder(kappa=1.0, nominal_speed=nominal),
+                      js.SpeedDependentDamping(kappa=1.0, nominal_speed=nominal),
+                      js.RudderOffset())
+    return base, ("K", "T", "rudder_offset.delta0")
+
+
+def esso_osaka_low_speed_discovery(root=None, *, factor: int = 5, progress=None):
+    """`jaxship.discover` from the speed-scaled Nomoto 1 with offset on the zig-zag
+    split (`esso_osaka_zigzag_split`; zig-zag and turn held out): does it find the
+    low-speed terms of `esso_osaka_low_speed_steering` by itself? Returns the
+    `DiscoveryReport`."""
+    train, test = esso_osaka_zigzag_split(root, factor=factor)
+    base, free = _speed_scaled_nomoto(train)
+    return js.discover(base, train, test, free=free, progress=progress)

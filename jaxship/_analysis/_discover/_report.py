@@ -14,7 +14,10 @@ class DiscoveryReport(eqx.Module):
       `p_value`, `delta_bic`, `equivalent_to` (`[{id, separate}]`: candidates these
       data cannot tell apart from it, with the experiment that would) and
       `holdout_cost`;
-    - `rejected`: candidates refitted or scored that did not pass, with `why`;
+    - `rejected`: candidates refitted or scored that did not pass, with `why` (a
+      joint step's set as one entry, its ids joined by "+");
+    - an effect accepted by the joint step (effects too weak alone that pass together)
+      also lists `jointly_with`, the others accepted with it;
     - `scores`: every candidate's score test at the base fit;
     - `model_before`, `model_after`: the fitted base and augmented models;
     - `train_cost_*`, `holdout_cost_*` (half the sum of squared normalised
@@ -94,6 +97,8 @@ class DiscoveryReport(eqx.Module):
         if self.rejected:
             lines += ["", "## Rejected", ""]
             lines += [f"- iteration {r['iteration']}, {r['id']}: {'; '.join(r['why'])}"
+                      + (f" (held-out cost with it {r['holdout_cost']:.4g})"
+                         if r.get("holdout_cost") is not None else "")
                       for r in self.rejected]
         lines += ["", "## The gap", "",
                   f"Training cost {self.train_cost_before:.5g} -> {self.train_cost_after:.5g}."]

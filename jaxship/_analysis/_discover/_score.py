@@ -27,11 +27,20 @@ variance of the per-sample scores in time with Andrews' bandwidth (as
 Candidates that the data cannot tell apart have (nearly) the same projected column
 space: their largest canonical correlation (cosine of the smallest principal angle,
 Bjorck & Golub 1973) is near 1.
+
+Effects that are each too weak alone can be strong together, and one may only show
+once another is in. `forward_path` picks a set by forward selection on the linearised
+conditional scores; the set is chosen after looking at the data, so its joint score is
+not $\\chi^2$ under the null: `joint_null` simulates it, selection included, from the
+scores' joint normal law $g \\sim N(0, V)$ (V the window-clustered variance of all
+candidates' scores; a Gaussian multiplier bootstrap, Chernozhukov, Chetverikov & Kato
+2013).
 """
 
 import dataclasses
 
 import numpy as np
+from scipy.stats import chi2
 
 from ..._foundation._covariance import _auto_lags, bartlett_long_run
 
@@ -118,3 +127,81 @@ def canonical_correlation(a: Score, b: Score) -> float:
     if a.basis.shape[1] == 0 or b.basis.shape[1] == 0:
         return 0.0
     return float(np.linalg.svd(a.basis.T @ b.basis, compute_uv=False)[0])
+
+
+
+def _groups(labels):
+    """(label index, rows) for each distinct label."""
+    order = np.argsort(labels, kind="stable")
+    cuts = np.cumsum(np.bincount(labels))[:-1]
+    return enumerate(np.split(order, cuts))
+
+
+def forward_path(g, v, gram, blocks, equivalent, lower, top, enter=0.05):
+    """Which candidates a forward search picks for each row of `g` (draws, p): one at a
+    time, the one whose robust score conditional on those picked before is the most
+    significant (linearised: its sensitivities projected against theirs), never one
+    equivalent to a pick or whose conditional step leaves the plausible range, only
+    while that score's p-value is below `enter`, and at most `top`. `v`, `gram`
+    (p, p): the scores' variance and the projected sensitivities' Gram matrix;
+    `blocks`: each candidate's columns; `equivalent` (m, m) bool; `lower` (p,) bool:
+    parameters that may not go negative. Returns (draws, m) bool."""
+    draws, m = g.shape[0], len(blocks)
+    chosen = np.zeros((draws, m), bool)
+    for _ in range(top):
+        best, best_p = np.full(draws, -1), np.full(draws, np.log(enter))
+        sets, label = np.unique(chosen, axis=0, return_inverse=True)
+        for i, rows in _groups(label.ravel()):
+            picked = np.flatnonzero(sets[i])
+            a = np.concatenate([blocks[j] for j in picked]) if picked.size else np.arange(0)
+            for k in range(m):
+                if sets[i, k] or equivalent[k, picked].any():
+                    continue
+                b = blocks[k]
+                coef = gram[np.ix_(b, a)] @ np.linalg.pinv(gram[np.ix_(a, a)], rcond=1e-12)
+                gk = g[np.ix_(rows, b)] - g[np.ix_(rows, a)] @ coef.T
+                lk = np.hstack([np.eye(b.size), -coef])
+                vk = lk @ v[np.ix_(np.r_[b, a], np.r_[b, a])] @ lk.T
+                stat = np.einsum("di,ij,dj->d", gk, np.linalg.pinv(vk, rcond=1e-12), gk)
+                step = -gk @ np.linalg.pinv(gram[np.ix_(b, b)] - coef @ gram[np.ix_(a, b)],
+                                            rcond=1e-12)
+                logp = np.where((lower[b] & (step < 0)).any(axis=1), 0.0,
+                                chi2.logsf(stat, b.size))
+                better = logp < best_p[rows]
+                best[rows[better]], best_p[rows[better]] = k, logp[better]
+        took = best >= 0
+        chosen[np.flatnonzero(took), best[took]] = True
+    return chosen
+
+
+def joint_scores(sens, fitted, candidates):
+    """(g (p,), v (p, p), gram (p, p), blocks) of all `candidates` `{id: names}` at the
+    fit: their projected scores, the scores' variance and Gram matrix."""
+    column = {n: i for i, n in enumerate(sens.names)}
+    names = [n for k in candidates for n in candidates[k]]
+    span = np.cumsum([0] + [len(c) for c in candidates.values()])
+    blocks = [np.arange(span[i], span[i + 1]) for i in range(len(candidates))]
+    q = _orthonormal(sens.jacobian[:, [column[n] for n in fitted]])
+    jk = sens.jacobian[:, [column[n] for n in names]]
+    jt = jk - q @ (q.T @ jk)
+    v = _score_variance(jt * sens.residuals[:, None], sens)
+    return jt.T @ sens.residuals, v, jt.T @ jt, blocks
+
+
+def joint_null(v, gram, blocks, equivalent, lower, top, draws=100_000, seed=0,
+               enter=0.05):
+    """The null law of the robust joint score of `forward_path`'s picks (module text),
+    sorted, from `draws` draws of $g \\sim N(0, V)$; 0 where it picks fewer than two."""
+    w, u = np.linalg.eigh(v)
+    g = np.random.default_rng(seed).standard_normal((draws, v.shape[0]))
+    g = g @ (u * np.sqrt(np.clip(w, 0.0, None))).T
+    chosen = forward_path(g, v, gram, blocks, equivalent, lower, top, enter)
+    joint = np.zeros(draws)
+    sets, label = np.unique(chosen, axis=0, return_inverse=True)
+    for i, rows in _groups(label.ravel()):
+        if sets[i].sum() < 2:
+            continue  # one pick is the single-candidate test
+        cols = np.concatenate([blocks[j] for j in np.flatnonzero(sets[i])])
+        gc = g[np.ix_(rows, cols)]
+        joint[rows] = np.einsum("di,ij,dj->d", gc, np.linalg.pinv(v[np.ix_(cols, cols)]), gc)
+    return np.sort(joint)

@@ -11,18 +11,24 @@ One iteration (design: ../shared/reference/discovery-design.md, sec. 4):
    fit (warm start);
 3. a candidate is accepted only if all of these hold: its robust score and its
    likelihood ratio (divided by the score's inflation by correlated residuals)
-   exceed the chi-square quantile at `alpha / (m K)` (Bonferroni over the m
-   candidates and K = `max_effects` iterations); its robust confidence interval at
-   the same level excludes zero; its estimate lies in the parameter's plausible
-   range; and the held-out cost falls;
-4. of the candidates that pass, the one that lowers the cost most joins the model,
-   which becomes the base of the next iteration, until nothing passes.
+   exceed the chi-square quantile at `alpha / ((m + 1) K)` (Bonferroni over the m
+   candidates, one joint test and K = `max_effects` iterations); its robust
+   confidence interval at the same level excludes zero; its estimate lies in the
+   parameter's plausible range; and the held-out cost falls;
+4. where no single candidate passes, effects too weak alone may pass together: a
+   forward search on the conditional scores (`forward_path`) picks up to `top`, and
+   their union is refitted and judged by the same gates, its threshold simulated
+   with the search (`joint_null`), each member's interval excluding zero;
+5. of the candidates that pass, the one that lowers the cost most joins the model
+   (a joint set joins whole), which becomes the base of the next iteration, until
+   nothing passes.
 """
 
 import dataclasses
 import math
 import warnings
 
+import numpy as np
 from scipy import stats
 
 from ..._estimate._fit import PredictionError, fit
@@ -35,7 +41,13 @@ from ._catalogue import DISCOVERY_CATALOGUE, applicable
 from ._holdout import holdout_check, holdout_indices
 from ._locate import locate_disagreement
 from ._report import DiscoveryReport
-from ._score import canonical_correlation, score_tests
+from ._score import (
+    canonical_correlation,
+    forward_path,
+    joint_null,
+    joint_scores,
+    score_tests,
+)
 
 
 def _split(model):
@@ -156,6 +168,8 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
     held_cost = before["cost"] if holdout else None
     accepted, rejected, first_scores = [], [], None
     for iteration in range(max_effects):
+        if len(accepted) >= max_effects:
+            break
         base, effects = _split(current.model)
         done = {e.id for e in effects}
         candidates = applicable(base, data, catalogue, exclude=done)
@@ -169,8 +183,8 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                              probes, start_offsets=current.start_offsets)
         nuisance = tuple(n for n in sens.names if n.startswith("start["))
         scores = score_tests(sens, theta + nuisance, names)
-        m = len(candidates) * max_effects
-        level = alpha / m
+        # one test per candidate and one joint test per iteration (Bonferroni)
+        level = alpha / ((len(candidates) + 1) * max_effects)
         threshold = lambda dof: float(stats.chi2.isf(level, dof))
         sigma2 = 2 * sens.cost / max(sens.residuals.size - len(theta) - len(nuisance), 1)
         ranked = sorted(scores, key=lambda k: -scores[k].statistic)
@@ -183,65 +197,112 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             if len(chosen) < top and not any(k in classes[c] for c in chosen):
                 chosen.append(k)
         entry = {c.id: (c, e, pr) for c, e, pr in candidates}
+
+        def judge(keys, s, limit, p_value=None):
+            """Refit with the candidates `keys` (one, or a joint union) from their probe values
+            and apply the gates (module text) against the score threshold `limit`. Returns
+            (one record per candidate, with `why` where the refit fails a gate; the fit)."""
+            start = augment(base, *effects, *(entry[k][1] for k in keys))
+            for k in keys:
+                for field, value in entry[k][2].items():
+                    start = _set(start, f"{k}.{field}", value)
+            free = sum((names[k] for k in keys), ())
+            trial = _quiet_fit(start, train, estimator=loss(start), free=theta + free)
+            lr = 2 * (cost - trial.cost) / sigma2 / max(s.inflation, 1.0)
+            z = float(stats.norm.isf(level / 2))
+            params = {k: _parameters(trial, names[k]) for k in keys}
+            why = []
+            if not trial.success:
+                why.append(f"the refit did not converge ({trial.message})")
+            if lr <= limit:
+                why.append(f"likelihood ratio {lr:.3g} (robust) below the threshold {limit:.3g}")
+            # an effect with several parameters (added mass in sway and yaw) needs one away from
+            # zero; the likelihood ratio tests them jointly
+            for k in keys:
+                if not any(abs(p["value"]) > z * p["std"] for p in params[k].values()):
+                    why.append(f"the confidence interval of {k} includes zero")
+            if not _in_range(trial, free):
+                why.append("an estimate lies at or beyond the edge of the plausible range")
+            after = check(trial.model) if holdout else None
+            if holdout and not after["cost"] < held_cost:
+                why.append(f"the held-out cost does not fall ({held_cost:.4g} -> "
+                           f"{after['cost']:.4g})")
+            shared = {"score": s.statistic, "score_naive": s.naive, "likelihood_ratio": lr,
+                      "p_value": float(stats.chi2.sf(lr, s.dof)) if p_value is None else p_value,
+                      "delta_bic": _delta_bic(cost, trial.cost, sens.residuals.size, s.dof),
+                      "holdout_cost": after["cost"] if holdout else None}
+            records = [{"id": k, "name": entry[k][0].name, "iteration": iteration + 1,
+                        "parameters": params[k], **shared,
+                        "equivalent_to": [{"id": j, "separate": entry[j][0].separate}
+                                          for j in classes[k]]}
+                       | ({"jointly_with": [j for j in keys if j != k]} if len(keys) > 1 else {})
+                       | ({"why": why} if why else {}) for k in keys]
+            return records, trial
+
         passed = []
         for k in chosen:
-            c, effect, probe = entry[k]
             s = scores[k]
-            why = []
             if s.statistic <= threshold(s.dof) or _points_outside(scored, names[k], s.step):
                 why = (f"score {s.statistic:.3g} below the threshold {threshold(s.dof):.3g}"
                        if s.statistic <= threshold(s.dof) else
                        "its score points out of the plausible range (a negative lag, rate "
                        "or area)")
-                rejected.append({"id": k, "name": c.name, "score": s.statistic,
+                rejected.append({"id": k, "name": entry[k][0].name, "score": s.statistic,
                                  "iteration": iteration + 1, "why": [why]})
                 continue
             say(f"iteration {iteration + 1}: refitting with {k}")
-            start = augment(base, *effects, effect)
-            for field, value in probe.items():
-                start = _set(start, f"{k}.{field}", value)
-            trial = _quiet_fit(start, train, estimator=loss(start), free=theta + names[k])
-            lr = 2 * (cost - trial.cost) / sigma2
-            lr_robust = lr / max(s.inflation, 1.0)
-            z = float(stats.norm.isf(level / 2))
-            params = _parameters(trial, names[k])
-            if not trial.success:
-                why.append(f"the refit did not converge ({trial.message})")
-            if lr_robust <= threshold(s.dof):
-                why.append(f"likelihood ratio {lr_robust:.3g} (robust) below the threshold "
-                           f"{threshold(s.dof):.3g}")
-            # an effect with several parameters (added mass in sway and yaw) needs one
-            # away from zero; the likelihood ratio tests them jointly
-            if not any(abs(p["value"]) > z * p["std"] for p in params.values()):
-                why.append("its confidence interval includes zero" if len(params) == 1 else
-                           "every one of its confidence intervals includes zero")
-            if not _in_range(trial, names[k]):
-                why.append("its estimate lies at or beyond the edge of the plausible range")
-            after = check(trial.model) if holdout else None
-            if holdout and not after["cost"] < held_cost:
-                why.append(f"the held-out cost does not fall ({held_cost:.4g} -> "
-                           f"{after['cost']:.4g})")
-            record = {"id": k, "name": c.name, "iteration": iteration + 1,
-                      "parameters": params, "score": s.statistic,
-                      "score_naive": s.naive, "likelihood_ratio": lr_robust,
-                      "p_value": float(stats.chi2.sf(lr_robust, s.dof)),
-                      "delta_bic": _delta_bic(cost, trial.cost, sens.residuals.size, s.dof),
-                      "equivalent_to": [{"id": j, "separate": entry[j][0].separate}
-                                        for j in classes[k]],
-                      "holdout_cost": after["cost"] if holdout else None}
-            if why:
-                rejected.append({**record, "why": why})
+            records, trial = judge((k,), s, threshold(s.dof))
+            if records[0].get("why"):
+                rejected.extend(records)
             else:
-                passed.append((record, trial))
+                passed.append((records, trial))
+        joint_size = min(top, max_effects - len(accepted))
+        if not passed and joint_size > 1:
+            # effects too weak alone may be strong together: a forward search on the
+            # conditional scores, its threshold simulated with the search (`joint_null`)
+            keys = list(scores)
+            equivalent = np.array([[j in classes[k] for j in keys] for k in keys])
+            fields = parameter_fields(scored)
+            lower = np.array([fields[n].lower == 0.0 for k in keys for n in names[k]])
+            g, v, gram, blocks = joint_scores(sens, theta + nuisance,
+                                              {k: names[k] for k in keys})
+            path = forward_path(g[None], v, gram, blocks, equivalent, lower, joint_size)[0]
+            union = [keys[i] for i in np.flatnonzero(path)]
+            if len(union) > 1:
+                null = joint_null(v, gram, blocks, equivalent, lower, joint_size)
+                joint = score_tests(sens, theta + nuisance,
+                                    {"+".join(union): sum((names[k] for k in union), ())})
+                s = next(iter(joint.values()))
+                limit = float(np.quantile(null, 1 - level))
+                if s.statistic <= limit:
+                    rejected.append({"id": "+".join(union), "name": "jointly: " + ", ".join(
+                        entry[k][0].name for k in union), "score": s.statistic,
+                        "iteration": iteration + 1,
+                        "why": [f"joint score {s.statistic:.3g} below the threshold "
+                                f"{limit:.3g} (simulated with the selection)"]})
+                else:
+                    say(f"iteration {iteration + 1}: refitting with {' + '.join(union)}")
+                    records, trial = judge(tuple(union), s, limit,
+                                           p_value=float(np.mean(null >= s.statistic)))
+                    if records[0].get("why"):  # one record for the group
+                        shared = {k: v for k, v in records[0].items()
+                                  if k not in ("equivalent_to", "jointly_with")}
+                        rejected.append({**shared, "id": "+".join(union),
+                                         "name": "jointly: " + ", ".join(
+                                             r["name"] for r in records),
+                                         "parameters": {n: p for r in records
+                                                        for n, p in r["parameters"].items()}})
+                    else:
+                        passed.append((records, trial))
         if not passed:
             break
         # of those that pass, the one that explains most (the largest cost decrease; the
         # robust ratios gate, but their per-candidate inflation must not rank)
-        record, trial = min(passed, key=lambda pair: pair[1].cost)
-        accepted.append(record)
-        say(f"accepted {record['id']}")
-        current, theta, cost = trial, theta + names[record["id"]], trial.cost
-        held_cost = record["holdout_cost"] if holdout else None
+        records, trial = min(passed, key=lambda pair: pair[1].cost)
+        accepted.extend(records)
+        say(f"accepted {' + '.join(r['id'] for r in records)}")
+        current, theta, cost = trial, theta + sum((names[r["id"]] for r in records), ()), trial.cost
+        held_cost = records[0]["holdout_cost"] if holdout else None
     after = check(current.model) if holdout else None
     say("locating the disagreement before and after")
     disagreement = {label: locate_disagreement(r.model, train, channels,
