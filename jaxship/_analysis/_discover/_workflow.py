@@ -256,44 +256,28 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                 rejected.extend(records)
             else:
                 passed.append((records, trial))
-        joint_size = min(top, max_effects - len(accepted))
-        if not passed and joint_size > 1:
-            # effects too weak alone may be strong together: a forward search on the
-            # conditional scores, its threshold simulated with the search (`joint_null`)
-            keys = list(scores)
-            equivalent = np.array([[j in classes[k] for j in keys] for k in keys])
-            fields = parameter_fields(scored)
-            lower = np.array([fields[n].lower == 0.0 for k in keys for n in names[k]])
-            g, v, gram, blocks = joint_scores(sens, theta + nuisance,
-                                              {k: names[k] for k in keys})
-            path = forward_path(g[None], v, gram, blocks, equivalent, lower, joint_size)[0]
-            union = [keys[i] for i in np.flatnonzero(path)]
-            if len(union) > 1:
-                null = joint_null(v, gram, blocks, equivalent, lower, joint_size)
-                joint = score_tests(sens, theta + nuisance,
-                                    {"+".join(union): sum((names[k] for k in union), ())})
-                s = next(iter(joint.values()))
-                limit = float(np.quantile(null, 1 - level))
-                if s.statistic <= limit:
-                    rejected.append({"id": "+".join(union), "name": "jointly: " + ", ".join(
-                        entry[k][0].name for k in union), "score": s.statistic,
-                        "iteration": iteration + 1,
-                        "why": [f"joint score {s.statistic:.3g} below the threshold "
-                                f"{limit:.3g} (simulated with the selection)"]})
+        size = min(top, max_effects - len(accepted))
+        joint = (_joint_set(sens, theta + nuisance, scores, names, classes, scored, size,
+                            level) if not passed and size > 1 else None)
+        if joint:
+            union, s, limit, null = joint
+            group = {"id": "+".join(union), "iteration": iteration + 1, "name": "jointly: "
+                     + ", ".join(entry[k][0].name for k in union)}
+            if s.statistic <= limit:
+                rejected.append({**group, "score": s.statistic,
+                                 "why": [f"joint score {s.statistic:.3g} below the threshold "
+                                         f"{limit:.3g} (simulated with the search)"]})
+            else:
+                say(f"iteration {iteration + 1}: refitting with {' + '.join(union)}")
+                records, trial = judge(union, s, limit,
+                                       p_value=float(np.mean(null >= s.statistic)))
+                if records[0].get("why"):  # one entry for the set
+                    shared = {key: value for key, value in records[0].items()
+                              if key not in ("equivalent_to", "jointly_with")}
+                    rejected.append(shared | group | {"parameters": {
+                        n: p for r in records for n, p in r["parameters"].items()}})
                 else:
-                    say(f"iteration {iteration + 1}: refitting with {' + '.join(union)}")
-                    records, trial = judge(tuple(union), s, limit,
-                                           p_value=float(np.mean(null >= s.statistic)))
-                    if records[0].get("why"):  # one record for the group
-                        shared = {k: v for k, v in records[0].items()
-                                  if k not in ("equivalent_to", "jointly_with")}
-                        rejected.append({**shared, "id": "+".join(union),
-                                         "name": "jointly: " + ", ".join(
-                                             r["name"] for r in records),
-                                         "parameters": {n: p for r in records
-                                                        for n, p in r["parameters"].items()}})
-                    else:
-                        passed.append((records, trial))
+                    passed.append((records, trial))
         if not passed:
             break
         # of those that pass, the one that explains most (the largest cost decrease; the
@@ -320,6 +304,24 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         holdout_indices=holdout_indices(holdout, before["predictions"],
                                         after["predictions"]) if holdout else {},
         alpha=alpha, channels=channels, disagreement=disagreement)
+
+
+def _joint_set(sens, fitted, scores, names, classes, model, size, level):
+    """The joint step (module text, step 4): `(ids, their joint robust Score, the
+    threshold at `level` simulated with the search, the simulated null statistics)`,
+    or None where the search picks fewer than two."""
+    keys = list(scores)
+    equivalent = np.array([[j in classes[k] for j in keys] for k in keys])
+    fields = parameter_fields(model)
+    lower = np.array([fields[n].lower == 0.0 for k in keys for n in names[k]])
+    g, v, gram, blocks = joint_scores(sens, fitted, {k: names[k] for k in keys})
+    picks = forward_path(g[None], v, gram, blocks, equivalent, lower, size)[0]
+    union = tuple(keys[i] for i in np.flatnonzero(picks))
+    if len(union) < 2:
+        return None
+    null = joint_null(v, gram, blocks, equivalent, lower, size)
+    joint = score_tests(sens, fitted, {"+".join(union): sum((names[k] for k in union), ())})
+    return union, next(iter(joint.values())), float(np.quantile(null, 1 - level)), null
 
 
 def _set(model, name, value):
