@@ -95,18 +95,29 @@ def _score_variance(contributions, sens):
     return bartlett_long_run(series, _auto_lags(series, valid))
 
 
+def _projector(sens, fitted):
+    """(the columns of `sens` for given names projected against those of `fitted`:
+    $(I - QQ^T)J_k$, the number of independent fitted columns)."""
+    column = {n: i for i, n in enumerate(sens.names)}
+    q = _orthonormal(sens.jacobian[:, [column[n] for n in fitted]])
+
+    def project(names):
+        jk = sens.jacobian[:, [column[n] for n in names]]
+        return jk - q @ (q.T @ jk)
+
+    return project, q.shape[1]
+
+
 def score_tests(sens, fitted, candidates) -> dict:
     """`Score` of every candidate. `sens`: `Sensitivities` with columns for the fitted
     parameter names `fitted` and for each candidate's names; `candidates`: `{id:
     (names, ...)}`."""
-    column = {n: i for i, n in enumerate(sens.names)}
     e = sens.residuals
-    q = _orthonormal(sens.jacobian[:, [column[n] for n in fitted]])
-    sigma2 = float(e @ e) / max(e.size - q.shape[1], 1)
+    project, rank = _projector(sens, fitted)
+    sigma2 = float(e @ e) / max(e.size - rank, 1)
     out = {}
     for key, names in candidates.items():
-        jk = sens.jacobian[:, [column[n] for n in names]]
-        jt = jk - q @ (q.T @ jk)
+        jt = project(names)
         g = jt.T @ e
         a = jt.T @ jt
         a_inv = np.linalg.pinv(a, rcond=1e-12)
@@ -177,13 +188,10 @@ def forward_path(g, v, gram, blocks, equivalent, lower, top, enter=0.05):
 def joint_scores(sens, fitted, candidates):
     """(g (p,), v (p, p), gram (p, p), blocks) of all `candidates` `{id: names}` at the
     fit: their projected scores, the scores' variance and Gram matrix."""
-    column = {n: i for i, n in enumerate(sens.names)}
     names = [n for k in candidates for n in candidates[k]]
     span = np.cumsum([0] + [len(c) for c in candidates.values()])
     blocks = [np.arange(span[i], span[i + 1]) for i in range(len(candidates))]
-    q = _orthonormal(sens.jacobian[:, [column[n] for n in fitted]])
-    jk = sens.jacobian[:, [column[n] for n in names]]
-    jt = jk - q @ (q.T @ jk)
+    jt = _projector(sens, fitted)[0](names)
     v = _score_variance(jt * sens.residuals[:, None], sens)
     return jt.T @ sens.residuals, v, jt.T @ jt, blocks
 
