@@ -233,6 +233,23 @@ def test_propeller_race_is_named_from_runs_at_two_rpm():
     assert report.holdout_cost_after < report.holdout_cost_before
 
 
+def test_an_estimate_pinned_at_its_plausible_bound_is_at_the_edge():
+    """A 0.15 rad rudder offset lies beyond RudderOffset's +-0.1 rad range: the fit pins
+    the estimate at the bound (the sigmoid leaves it about 1e-6 of the span short),
+    which the refit gate reads as at the edge; a 0.05 rad offset is inside."""
+    from jaxship._analysis._discover._workflow import _at_edge, _quiet_fit
+
+    def fitted(delta0):
+        truth = js.augment(js.Nomoto1(K=K, T=25.0), js.RudderOffset(delta0=delta0))
+        train, _ = hidden_effect_records(truth, 0)
+        return _quiet_fit(js.augment(js.Nomoto1(K=0.05, T=20.0), js.RudderOffset()), train)
+
+    pinned, inside = fitted(0.15), fitted(0.05)
+    assert 0 < 0.1 - pinned.values[-1] < 1e-4
+    assert _at_edge(pinned, pinned.names) == ("rudder_offset.delta0",)
+    assert _at_edge(inside, inside.names) == ()
+
+
 def test_the_loads_a_vessel_lacks_are_located_from_the_measured_states():
     """Mariner records with a hidden 30 kN sway force, then a 3 MN m yaw moment: the
     mean missing load ($M\\dot\\nu - \\tau$ from the smoothed measured u, v, r) is that

@@ -105,12 +105,17 @@ def test_discover_finds_the_esso_osaka_low_speed_terms_only_together():
     candidate passes (wind scores 15.6 against 16.5), but the joint step's forward
     search picks exactly the propeller race, the wind and r|r|, whose refit cuts the
     held-out cost by three quarters (168.9 -> 40.6). Each one's robust interval
-    includes zero (race 0.0045 +- 0.0059), so the verdict stays "nothing missing":
-    on these eight zig-zags the three cannot be told apart one by one."""
+    includes zero (race 0.0045 +- 0.0059), and the refit pins the base's rudder offset
+    at its -0.1 rad bound (T 7 -> 59 s), so the verdict stays "nothing missing": on
+    these eight zig-zags the three cannot be told apart one by one."""
     report = esso_osaka_low_speed_discovery()
     joint = [r for r in report.rejected if "+" in r["id"]]
     assert [set(r["id"].split("+")) for r in joint] == [
         {"propeller_race", "wind", "yaw_quadratic_damping"}]
     assert joint[0]["holdout_cost"] < 0.5 * report.holdout_cost_before
     assert report.verdict == "nothing_missing"
-    assert all("confidence interval" in why for why in joint[0]["why"])
+    why = joint[0]["why"]
+    assert [w for w in why if "confidence interval" in w] == [
+        f"the confidence interval of {k} includes zero"
+        for k in ("propeller_race", "wind", "yaw_quadratic_damping")]
+    assert "at or beyond the edge of the plausible range: rudder_offset.delta0" in why

@@ -14,7 +14,8 @@ One iteration (design: ../shared/reference/discovery-design.md, sec. 4):
    exceed the chi-square quantile at `alpha / ((m + 1) K)` (Bonferroni over the m
    candidates, one joint test and K = `max_effects` iterations); its robust
    confidence interval at the same level excludes zero; its estimate lies in the
-   parameter's plausible range; and the held-out cost falls;
+   parameter's plausible range, and the refit pushes no base parameter onto the edge
+   of its range; and the held-out cost falls;
 4. where no single candidate passes, effects too weak alone may pass together: a
    forward search on the conditional scores (`forward_path`) picks up to `top`, and
    their union is refitted and judged by the same gates, its threshold simulated
@@ -74,18 +75,20 @@ def _parameters(result, names) -> dict:
     return out
 
 
-def _in_range(result, names) -> bool:
-    """Every estimate strictly inside its plausible range: one pinned at a bound (within
-    1e-6 of the span) is where the data want it beyond the range."""
+def _at_edge(result, names) -> tuple[str, ...]:
+    """The parameters among `names` whose estimate is not strictly inside its plausible
+    range: one pinned at a bound is where the data want it beyond the range (a range
+    with two bounds is mapped by a sigmoid, which reaches a bound only in the limit: a
+    pinned estimate stops within about 1e-6 of the span, so within 1e-3 counts)."""
     fields = parameter_fields(result.model)
     values = dict(zip(result.names, result.values))
 
     def inside(n):
         lower, upper = fields[n].lower, fields[n].upper
-        edge = 1e-6 * (upper - lower) if math.isfinite(upper - lower) else -1e-12
+        edge = 1e-3 * (upper - lower) if math.isfinite(upper - lower) else -1e-12
         return lower + edge < values[n] < upper - edge
 
-    return all(inside(n) for n in names)
+    return tuple(n for n in names if not inside(n))
 
 
 def _points_outside(model, names, step) -> bool:
@@ -221,8 +224,11 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             for k in keys:
                 if not any(abs(p["value"]) > z * p["std"] for p in params[k].values()):
                     why.append(f"the confidence interval of {k} includes zero")
-            if not _in_range(trial, free):
-                why.append("an estimate lies at or beyond the edge of the plausible range")
+            # the new parameters, and base ones the refit pushes onto a bound (the new
+            # terms then distort the base model rather than add to it)
+            edge = _at_edge(trial, free + tuple(n for n in theta if not _at_edge(current, (n,))))
+            if edge:
+                why.append(f"at or beyond the edge of the plausible range: {', '.join(edge)}")
             after = check(trial.model) if holdout else None
             if holdout and not after["cost"] < held_cost:
                 why.append(f"the held-out cost does not fall ({held_cost:.4g} -> "
