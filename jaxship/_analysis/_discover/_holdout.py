@@ -14,15 +14,16 @@ def holdout_check(model, holdout, channels, wind: bool = False, window=None) -> 
     """Output-error predictions of `holdout` by `model` (with the logged wind replayed
     if `wind`): `cost` (half the sum of squared residuals, each channel divided by the
     standard deviation of its measured record, so models compare on one scale),
-    `fit_percent` per channel and the predicted timelines `predictions`
-    `{channel: (E, N)}`. Positions x, y are predicted over `window`-second stretches
-    from the measured state (None: whole records too): over a whole record a position
+    `fit_percent` per channel, the predicted timelines `predictions`
+    `{channel: (E, N)}` and each sample's share of the cost `terms` (E, N, with `t`
+    and `mask`). Positions x, y are predicted over `window`-second stretches from
+    the measured state (None: whole records too): over a whole record a position
     integrates every heading error before it, which the heading's own residual
     already counts, while a window shows the drift a current or a heading bias makes."""
     ds = as_dataset(holdout)
     tracks = tuple(c for c in channels if c in ("x", "y") and window is not None)
     parts = [(None, tuple(c for c in channels if c not in tracks)), (window, tracks)]
-    cost, fit, filled = 0.0, {}, {}
+    fit, filled, terms = {}, {}, np.zeros(ds.mask.shape)
     for horizon, group in (part for part in parts if part[1]):
         out = predict(model, ds, estimator=PredictionError(horizon=horizon, channels=group,
                                                            wind=wind))
@@ -31,9 +32,26 @@ def holdout_check(model, holdout, channels, wind: bool = False, window=None) -> 
             measured = np.asarray(getattr(ds, c), dtype=np.float64)
             hit = out.predicted & ds.mask
             scale = float(np.std(measured[hit])) or 1.0
-            cost += 0.5 * float(np.sum(((measured - out.predictions[c])[hit] / scale) ** 2))
+            terms += np.where(hit, 0.5 * ((measured - out.predictions[c]) / scale) ** 2, 0.0)
             filled[c] = np.where(out.predicted, out.predictions[c], measured)  # start samples
-    return {"cost": cost, "fit_percent": fit, "predictions": filled}
+    return {"cost": float(terms.sum()), "fit_percent": fit, "predictions": filled,
+            "terms": terms, "t": np.asarray(ds.t), "mask": np.asarray(ds.mask)}
+
+
+def cost_rise(before: dict, after: dict, block: float) -> tuple[float, float]:
+    r"""The held-out cost's change $\Delta = C_{after} - C_{before}$ and its standard error
+    $\sqrt{\tfrac{B}{B-1} \sum_b (\Delta_b - \bar\Delta)^2}$ over the B stretches of
+    `block` seconds of each record (`holdout_check` outputs). A disturbance that moves
+    the heading for less than a block makes the stretches' changes about independent,
+    so a rise within a couple of standard errors is the disturbance's, not the model's
+    (the cluster-robust variance of a sum, with the stretches as clusters)."""
+    t, mask = after["t"], after["mask"]
+    stretch = np.floor((t - t[:, :1]) / block).astype(int)[mask]
+    record = np.broadcast_to(np.arange(t.shape[0])[:, None], t.shape)[mask]
+    _, keys = np.unique(np.stack([record, stretch]), axis=1, return_inverse=True)
+    change = np.bincount(keys.ravel(), (after["terms"] - before["terms"])[mask])
+    spread = np.sqrt(change.size / max(change.size - 1, 1) * np.sum((change - change.mean()) ** 2))
+    return float(change.sum()), float(spread)
 
 
 def _track(t, psi, u, v):

@@ -15,7 +15,11 @@ One iteration (design: ../shared/reference/discovery-design.md, sec. 4):
    candidates, one joint test and K = `max_effects` iterations); its robust
    confidence interval at the same level excludes zero; its estimate lies in the
    parameter's plausible range, and the refit pushes no base parameter onto the edge
-   of its range; and the held-out cost falls;
+   of its range; and the held-out cost does not rise beyond the spread a disturbance
+   gives it (`cost_rise`: more than `HELDOUT_Z` standard errors over stretches of the
+   estimator's horizon; without such spread it must fall). The held-out check vetoes
+   but does not choose: no candidate is accepted while a rival that lowers the
+   training cost more fails on the held-out runs alone;
 4. where no single candidate passes, effects too weak alone may pass together: a
    forward search on the conditional scores (`forward_path`) picks up to `top`, and
    their union is refitted and judged by the same gates, its threshold simulated
@@ -39,7 +43,7 @@ from ..._estimate._windows import as_dataset
 from ..._foundation._params import default_free, parameter_fields, rebuild
 from ..._models._effects import augment
 from ._catalogue import DISCOVERY_CATALOGUE, applicable
-from ._holdout import holdout_check, holdout_indices
+from ._holdout import cost_rise, holdout_check, holdout_indices
 from ._locate import locate_disagreement
 from ._report import DiscoveryReport
 from ._score import (
@@ -49,6 +53,13 @@ from ._score import (
     joint_scores,
     score_tests,
 )
+
+
+HELDOUT_Z = float(stats.norm.isf(0.05))  # a held-out rise beyond this many standard errors
+BLOCK = 60.0  # [s] stretches of the held-out cost's spread when the estimator has no horizon
+# warm-started refits converged in 12-57 LM steps on the Monte-Carlo, KVLCC2 and Esso data;
+# one that needs more is not converging (Esso's r|r|: 256 steps, 100 s) and is rejected
+REFIT_STEPS = 100
 
 
 def _split(model):
@@ -167,8 +178,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
     base_fit = _quiet_fit(model, train, estimator=loss(model), free=free)
     channels = tuple(base_fit.metrics)
     current, theta, cost = base_fit, free, base_fit.cost
-    before = check(base_fit.model) if holdout else None
-    held_cost = before["cost"] if holdout else None
+    before = held = check(base_fit.model) if holdout else None
     accepted, rejected, first_scores = [], [], None
     for iteration in range(max_effects):
         if len(accepted) >= max_effects:
@@ -210,7 +220,9 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                 for field, value in entry[k][2].items():
                     start = _set(start, f"{k}.{field}", value)
             free = sum((names[k] for k in keys), ())
-            trial = _quiet_fit(start, train, estimator=loss(start), free=theta + free)
+            refit = dataclasses.replace(loss(start), max_steps=min(estimator.max_steps,
+                                                                   REFIT_STEPS))
+            trial = _quiet_fit(start, train, estimator=refit, free=theta + free)
             lr = 2 * (cost - trial.cost) / sigma2 / max(s.inflation, 1.0)
             z = float(stats.norm.isf(level / 2))
             params = {k: _parameters(trial, names[k]) for k in keys}
@@ -230,9 +242,14 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             if edge:
                 why.append(f"at or beyond the edge of the plausible range: {', '.join(edge)}")
             after = check(trial.model) if holdout else None
-            if holdout and not after["cost"] < held_cost:
-                why.append(f"the held-out cost does not fall ({held_cost:.4g} -> "
-                           f"{after['cost']:.4g})")
+            if holdout:
+                rise, spread = cost_rise(held, after, estimator.horizon or BLOCK)
+                if not rise < HELDOUT_Z * spread:
+                    why.append(f"the held-out cost rises ({held['cost']:.4g} -> "
+                               f"{after['cost']:.4g}; {rise:.3g} against a standard error "
+                               f"of {spread:.3g} over the stretches)" if spread else
+                               f"the held-out cost does not fall ({held['cost']:.4g} -> "
+                               f"{after['cost']:.4g})")
             shared = {"score": s.statistic, "score_naive": s.naive, "likelihood_ratio": lr,
                       "p_value": float(stats.chi2.sf(lr, s.dof)) if p_value is None else p_value,
                       "delta_bic": _delta_bic(cost, trial.cost, sens.residuals.size, s.dof),
@@ -243,9 +260,9 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                                           for j in classes[k]]}
                        | ({"jointly_with": [j for j in keys if j != k]} if len(keys) > 1 else {})
                        | ({"why": why} if why else {}) for k in keys]
-            return records, trial
+            return records, trial, after
 
-        passed = []
+        passed, vetoed = [], []  # vetoed: (id, cost) of refits failing only the held-out check
         for k in chosen:
             s = scores[k]
             if s.statistic <= threshold(s.dof) or _points_outside(scored, names[k], s.step):
@@ -257,14 +274,27 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                                  "iteration": iteration + 1, "why": [why]})
                 continue
             say(f"iteration {iteration + 1}: refitting with {k}")
-            records, trial = judge((k,), s, threshold(s.dof))
-            if records[0].get("why"):
+            records, trial, after = judge((k,), s, threshold(s.dof))
+            why = records[0].get("why", [])
+            if len(why) == 1 and why[0].startswith("the held-out cost"):
+                vetoed.append((k, trial.cost))
+            if why:
                 rejected.extend(records)
             else:
-                passed.append((records, trial))
+                passed.append((records, trial, after))
+        # the held-out check vetoes, it does not choose: where a rival explains the training
+        # data better and fails only on the held-out runs, these data do not say which
+        # (if either) is missing
+        rival = min(vetoed, key=lambda pair: pair[1], default=None)
+        contested = bool(rival and passed and rival[1] < min(row[1].cost for row in passed))
+        if contested:
+            for records, _, _ in passed:
+                rejected.extend(r | {"why": [f"{rival[0]} explains the training data better "
+                                             "but fails on the held-out runs"]} for r in records)
+            passed = []
         size = min(top, max_effects - len(accepted))
         joint = (_joint_set(sens, theta + nuisance, scores, names, classes, scored, size,
-                            level) if not passed and size > 1 else None)
+                            level) if not (passed or contested) and size > 1 else None)
         if joint:
             union, s, limit, null = joint
             group = {"id": "+".join(union), "iteration": iteration + 1, "name": "jointly: "
@@ -275,24 +305,23 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                                          f"{limit:.3g} (simulated with the search)"]})
             else:
                 say(f"iteration {iteration + 1}: refitting with {' + '.join(union)}")
-                records, trial = judge(union, s, limit,
-                                       p_value=float(np.mean(null >= s.statistic)))
+                records, trial, after = judge(union, s, limit,
+                                              p_value=float(np.mean(null >= s.statistic)))
                 if records[0].get("why"):  # one entry for the set
                     shared = {key: value for key, value in records[0].items()
                               if key not in ("equivalent_to", "jointly_with")}
                     rejected.append(shared | group | {"parameters": {
                         n: p for r in records for n, p in r["parameters"].items()}})
                 else:
-                    passed.append((records, trial))
+                    passed.append((records, trial, after))
         if not passed:
             break
         # of those that pass, the one that explains most (the largest cost decrease; the
         # robust ratios gate, but their per-candidate inflation must not rank)
-        records, trial = min(passed, key=lambda pair: pair[1].cost)
+        records, trial, held = min(passed, key=lambda row: row[1].cost)
         accepted.extend(records)
         say(f"accepted {' + '.join(r['id'] for r in records)}")
         current, theta, cost = trial, theta + sum((names[r["id"]] for r in records), ()), trial.cost
-        held_cost = records[0]["holdout_cost"] if holdout else None
     after = check(current.model) if holdout else None
     say("locating the disagreement before and after")
     disagreement = {label: locate_disagreement(r.model, train, channels,
