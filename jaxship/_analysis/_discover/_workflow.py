@@ -214,7 +214,8 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         def judge(keys, s, limit, p_value=None):
             """Refit with the candidates `keys` (one, or a joint union) from their probe values
             and apply the gates (module text) against the score threshold `limit`. Returns
-            (one record per candidate, with `why` where the refit fails a gate; the fit)."""
+            (one record per candidate, with `why` where the refit fails a gate; the fit;
+            its held-out check; whether that check alone failed)."""
             start = augment(base, *effects, *(entry[k][1] for k in keys))
             for k in keys:
                 for field, value in entry[k][2].items():
@@ -242,6 +243,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             if edge:
                 why.append(f"at or beyond the edge of the plausible range: {', '.join(edge)}")
             after = check(trial.model) if holdout else None
+            others = len(why)
             if holdout:
                 rise, spread = cost_rise(held, after, estimator.horizon or BLOCK)
                 if not rise < HELDOUT_Z * spread:
@@ -260,7 +262,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                                           for j in classes[k]]}
                        | ({"jointly_with": [j for j in keys if j != k]} if len(keys) > 1 else {})
                        | ({"why": why} if why else {}) for k in keys]
-            return records, trial, after
+            return records, trial, after, others == 0 and len(why) == 1
 
         passed, vetoed = [], []  # vetoed: (id, cost) of refits failing only the held-out check
         for k in chosen:
@@ -274,11 +276,10 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                                  "iteration": iteration + 1, "why": [why]})
                 continue
             say(f"iteration {iteration + 1}: refitting with {k}")
-            records, trial, after = judge((k,), s, threshold(s.dof))
-            why = records[0].get("why", [])
-            if len(why) == 1 and why[0].startswith("the held-out cost"):
+            records, trial, after, veto = judge((k,), s, threshold(s.dof))
+            if veto:
                 vetoed.append((k, trial.cost))
-            if why:
+            if records[0].get("why"):
                 rejected.extend(records)
             else:
                 passed.append((records, trial, after))
@@ -305,7 +306,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                                          f"{limit:.3g} (simulated with the search)"]})
             else:
                 say(f"iteration {iteration + 1}: refitting with {' + '.join(union)}")
-                records, trial, after = judge(union, s, limit,
+                records, trial, after, _ = judge(union, s, limit,
                                               p_value=float(np.mean(null >= s.statistic)))
                 if records[0].get("why"):  # one entry for the set
                     shared = {key: value for key, value in records[0].items()
