@@ -93,8 +93,9 @@ class PredictionError(AbstractEstimator):
       start sample: use it for output error on noisy data (MATLAB's
       `InitialState='estimate'`). Costs two parameters per window. A list of
       `SmoothedStates` (one per experiment, from `jaxship.smooth_states`) starts
-      the windows from the EKF + RTS smoothed r and psi instead (the targets stay
-      the measurements).
+      the windows from the EKF + RTS smoothed r and psi instead (and a vessel's u and
+      v: so a vessel can be fitted to records without a logged v); the targets stay
+      the measurements.
     - `wind`: vessels only: replay the measured true wind (`wind_speed`,
       `wind_dir`) as loads of `jaxship.Wind` on the vessel's wind areas. Default
       False: calm water.
@@ -323,7 +324,10 @@ def _prepare(model, dataset, estimator):
                          f"effect (jaxship.ApparentWind); {type(model).__name__} has no wind "
                          "loads.")
     servo = estimator.rudder == "delta_c"
-    needed = list(model.start_channels) + (["delta"] if servo and model.has_servo else [])
+    smoothed = not isinstance(estimator.initial, str)
+    starts = _smoothed_starts(ds, estimator.initial) if smoothed else None
+    needed = [c for c in model.start_channels if starts is None or c not in starts]
+    needed += ["delta"] if servo and model.has_servo else []
     needed += ["wind_speed", "wind_dir"] if estimator.wind else []
     for i, name in enumerate(ds.names):
         missing = [c for c in needed if c not in ds.experiment_channels[i]]
@@ -332,11 +336,10 @@ def _prepare(model, dataset, estimator):
                 f"experiment {name!r} (dataset entry {i}): no measured {missing[0]!r}; "
                 f"{type(model).__name__} restarts every window from the measured "
                 f"{', '.join(needed)} (and `wind=True` replays the measured wind), so these "
-                "must be measured (or fit a steering model instead).")
+                "must be measured (or smoothed: `initial=jaxship.smooth_states(...)`; or fit "
+                "a steering model instead).")
     if int(estimator.substeps) < 1:
         raise ValueError(f"`substeps` must be a positive integer, got {estimator.substeps}.")
-    smoothed = not isinstance(estimator.initial, str)
-    starts = _smoothed_starts(ds, estimator.initial) if smoothed else None
     if not smoothed and estimator.initial not in ("measured", "estimate"):
         raise ValueError(f"`initial` must be 'measured', 'estimate' or a list of smoothed "
                          f"states, got {estimator.initial!r}.")
@@ -375,13 +378,15 @@ def _jacobian(p, model, transform, windows):
 
 def _smoothed_starts(ds, smoothed) -> dict:
     """`{"r": (E, N), "psi": (E, N)}` window starts from `SmoothedStates` (one per
-    experiment of `ds`, e.g. from `jaxship.smooth_states`)."""
+    experiment of `ds`, e.g. from `jaxship.smooth_states`), and `"u"`, `"v"` where
+    they are smoothed states (a vessel's)."""
     smoothed = list(smoothed)
     if len(smoothed) != ds.num_experiments or not all(hasattr(s, "state") for s in smoothed):
         raise ValueError(f"`initial` as smoothed states needs one SmoothedStates per "
                          f"experiment ({ds.num_experiments}), got {len(smoothed)} items.")
     out = {}
-    for name in ("r", "psi"):
+    both = lambda name: all(name in s.names for s in smoothed)
+    for name in ("r", "psi") + tuple(c for c in ("u", "v") if both(c)):
         a = np.array(getattr(ds, name), dtype=np.float64)
         for i, s in enumerate(smoothed):
             if s.mean.shape[0] != ds.lengths[i]:

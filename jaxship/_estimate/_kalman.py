@@ -1,12 +1,15 @@
-"""State estimation of steering models: extended Kalman filter and
+"""State estimation of steering models and vessels: extended Kalman filter and
 Rauch-Tung-Striebel smoother (the innovations-form (PEM) and maximum-likelihood
-fits on top of them are in `jaxship._estimate._likelihood`).
+fits of steering models on top of them are in `jaxship._estimate._likelihood`).
 
-**Model.** The filter works on the augmented state $z = (x, \\psi)$ of a steering model
-(`AbstractSteeringModel.state_names` followed by the heading). Over one sample
-interval the recorded rudder and auxiliary inputs are replayed as `fit` replays them
-(the measured angle linear between $\\delta_k$ and $\\delta_{k+1}$, a command held) and
-the interval map $F$ is the simulator's time loop over the interval
+**Model.** The filter works on the state $z$ that `fit` simulates (the model contract
+shared by steering models and vessels: `replay_state`, `replay_field`,
+`channel_index`): for a steering model $z = (x, \\psi)$ (`state_names` followed by the
+heading), for a vessel $z = (u, v, r, x, y, \\psi, \\delta, n)$ and its effects' states
+(the replayed $\\delta$ and $n$ do not move). Over one sample interval the recorded
+rudder and auxiliary inputs are replayed as `fit` replays them (the measured angle
+linear between $\\delta_k$ and $\\delta_{k+1}$, a command held) and the interval map
+$F$ is the simulator's time loop over the interval
 (`jaxship._simulation._simulate.integrate`, the same numerics as `simulate_steering` and `fit`):
 
 $$z_{k+1} = F(z_k, \\delta_k + w_k) + v_k, \\qquad y_k = h(z_k) + e_k,$$
@@ -14,8 +17,9 @@ $$z_{k+1} = F(z_k, \\delta_k + w_k) + v_k, \\qquad y_k = h(z_k) + e_k,$$
 with $w_k \\sim N(0, q_\\delta)$ a rudder-equivalent disturbance held over the interval
 (any yaw moment acting like the rudder: waves, wind), $v_k \\sim N(0, Q)$ a disturbance
 on the states, and $e_k \\sim N(0, R)$ the measurement noise of the channels
-$y = (\\psi, r)$ (unwrapped heading and yaw rate). Linearised, the process noise of an
-interval is $Q_k = Q + q_\\delta B_kB_k^T$, $B_k = \\partial F/\\partial\\delta$.
+(unwrapped heading and yaw rate $y = (\\psi, r)$; for a vessel also u, v, x, y).
+Linearised, the process noise of an interval is $Q_k = Q + q_\\delta B_kB_k^T$,
+$B_k = \\partial F/\\partial\\delta$.
 
 **Filter** (Simon 2006, sec. 13.2; Sarkka 2013, alg. 5.4), with
 $A_k = \\partial F/\\partial z$ by `jax.jacfwd` of the interval map:
@@ -30,7 +34,7 @@ P_{k|k} = (I - K_kH)P_{k|k-1}(I - K_kH)^T + K_kRK_k^T \\;\\text{(Joseph form)}.$
 The innovations $\\varepsilon_k$ are the one-step-ahead prediction errors of the
 innovations-form predictor (Ljung 1999, sec. 4.3, eq. 4.84-4.87); for a linear model
 with stationary noise the gain $K_k$ converges to the stationary Kalman gain. Sample 0
-is the prior: the model's `window_state` of the first record sample (as `fit` starts),
+is the prior: the model's `replay_state` of the first record sample (as `fit` starts),
 with covariance $P_0$; samples 1..N-1 are predicted and updated; masked (padded)
 samples are predicted without update and add nothing to the likelihood.
 
@@ -55,14 +59,17 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._foundation._params import as_arrays
+from .._foundation._state import STATE_FIELDS
 from .._models._steering._base import AbstractSteeringModel, AuxInputs, WindowStart
+from .._models._vessel._base import AbstractVessel
 from .._simulation._data import Experiment
 from .._simulation._simulate import Held, Simulator, integrate
-from .._simulation._simulate_steering import steering_field
 from ._windows import as_dataset, check_data, resolve_holds
 
 
 KALMAN_CHANNELS = ("psi", "r")
+VESSEL_CHANNELS = ("psi", "r", "u", "v", "x", "y")  # what a vessel's filter can measure
+REPLAYED = ("delta", "u", "v", "n")  # the recorded inputs (a vessel reads delta and n)
 _LOG_2PI = math.log(2.0 * math.pi)
 
 
@@ -70,19 +77,24 @@ _LOG_2PI = math.log(2.0 * math.pi)
 
 
 def _augmented_names(model) -> tuple[str, ...]:
-    return tuple(model.state_names) + ("psi",)
+    """Names of the filtered state z (module docstring)."""
+    if isinstance(model, AbstractSteeringModel):
+        return tuple(model.state_names) + ("psi",)
+    return STATE_FIELDS + tuple(f"{e.id}.{name}" for e in getattr(model, "effects", ())
+                                for name in e.state_names)
 
 
-def _check_channels(channels) -> tuple[str, ...]:
+def _check_channels(model, channels) -> tuple[str, ...]:
     if isinstance(channels, str):
         channels = (channels,)
     channels = tuple(channels)
+    allowed = KALMAN_CHANNELS if isinstance(model, AbstractSteeringModel) else VESSEL_CHANNELS
     if not channels:
-        raise ValueError(f"`channels` is empty; choose from {KALMAN_CHANNELS}.")
+        raise ValueError(f"`channels` is empty; choose from {allowed}.")
     for c in channels:
-        if c not in KALMAN_CHANNELS:
-            raise ValueError(f"unknown channel {c!r} for the Kalman filter; choose from "
-                             f"{KALMAN_CHANNELS} (unwrapped heading and yaw rate).")
+        if c not in allowed:
+            raise ValueError(f"unknown channel {c!r} for the Kalman filter of "
+                             f"{type(model).__name__}; choose from {allowed}.")
     if len(set(channels)) != len(channels):
         raise ValueError(f"`channels` repeats a channel: {channels}.")
     return channels
@@ -176,8 +188,8 @@ def _check_measured(ds, channels):
 
 
 class KalmanOutput(eqx.Module):
-    """Output of `ekf` for one record of N samples; the state is the augmented
-    $z = (x, \\psi)$ (`names`).
+    """Output of `ekf` for one record of N samples; the state is $z$ (module
+    docstring; `names`).
 
     - `predicted`, `predicted_cov`: $\\hat z_{k|k-1}$ (N, n), $P_{k|k-1}$ (N, n, n)
       (sample 0: the prior);
@@ -202,16 +214,16 @@ class KalmanOutput(eqx.Module):
 
 def _interval_map(model, substeps, holds):
     """$F(z, \\delta + w)$: one sample interval of the simulator's time loop, the
-    recorded inputs replayed from sample k to k + 1 with `holds` (as `fit` replays
-    them) and the disturbance $w$ held over the interval."""
+    recorded inputs `{name: (2,)}` replayed from sample k to k + 1 with `holds` (as
+    `fit` replays them) and the disturbance $w$ held over the interval."""
     simulator = Simulator(max_step=math.inf, substeps=substeps)
-    field = steering_field(model)
+    replay = model.replay_field()
+    field = lambda t, y, args: replay(t, y, args[0].at(t - args[1]))
 
-    def f(z, w, delta, aux, dt):
-        start = {"delta": delta[0] + w, "u": aux.u[0], "v": aux.v[0], "n": aux.n[0]}
-        end = {"delta": delta[1] + w, "u": aux.u[1], "v": aux.v[1], "n": aux.n[1]}
-        slope = {k: (end[k] - start[k]) / dt if holds[k] == "foh" else 0.0 * start[k]
-                 for k in start}
+    def f(z, w, inputs, dt):
+        start = {k: a[0] + (w if k == "delta" else 0.0) for k, a in inputs.items()}
+        slope = {k: (a[1] - a[0]) / dt if holds[k] == "foh" else 0.0 * a[0]
+                 for k, a in inputs.items()}
         held = Held(start, slope)
         out, _ = integrate(field, z, lambda t, y, s, h: (held, s), None, 0.0, dt, 1,
                            simulator, substeps, lambda y, _: y, emit="end")
@@ -221,17 +233,17 @@ def _interval_map(model, substeps, holds):
 
 
 def _measure(model, channels):
+    index = [model.channel_index(c) for c in channels]
+
     def h(z):
-        out = {"psi": z[-1], "r": model.output(z[:-1])}
-        return jnp.stack([out[c] for c in channels])
+        return jnp.stack([model.measure(c, z[i]) for c, i in zip(channels, index)])
 
     return h
 
 
-def _filter(model, delta, aux, y, mask, dt, z0, P0, Q, q_rudder, R, channels, substeps,
-            holds):
-    """The EKF over one record (module docstring); `delta`, `aux` leaves, `mask`: (N,);
-    `y`: (N, C). Returns a `KalmanOutput`."""
+def _filter(model, inputs, y, mask, dt, z0, P0, Q, q_rudder, R, channels, substeps, holds):
+    """The EKF over one record (module docstring); `inputs` `{name: (N,)}`, `mask`:
+    (N,); `y`: (N, C). Returns a `KalmanOutput`."""
     F = _interval_map(model, substeps, dict(holds))
     h = _measure(model, channels)
     jac = jax.jacfwd(F, argnums=(0, 1))
@@ -240,9 +252,9 @@ def _filter(model, delta, aux, y, mask, dt, z0, P0, Q, q_rudder, R, channels, su
 
     def step(carry, inputs):
         z, P = carry
-        d, a, yk, mk = inputs
-        A, B = jac(z, 0.0, d, a, dt)
-        z_pred = F(z, 0.0, d, a, dt)
+        d, yk, mk = inputs
+        A, B = jac(z, 0.0, d, dt)
+        z_pred = F(z, 0.0, d, dt)
         P_pred = A @ P @ A.T + Q + q_rudder * jnp.outer(B, B)
         P_pred = 0.5 * (P_pred + P_pred.T)
         H = jax.jacfwd(h)(z_pred)
@@ -263,8 +275,8 @@ def _filter(model, delta, aux, y, mask, dt, z0, P0, Q, q_rudder, R, channels, su
         return (z_new, P_new), out
 
     pairs = lambda v: jnp.stack([v[:-1], v[1:]], axis=-1)  # (N - 1, 2): each interval's ends
-    inputs = (pairs(delta), jax.tree.map(pairs, aux), y[1:], mask[1:])
-    _, (zp, Pp, zf, Pf, e, S, A, nll) = jax.lax.scan(step, (z0, P0), inputs)
+    scanned = (jax.tree.map(pairs, inputs), y[1:], mask[1:])
+    _, (zp, Pp, zf, Pf, e, S, A, nll) = jax.lax.scan(step, (z0, P0), scanned)
     first = lambda a0, a: jnp.concatenate([a0[None], a])
     c = y.shape[1]
     S0 = _measure_cov0(model, channels, z0, P0, R)
@@ -305,11 +317,11 @@ def _smooth(out: KalmanOutput):
 
 
 class _Records(eqx.Module):
-    """A dataset as arrays for the filter: `delta`, `aux` leaves, `mask`: (E, N);
-    `y`: (E, N, C); `dt`: (E,); `start`: `WindowStart` of sample 0, leaves (E,)."""
+    """A dataset as arrays for the filter: `inputs` `{name: (E, N)}` (`REPLAYED`),
+    `mask`: (E, N); `y`: (E, N, C); `dt`: (E,); `start`: `WindowStart` of sample 0,
+    leaves (E,)."""
 
-    delta: jax.Array
-    aux: AuxInputs
+    inputs: dict
     y: jax.Array
     mask: jax.Array
     dt: jax.Array
@@ -325,42 +337,42 @@ def _records(ds, channels, rudder, substeps, hold=None) -> _Records:
     zero = jnp.zeros(ds.num_experiments)
     start = WindowStart(r=first("r"), psi=first("psi"), delta=first(rudder), r_first=first("r"),
                         psi_first=first("psi"), delta_integral=zero, elapsed=zero,
-                        aux=AuxInputs(u=first("u"), v=first("v"), n=first("n")))
+                        aux=AuxInputs(u=first("u"), v=first("v"), n=first("n")),
+                        rudder_angle=first("delta"), x=first("x"), y=first("y"))
     return _Records(
-        delta=f(getattr(ds, rudder)),
-        aux=AuxInputs(u=f(ds.u), v=f(ds.v), n=f(ds.n)),
+        inputs={name: f(getattr(ds, rudder if name == "delta" else name)) for name in REPLAYED},
         y=f(np.stack([np.asarray(getattr(ds, c)) for c in channels], axis=-1)),
         mask=jnp.asarray(np.asarray(ds.mask, dtype=bool)),
         dt=f(ds.dt), start=start, channels=tuple(channels), substeps=int(substeps),
-        holds=resolve_holds(rudder, hold, ("delta", "u", "v", "n")),
+        holds=resolve_holds(rudder, hold, REPLAYED),
     )
 
 
 def _prior(model, start, channels, R, P0):
-    """Prior of sample 0: the model's window state at the first sample and the measured
-    heading; covariance `P0`, or by default R on the measured entries (psi, and the
-    first state, r) and 0 on hidden states."""
-    z0 = jnp.concatenate([model.window_state(start), jnp.asarray(start.psi)[None]])
+    """Prior of sample 0: the state `fit` starts a window from at the first sample
+    (`replay_state`: a steering model's `window_state` and the measured heading; a
+    vessel's measured states); covariance `P0`, or by default R on the measured
+    entries and 0 on the others."""
+    z0 = model.replay_state(start)
     if P0 is not None:
         return z0, P0
-    n = z0.shape[0]
-    diag = jnp.zeros(n, dtype=z0.dtype)
+    diag = jnp.zeros(z0.shape[0], dtype=z0.dtype)
     for i, c in enumerate(channels):
-        diag = diag.at[n - 1 if c == "psi" else 0].set(R[i, i])
+        diag = diag.at[model.channel_index(c)].set(R[i, i])
     return z0, jnp.diag(diag)
 
 
 def _batch_filter(model, rec: _Records, Q, q_rudder, R, P0=None):
     """The EKF of every record (vmapped): a `KalmanOutput` with a leading axis E."""
 
-    def one(delta, aux, y, mask, dt, start):
+    def one(inputs, y, mask, dt, start):
         z0, p0 = _prior(model, start, rec.channels, R, P0)
-        return _filter(model, delta, aux, y, mask, dt, z0, p0, Q, q_rudder, R, rec.channels,
+        return _filter(model, inputs, y, mask, dt, z0, p0, Q, q_rudder, R, rec.channels,
                        rec.substeps, rec.holds)
 
     # plain vmap: reverse mode (the ML Hessian) of a scan inside shard_map fails in
     # jax 0.10 ("context mesh ... should match"); records are few, windows are many
-    return jax.vmap(one)(rec.delta, rec.aux, rec.y, rec.mask, rec.dt, rec.start)
+    return jax.vmap(one)(rec.inputs, rec.y, rec.mask, rec.dt, rec.start)
 
 
 @eqx.filter_jit
@@ -375,12 +387,15 @@ def _smooth_jit(model, rec, Q, q_rudder, R, P0):
     return out, zs, Ps
 
 
-def _check_inputs(model, data, channels, rudder, substeps):
-    """`(dataset, channels)` after checking the model, the channels and the data."""
-    if not isinstance(model, AbstractSteeringModel):
-        raise ValueError(f"`model` must be a jaxship AbstractSteeringModel, got "
+def _check_inputs(model, data, channels, rudder, substeps, *, vessels=True):
+    """`(dataset, channels)` after checking the model (a steering model, or with
+    `vessels` also a vessel), the channels and the data."""
+    kinds = (AbstractSteeringModel, AbstractVessel) if vessels else AbstractSteeringModel
+    if not isinstance(model, kinds):
+        raise ValueError(f"`model` must be a jaxship AbstractSteeringModel"
+                         f"{' or AbstractVessel' if vessels else ''}, got "
                          f"{type(model).__name__}.")
-    channels = _check_channels(channels)
+    channels = _check_channels(model, channels)
     if int(substeps) < 1:
         raise ValueError(f"`substeps` must be a positive integer, got {substeps}.")
     ds = as_dataset(data)
@@ -402,26 +417,28 @@ def _prepare(model, data, channels, rudder, substeps, process_noise, measurement
     return ds, rec, jnp.asarray(Q), jnp.asarray(q_rudder), jnp.asarray(R), P0
 
 
-def ekf(model: AbstractSteeringModel, experiment, *, process_noise, measurement_noise,
-        channels=KALMAN_CHANNELS, rudder: str = "delta", initial_covariance=None,
+def ekf(model: AbstractSteeringModel | AbstractVessel, experiment, *, process_noise,
+        measurement_noise, channels=KALMAN_CHANNELS, rudder: str = "delta", initial_covariance=None,
         substeps: int = 1, hold=None) -> KalmanOutput:
-    """Extended Kalman filter of a steering model over one measured record (module
-    docstring for the equations).
+    """Extended Kalman filter of a steering model or a vessel over one measured record
+    (module docstring for the equations).
 
     **Arguments:**
 
-    - `model`: any `AbstractSteeringModel` (parameter values as they are).
-    - `experiment`: a `jaxship.Experiment` (replayed rudder, measured psi and/or r).
-    - `process_noise`: dict `{name: variance}` over the augmented state
-      (`model.state_names` and `"psi"`, per sample interval) and `"rudder"` (variance
-      [rad^2] of a rudder-equivalent disturbance held over each interval), or an
-      (n, n) covariance matrix over the augmented state.
+    - `model`: any `AbstractSteeringModel` or `AbstractVessel` (parameter values as
+      they are).
+    - `experiment`: a `jaxship.Experiment` (replayed rudder, the measured channels).
+    - `process_noise`: dict `{name: variance}` over the state z (a steering model's
+      `state_names` and `"psi"`; a vessel's u, v, r, x, y, psi, delta, n; per sample
+      interval) and `"rudder"` (variance [rad^2] of a rudder-equivalent disturbance
+      held over each interval), or an (n, n) covariance matrix over z.
     - `measurement_noise`: dict `{channel: variance}`, variances in channel order, or a
       (C, C) covariance; positive definite.
-    - `channels`: measured outputs, `"psi"` [rad] and/or `"r"` [rad/s], unwrapped.
+    - `channels`: measured outputs, `"psi"` [rad] and/or `"r"` [rad/s], unwrapped; for a
+      vessel also `"u"`, `"v"` [m/s], `"x"`, `"y"` [m].
     - `rudder`: `"delta"` or `"delta_c"`.
-    - `initial_covariance`: $P_0$ (n, n) of the prior at sample 0 (default: R on psi and
-      r, 0 on hidden states).
+    - `initial_covariance`: $P_0$ (n, n) of the prior at sample 0 (default: R on the
+      measured states, 0 on the others).
     - `substeps`: RK4 steps per sample interval.
     - `hold`: how the recorded inputs are replayed between samples, as
       `PredictionError(hold=...)`.
@@ -464,9 +481,10 @@ class SmoothedStates(eqx.Module):
         return np.sqrt(np.maximum(self.covariance[:, i, i], 0.0))
 
 
-def smooth_states(model: AbstractSteeringModel, data, *, process_noise, measurement_noise,
-                  channels=KALMAN_CHANNELS, rudder: str = "delta", initial_covariance=None,
-                  substeps: int = 1, hold=None) -> list[SmoothedStates]:
+def smooth_states(model: AbstractSteeringModel | AbstractVessel, data, *, process_noise,
+                  measurement_noise, channels=KALMAN_CHANNELS, rudder: str = "delta",
+                  initial_covariance=None, substeps: int = 1, hold=None
+                  ) -> list[SmoothedStates]:
     """Smoothed states (EKF + RTS smoother) of every experiment of `data` (an
     `Experiment`, a list of them or a `Dataset`), e.g. for the start states of
     prediction windows or for residual forces. Arguments as `ekf`; the noise is

@@ -272,7 +272,7 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
     """
     if criterion not in ("ml", "pem"):
         raise ValueError(f"`criterion` must be 'ml' or 'pem', got {criterion!r}.")
-    ds, channels = _check_inputs(model, dataset, channels, rudder, substeps)
+    ds, channels = _check_inputs(model, dataset, channels, rudder, substeps, vessels=False)
     specs = resolve_free(model, free)
     transform = Transform.from_specs(specs)
     layout, z_noise = _noise_layout(model, ds, channels, process, noise, noise_start, criterion)

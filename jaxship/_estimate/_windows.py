@@ -205,8 +205,9 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
                   wind: bool = False):
     """`(Windows, layout)`; `layout` holds the NumPy index arrays to map window
     predictions back onto the samples: `target` (E, W, L) sample index, `mask`.
-    `starts`: optional `{"r": (E, N), "psi": (E, N)}` start values of the windows in
-    place of the measured ones (e.g. smoothed states); targets stay measured. `hold`:
+    `starts`: optional `{"r": (E, N), "psi": (E, N)}` (and `"u"`, `"v"`) start values of
+    the windows in place of the measured ones (e.g. smoothed states); targets stay
+    measured. `hold`:
     see `resolve_holds`; `wind`: also replay the measured wind, and the apparent wind
     it makes (`apparent_wind`) for steering models."""
     lengths = window_lengths(ds, horizon)
@@ -265,7 +266,7 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
         psi_first=f(first("psi")),
         delta_integral=f(integral[rows2, start_index]),
         elapsed=f(start_index * dt_e[:, None]),
-        aux=AuxInputs(*(f(at(c, start_index, rows2)) if c in names else None
+        aux=AuxInputs(*(f(start_at(c, start_index, rows2)) if c in names else None
                         for c in ("u", "v", "n", "wind_u", "wind_v"))),
         rudder_angle=f(at("delta", start_index, rows2)),
         x=f(at("x", start_index, rows2)), y=f(at("y", start_index, rows2)),

@@ -8,7 +8,7 @@ import numpy as np
 from ..._estimate._fit import PredictionError
 from ..._estimate._predict import predict
 from ..._estimate._windows import as_dataset
-from ._forces import LOADS, residual_loads
+from ._forces import LOADS, residual_loads, smoothed_vessel_states
 
 
 # state regions, each a mask over samples from the measured signals (thresholds as
@@ -76,17 +76,23 @@ def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 6
       `_signals` (largest over lags of up to 10 % of a record), against the 95 % band
       $1.96/\\sqrt{N}$ of independent series; `whiteness`: the fraction of residual
       autocorrelations (lags 1-25) outside that band.
-    - `forces` (vessels on records with u, v and r; else None): the residual loads X,
-      Y, N the model lacks (`residual_loads`: $M\\dot\\nu - \\tau$ from the smoothed
-      measured states), each with its mean and RMS [N, N m], its means while turning
-      to starboard and to port, and the signals it follows.
+    - `forces` (vessels on records with u, v and r, or psi, r, u and the track x, y;
+      else None): the residual loads X, Y, N the model lacks (`residual_loads`:
+      $M\\dot\\nu - \\tau$ from the smoothed measured states, or without a logged v
+      the vessel's EKF + RTS smoothed states, from which the simulations then also
+      start), each with its mean and RMS [N, N m], its means while turning to
+      starboard and to port, and the signals it follows.
 
     `wind`: replay the logged wind (for a model with wind loads).
     """
     ds = as_dataset(data)
     channels = tuple(c for c in channels if all(c in h for h in ds.experiment_channels))
-    out = predict(model, ds, estimator=PredictionError(horizon=None, channels=channels,
-                                                       wind=wind))
+    vessel = hasattr(model, "mass_matrix")
+    smoothed = (smoothed_vessel_states(model, ds) if vessel and not all(
+        "v" in h for h in ds.experiment_channels) else None)
+    out = predict(model, ds, estimator=PredictionError(
+        horizon=None, channels=channels, wind=wind,
+        initial="measured" if smoothed is None else smoothed))
     fit = out.fit_per_experiment()
     res, sig, reg = {c: [] for c in channels}, {}, {}
     records, windows = {}, {}
@@ -145,7 +151,7 @@ def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 6
         per_record = np.split(e, ends)
         correlations[c] = {k: _largest_correlation(per_record, sig[k], ds) for k in sig}
         whiteness[c] = _outside_band(per_record, band)
-    loads = residual_loads(model, ds, wind=wind) if hasattr(model, "mass_matrix") else None
+    loads = residual_loads(model, ds, wind=wind, smoothed=smoothed) if vessel else None
     forces = None if loads is None else {
         name: _describe_load(loads[name], sig, ds, unit) for name, unit in LOADS}
     return {"records": records, "windows": windows, "regions": regions, "sides": sides,
