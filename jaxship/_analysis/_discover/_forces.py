@@ -9,8 +9,8 @@ Savitzky & Golay 1964). Where u, v and r are all logged, every state is measured
 the smoother of each channel is the smoothed state. Where v is not logged but psi, r, u
 and the track x, y are, the velocities are the vessel's smoothed states (`jaxship.smooth_states`:
 EKF and RTS smoother of the vessel measuring those; the track makes the drift
-observable), with a process noise that lets them leave the model's
-prediction by about 1 cm/s per second (`ACCELERATION_NOISE`): the missing loads move
+observable), with a process noise that lets them leave the model's prediction as a
+random walk of 2e-4 (m/s)^2 per second (`ACCELERATION_NOISE`): the missing loads move
 the states, so a filter that trusted the model would hide them.
 """
 
@@ -82,10 +82,10 @@ def residual_loads(vessel, data, *, smoothing: float = 10.0, wind: bool = False,
     mass = np.asarray(vessel.mass_matrix())
     out = {name: [] for name, _ in LOADS}
     logged = all({"u", "v", "r"} <= set(have) for have in ds.experiment_channels)
-    if not logged and smoothed is None:
-        smoothed = smoothed_vessel_states(vessel, ds, smoothing=smoothing)
-    if not logged and smoothed is None:
-        return None
+    if not logged:
+        smoothed = smoothed or smoothed_vessel_states(vessel, ds, smoothing=smoothing)
+        if smoothed is None:
+            return None
     for e in range(ds.num_experiments):
         n, dt = int(ds.lengths[e]), float(ds.dt[e])
         span = _span(smoothing, dt)
