@@ -14,6 +14,8 @@ import pytest
 
 import jaxship as js
 from jaxship._analysis._discover._holdout import cost_rise
+from jaxship._analysis._discover._plausible import rudder_equivalent
+from jaxship._estimate._windows import as_dataset
 from jaxship.cli import main
 from jaxship.studies.discovery import (
     hidden_effect_records,
@@ -92,6 +94,55 @@ def test_the_held_out_rise_and_its_standard_error_over_stretches():
     assert cost_rise(before, before, 60.0) == (0.0, 0.0)
 
 
+def test_an_effect_in_family_units_is_sized_as_the_rudder_angle_of_its_loads():
+    """$N_0/K$, $\\lVert\\beta r|r|\\rVert/(K\\sqrt N)$ and a propeller race's
+    $\\lVert b n^2\\delta\\rVert/((K + bn^2)\\sqrt N)$ on Nomoto 1; on a vessel the
+    yaw moment over the rudder's $\\partial N/\\partial\\delta$ (central difference of
+    the vessel's own forces)."""
+    rng = np.random.default_rng(0)
+    num = 400
+    delta = 10 * DEG * np.sign(np.sin(np.arange(num) / 30.0) + 1e-9)
+    r = rng.normal(0.0, 0.01, num)
+    data = as_dataset(js.Experiment(np.arange(num) * 0.5, delta, psi=np.zeros(num), r=r,
+                                    u=np.full(num, 5.0), n=np.full(num, 1.5)))
+    model = js.augment(js.Nomoto1(K=K, T=25.0), js.YawMomentBias(n0=0.2 * K),
+                       js.YawQuadraticDamping(beta=50.0))
+    assert rudder_equivalent(model, "yaw_moment_bias", data) == pytest.approx(0.2, rel=1e-12)
+    quadratic = np.linalg.norm(50.0 * r * np.abs(r)) / (K * np.sqrt(num))
+    assert rudder_equivalent(model, "yaw_quadratic_damping", data) == pytest.approx(
+        quadratic, rel=1e-12)
+    # a race's share of the rudder force against the rudder's gain with it: at most delta
+    race = js.augment(js.Nomoto1(K=K, T=25.0), js.PropellerRace(gain=0.04))
+    share = 0.04 * 1.5**2
+    assert rudder_equivalent(race, "propeller_race", data) == pytest.approx(
+        share * np.linalg.norm(delta) / ((K + share) * np.sqrt(num)), rel=1e-12)
+    mariner = js.get_vessel("mariner")
+    u0 = float(mariner.nominal_speed)
+    straight = as_dataset(js.Experiment(np.arange(num) * 0.5, np.zeros(num), psi=np.zeros(num),
+                                        r=np.zeros(num), u=np.full(num, u0), v=np.zeros(num),
+                                        n=np.full(num, float(js.straight_run(mariner).n))))
+    n_delta = np.diff([float(mariner.forces(u0, 0.0, 0.0, d, straight.n[0, 0])[2])
+                       for d in (-1e-6, 1e-6)])[0] / 2e-6
+    vessel = js.augment(mariner, js.YawMomentBias(n0=3e6))
+    assert rudder_equivalent(vessel, "yaw_moment_bias", straight) == pytest.approx(
+        3e6 / abs(n_delta), rel=1e-5)
+
+
+def test_an_implausibly_large_constant_moment_is_not_named():
+    """A yaw moment worth 10 deg of rudder is no hidden asymmetry (the rudder offset's
+    range is 5.7 deg): refitted, it fails the plausibility gate; one worth 1 deg passes."""
+    only = tuple(c for c in js.DISCOVERY_CATALOGUE if c.id == "yaw_moment_bias")
+    for angle, named in ((10 * DEG, False), (1 * DEG, True)):
+        report = run_case((js.YawMomentBias(n0=K * angle),), 3, catalogue=only,
+                          max_effects=1)[0]
+        assert (report.verdict == "missing_effect") is named, report.to_markdown()
+        record = (report.effects or report.rejected)[0]
+        assert record["rudder_equivalent_deg"] == pytest.approx(np.degrees(angle), rel=0.1)
+        if not named:
+            assert any("deg of rudder, beyond the plausible 5.7 deg" in why
+                       for why in record["why"]), record
+
+
 def test_a_rudder_offset_is_named_with_its_class_and_the_gap_shrinks():
     report = run(js.RudderOffset(delta0=0.5 * DEG), seed=3)
     assert report.verdict == "missing_effect" and len(report.effects) == 1
@@ -160,6 +211,23 @@ def test_every_vessel_effect_is_named(effect):
     train, holdout = vessel_records(truth, 0)
     report = js.discover(js.vessel("mariner"), train, holdout)
     assert outcome(report, (effect.id,)) == "correct", report.to_markdown()
+    assert report.holdout_cost_after < report.holdout_cost_before
+
+
+@pytest.mark.slow
+def test_a_vessel_effect_is_named_from_records_without_a_logged_drift():
+    """The Mariner records of the test above with a hidden 30 kN sway force and no v
+    logged (psi, r, u and the GNSS track): discover fits the channels logged, starts
+    every window from the vessel's states smoothed from them, and names the force."""
+    truth = js.augment(js.vessel("mariner"), js.SwayForceBias(y0=3e4))
+    drop = lambda e: js.Experiment(e.t, e.delta, psi=e.psi, r=e.r, u=e.u, x=e.x, y=e.y,
+                                   n=e.n, name=e.name)
+    train, holdout = ([drop(e) for e in records] for records in vessel_records(truth, 0))
+    report = js.discover(js.vessel("mariner"), train, holdout)
+    assert report.channels == ("psi", "r", "u", "x", "y")
+    assert outcome(report, ("sway_force_bias",)) == "correct", report.to_markdown()
+    force = report.effects[0]["parameters"]["sway_force_bias.y0"]
+    assert abs(force["value"] - 3e4) < 4 * force["std"], force
     assert report.holdout_cost_after < report.holdout_cost_before
 
 

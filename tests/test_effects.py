@@ -108,6 +108,21 @@ def test_fit_recovers_a_rudder_lag_on_a_steering_model():
         assert values[name] == pytest.approx(value, rel=1e-3), name
 
 
+
+def test_a_model_augmented_with_no_effects_fits_as_its_base():
+    """`augment(model)` with nothing added is the base, in `fit` too (the parameter
+    lookup once failed on the empty effects tuple)."""
+    delta = 10 * DEG * np.sign(np.sin(2 * np.pi * np.arange(400) / 160.0) + 1e-9)
+    delta[0] = 0.0
+    out = js.simulate_steering(js.Nomoto1(K=K, T=T), delta, 0.5)
+    data = js.Experiment(np.asarray(out.t), delta, psi=np.asarray(out.psi), r=np.asarray(out.r))
+    estimator = js.PredictionError(horizon=None)
+    start = js.Nomoto1(K=0.05, T=20.0)
+    plain = js.fit(start, data, estimator=estimator)
+    augmented = js.fit(js.augment(start), data, estimator=estimator)
+    np.testing.assert_allclose(augmented.values, plain.values, rtol=1e-10)
+    assert augmented.values == pytest.approx([K, T], rel=1e-6)
+
 def test_nonlinear_nomoto2_is_nomoto2_with_cubic_damping():
     """Lu & Zhao (2008, eq. 4) in the states of `Nomoto2`: $\\dot r_{aux} = K(\\delta
     + \\delta_0) - r - \\beta_1 r^3$, $\\dot r$ as `Nomoto2`."""

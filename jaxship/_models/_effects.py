@@ -291,7 +291,8 @@ class _Augmented(eqx.Module):
 
     def lookup(self, name: str):
         """The base's field `name`, or the effect with the id `name`."""
-        for effect in self.effects:
+        # `eqx.tree_at` wraps an empty `effects` tuple while it looks paths up
+        for effect in self.effects if isinstance(self.effects, tuple) else ():
             if effect.id == name:
                 return effect
         return getattr(self.base, name)

@@ -40,6 +40,7 @@ from ..._models._hydro_effects import (
 )
 from ..._models._steering._base import AbstractSteeringModel
 from ..._models._vessel._base import AbstractVessel
+from ._plausible import HARD_OVER
 
 
 @dataclasses.dataclass(frozen=True)
@@ -50,13 +51,16 @@ class Candidate:
     `probes(model, data)` `{field: value}` for parameters scored by a secant to that
     value (parameters bounded at zero, or switched off below a threshold, have no
     useful derivative there); `separate`: the experiment that tells it apart from the
-    effects it resembles."""
+    effects it resembles; `rudder_range`: for effects whose parameters have family
+    units (no bounds), the largest plausible rudder-equivalent angle [rad] of their
+    loads (`rudder_equivalent`)."""
 
     id: str
     name: str
     make: Callable
     probes: Callable = lambda model, data: {}
     separate: str = ""
+    rudder_range: float | None = None
 
 
 def _is(model, family):
@@ -126,6 +130,10 @@ SPEEDS = ("runs at two speeds or rpm: a rudder offset's moment scales with the r
 STEADY_TURNS = ("steady turns over a wide range of yaw rate and rudder angle (turning "
                 "circles at several angles) tell r|r| from r^3, and transients at peak "
                 "rudder (stall) from those at peak yaw rate (damping)")
+# a constant load needing more rudder than the rudder offset's range (5.7 deg) to hold
+# a course is no hidden asymmetry; a damping, race or wind load beyond hard over would
+# have left the ship unsteerable
+BIAS_RANGE = 0.1
 RUDDER_STEPS = ("rudder steps of different sizes and fast reversals: a lag's or delay's "
                 "timing is the same for every step, a rate limit's grows with the step")
 
@@ -133,26 +141,29 @@ DISCOVERY_CATALOGUE = (
     Candidate("rudder_offset", "rudder zero offset (indicator error or hull asymmetry)",
               _simple(RudderOffset, *BOTH), separate=SPEEDS),
     Candidate("yaw_moment_bias", "constant yaw moment (hull or appendage asymmetry)",
-              _simple(YawMomentBias, *BOTH), separate=SPEEDS),
+              _simple(YawMomentBias, *BOTH), separate=SPEEDS, rudder_range=BIAS_RANGE),
     Candidate("propeller_asymmetry", "propeller-induced yaw moment (single screw)",
-              _propeller_asymmetry, separate=SPEEDS),
+              _propeller_asymmetry, separate=SPEEDS, rudder_range=BIAS_RANGE),
     Candidate("propeller_race", "rudder in the propeller race (inflow from rpm)",
               _propeller_race,
               separate="runs at several rpm and at low or changing speed: the race's rudder "
-                       "force grows with rpm squared, a rudder gain does not"),
+                       "force grows with rpm squared, a rudder gain does not",
+              rudder_range=HARD_OVER),
     Candidate("sway_force_bias", "constant sway force", _simple(SwayForceBias, *VESSEL),
-              separate="measured sway velocity on straight legs"),
+              separate="measured sway velocity on straight legs", rudder_range=BIAS_RANGE),
     Candidate("current", "uniform current", _simple(UniformCurrent, *VESSEL),
               separate="GNSS tracks on several headings: a current drifts each the same "
                        "earth-fixed way, a compass bias sets it off to one side of the heading"),
     Candidate("wind", "wind loads (windage the model lacks)", _wind, probes=_wind_probes,
-              separate="runs at several headings to the wind"),
+              separate="runs at several headings to the wind", rudder_range=HARD_OVER),
     Candidate("crossflow_drag", "cross-flow drag of the hull", _simple(CrossflowDrag, *VESSEL),
               probes=lambda model, data: {"coefficient": 0.02}, separate=STEADY_TURNS),
     Candidate("yaw_quadratic_damping", "quadratic yaw damping r|r|",
-              _simple(YawQuadraticDamping, *BOTH), separate=STEADY_TURNS),
+              _simple(YawQuadraticDamping, *BOTH), separate=STEADY_TURNS,
+              rudder_range=HARD_OVER),
     Candidate("yaw_cubic_damping", "cubic yaw damping r^3 (Norrbin)",
-              _simple(YawCubicDamping, *BOTH), separate=STEADY_TURNS),
+              _simple(YawCubicDamping, *BOTH), separate=STEADY_TURNS,
+              rudder_range=HARD_OVER),
     Candidate("speed_dependent_rudder", "rudder force changing with inflow speed",
               _speed_dependent_rudder,
               separate="turning circles (speed loss) or runs at several speeds"),

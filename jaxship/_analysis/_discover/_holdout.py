@@ -10,7 +10,8 @@ from ..._estimate._windows import as_dataset
 from .._indices import turning_indices, zigzag_indices
 
 
-def holdout_check(model, holdout, channels, wind: bool = False, window=None) -> dict:
+def holdout_check(model, holdout, channels, wind: bool = False, window=None,
+                  initial="measured") -> dict:
     """Output-error predictions of `holdout` by `model` (with the logged wind replayed
     if `wind`): `cost` (half the sum of squared residuals, each channel divided by the
     standard deviation of its measured record, so models compare on one scale),
@@ -19,14 +20,16 @@ def holdout_check(model, holdout, channels, wind: bool = False, window=None) -> 
     and `mask`). Positions x, y are predicted over `window`-second stretches from
     the measured state (None: whole records too): over a whole record a position
     integrates every heading error before it, which the heading's own residual
-    already counts, while a window shows the drift a current or a heading bias makes."""
+    already counts, while a window shows the drift a current or a heading bias makes.
+    `initial`: where predictions start (`PredictionError.initial`: smoothed states
+    where a vessel's records lack v)."""
     ds = as_dataset(holdout)
     tracks = tuple(c for c in channels if c in ("x", "y") and window is not None)
     parts = [(None, tuple(c for c in channels if c not in tracks)), (window, tracks)]
     fit, filled, terms = {}, {}, np.zeros(ds.mask.shape)
     for horizon, group in (part for part in parts if part[1]):
         out = predict(model, ds, estimator=PredictionError(horizon=horizon, channels=group,
-                                                           wind=wind))
+                                                           wind=wind, initial=initial))
         fit.update(out.fit_percent())
         for c in group:
             measured = np.asarray(getattr(ds, c), dtype=np.float64)
@@ -118,7 +121,7 @@ def holdout_indices(holdout, before: dict, after: dict) -> dict:
 
         def indices(source, u=u, v=v):
             psi = np.asarray(source["psi"][i, :n]) if source else np.asarray(ds.psi[i, :n])
-            if source and "u" in source:
+            if source and "u" in source and "v" in source:
                 u, v = np.asarray(source["u"][i, :n]), np.asarray(source["v"][i, :n])
             return record_indices(t, delta, psi, u, v)
 

@@ -12,8 +12,10 @@ class DiscoveryReport(eqx.Module):
       `parameters` (`{name: {value, std, unit}}`, robust standard errors), `score`
       (robust score statistic), `score_naive`, `likelihood_ratio` (robust),
       `p_value`, `delta_bic`, `equivalent_to` (`[{id, separate}]`: candidates these
-      data cannot tell apart from it, with the experiment that would) and
-      `holdout_cost`;
+      data cannot tell apart from it, with the experiment that would),
+      `holdout_cost` and `rudder_equivalent_deg` (for effects whose parameters have
+      family units: the rudder angle whose loads match the effect's, the size its
+      plausible range bounds; None for others);
     - `rejected`: candidates refitted or scored that did not pass, with `why` (a
       joint step's set as one entry, its ids joined by "+");
     - an effect accepted by the joint step (effects too weak alone that pass together)

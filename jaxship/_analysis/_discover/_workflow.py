@@ -14,10 +14,12 @@ One iteration (design: ../shared/reference/discovery-design.md, sec. 4):
    exceed the chi-square quantile at `alpha / ((m + 1) K)` (Bonferroni over the m
    candidates, one joint test and K = `max_effects` iterations); its robust
    confidence interval at the same level excludes zero; its estimate lies in the
-   parameter's plausible range, and the refit pushes no base parameter onto the edge
-   of its range; and the held-out cost does not rise beyond the spread a disturbance
-   gives it (`cost_rise`: more than `HELDOUT_Z` standard errors over stretches of the
-   estimator's horizon; without such spread it must fall). The held-out check vetoes
+   parameter's plausible range (for parameters with family units: its loads as a
+   rudder angle, `rudder_equivalent`, within the entry's `rudder_range`), and the
+   refit pushes no base parameter onto the edge of its range; and the held-out cost
+   does not rise beyond the spread a disturbance gives it (`cost_rise`: more than
+   `HELDOUT_Z` standard errors over stretches of the estimator's horizon; without
+   such spread it must fall). The held-out check vetoes
    but does not choose: no candidate is accepted while a rival that lowers the
    training cost more fails on the held-out runs alone;
 4. where no single candidate passes, effects too weak alone may pass together: a
@@ -43,8 +45,10 @@ from ..._estimate._windows import as_dataset
 from ..._foundation._params import default_free, parameter_fields, rebuild
 from ..._models._effects import augment
 from ._catalogue import DISCOVERY_CATALOGUE, applicable
+from ._forces import smoothed_vessel_states
 from ._holdout import cost_rise, holdout_check, holdout_indices
 from ._locate import locate_disagreement
+from ._plausible import rudder_equivalent
 from ._report import DiscoveryReport
 from ._score import (
     canonical_correlation,
@@ -100,6 +104,17 @@ def _at_edge(result, names) -> tuple[str, ...]:
         return lower + edge < values[n] < upper - edge
 
     return tuple(n for n in names if not inside(n))
+
+
+def _rudder_size(result, candidate, names, data, wind):
+    """`(rudder-equivalent angle, its plausible limit)` [rad] of a candidate whose
+    parameters have family units (no bounds) and a `rudder_range`; None for others
+    (their parameters' own ranges apply)."""
+    fields = parameter_fields(result.model)
+    unbounded = all(math.isinf(fields[n].lower) and math.isinf(fields[n].upper) for n in names)
+    if candidate.rudder_range is None or not unbounded:
+        return None
+    return rudder_equivalent(result.model, candidate.id, data, wind), candidate.rudder_range
 
 
 def _points_outside(model, names, step) -> bool:
@@ -161,10 +176,21 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
     logs = lambda d, *names: all(set(names) <= set(c) for c in d.experiment_channels)
     windy = estimator.wind or logs(data, "wind_speed", "wind_dir")
     held_windy = held is not None and logs(held, "wind_speed", "wind_dir")
-    if (estimator.channels is None and _has_output(model, "x") and logs(data, "x", "y")
-            and (held is None or logs(held, "x", "y"))):
-        # a vessel on records with positions (GNSS) fits its track too: a current shows
-        estimator = dataclasses.replace(estimator, channels=model.default_channels + ("x", "y"))
+    everywhere = lambda c: logs(data, c) and (held is None or logs(held, c))
+    if estimator.channels is None and _has_output(model, "x"):
+        # a vessel fits the channels every record logs, and on records with positions
+        # (GNSS) its track too: a current shows
+        channels = tuple(c for c in model.default_channels + ("x", "y") if everywhere(c))
+        estimator = dataclasses.replace(estimator, channels=channels)
+    held_start = "measured"
+    if _has_output(model, "v") and not everywhere("v") and isinstance(estimator.initial, str):
+        # a vessel's windows start from its states smoothed from psi, r, u and the track
+        smoothed = [smoothed_vessel_states(model, d) for d in (data, held) if d is not None]
+        if any(s is None for s in smoothed):
+            raise ValueError("records without a measured sway velocity v need psi, r, u and "
+                             "the track x, y logged (the drift is smoothed from them).")
+        estimator = dataclasses.replace(estimator, initial=smoothed[0])
+        held_start = smoothed[-1]
 
     def loss(m):
         """The estimator for model `m`: the logged wind replayed where `m` feels it."""
@@ -172,7 +198,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
 
     def check(m):
         return holdout_check(m, holdout, channels, wind=bool(held_windy and m.wind_loads),
-                             window=estimator.horizon)
+                             window=estimator.horizon, initial=held_start)
 
     say("fitting the base model")
     base_fit = _quiet_fit(model, train, estimator=loss(model), free=free)
@@ -242,6 +268,12 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             edge = _at_edge(trial, free + tuple(n for n in theta if not _at_edge(current, (n,))))
             if edge:
                 why.append(f"at or beyond the edge of the plausible range: {', '.join(edge)}")
+            sizes = {k: _rudder_size(trial, entry[k][0], names[k], data, loss(trial.model).wind)
+                     for k in keys}
+            for k, size in sizes.items():
+                if size and size[0] > size[1]:
+                    why.append(f"{k}'s loads equal {np.degrees(size[0]):.1f} deg of rudder, "
+                               f"beyond the plausible {np.degrees(size[1]):.1f} deg")
             after = check(trial.model) if holdout else None
             others = len(why)
             if holdout:
@@ -258,6 +290,8 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                       "holdout_cost": after["cost"] if holdout else None}
             records = [{"id": k, "name": entry[k][0].name, "iteration": iteration + 1,
                         "parameters": params[k], **shared,
+                        "rudder_equivalent_deg": (float(np.degrees(sizes[k][0])) if sizes[k]
+                                                  else None),
                         "equivalent_to": [{"id": j, "separate": entry[j][0].separate}
                                           for j in classes[k]]}
                        | ({"jointly_with": [j for j in keys if j != k]} if len(keys) > 1 else {})
@@ -312,7 +346,9 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                     shared = {key: value for key, value in records[0].items()
                               if key not in ("equivalent_to", "jointly_with")}
                     rejected.append(shared | group | {"parameters": {
-                        n: p for r in records for n, p in r["parameters"].items()}})
+                        n: p for r in records for n, p in r["parameters"].items()},
+                        "rudder_equivalent_deg": {r["id"]: r["rudder_equivalent_deg"]
+                                                  for r in records}})
                 else:
                     passed.append((records, trial, after))
         if not passed:
