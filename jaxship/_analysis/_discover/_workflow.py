@@ -19,9 +19,9 @@ One iteration (design: ../shared/reference/discovery-design.md, sec. 4):
    refit pushes no base parameter onto the edge of its range; and the held-out cost
    does not rise beyond the spread a disturbance gives it (`cost_rise`: more than
    `HELDOUT_Z` standard errors over stretches of the estimator's horizon; without
-   such spread it must fall). The held-out check vetoes
-   but does not choose: no candidate is accepted while a rival that lowers the
-   training cost more fails on the held-out runs alone;
+   such spread it must fall). The held-out check vetoes but does not choose: no
+   candidate is accepted while a rival that lowers the training cost more fails on
+   the held-out runs alone;
 4. where no single candidate passes, effects too weak alone may pass together: a
    forward search on the conditional scores (`forward_path`) picks up to `top`, and
    their union is refitted and judged by the same gates, its threshold simulated
@@ -160,8 +160,10 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
       so that the noise of a start sample does not run through its window); `free`:
       the base parameters fitted (default the model's). Where every training record
       logs the wind, models that feel it (vessels; steering models with the `wind`
-      candidate) replay it; a vessel on records that all log positions fits x and y
-      as well (where a current shows).
+      candidate) replay it; a vessel fits the channels every record logs, x and y
+      as well where they are (a current shows there), and where v is not logged its
+      windows and held-out predictions start from its states smoothed from psi, r, u
+      and the track (`smoothed_vessel_states`).
     - `max_effects`: most effects added; `alpha`: family-wise false-alarm rate over
       candidates and iterations; `top`: classes refitted per iteration;
       `equivalence`: canonical correlation above which candidates are one class.
