@@ -207,9 +207,8 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
     predictions back onto the samples: `target` (E, W, L) sample index, `mask`.
     `starts`: optional `{"r": (E, N), "psi": (E, N)}` (and `"u"`, `"v"`) start values of
     the windows in place of the measured ones (e.g. smoothed states); targets stay
-    measured. `hold`:
-    see `resolve_holds`; `wind`: also replay the measured wind, and the apparent wind
-    it makes (`apparent_wind`) for steering models."""
+    measured. `hold`: see `resolve_holds`; `wind`: also replay the measured wind, and
+    the apparent wind it makes (`apparent_wind`) for steering models."""
     lengths = window_lengths(ds, horizon)
     num_exp, num = ds.num_experiments, ds.num_samples
     counts = [len(range(0, n - 1, L)) for n, L in zip(ds.lengths, lengths)]

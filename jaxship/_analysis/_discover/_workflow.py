@@ -179,13 +179,14 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
     windy = estimator.wind or logs(data, "wind_speed", "wind_dir")
     held_windy = held is not None and logs(held, "wind_speed", "wind_dir")
     everywhere = lambda c: logs(data, c) and (held is None or logs(held, c))
-    if estimator.channels is None and _has_output(model, "x"):
+    vessel = _has_output(model, "x")  # steering models have no track
+    if estimator.channels is None and vessel:
         # a vessel fits the channels every record logs, and on records with positions
         # (GNSS) its track too: a current shows
         channels = tuple(c for c in model.default_channels + ("x", "y") if everywhere(c))
         estimator = dataclasses.replace(estimator, channels=channels)
     held_start = "measured"
-    if _has_output(model, "v") and not everywhere("v") and isinstance(estimator.initial, str):
+    if vessel and not everywhere("v") and isinstance(estimator.initial, str):
         # a vessel's windows start from its states smoothed from psi, r, u and the track
         smoothed = [smoothed_vessel_states(model, d) for d in (data, held) if d is not None]
         if any(s is None for s in smoothed):
