@@ -229,8 +229,9 @@ nb.cells = [
         "        for name, v in r.get('parameters', {}).items():\n"
         "            print(f\"    {name} = {v['value']:.3g} +- {v['std']:.2g} {v['unit']}\")"),
     nbf.v4.new_markdown_cell(
-        "The same three terms fitted by hand (output error on r) and simulated over the "
-        "held-out runs; held-out fit % against the base model:"),
+        "The same three terms fitted by hand (output error on r), then with the two speed "
+        "exponents free too, and simulated over the held-out runs; held-out fit % against "
+        "the base model:"),
     nbf.v4.new_code_cell(
         "if HAVE['esso_osaka_frt']:\n"
         "    hand = esso_osaka_low_speed_steering(data)\n"
@@ -239,7 +240,7 @@ nb.cells = [
         "    fig, axes = plt.subplots(1, len(test), figsize=(11, 3))\n"
         "    for i, (ax, e) in enumerate(zip(axes, test)):\n"
         "        ax.plot(e.t, np.rad2deg(e.r), 'k', lw=0.8, label='measured')\n"
-        "        for m, colour in zip(hand.models, ('C3', 'C2')):\n"
+        "        for m, colour in zip(hand.models, ('C3', 'C2', 'C0')):\n"
         "            pred = m.validation['simulation'].predictions['r'][i, :e.t.size]\n"
         "            ax.plot(e.t, np.rad2deg(pred), colour, lw=1, label=m.label)\n"
         "        ax.set_title(e.name, fontsize=8)\n"

@@ -250,7 +250,10 @@ def esso_osaka_low_speed_steering(root=None, *, factor: int = 5) -> RealDataRepo
       together: the propeller race on the rudder (`PropellerRace`, $b n^2\\delta$),
       the logged apparent wind (`ApparentWind`) and quadratic yaw damping
       (`YawQuadraticDamping`). At 0.1-0.5 m/s in 1-4 m/s of wind, the race and the
-      wind carry rudder and yaw moments of the size the hull's speed gives.
+      wind carry rudder and yaw moments of the size the hull's speed gives;
+    - `+ speed exponents free`: the same with the two speed exponents $\\kappa$ of
+      `SpeedDependentRudder` and `SpeedDependentDamping` fitted too (1 and 1 above,
+      Nomoto's scaling).
     """
     train, test = esso_osaka_zigzag_split(root, factor=factor)
     base, free = _speed_scaled_nomoto(train)
@@ -259,13 +262,17 @@ def esso_osaka_low_speed_steering(root=None, *, factor: int = 5) -> RealDataRepo
     full = js.augment(fit0.model.base, *fit0.model.effects, js.PropellerRace(),
                       js.ApparentWind(), js.YawQuadraticDamping())
     windy = dataclasses.replace(est, wind=True)
-    fit1 = _quiet_fit(full, train, estimator=windy, free=free + (
-        "propeller_race.gain", "wind.c1", "wind.c2", "yaw_quadratic_damping.beta"))
+    terms = ("propeller_race.gain", "wind.c1", "wind.c2", "yaw_quadratic_damping.beta")
+    fit1 = _quiet_fit(full, train, estimator=windy, free=free + terms)
+    fit2 = _quiet_fit(fit1.model, train, estimator=windy, free=free + terms + (
+        "speed_dependent_rudder.kappa", "speed_dependent_damping.kappa"))
     shown = lambda e: dataclasses.replace(e, channels=("psi", "r"))
     models = (Identified("speed-scaled Nomoto 1 + offset", fit0,
                          _validate(fit0.model, test, shown(est), (None,))),
               Identified("+ race, wind, r|r|", fit1,
-                         _validate(fit1.model, test, shown(windy), (None,))))
+                         _validate(fit1.model, test, shown(windy), (None,))),
+              Identified("+ speed exponents free", fit2,
+                         _validate(fit2.model, test, shown(windy), (None,))))
     return RealDataReport("Esso Osaka FRT, zig-zag split", models,
                           tuple(e.name for e in train), tuple(e.name for e in test))
 
