@@ -142,6 +142,7 @@ from ._models._steering import (
     AbstractSteeringModel as AbstractSteeringModel,
     AuxInputs as AuxInputs,
     LinearSwayYaw as LinearSwayYaw,
+    LowSpeedSwayYaw as LowSpeedSwayYaw,
     Nomoto1 as Nomoto1,
     Nomoto2 as Nomoto2,
     NonlinearNomoto as NonlinearNomoto,

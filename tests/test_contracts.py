@@ -25,6 +25,7 @@ STEERING = {
                                        n_delta=2.5, n_uv=-1.0),
     "linear_sway_yaw": js.LinearSwayYaw.from_vessel(js.vessel("sea_stratus_linear")),
     "norrbin_crossflow": js.NorrbinCrossFlow.from_vessel(js.vessel("sea_stratus_nonlinear")),
+    "low_speed_sway_yaw": js.LowSpeedSwayYaw(),
 }
 # effect, a parameter name, a non-zero value of realistic size for the Mariner and
 # Nomoto 1 (K = 0.06 1/s, T = 25 s) -- one number, or one per family where the units

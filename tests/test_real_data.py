@@ -9,6 +9,7 @@ from jaxship.studies.real_data import (
     decimate,
     esso_osaka_low_speed_discovery,
     esso_osaka_low_speed_steering,
+    esso_osaka_low_speed_sway_yaw,
     esso_osaka_split,
     hsva_split,
     identify_esso_osaka,
@@ -101,6 +102,26 @@ def test_esso_osaka_low_speed_terms_beat_the_speed_scaled_nomoto_on_held_out_run
         assert kappas[run]["r"] > base[run]["r"] + 10.0, (run, base[run], kappas[run])
     assert full["zigzag_31-Jul-2020_13_42_53"]["r"] > 62.4 + 10.0
     assert kappas["zigzag_31-Jul-2020_13_42_53"]["r"] > 85.0
+
+
+@needs_esso
+def test_esso_osaka_low_speed_sway_yaw_follows_the_held_out_turn():
+    """Trained on the eight zig-zags and 13 turns, the low-speed sway-yaw model with a
+    rudder offset (fitted on r and v) predicts the held-out turn's r 10 points better
+    than the richest speed-scaled Nomoto 1 on the same runs, keeps r above 75 % on
+    both held-out runs and predicts their drift v above 60 %; every coefficient lies
+    two robust standard errors from zero. Measured: zig-zag r 80.0 (Nomoto 84.7), turn
+    r 76.7 (Nomoto 63.6), v 70.8 and 67.9 %."""
+    report = esso_osaka_low_speed_sway_yaw()
+    nomoto, sway_yaw = (m.validation["simulation"].fit_per_experiment()
+                        for m in report.models)
+    turn = "turn_14-Oct-2020_15_06_53"
+    assert sway_yaw[turn]["r"] > nomoto[turn]["r"] + 10.0, (nomoto, sway_yaw)
+    for run, fits in sway_yaw.items():
+        assert fits["r"] > 75.0 and fits["v"] > 60.0, (run, fits)
+    result = report.models[1].result
+    assert result.success
+    assert np.all(np.abs(result.values) > 2 * result.parameters.std_robust), result.names
 
 
 @needs_esso

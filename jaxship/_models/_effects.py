@@ -463,8 +463,8 @@ class AugmentedSteering(_Augmented, AbstractSteeringModel):
 
     @property
     def wind_loads(self) -> bool:
-        """Whether an effect reads the replayed wind (`jaxship.ApparentWind`)."""
-        return any(e.uses_wind for e in self.effects)
+        """Whether the base or an effect reads the replayed wind (`jaxship.ApparentWind`)."""
+        return self.base.wind_loads or any(e.uses_wind for e in self.effects)
 
     @property
     def state_names(self):

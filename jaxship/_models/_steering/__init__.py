@@ -5,6 +5,7 @@ from ._base import (
     AuxInputs as AuxInputs,
     WindowStart as WindowStart,
 )
+from .low_speed import LowSpeedSwayYaw as LowSpeedSwayYaw
 from .nomoto import Nomoto1 as Nomoto1, Nomoto2 as Nomoto2, NonlinearNomoto as NonlinearNomoto
 from .ross import (
     ROSS_FREE as ROSS_FREE,
