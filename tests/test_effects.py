@@ -436,3 +436,15 @@ def test_fit_recovers_the_wind_a_steering_model_feels_from_logged_wind():
     for name, value in (("wind.c2", 3e-6), ("wind.c1", 0.0)):
         assert abs(got[name][0] - value) < 3 * got[name][1], (name, got[name])
     np.testing.assert_allclose([got["K"][0], got["T"][0]], [K, T], rtol=0.02)
+
+
+@pytest.mark.parametrize("effect", [js.SwayForceBias(y0=1e4), js.CrossflowDrag(),
+                                    js.SurgeTurnResistance(), js.AddedMassError(),
+                                    js.UniformCurrent(), js.Windage()], ids=lambda e: e.id)
+def test_a_vessel_only_effect_on_a_steering_model_is_an_error(effect):
+    """Effects that act on a vessel's loads, mass, environment or wind areas only would
+    add a parameter with no effect to a steering model (a singular fit): refused,
+    while the same effect on a vessel is accepted."""
+    with pytest.raises(ValueError, match="augment a vessel instead"):
+        js.augment(js.Nomoto1(K=K, T=T), effect)
+    assert js.augment(js.vessel("mariner"), effect).effects == (effect,)

@@ -34,7 +34,7 @@ DT = 0.5
 NUM = 600
 TRUTH = Nomoto1(K=0.06, T=25.0)  # K [1/s], T [s]
 STEERING_MODELS = ("nomoto1", "nomoto2", "nomoto1-nonlinear", "ross-autopilot",
-                   "linear-sway-yaw", "norrbin-crossflow", "armax")
+                   "linear-sway-yaw", "norrbin-crossflow", "low-speed-sway-yaw", "armax")
 
 
 def rudder_sequence(seed, amplitudes=(10.0,), hold=(16, 48)):

@@ -459,6 +459,13 @@ class AugmentedSteering(_Augmented, AbstractSteeringModel):
     effects: tuple[AbstractEffect, ...]
 
     def __init__(self, base: AbstractSteeringModel, effects=()):
+        for e in effects:  # an effect with vessel hooks only would be a null parameter
+            if isinstance(e, AbstractEffect) and not any(
+                    getattr(type(e), hook) is not getattr(AbstractEffect, hook)
+                    for hook in ("rudder", "yaw_term", "measure", "state_rate")):
+                raise ValueError(f"{type(e).__name__} acts on a vessel's loads, mass, "
+                                 "environment or wind areas only; a steering model has none "
+                                 "of these (augment a vessel instead).")
         self.base, self.effects = base, _check_effects(effects)
 
     @property

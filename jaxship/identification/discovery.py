@@ -13,7 +13,7 @@ import jaxship as js
 from .._foundation._files import staged_folder
 from .data import read_experiments
 from .registry import get_model_entry
-from .workflow import identify
+from .workflow import identify, logs_wind
 
 
 def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
@@ -48,10 +48,15 @@ def save_discovery_figures(report, train, holdout, folder: pathlib.Path) -> list
     folder.mkdir(parents=True, exist_ok=True)
     records = holdout if holdout else train
     channels = tuple(report.channels)
-    estimator = js.PredictionError(horizon=None, channels=channels)
-    before = js.predict(report.model_before, records, estimator=estimator)
-    after = js.predict(report.model_after, records, estimator=estimator)
     data = js.Dataset.from_experiments(records) if isinstance(records, list) else records
+    windy = logs_wind(data)
+
+    def simulate(model):  # with the logged wind where the model feels it, as it was fitted
+        estimator = js.PredictionError(horizon=None, channels=channels,
+                                       wind=windy and model.wind_loads)
+        return js.predict(model, records, estimator=estimator)
+
+    before, after = simulate(report.model_before), simulate(report.model_after)
     paths = []
     for i, name in enumerate(data.names):
         n = int(data.lengths[i])

@@ -32,11 +32,11 @@ class ModelEntry:
       `ValueError` naming its file.
     - `initial`: the window-start modes the fit supports (`PredictionError.initial`);
       `"auto"` picks `"estimate"` for output error where it is supported.
-    - `simulate(model, dataset, rudder, channels, substeps=1) -> (predictions,
-      mask)`: the output-error simulation of the model on records, starting from
-      the measured state: `{channel: (E, N) array}` and the (E, N) mask of
-      simulated samples. None: `simulate_records`, which serves every steering
-      model and vessel.
+    - `simulate(model, dataset, rudder, channels, substeps=1, wind=False) ->
+      (predictions, mask)`: the output-error simulation of the model on records,
+      starting from the measured state (with the logged wind replayed if `wind`):
+      `{channel: (E, N) array}` and the (E, N) mask of simulated samples. None:
+      `simulate_records`, which serves every steering model and vessel.
     - `fit(start, train, context) -> FitResult`: replaces the prediction-error fit
       (`jaxship.fit` with `context.estimator`) for models it does not serve, e.g.
       the discrete ARMAX model; None: `jaxship.fit`.
@@ -101,6 +101,14 @@ MODELS: dict[str, ModelEntry] = {
         "(Astrom & Kallstrom 1979, sec. 2)",
         starts.start_norrbin, starts.start_norrbin, channels=("psi", "r", "v"), requires=("u",),
         start_method="the sea_stratus_nonlinear preset (NorrbinCrossFlow.from_vessel)",
+    ),
+    "low-speed-sway-yaw": ModelEntry(
+        "sway-yaw model for low speed (LowSpeedSwayYaw): hull terms scaled by the measured "
+        "u, the rudder in u^2 + c_R n^2 (propeller race), cross-flow drag and, where wind is "
+        "logged, its sway force and yaw moment: 12 coefficients per unit inertia; "
+        "model-basin speeds (L = 3 m)",
+        starts.start_low_speed, starts.start_low_speed, channels=("psi", "r", "v"),
+        requires=("u",), start_method="the class's values (a 3 m model at 0.3 m/s)",
     ),
     "armax": ModelEntry(
         "ARMAX(2,2,2), delay 1 sample, of the yaw rate (Astrom & Kallstrom 1979, eq. 7): "

@@ -13,11 +13,12 @@ from .._models._armax_model import ARMAXModel, simulate_armax
 
 
 def simulate_records(model, dataset: js.Dataset, rudder: str, channels=("psi", "r"),
-                     substeps: int = 1):
+                     substeps: int = 1, wind: bool = False):
     """Output-error simulation of a steering model or a 3-DOF vessel on every record
     of `dataset`, each from its measured state at the first sample (hidden states by
     the model's `window_state`), driven by the recorded `rudder` and the other
-    recorded inputs (`jaxship.predict` with horizon None).
+    recorded inputs (`jaxship.predict` with horizon None), with the logged wind
+    replayed if `wind`.
 
     `channels`: `"psi"`, `"r"` and names of model states (e.g. a sway velocity `"v"`).
 
@@ -29,17 +30,19 @@ def simulate_records(model, dataset: js.Dataset, rudder: str, channels=("psi", "
             raise ValueError(f"{type(model).__name__} has no output {unknown[0]!r}; its outputs "
                              f"are psi, r and its states {', '.join(model.state_names)}.")
     out = js.predict(model, dataset, estimator=js.PredictionError(
-        horizon=None, channels=tuple(channels), rudder=rudder, substeps=int(substeps)))
+        horizon=None, channels=tuple(channels), rudder=rudder, substeps=int(substeps),
+        wind=bool(wind)))
     return out.predictions, np.asarray(out.predicted, dtype=bool)
 
 
 def simulate_armax_records(model: ARMAXModel, dataset: js.Dataset, rudder: str,
-                           channels=("psi", "r"), substeps: int = 1):
+                           channels=("psi", "r"), substeps: int = 1, wind: bool = False):
     """Output-error simulation of an `ARMAXModel` on every record (the noise-free
     part $A r = B\\delta(t - n_k)$, `simulate_armax`): the recursion starts at the
     measured r of the first sample, with r and the rudder before it held at their
     first values; psi integrates the simulated r (trapezoid rule) from the measured
-    first heading. `substeps` is unused (a discrete model). Returns `(predictions,
+    first heading. `substeps` and `wind` are unused (a discrete model without wind
+    loads). Returns `(predictions,
     mask)` as `simulate_records`."""
     lengths = np.asarray(dataset.lengths)
     valid = np.arange(dataset.num_samples)[None, :] < lengths[:, None]

@@ -177,3 +177,21 @@ def start_linear_sway_yaw(train: js.Dataset, context: StartContext) -> js.Linear
 def start_norrbin(train: js.Dataset, context: StartContext) -> js.NorrbinCrossFlow:
     return _sway_yaw_start(js.NorrbinCrossFlow.from_vessel(js.vessel("sea_stratus_nonlinear")),
                            train, context, "sea_stratus_nonlinear")
+
+
+# -- low-speed sway-yaw model ---------------------------------------------------------
+
+
+def start_low_speed(train: js.Dataset, context: StartContext) -> js.LowSpeedSwayYaw:
+    """The class's start values (a 3 m tanker model at 0.3 m/s; its length sets the
+    cross-flow integrals and is kept) at the records' mean surge speed and positive
+    propeller rate (the conditions of `steady_turn`, not fitted)."""
+    speed = abs(mean_valid(train, "u"))
+    rate = max(mean_valid(train, "n"), 0.0) if "n" in train.channels else 0.0
+    model = js.LowSpeedSwayYaw(speed=speed if speed > 0 else 0.3, propeller_rate=rate)
+    context.note(f"LowSpeedSwayYaw start: the class's values, with its length L = "
+                 f"{float(model.length):.4g} m (frozen: another hull needs "
+                 "jaxship.LowSpeedSwayYaw(length=...) and jaxship.fit); speed "
+                 f"{float(model.speed):.4g} m/s and propeller rate "
+                 f"{float(model.propeller_rate):.4g} rev/s are the records' means.")
+    return model

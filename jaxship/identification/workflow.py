@@ -112,9 +112,11 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     - `train`: the training records: an `Experiment`, a list of them, a `Dataset`,
       or file/folder paths (see `read_experiments`).
     - `model`: a name in `MODELS`: `nomoto1`, `nomoto2`, `nomoto1-nonlinear`,
-      `ross-autopilot`, `linear-sway-yaw`, `norrbin-crossflow`, `armax` or a vessel
-      preset of `jaxship.VESSELS` (its `default_free` coefficients are estimated
-      from the preset's values; records need u and v).
+      `ross-autopilot`, `linear-sway-yaw`, `norrbin-crossflow`, `low-speed-sway-yaw`,
+      `armax` or a vessel preset of `jaxship.VESSELS` (its `default_free`
+      coefficients are estimated from the preset's values; records need u and v).
+      Models that feel the wind (vessels, `low-speed-sway-yaw`) get the logged wind
+      replayed when every training record logs it (each validation set likewise).
     - `horizon`: prediction horizon of the fit [s] (`PredictionError.horizon`):
       None (default) output error, 0 equation error, else windows of `horizon`
       seconds from the measured state.
@@ -250,6 +252,11 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
         notes.append(f"start values: {error} A neutral start was used instead; the fit "
                      "below says whether the data determine the parameters.")
     report(Progress("start", "start values", done=True))
+    wind = getattr(start, "wind_loads", False) and logs_wind(train_ds)
+    if wind:  # replayed where the model feels it, as `jaxship.discover` does
+        estimator = dataclasses.replace(estimator, wind=True)
+        notes.append(f"every training record logs the wind (wind_speed, wind_dir): replayed "
+                     f"as loads on {type(start).__name__}.")
 
     def attempt(start_model):
         try:
@@ -295,14 +302,18 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
         return tuple(c for c in entry.channels if c in ("psi", "r") or c in ds.channels)
 
     predictions, mask = simulate(result.model, train_ds, rudder, measured(train_ds),
-                                 substeps=int(substeps))
+                                 substeps=int(substeps), wind=wind)
     train_sim = assess("simulation", None, train_ds, rudder, predictions, mask, d, max_lag,
                         notes)
     valid_block = None
     if valid_ds is not None:
         report(Progress("validate", "simulating the validation records"))
+        held_wind = wind and logs_wind(valid_ds)
+        if wind and not held_wind:
+            notes.append("the validation records do not all log the wind: simulated in calm "
+                         "air.")
         predictions, mask = simulate(result.model, valid_ds, rudder, measured(valid_ds),
-                                     substeps=int(substeps))
+                                     substeps=int(substeps), wind=held_wind)
         valid_block = assess("simulation", None, valid_ds, rudder, predictions, mask, d,
                               max_lag, notes)
     report(Progress("validate", "validation", done=True))
@@ -328,6 +339,11 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     for flag in result.flags:  # one warning per flag: one line each
         warnings.warn(f"identify {name}: {flag}", js.IdentifiabilityWarning, stacklevel=2)
     return out
+
+
+def logs_wind(ds: js.Dataset) -> bool:
+    """Whether every record of `ds` logs the true wind (`wind_speed`, `wind_dir`)."""
+    return all({"wind_speed", "wind_dir"} <= set(c) for c in ds.experiment_channels)
 
 
 def _derived_notes(train, held_out, channels, default_channels, notes) -> tuple[str, ...]:

@@ -157,13 +157,17 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
     - `estimator`: the prediction-error loss of every fit and score (default: 60 s
       windows, so that the window-clustered score variance holds for coloured
       residuals, each starting from an estimated correction of the measured r and psi,
-      so that the noise of a start sample does not run through its window); `free`:
+      so that the noise of a start sample does not run through its window; a
+      steering model's other states, e.g. the sway velocity of the sway-yaw models,
+      start from their measured values, whose noise does run through, and at a few
+      per cent of v's range can pass as a small extra term); `free`:
       the base parameters fitted (default the model's). Where every training record
       logs the wind, models that feel it (vessels; steering models with the `wind`
-      candidate) replay it; a vessel fits the channels every record logs, x and y
-      as well where they are (a current shows there), and where v is not logged its
-      windows and held-out predictions start from its states smoothed from psi, r, u
-      and the track (`smoothed_vessel_states`).
+      candidate or wind terms of their own) replay it; candidates a model's own
+      equations carry (its `built_in_effects`) are not offered; a vessel fits the
+      channels every record logs, x and y as well where they are (a current shows
+      there), and where v is not logged its windows and held-out predictions start
+      from its states smoothed from psi, r, u and the track (`smoothed_vessel_states`).
     - `max_effects`: most effects added; `alpha`: family-wise false-alarm rate over
       candidates and iterations; `top`: classes refitted per iteration;
       `equivalence`: canonical correlation above which candidates are one class.
@@ -213,7 +217,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         if len(accepted) >= max_effects:
             break
         base, effects = _split(current.model)
-        done = {e.id for e in effects}
+        done = {e.id for e in effects} | set(getattr(base, "built_in_effects", ()))
         candidates = applicable(base, data, catalogue, exclude=done)
         if not candidates:
             break

@@ -81,11 +81,14 @@ class AbstractSteeringModel(eqx.Module):
 
     state_names: eqx.AbstractClassVar[tuple[str, ...]]
     # the model contract shared with vessels (see `jaxship.fit`): fitted outputs by
-    # default, channels every window starts from, wind loads, a rudder servo
+    # default, channels every window starts from, wind loads, a rudder servo; and
+    # the ids of the discovery catalogue's effects its own equations already carry
+    # (`jaxship.discover` does not offer them again)
     default_channels: ClassVar[tuple[str, ...]] = ("psi", "r")
     start_channels: ClassVar[tuple[str, ...]] = ()
     wind_loads: ClassVar[bool] = False
     has_servo: ClassVar[bool] = False
+    built_in_effects: ClassVar[tuple[str, ...]] = ()
 
     @abc.abstractmethod
     def rhs(self, state: Array, delta: ArrayLike, aux: AuxInputs) -> Array:

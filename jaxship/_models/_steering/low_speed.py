@@ -48,7 +48,7 @@ class LowSpeedSwayYaw(AbstractSteeringModel):
     0.3 m/s (time constants of 5-15 s, race giving the rudder about its inflow at
     10 rev/s)."""
 
-    n_v: float = param(0.0, scale=0.2, unit="1/m")  # N_v, yaw from drift
+    n_v: float = param(0.0, scale=0.2, unit="1/m^2")  # N_v, yaw from drift
     n_r: float = param(-0.2, scale=0.2, unit="1/m")  # N_r, yaw damping (< 0)
     n_delta: float = param(0.04, scale=0.02, unit="1/m^2")  # N_delta (> 0: starboard)
     y_v: float = param(-0.6, scale=0.3, unit="1/m")  # Y_v, sway damping (< 0)
@@ -67,6 +67,8 @@ class LowSpeedSwayYaw(AbstractSteeringModel):
     state_names = ("r", "v")
     default_channels = ("psi", "r", "v")
     wind_loads = True
+    built_in_effects = ("speed_dependent_rudder", "speed_dependent_damping", "propeller_race",
+                        "crossflow_drag", "wind")
 
     def rhs(self, state: Array, delta: ArrayLike, aux: AuxInputs) -> Array:
         r, v = state[0], state[1]
