@@ -42,8 +42,7 @@ def simulate_armax_records(model: ARMAXModel, dataset: js.Dataset, rudder: str,
     measured r of the first sample, with r and the rudder before it held at their
     first values; psi integrates the simulated r (trapezoid rule) from the measured
     first heading. `substeps` and `wind` are unused (a discrete model without wind
-    loads). Returns `(predictions,
-    mask)` as `simulate_records`."""
+    loads). Returns `(predictions, mask)` as `simulate_records`."""
     lengths = np.asarray(dataset.lengths)
     valid = np.arange(dataset.num_samples)[None, :] < lengths[:, None]
     r_measured = np.asarray(dataset.r, dtype=np.float64)
