@@ -143,19 +143,26 @@ def test_identify_recovers_every_coefficient_with_the_logged_wind(tmp_path):
     assert result["validation"]["channels"]["v"]["fit_percent"] > 99.999
 
 
+def with_noise(e, rng, name=None):
+    """Experiment `e` with white measurement noise of 0.3 deg on psi, 0.03 deg/s on r
+    and 0.3 mm/s on v. Each 60 s window of `discover` starts from the measured v (only
+    r and psi are corrected): with 3 mm/s, after the true offset a second, spurious
+    term passed on 2 of 4 noise seeds (LR 14 and 22 against a threshold near 13), the
+    null stayed clean on 4 of 4."""
+    noise = lambda size: size * rng.standard_normal(e.t.size)
+    logged = {c: getattr(e, c) for c in ("u", "n", "wind_speed", "wind_dir") if c in e.channels}
+    return js.Experiment(e.t, e.delta, psi=e.psi + noise(0.3 * DEG), r=e.r + noise(0.03 * DEG),
+                         v=e.v + noise(3e-4), **logged, name=name or e.name)
+
+
 def noisy(record, truth, seed):
-    """`record`'s inputs driving `truth`, with white measurement noise of 0.3 deg on
-    psi, 0.03 deg/s on r and 0.3 mm/s on v. Each 60 s window of `discover` starts
-    from the measured v (only r and psi are corrected): with 3 mm/s, after the true
-    offset a second, spurious term passed on 2 of 4 noise seeds (LR 14 and 22 against
-    a threshold near 13), the null stayed clean on 4 of 4."""
+    """`record`'s inputs driving `truth`, with measurement noise (`with_noise`)."""
     tr = js.simulate_steering(truth, record.delta, 0.5, aux=js.AuxInputs(u=record.u,
                                                                           n=record.n))
-    rng = np.random.default_rng(100 + seed)
-    noise = lambda size: size * rng.standard_normal(record.t.size)
-    return js.Experiment(record.t, record.delta, psi=np.asarray(tr.psi) + noise(0.3 * DEG),
-                         r=np.asarray(tr.r) + noise(0.03 * DEG), u=record.u, n=record.n,
-                         v=np.asarray(tr.state[:, 1]) + noise(3e-4), name=f"run{seed}")
+    clean = js.Experiment(record.t, record.delta, psi=np.asarray(tr.psi),
+                          r=np.asarray(tr.r), u=record.u, n=record.n,
+                          v=np.asarray(tr.state[:, 1]))
+    return with_noise(clean, np.random.default_rng(100 + seed), name=f"run{seed}")
 
 
 @pytest.mark.parametrize("hidden", [None, js.RudderOffset(delta0=1.0 * DEG)],
@@ -187,15 +194,10 @@ def test_the_discover_command_from_it_on_windy_records_finds_nothing_missing(tmp
     from jaxship.cli import main
 
     rng = np.random.default_rng(5)
-    noise = lambda size, e: size * rng.standard_normal(e.t.size)
     paths = []
     for seed in range(4):
-        e = windy_record(seed, f"w{seed}")
-        e = js.Experiment(e.t, e.delta, psi=e.psi + noise(0.3 * DEG, e),
-                          r=e.r + noise(0.03 * DEG, e), u=e.u, v=e.v + noise(3e-4, e), n=e.n,
-                          wind_speed=e.wind_speed, wind_dir=e.wind_dir, name=e.name)
         paths.append(str(tmp_path / f"w{seed}.csv"))
-        js.write_trial_csv(paths[-1], e)
+        js.write_trial_csv(paths[-1], with_noise(windy_record(seed, f"w{seed}"), rng))
     out = tmp_path / "disc"
     code = main(["discover", *paths[:3], "--holdout", paths[3], "--model",
                  "low-speed-sway-yaw", "--out", str(out)])
