@@ -474,6 +474,15 @@ class AugmentedSteering(_Augmented, AbstractSteeringModel):
         return self.base.wind_loads or any(e.uses_wind for e in self.effects)
 
     @property
+    def default_channels(self) -> tuple[str, ...]:
+        """The base's fitted outputs (a sway-yaw model's v as well)."""
+        return self.base.default_channels
+
+    @property
+    def built_in_effects(self) -> tuple[str, ...]:
+        return self.base.built_in_effects
+
+    @property
     def state_names(self):
         return self.base.state_names + tuple(f"{e.id}.{name}" for e in self.effects
                                              for name in e.state_names)

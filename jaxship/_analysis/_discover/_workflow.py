@@ -159,8 +159,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
       residuals, each starting from an estimated correction of the measured r and psi,
       so that the noise of a start sample does not run through its window; a
       steering model's other states, e.g. the sway velocity of the sway-yaw models,
-      start from their measured values, whose noise does run through, and at a few
-      per cent of v's range can pass as a small extra term); `free`:
+      start from their measured values, whose noise does run through); `free`:
       the base parameters fitted (default the model's). Where every training record
       logs the wind, models that feel it (vessels; steering models with the `wind`
       candidate or wind terms of their own) replay it; candidates a model's own
