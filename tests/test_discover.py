@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._analysis._discover._holdout import cost_rise
+from jaxship._analysis._discover._holdout import cost_rise, record_indices
 from jaxship._analysis._discover._plausible import rudder_equivalent
+from jaxship._analysis._discover._workflow import heldout_rise
 from jaxship._estimate._windows import as_dataset
 from jaxship.cli import main
 from jaxship.studies.discovery import (
@@ -92,6 +93,51 @@ def test_the_held_out_rise_and_its_standard_error_over_stretches():
     assert spread == pytest.approx(np.sqrt(5 / 4) * np.sqrt(np.sum(
         (np.array(stretches) - np.mean(stretches)) ** 2)))
     assert cost_rise(before, before, 60.0) == (0.0, 0.0)
+
+
+def test_held_out_rises_each_within_the_spread_cannot_add_up():
+    """Each step raises the held-out cost by about one standard error (the gate allows
+    1.645) and passes against the model before it; the second step undoes the first's
+    scatter, so that its rise since the base model is two standard errors of the first
+    step with little scatter of its own, and fails. A step that lowers the cost passes."""
+    rng = np.random.default_rng(1)
+    t = np.tile(np.arange(0.0, 600.0, 0.5), (2, 1))
+    mask = np.ones(t.shape, bool)
+    base = {"t": t, "mask": mask, "terms": rng.random(t.shape), "cost": 1.0}
+    noise = rng.normal(0.0, 1.0, (2,) + t.shape)
+    noise -= noise.mean(axis=(1, 2), keepdims=True)
+    _, spread = cost_rise(base, base | {"terms": base["terms"] + noise[0]}, 60.0)
+    rise = spread / t.size  # per sample: one standard error in all
+    one = base | {"terms": base["terms"] + noise[0] + rise}
+    two = one | {"terms": one["terms"] - noise[0] + 0.1 * noise[1] + rise}
+    assert cost_rise(base, one, 60.0) == pytest.approx((spread, spread))
+    assert cost_rise(one, two, 60.0)[0] < 1.1 * cost_rise(one, two, 60.0)[1]
+    assert cost_rise(base, two, 60.0)[0] > 1.645 * cost_rise(base, two, 60.0)[1]
+    assert heldout_rise(one, base, base, 60.0) is None
+    assert heldout_rise(two, one, base, 60.0).startswith("the held-out cost rises since the")
+    assert heldout_rise(two, one, one, 60.0) is None  # the per-step gate alone passes it
+    better = one | {"terms": one["terms"] - noise[0] - 2 * rise}
+    assert heldout_rise(better, one, base, 60.0) is None
+
+
+def test_a_predicted_overshoot_is_measured_between_the_logged_rudder_reversals():
+    """On the measured heading the overshoots are the IMO ones; a prediction that
+    replays the logged rudder but turns too little never reaches the switch angle, and
+    its overshoots come out negative (before, such a prediction had none)."""
+    out = js.steer_manoeuvre(js.Nomoto1(K=K, T=25.0), js.ZigZag(10 * DEG, 10 * DEG,
+                                                                duration=400.0, dt=0.5),
+                             rudder_rate=2.3 * DEG)
+    t, delta, psi = (np.asarray(a) for a in (out.t, out.delta, out.psi))
+    imo = js.zigzag_indices(heading_switch=10 * DEG, t=t, psi=psi, delta=delta).overshoots
+    measured = record_indices(t, delta, psi)
+    assert [measured["overshoot_1_deg"], measured["overshoot_2_deg"]] == pytest.approx(
+        np.rad2deg(imo[:2]), abs=1e-3)
+    weak = record_indices(t, delta, 0.5 * psi, measured_psi=psi)
+    for k in ("overshoot_1_deg", "overshoot_2_deg"):
+        assert weak[k] == pytest.approx(0.5 * (measured[k] + 10.0) - 10.0, abs=1e-3)
+        assert weak[k] < 0
+    with pytest.raises(ValueError, match="never reached the switch"):
+        js.zigzag_indices(heading_switch=10 * DEG, t=t, psi=0.5 * psi, delta=delta)
 
 
 def test_an_effect_in_family_units_is_sized_as_the_rudder_angle_of_its_loads():

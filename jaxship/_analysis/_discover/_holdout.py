@@ -83,18 +83,35 @@ def record_kind(delta) -> str | None:
     return None
 
 
-def record_indices(t, delta, psi, u=None, v=None) -> dict:
-    """The indices of one record [deg, m]: a zig-zag's first and second overshoots
-    (heading switch = the rudder amplitude, as in x/x zig-zags), a turn's advance and
-    tactical diameter (track from u, v and the heading). Empty when neither."""
+def record_indices(t, delta, psi, u=None, v=None, measured_psi=None) -> dict:
+    """The indices of one record [deg, m]: a zig-zag's first and second overshoots, a
+    turn's advance and tactical diameter (track from u, v and the heading). Empty when
+    neither. The zig-zag's executes and side come from the `measured_psi` (default
+    `psi`) and the rudder, its heading switch is the rudder amplitude (as in x/x
+    zig-zags); each overshoot is the peak heading change between one rudder reversal
+    and the next, less the switch. On the measured heading that is the IMO overshoot;
+    a prediction replaying the logged rudder is measured the same way, even where its
+    heading never reaches the switch (it then comes out negative)."""
     kind = record_kind(delta)
     try:
         if kind == "zigzag":
-            switch = float(np.median(np.abs(delta[np.abs(delta) > 0.5 * np.max(np.abs(delta))])))
-            z = zigzag_indices(heading_switch=switch, t=t, psi=psi, delta=delta)
+            large = np.flatnonzero(np.abs(delta) > 0.5 * np.max(np.abs(delta)))
+            switch = float(np.median(np.abs(delta[large])))
+            z = zigzag_indices(heading_switch=switch, t=t, delta=delta,  # the first execute
+                               psi=psi if measured_psi is None else measured_psi)
+            side = np.sign(delta[large[0]])  # of the first order (z.side reads a record
+            # that starts with the rudder over as starting at its first reversal)
+            change = side * (psi - np.interp(z.execute_times[0], t, psi))
+            # the rudder's reversals: where it has moved half way to the other side
+            bounds = np.append(large[1:][np.diff(np.sign(delta[large])) != 0], t.size)
             out = {}
-            for k, value in enumerate(np.asarray(z.overshoots)[:2]):
-                out[f"overshoot_{k + 1}_deg"] = float(np.rad2deg(value))
+            for k in (1, 2):  # after the first and the second reversal
+                if k > bounds.size - 1:
+                    break
+                turned = (-1) ** (k + 1) * change[bounds[k - 1]:bounds[k]]  # its turning side
+                if bounds[k] == t.size and np.argmax(turned) == turned.size - 1:
+                    break  # the record ends before the heading turns back
+                out[f"overshoot_{k}_deg"] = float(np.rad2deg(np.max(turned) - switch))
             return out
         if kind == "turn" and u is not None and v is not None:
             x, y = _track(t, psi, u, v)
@@ -119,11 +136,13 @@ def holdout_indices(holdout, before: dict, after: dict) -> dict:
         u = np.asarray(ds.u[i, :n]) if measured_uv else None
         v = np.asarray(ds.v[i, :n]) if measured_uv else None
 
+        psi = np.asarray(ds.psi[i, :n])
+
         def indices(source, u=u, v=v):
-            psi = np.asarray(source["psi"][i, :n]) if source else np.asarray(ds.psi[i, :n])
             if source and "u" in source and "v" in source:
                 u, v = np.asarray(source["u"][i, :n]), np.asarray(source["v"][i, :n])
-            return record_indices(t, delta, psi, u, v)
+            return record_indices(t, delta, np.asarray(source["psi"][i, :n]) if source else psi,
+                                  u, v, measured_psi=psi)
 
         measured = indices(None)
         b, a = indices(before), indices(after)

@@ -19,9 +19,10 @@ One iteration (design: ../shared/reference/discovery-design.md, sec. 4):
    refit pushes no base parameter onto the edge of its range; and the held-out cost
    does not rise beyond the spread a disturbance gives it (`cost_rise`: more than
    `HELDOUT_Z` standard errors over stretches of the estimator's horizon; without
-   such spread it must fall). The held-out check vetoes but does not choose: no
-   candidate is accepted while a rival that lowers the training cost more fails on
-   the held-out runs alone;
+   such spread it must fall), neither against the current model nor since the base
+   model (steps each within the spread must not add up: `heldout_rise`). The
+   held-out check vetoes but does not choose: no candidate is accepted while a rival
+   that lowers the training cost more fails on the held-out runs alone;
 4. where no single candidate passes, effects too weak alone may pass together: a
    forward search on the conditional scores (`forward_path`) picks up to `top`, and
    their union is refitted and judged by the same gates, its threshold simulated
@@ -283,13 +284,9 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             after = check(trial.model) if holdout else None
             others = len(why)
             if holdout:
-                rise, spread = cost_rise(held, after, estimator.horizon or BLOCK)
-                if not rise < HELDOUT_Z * spread:
-                    why.append(f"the held-out cost rises ({held['cost']:.4g} -> "
-                               f"{after['cost']:.4g}; {rise:.3g} against a standard error "
-                               f"of {spread:.3g} over the stretches)" if spread else
-                               f"the held-out cost does not fall ({held['cost']:.4g} -> "
-                               f"{after['cost']:.4g})")
+                reason = heldout_rise(after, held, before, estimator.horizon or BLOCK)
+                if reason:
+                    why.append(reason)
             shared = {"score": s.statistic, "score_naive": s.naive, "likelihood_ratio": lr,
                       "p_value": float(stats.chi2.sf(lr, s.dof)) if p_value is None else p_value,
                       "delta_bic": _delta_bic(cost, trial.cost, sens.residuals.size, s.dof),
@@ -382,6 +379,22 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         holdout_indices=holdout_indices(holdout, before["predictions"],
                                         after["predictions"]) if holdout else {},
         alpha=alpha, channels=channels, disagreement=disagreement)
+
+
+def heldout_rise(after: dict, current: dict, base: dict, block: float) -> str | None:
+    """Why the held-out check fails, or None: the held-out cost after a refit (`holdout_check`
+    outputs) must not rise beyond `HELDOUT_Z` standard errors over stretches of `block`
+    seconds (`cost_rise`; without such spread it must fall), neither against the `current`
+    model nor since the `base` model, so that steps each within the spread cannot add up."""
+    references = [(current, "")] + ([] if base is current else [(base, " since the base model")])
+    for reference, since in references:
+        rise, spread = cost_rise(reference, after, block)
+        if not rise < HELDOUT_Z * spread:
+            change = f"{reference['cost']:.4g} -> {after['cost']:.4g}"
+            return (f"the held-out cost rises{since} ({change}; {rise:.3g} against a standard "
+                    f"error of {spread:.3g} over the stretches)" if spread else
+                    f"the held-out cost does not fall{since} ({change})")
+    return None
 
 
 def _joint_set(sens, fitted, scores, names, classes, model, size, level):
