@@ -86,12 +86,13 @@ def record_kind(delta) -> str | None:
 def record_indices(t, delta, psi, u=None, v=None, measured_psi=None) -> dict:
     """The indices of one record [deg, m]: a zig-zag's first and second overshoots, a
     turn's advance and tactical diameter (track from u, v and the heading). Empty when
-    neither. The zig-zag's executes and side come from the `measured_psi` (default
-    `psi`) and the rudder, its heading switch is the rudder amplitude (as in x/x
-    zig-zags); each overshoot is the peak heading change between one rudder reversal
-    and the next, less the switch. On the measured heading that is the IMO overshoot;
-    a prediction replaying the logged rudder is measured the same way, even where its
-    heading never reaches the switch (it then comes out negative)."""
+    neither. A zig-zag's heading switch is the rudder amplitude (as in x/x zig-zags),
+    its first execute is read from the `measured_psi` (default `psi`) and the rudder,
+    its side and reversals from the rudder; each overshoot is the peak heading change
+    from the first execute between one reversal and the next, less the switch. On the
+    measured heading that is the IMO overshoot; a prediction replaying the logged
+    rudder is measured the same way, even where its heading never reaches the switch
+    (it then comes out negative)."""
     kind = record_kind(delta)
     try:
         if kind == "zigzag":
@@ -99,9 +100,9 @@ def record_indices(t, delta, psi, u=None, v=None, measured_psi=None) -> dict:
             switch = float(np.median(np.abs(delta[large])))
             z = zigzag_indices(heading_switch=switch, t=t, delta=delta,  # the first execute
                                psi=psi if measured_psi is None else measured_psi)
-            side = np.sign(delta[large[0]])  # of the first order (z.side reads a record
-            # that starts with the rudder over as starting at its first reversal)
-            change = side * (psi - np.interp(z.execute_times[0], t, psi))
+            # the side of the first order (z.side takes a record that starts with the
+            # rudder over for one that starts at its first reversal)
+            change = np.sign(delta[large[0]]) * (psi - np.interp(z.execute_times[0], t, psi))
             # the rudder's reversals: where it has moved half way to the other side
             bounds = np.append(large[1:][np.diff(np.sign(delta[large])) != 0], t.size)
             out = {}
@@ -135,7 +136,6 @@ def holdout_indices(holdout, before: dict, after: dict) -> dict:
         measured_uv = "u" in ds.experiment_channels[i] and "v" in ds.experiment_channels[i]
         u = np.asarray(ds.u[i, :n]) if measured_uv else None
         v = np.asarray(ds.v[i, :n]) if measured_uv else None
-
         psi = np.asarray(ds.psi[i, :n])
 
         def indices(source, u=u, v=v):
