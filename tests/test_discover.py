@@ -131,10 +131,10 @@ def test_a_predicted_overshoot_is_measured_between_the_logged_rudder_reversals()
     imo = js.zigzag_indices(heading_switch=10 * DEG, t=t, psi=psi, delta=delta).overshoots
     measured = record_indices(t, delta, psi)
     assert [measured["overshoot_1_deg"], measured["overshoot_2_deg"]] == pytest.approx(
-        np.rad2deg(imo[:2]), abs=1e-3)
+        np.rad2deg(imo[:2]), abs=1e-9)
     weak = record_indices(t, delta, 0.5 * psi, measured_psi=psi)
     for k in ("overshoot_1_deg", "overshoot_2_deg"):
-        assert weak[k] == pytest.approx(0.5 * (measured[k] + 10.0) - 10.0, abs=1e-3)
+        assert weak[k] == pytest.approx(0.5 * (measured[k] + 10.0) - 10.0, abs=1e-9)
         assert weak[k] < 0
     with pytest.raises(ValueError, match="never reached the switch"):
         js.zigzag_indices(heading_switch=10 * DEG, t=t, psi=0.5 * psi, delta=delta)

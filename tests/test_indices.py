@@ -200,6 +200,20 @@ def test_zigzag_indices_of_a_known_heading_history(side):
     assert again.side == side
 
 
+@pytest.mark.parametrize("side", [1, -1])
+def test_a_zigzag_logged_from_its_execute_on(side):
+    """A record that starts with the first order already given (the rudder over at the
+    first sample, as a log cut at the execute or an instant rudder has it): the side is
+    that order's. Before, the order at the first sample was taken for a neutral helm and
+    the first reversal for the first order: the wrong side, one leg late."""
+    amplitudes = np.array([16.0, 19.0, 17.5, 18.0]) * DEG
+    data, _ = zigzag_heading(side=side, amplitudes=amplitudes, psi_s=10 * DEG, t1=0.0)
+    assert data["delta"][0] == side * 10 * DEG
+    ind = zigzag_indices(None, 10 * DEG, **data)
+    assert ind.side == side and ind.execute_times[0] == 0.0
+    np.testing.assert_allclose(ind.overshoots, amplitudes - 10 * DEG, atol=1e-6 * DEG)
+
+
 def test_zigzag_incomplete_last_overshoot_is_dropped():
     amplitudes = np.array([16.0, 19.0, 17.5]) * DEG
     data, _ = zigzag_heading(side=1, amplitudes=amplitudes, psi_s=10 * DEG, tail=0.0)

@@ -8,6 +8,7 @@ from ..._estimate._fit import PredictionError
 from ..._estimate._predict import predict
 from ..._estimate._windows import as_dataset
 from .._indices import turning_indices, zigzag_indices
+from .._indices._series import _peak
 
 
 def holdout_check(model, holdout, channels, wind: bool = False, window=None,
@@ -87,8 +88,8 @@ def record_indices(t, delta, psi, u=None, v=None, measured_psi=None) -> dict:
     """The indices of one record [deg, m]: a zig-zag's first and second overshoots, a
     turn's advance and tactical diameter (track from u, v and the heading). Empty when
     neither. A zig-zag's heading switch is the rudder amplitude (as in x/x zig-zags),
-    its first execute is read from the `measured_psi` (default `psi`) and the rudder,
-    its side and reversals from the rudder; each overshoot is the peak heading change
+    its first execute and side are read from the `measured_psi` (default `psi`) and the
+    rudder, its reversals from the rudder; each overshoot is the peak heading change
     from the first execute between one reversal and the next, less the switch. On the
     measured heading that is the IMO overshoot; a prediction replaying the logged
     rudder is measured the same way, even where its heading never reaches the switch
@@ -100,19 +101,18 @@ def record_indices(t, delta, psi, u=None, v=None, measured_psi=None) -> dict:
             switch = float(np.median(np.abs(delta[large])))
             z = zigzag_indices(heading_switch=switch, t=t, delta=delta,  # the first execute
                                psi=psi if measured_psi is None else measured_psi)
-            # the side of the first order (z.side takes a record that starts with the
-            # rudder over for one that starts at its first reversal)
-            change = np.sign(delta[large[0]]) * (psi - np.interp(z.execute_times[0], t, psi))
-            # the rudder's reversals: where it has moved half way to the other side
-            bounds = np.append(large[1:][np.diff(np.sign(delta[large])) != 0], t.size)
+            change = z.side * (psi - np.interp(z.execute_times[0], t, psi))
+            # the rudder's reversals: where it leaves the half of its way on one side
+            bounds = np.append(large[:-1][np.diff(np.sign(delta[large])) != 0], t.size)
             out = {}
             for k in (1, 2):  # after the first and the second reversal
                 if k > bounds.size - 1:
                     break
-                turned = (-1) ** (k + 1) * change[bounds[k - 1]:bounds[k]]  # its turning side
-                if bounds[k] == t.size and np.argmax(turned) == turned.size - 1:
+                _, peak, interior = _peak(t, (-1) ** (k + 1) * change,  # its turning side
+                                          t[bounds[k - 1]], t[bounds[k] - 1])
+                if bounds[k] == t.size and not interior:
                     break  # the record ends before the heading turns back
-                out[f"overshoot_{k}_deg"] = float(np.rad2deg(np.max(turned) - switch))
+                out[f"overshoot_{k}_deg"] = float(np.rad2deg(peak - switch))
             return out
         if kind == "turn" and u is not None and v is not None:
             x, y = _track(t, psi, u, v)

@@ -197,8 +197,10 @@ def zigzag_indices(traj=None, heading_switch=None, *, execute_times=None, initia
     i = int(np.searchsorted(s.t, times[0]))
     if s.delta is not None and i < s.t.size:
         # side of the first order relative to the rudder before it (a neutral-helm offset,
-        # as in the MARIN runs, must not decide it): where it has moved half its way
-        baseline = s.delta[0] if s.delta_command is not None else s.rudder_order[0]
+        # as in the MARIN runs, must not decide it): where it has moved half its way; a
+        # record that starts with the order given (the rudder already over) has no before
+        baseline = (s.delta[0] if s.delta_command is not None else
+                    s.rudder_order[0] if i > 0 else 0.0)
         moved = s.rudder_order[i:] - baseline
         k = i + int(np.argmax(np.abs(moved) >= 0.5 * np.max(np.abs(moved))))
         side, rudder_angle = int(np.sign(s.rudder_order[k])), abs(float(s.rudder_order[k]))
