@@ -158,7 +158,8 @@ nb.cells = [
         "    ax.set_ylabel('first overshoot [deg]')\n"
         "    ax.legend(frameon=False, fontsize=8)\n"
         "    ax.set_title('held-out zig-zags: measured, before and after discovery '\n"
-        "                 '(no bar: the prediction has no such overshoot)', fontsize=9)\n"
+        "                 '(below zero: the prediction never reaches the switch angle)',\n"
+        "                 fontsize=9)\n"
         "    fig.tight_layout()"),
     nbf.v4.new_markdown_cell(
         "## Real data: Esso Osaka, with its logged wind\n\n"

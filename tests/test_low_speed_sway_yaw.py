@@ -64,7 +64,7 @@ def test_steady_turn_is_an_equilibrium():
     assert TRUTH.wind_loads and js.augment(TRUTH, js.RudderOffset()).wind_loads
 
 
-def low_speed_record(seed):
+def low_speed_record(seed, truth=TRUTH, metadata=()):
     """Rudder steps of 10-35 deg held 20-60 s at 2 Hz, u wandering 0.15-0.45 m/s and
     the propeller at 8, 10 or 15 rev/s, from a straight run, without wind."""
     rng = np.random.default_rng(seed)
@@ -77,9 +77,9 @@ def low_speed_record(seed):
     delta = np.array(delta[:num])
     u = 0.3 + 0.15 * np.sin(2 * np.pi * t / rng.uniform(80, 200) + seed)
     n = np.full(num, rng.choice([8.0, 10.0, 15.0]))
-    tr = js.simulate_steering(TRUTH, delta, dt, aux=js.AuxInputs(u=u, n=n))
+    tr = js.simulate_steering(truth, delta, dt, aux=js.AuxInputs(u=u, n=n))
     return js.Experiment(t, delta, psi=np.asarray(tr.psi), r=np.asarray(tr.r), u=u, n=n,
-                         v=np.asarray(tr.state[:, 1]))
+                         v=np.asarray(tr.state[:, 1]), metadata=metadata)
 
 
 def test_fit_recovers_the_hull_and_race_coefficients_from_its_own_records():
@@ -93,6 +93,30 @@ def test_fit_recovers_the_hull_and_race_coefficients_from_its_own_records():
     assert res.success
     got = dict(zip(res.names, np.asarray(res.values)))
     np.testing.assert_allclose([got[k] for k in HULL], [ESSO[k] for k in HULL], rtol=1e-4)
+
+
+def test_identify_takes_the_hull_length_from_the_records():
+    """`identify` gives `LowSpeedSwayYaw` the hull length of the records' metadata
+    (`lpp`, set by the measured-data readers): on records of a 5 m hull it recovers
+    the hull coefficients (the cross-flow ones depend on L) from the registry's start;
+    records without one length keep the class's 3 m, and the note says which."""
+    from jaxship.identification.starts import StartContext, start_low_speed
+
+    truth = eqx.tree_at(lambda m: m.length, TRUTH, 5.0)
+    records = [low_speed_record(s, truth, {"lpp": 5.0}) for s in range(3)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", js.IdentifiabilityWarning)
+        result = js.identify(records, model="low-speed-sway-yaw", channels="r,v")
+    assert float(result.fit.model.length) == 5.0
+    got = dict(zip(result.fit.names, np.asarray(result.fit.values)))
+    np.testing.assert_allclose([got[k] for k in HULL], [ESSO[k] for k in HULL], rtol=1e-4)
+    assert any("L = 5 m (the records' lpp" in note for note in result.notes)
+    for metadata in ((), {"lpp": 7.0}):  # no length, or two lengths
+        notes = []
+        context = StartContext("delta", ("r", "v"), js.PredictionError(), None, notes.append)
+        mixed = js.Dataset.from_experiments([records[0], low_speed_record(1, TRUTH, metadata)])
+        assert float(start_low_speed(mixed, context).length) == 3.0
+        assert "no single lpp" in notes[0]
 
 
 def test_an_augmented_model_fits_the_base_outputs_by_default():

@@ -183,15 +183,23 @@ def start_norrbin(train: js.Dataset, context: StartContext) -> js.NorrbinCrossFl
 
 
 def start_low_speed(train: js.Dataset, context: StartContext) -> js.LowSpeedSwayYaw:
-    """The class's start values (a 3 m tanker model at 0.3 m/s; its length sets the
-    cross-flow integrals and is kept) at the records' mean surge speed and positive
-    propeller rate (the conditions of `steady_turn`, not fitted)."""
+    """The class's start values (a 3 m tanker model at 0.3 m/s) at the records' mean
+    surge speed and positive propeller rate (the conditions of `steady_turn`, not
+    fitted), with the hull length $L$ of the cross-flow integrals (kept, not fitted)
+    from the records' metadata (`lpp`, which the measured-data readers set) when they
+    all give the same one (to 0.1 %)."""
     speed = abs(mean_valid(train, "u"))
     rate = max(mean_valid(train, "n"), 0.0) if "n" in train.channels else 0.0
+    lengths = np.array([float(dict(m).get("lpp", np.nan)) for m in train.experiment_metadata])
+    given = bool(np.all(lengths > 0) and np.ptp(lengths) <= 1e-3 * lengths.max())
     model = js.LowSpeedSwayYaw(speed=speed if speed > 0 else 0.3, propeller_rate=rate)
+    if given:  # HSVA's 7.0 m and MARIN's 320 m / 45.714 agree to 1e-5
+        model = eqx.tree_at(lambda m: m.length, model, float(lengths.mean()))
+    where = ("the records' lpp" if given else
+             "the class's (the records give no single lpp: another hull needs "
+             "jaxship.LowSpeedSwayYaw(length=...) and jaxship.fit)")
     context.note(f"LowSpeedSwayYaw start: the class's values, with its length L = "
-                 f"{float(model.length):.4g} m (frozen: another hull needs "
-                 "jaxship.LowSpeedSwayYaw(length=...) and jaxship.fit); speed "
+                 f"{float(model.length):.4g} m ({where}; kept, not fitted); speed "
                  f"{float(model.speed):.4g} m/s and propeller rate "
                  f"{float(model.propeller_rate):.4g} rev/s are the records' means.")
     return model
