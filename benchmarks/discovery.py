@@ -20,6 +20,10 @@ nulls, wrong names <= 5 %, both of two effects >= 80 %.
 """
 
 import argparse
+import json
+import pathlib
+import subprocess
+import tempfile
 import time
 
 import jax
@@ -50,25 +54,50 @@ SCENARIOS = {  # name: (hidden effects, coloured-disturbance std [rad], true val
 }
 
 
+def time_mariner():
+    """One discovery on Mariner-size records (4 + 3 records of 800 s at 2 Hz, 8 channels,
+    a hidden 0.5 deg rudder offset): `jaxship.discover` from the preset, then the
+    `jaxship discover` command on the same records written as trial CSVs, in a new
+    process (import, compilation, the preset's `identify` start, discovery, report
+    and figures), as a user runs it."""
+    truth = js.augment(js.vessel("mariner"), js.RudderOffset(delta0=0.5 * DEG))
+    train, holdout = vessel_records(truth, 0)
+    began = time.perf_counter()
+    report = js.discover(js.vessel("mariner"), train, holdout,
+                         progress=lambda m: print(f"{time.perf_counter() - began:6.1f} s {m}",
+                                                  flush=True))
+    print(report.to_markdown())
+    print(f"Mariner discovery (library): {time.perf_counter() - began:.1f} s; named "
+          f"{report.names_or_classes()}")
+    with tempfile.TemporaryDirectory() as folder:
+        paths = {}
+        for role, records in (("train", train), ("holdout", holdout)):
+            paths[role] = [f"{folder}/{role}{i}.csv" for i in range(len(records))]
+            for path, e in zip(paths[role], records):
+                js.write_trial_csv(path, e)
+        command = ["jaxship", "discover", *paths["train"], "--holdout", *paths["holdout"],
+                   "--model", "mariner", "--out", f"{folder}/out", "--quiet"]
+        began = time.perf_counter()
+        subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+        seconds = time.perf_counter() - began
+        named = [e["id"] for e in json.loads(pathlib.Path(f"{folder}/out/discovery.json")
+                                              .read_text())["effects"]]
+    print(f"`jaxship discover --model mariner` on the same records (new process): "
+          f"{seconds:.1f} s; named {named}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--only", nargs="*", default=None, help="scenario names to run")
     parser.add_argument("--mariner", action="store_true",
                         help="instead: time one discovery on Mariner records (4 + 3 records of "
-                             "800 s at 2 Hz, 8 channels) with a hidden 0.5 deg rudder offset")
+                             "800 s at 2 Hz, 8 channels) with a hidden 0.5 deg rudder offset, "
+                             "by the library and by the `jaxship discover` command")
     args = parser.parse_args()
     jax.config.update("jax_enable_x64", True)
     if args.mariner:
-        truth = js.augment(js.vessel("mariner"), js.RudderOffset(delta0=0.5 * DEG))
-        train, holdout = vessel_records(truth, 0)
-        began = time.perf_counter()
-        report = js.discover(js.vessel("mariner"), train, holdout,
-                             progress=lambda m: print(f"{time.perf_counter() - began:6.1f} s "
-                                                      f"{m}", flush=True))
-        print(report.to_markdown())
-        print(f"Mariner discovery: {time.perf_counter() - began:.1f} s; named "
-              f"{report.names_or_classes()}")
+        time_mariner()
         return
     rows = []
     for name, (effects, colour, truth) in SCENARIOS.items():

@@ -66,7 +66,7 @@ def save_discovery_figures(report, train, holdout, folder: pathlib.Path) -> list
         for ax, c in zip(axes[:, 0], channels):
             measured = np.asarray(getattr(data, c)[i, :n])
             scale = np.rad2deg(1.0) if c in ("psi", "r") else 1.0
-            unit = {"psi": "deg", "r": "deg/s"}.get(c, "m/s")
+            unit = {"psi": "deg", "r": "deg/s", "x": "m", "y": "m"}.get(c, "m/s")
             for label, p, style in (("before", before, "C3"), ("after", after, "C2")):
                 hit = p.predicted[i, :n]
                 ax.plot(t[hit], scale * (measured - p.predictions[c][i, :n])[hit], style,

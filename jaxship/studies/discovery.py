@@ -61,25 +61,36 @@ def hidden_effect_records(truth, seed, *, disturbance_std=0.0):
     return train, holdout
 
 
-def race_records(K, T, gain, seed, *, rpms=(1.0, 2.0)):
-    """`(train, holdout)` of Nomoto 1 ($K$ [1/s], $T$ [s]) whose rudder sits in the
-    propeller race (`PropellerRace(gain)`), with the propeller rate logged: 10/10 and
-    20/20 zig-zags to starboard at each rate of `rpms` [rev/s] to train, +-20 deg
-    turns at their mean rate held out. At a constant rate the race is a rudder gain,
-    so each record is Nomoto 1 with $K + b n^2$ (exact), run as `record` does."""
+def condition_records(at, seed, *, channel="n", values=(1.0, 2.0), held=None):
+    """`(train, holdout)` of a steering truth that changes with a logged condition
+    held constant in each run: the propeller rate (`channel="n"`, [rev/s]) or the
+    surge speed (`"u"`, [m/s]). `at(value)` is the truth at that value, exact where
+    the effect is a gain, time constant or moment constant at a constant rate or
+    speed (`steer_manoeuvre` has no logged inputs). 10/10 and 20/20 zig-zags to
+    starboard at each of `values` to train, +-20 deg turns at `held` (default their
+    mean) held out, run as `record` does."""
     rng = np.random.default_rng(seed)
+    unit = {"n": "rev/s", "u": "m/s"}[channel]
 
-    def one(manoeuvre, n, name):
-        out = record(js.Nomoto1(K=K + gain * n**2, T=T), manoeuvre, name, rng)
-        return js.Experiment(out.t, out.delta, psi=out.psi, r=out.r, n=np.full(out.t.size, n),
-                             name=name)
+    def one(manoeuvre, value, name):
+        out = record(at(value), manoeuvre, name, rng)
+        return js.Experiment(out.t, out.delta, psi=out.psi, r=out.r, name=name,
+                             **{channel: np.full(out.t.size, value)})
 
-    train = [one(js.ZigZag(a * DEG, a * DEG, duration=400.0, dt=0.5), n,
-                 f"zigzag {a}/{a} at {n} rev/s") for a in (10, 20) for n in rpms]
-    mean = float(np.mean(rpms))
-    holdout = [one(js.Turn(a * DEG, duration=300.0, dt=0.5), mean, f"turn {a:+d} at {mean} rev/s")
-               for a in HOLDOUT]
+    train = [one(js.ZigZag(a * DEG, a * DEG, duration=400.0, dt=0.5), value,
+                 f"zigzag {a}/{a} at {value} {unit}") for a in (10, 20) for value in values]
+    held = float(np.mean(values)) if held is None else held
+    holdout = [one(js.Turn(a * DEG, duration=300.0, dt=0.5), held,
+                   f"turn {a:+d} at {held} {unit}") for a in HOLDOUT]
     return train, holdout
+
+
+def race_records(K, T, gain, seed, *, rpms=(1.0, 2.0)):
+    """`condition_records` of Nomoto 1 ($K$ [1/s], $T$ [s]) whose rudder sits in the
+    propeller race (`PropellerRace(gain)`) at the propeller rates `rpms` [rev/s]: at
+    a constant rate the race is a rudder gain, so each record is Nomoto 1 with
+    $K + b n^2$."""
+    return condition_records(lambda n: js.Nomoto1(K=K + gain * n**2, T=T), seed, values=rpms)
 
 
 def wind_records(truth, seed, *, speed=7.0, wind=(15.0, 60.0 * DEG), noise=(0.1, 0.05)):
@@ -141,25 +152,31 @@ def outcome(report, hidden_ids) -> str:
     return "correct" if found == set(hidden_ids) else "missed"
 
 
-def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02, 1.0)):
+def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02, 1.0),
+                   wind=None):
     """`(train, holdout)` of a 3-DOF `truth` vessel (e.g. the Mariner with an effect):
     10/10 and 20/20 zig-zags to both sides to train, +-35 deg turning circles and a
     15/15 zig-zag held out, `duration` s at 2 Hz from the nominal straight run, with
     the servo's rudder logged at the samples and noise on psi [deg], r [deg/s], u, v
     [m/s] and the positions x, y [m] (GNSS; rudder and rpm exact): 8 channels per
-    record."""
+    record. With a steady true `wind` (`jaxship.Wind`) the ship sails in it and the
+    records log it (10 channels)."""
     rng = np.random.default_rng(seed)
     x0 = js.straight_run(truth)
+    environment = js.Environment() if wind is None else js.Environment(wind=wind)
 
     def one(manoeuvre, name):
-        traj = js.simulate(truth, manoeuvre, x0, simulator=FINE)
+        traj = js.simulate(truth, manoeuvre, x0, environment=environment, simulator=FINE)
         e = js.Experiment.from_trajectory(traj, name=name)
         scale = {"psi": noise[0] * DEG, "r": noise[1] * DEG, "u": noise[2], "v": noise[3],
                  "x": noise[4], "y": noise[4]}
         noisy = {c: getattr(e, c) + rng.normal(0, s, e.t.size) for c, s in scale.items()}
+        logged = {} if wind is None else {
+            "wind_speed": np.full(e.t.size, float(wind.speed)),
+            "wind_dir": np.full(e.t.size, float(wind.direction))}
         return js.Experiment(e.t, e.delta, psi=truth.measure("psi", noisy["psi"]),
                              r=truth.measure("r", noisy["r"]), u=noisy["u"], v=noisy["v"],
-                             x=noisy["x"], y=noisy["y"], n=e.n, name=name)
+                             x=noisy["x"], y=noisy["y"], n=e.n, name=name, **logged)
 
     train = [one(js.ZigZag(a * DEG, s * a * DEG, duration=duration, dt=0.5),
                  f"zigzag {a}/{a} {'starboard' if s > 0 else 'port'}") for a, s in TRAIN]
