@@ -59,12 +59,16 @@ from ._estimate._linear import (
     initial_estimate as initial_estimate,
     ross_initial_estimate as ross_initial_estimate,
 )
-from ._estimate._lm import LevenbergMarquardt as LevenbergMarquardt
+from ._estimate._lm import RESULTS as RESULTS, LevenbergMarquardt as LevenbergMarquardt
 from ._estimate._predict import predict as predict
 from ._estimate._result import (
     ConvergenceWarning as ConvergenceWarning,
     FitResult as FitResult,
     IdentifiabilityWarning as IdentifiabilityWarning,
+)
+from ._foundation._cache import (
+    compilation_cache_dir as compilation_cache_dir,
+    enable_compilation_cache as enable_compilation_cache,
 )
 from ._foundation._covariance import parameter_report as parameter_report
 from ._foundation._kinematics import body_to_earth as body_to_earth, ssa as ssa

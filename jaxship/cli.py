@@ -19,7 +19,8 @@ matplotlib.use("Agg")  # the command writes files; it never opens a window
 import matplotlib.pyplot as plt  # noqa: E402
 
 from ._estimate._result import ConvergenceWarning  # noqa: E402
-from ._foundation._files import staged_folder, write_whole  # noqa: E402
+from ._foundation._cache import enable_compilation_cache  # noqa: E402
+from ._foundation._files import staged_folder  # noqa: E402
 from ._models._vessel._base import surge_force  # noqa: E402
 from ._models._vessel.catalogue import VESSELS, get_vessel  # noqa: E402
 from ._trials import TrialSpec, simulate_to_folder  # noqa: E402
@@ -39,8 +40,10 @@ from .studies.reproduce import reproduce  # noqa: E402
 
 EXIT_STATUS = """exit status: 0 done; 2 bad input (arguments, records, an --out that cannot be
 written: one line on stderr, nothing written); 1 a file-system failure while writing;
-3 the fit did not converge, ended on a parameter bound (results written, the reason on
-stderr) or diverged (nothing written); 130 interrupted."""
+3 the fit did not converge, blew up, never moved, ended on a parameter bound, or a closed
+loop blew up (results written, the reason on stderr) or diverged (nothing written); 130
+interrupted. JAXSHIP_CACHE_DIR: where compiled programs are kept for later runs (default
+~/.cache/jaxship/jax; "off" disables)."""
 
 # the most samples `simulate` integrates (10 million samples hold gigabytes)
 MAX_SAMPLES = 5_000_000
@@ -142,6 +145,7 @@ def main(argv=None) -> int:
 
     args = parser.parse_args(argv)
     jax.config.update("jax_enable_x64", True)
+    enable_compilation_cache()  # second runs skip compilation ($JAXSHIP_CACHE_DIR moves it)
     commands = {"vessels": _vessels, "simulate": _simulate, "reproduce": _reproduce,
                 "identify": _identify, "autopilot": _autopilot, "discover": _discover}
     try:
@@ -184,15 +188,8 @@ def _simulate(args) -> int:
             raise ValueError(f"--manoeuvre {args.manoeuvre}: the rudder angle {angle:g} deg is "
                              f"beyond the rudder limit of {args.vessel} ({limit:g} deg); give "
                              f"at most {limit:g}.")
-    nominal = float(vessel.nominal_speed)
-    if speed is not None and speed > 10 * nominal:
-        raise ValueError(f"--speed {speed:g} m/s: more than 10 times the service speed of "
-                         f"{args.vessel} ({nominal:.3g} m/s); give an approach speed in m/s.")
-    if rpm is not None and float(surge_force(vessel, nominal, 1.0)
-                                 - surge_force(vessel, nominal, 0.0)) == 0.0:
-        raise ValueError(f"--rpm: {args.vessel} has no propeller model, so the propeller rate "
-                         "does nothing; give --speed instead.")
-    tau = float(vessel.length) / (speed or nominal)  # the time scale L/U [s]
+    _check_operating_point(vessel, args.vessel, [speed] if speed else [], [rpm] if rpm else [])
+    tau = float(vessel.length) / (speed or float(vessel.nominal_speed))  # time scale L/U [s]
     if dt is not None and dt > tau:
         raise ValueError(f"--dt {dt:g} s is longer than the time scale L/U = {tau:.3g} s of "
                          f"{args.vessel}, which the simulation could not resolve; give at most "
@@ -310,6 +307,25 @@ def _identify(args) -> int:
     return 0
 
 
+def _check_operating_point(vessel, name, speeds, rpms):
+    """Approach speeds [m/s] and propeller rates [rpm] a vessel can sail at: at most 10
+    times its service speed and rate, and a rate only where it has a propeller model."""
+    nominal = float(vessel.nominal_speed)
+    for speed in speeds:
+        if speed > 10 * nominal:
+            raise ValueError(f"--speed {speed:g} m/s: more than 10 times the service speed "
+                             f"of {name} ({nominal:.3g} m/s); give an approach speed in m/s.")
+    if rpms and float(surge_force(vessel, nominal, 1.0)
+                      - surge_force(vessel, nominal, 0.0)) == 0.0:
+        raise ValueError(f"--rpm: {name} has no propeller model, so the propeller rate "
+                         "does nothing; give --speed instead.")
+    service = 60.0 * float(vessel.nominal_n)
+    for rpm in rpms:
+        if rpm > 10 * service:
+            raise ValueError(f"--rpm {rpm:g}: more than 10 times the service propeller rate "
+                             f"of {name} ({service:.4g} rpm).")
+
+
 def _positive(option, value):
     """`value` (a float or None) checked: finite and positive."""
     if value is not None and not (math.isfinite(value) and value > 0):
@@ -381,6 +397,8 @@ def _autopilot(args) -> int:
         raise ValueError("--step, --natural-frequency and --damping take numbers.") from None
     design.check()
     vessel = get_vessel(args.vessel)
+    _check_operating_point(vessel, args.vessel, [] if by_rpm else values,
+                           values if by_rpm else [])
     model, report = read_result(args.model)
     _check_out(args.out)
 
@@ -400,44 +418,52 @@ def _autopilot(args) -> int:
     bar.update(bar.total - bar.n)
     bar.close()
 
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "figures").mkdir(exist_ok=True)
     names = list(evaluation.runs)
     loops = [evaluation.runs[n] for n in names]
-    figures = []
-    for j, row in enumerate(evaluation.rows[:len(values)]):
-        point = _point_name(row, by_rpm)
-        fig = plot_autopilot(
-            loops[0], index=j, others=loops[1:], labels=names,
-            max_angle=float(vessel.rudder.max_angle),
-            window=(design.step_time - 10.0, design.duration),
-            title=f"{report['model']} autopilot on {args.vessel} at {row['rpm']:.0f} rpm, "
-            f"{row['speed']:.3g} m/s")
-        name = f"figures/heading_{point}.png"
-        write_whole(args.out / name, lambda p, fig=fig: fig.savefig(p, dpi=100, format="png"))
-        plt.close(fig)
-        figures.append(name)
-    result = {
-        "model": {"file": str(args.model), "name": report["model"],
-                  "class": type(model).__name__,
-                  "parameters": {k: e["value"] for k, e in report["parameters"].items()}},
-        "vessel": args.vessel,
-        **evaluation.to_dict(),
-        "figures": figures,
-    }
-    write_whole(args.out / "autopilot.json",
-             lambda p: p.write_text(json.dumps(result, indent=2) + "\n"))
-    parameters = ", ".join(f"{k} = {float(v):.4g}"
-                           for k, v in result["model"]["parameters"].items())
-    page = autopilot_study.evaluation_report(
-        evaluation, title=f"Heading autopilot: {report['model']} on {args.vessel}",
-        model_text=f"Model: {report['model']} ({type(model).__name__}) from `{args.model}`: "
-        f"{parameters}.", figures=figures)
-    write_whole(args.out / "report.md", lambda p: p.write_text(page))
+    failed = [f"{row['controller']} at {row['rpm']:.4g} rpm, {row['speed']:.3g} m/s"
+              for row in evaluation.rows if not row["success"]]
+    failure = (f"The closed loop blew up (not finite) for {'; '.join(failed)}: those runs "
+               "have no metrics and say nothing about the autopilot." if failed else "")
+    with staged_folder(args.out) as stage:  # the whole set appears, or none of it
+        (stage / "figures").mkdir()
+        figures = []
+        for j, row in enumerate(evaluation.rows[:len(values)]):
+            fig = plot_autopilot(
+                loops[0], index=j, others=loops[1:], labels=names,
+                max_angle=float(vessel.rudder.max_angle),
+                window=(design.step_time - 10.0, design.duration),
+                title=f"{report['model']} autopilot on {args.vessel} at {row['rpm']:.0f} rpm, "
+                f"{row['speed']:.3g} m/s")
+            name = f"figures/heading_{_point_name(row, by_rpm)}.png"
+            fig.savefig(stage / name, dpi=100, format="png")
+            plt.close(fig)
+            figures.append(name)
+        result = {
+            "model": {"file": str(args.model), "name": report["model"],
+                      "class": type(model).__name__,
+                      "parameters": {k: e["value"] for k, e in report["parameters"].items()}},
+            "vessel": args.vessel,
+            **evaluation.to_dict(),
+            "figures": figures,
+        }
+        (stage / "autopilot.json").write_text(json.dumps(result, indent=2) + "\n")
+        parameters = ", ".join(f"{k} = {float(v):.4g}"
+                               for k, v in result["model"]["parameters"].items())
+        page = autopilot_study.evaluation_report(
+            evaluation, title=f"Heading autopilot: {report['model']} on {args.vessel}",
+            model_text=f"Model: {report['model']} ({type(model).__name__}) from "
+            f"`{args.model}`: {parameters}.", figures=figures)
+        if failure:  # first, under the title
+            title, _, rest = page.partition("\n")
+            page = f"{title}\n\n**{failure}**\n{rest}"
+        (stage / "report.md").write_text(page)
     print(autopilot_study.gains_table(evaluation.gains()))
     print(autopilot_study.runs_table(evaluation.rows))
     print(f"wrote {args.out}/autopilot.json, {args.out}/report.md, {args.out}/figures/ "
           f"({len(figures)} figures)")
+    if failure:
+        print(f"jaxship: {failure}", file=sys.stderr)
+        return 3
     return 0
 
 

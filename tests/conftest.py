@@ -1,5 +1,6 @@
 import gc
 import os
+import pathlib
 
 import jax
 import pytest
@@ -8,6 +9,12 @@ import jaxship as js
 
 
 jax.config.update("jax_enable_x64", True)
+# one compilation cache for the run, inside the checkout (a fresh clone starts empty):
+# programs compiled in one test module, by the other xdist worker, by a `jaxship`
+# subprocess or a notebook kernel are read back, not compiled again
+os.environ.setdefault("JAXSHIP_CACHE_DIR", str(pathlib.Path(__file__).parent.parent
+                                              / ".pytest_cache" / "jax-compilation"))
+js.enable_compilation_cache()
 
 
 def pytest_sessionstart(session):

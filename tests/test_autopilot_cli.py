@@ -108,6 +108,17 @@ def _bad_cases(tmp_path, identified):
     a_file.write_text("keep")
     latin1 = tmp_path / "latin1.json"
     latin1.write_bytes('{"model": "nomoto1", "note": "Kr\u00e5ke"}'.encode("latin-1"))
+    report = json.loads(pathlib.Path(identified).read_text())
+
+    def crafted(name, change):
+        path = tmp_path / f"{name}.json"
+        path.write_text(json.dumps(report | change))
+        return path
+
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 100_000 + "]" * 100_000)
+    fifo = tmp_path / "fifo.json"
+    os.mkfifo(fifo)
     model = ["--model", str(identified)]
     out = ["--out", str(tmp_path / "out")]
     return [
@@ -115,6 +126,9 @@ def _bad_cases(tmp_path, identified):
         (model + ["--vessel", "thesis", "--rpm", "-300"] + out, "positive"),
         (model + ["--vessel", "thesis", "--speed", "0"] + out, "positive"),
         (model + ["--vessel", "thesis", "--rpm", "fast"] + out, "not a number"),
+        # the trust audit: these ran, blew up and exited 0 with a table of "-"
+        (model + ["--vessel", "thesis", "--speed", "1e6"] + out, "10 times the service speed"),
+        (model + ["--vessel", "thesis", "--rpm", "1e9"] + out, "10 times the service propeller"),
         (model + ["--vessel", "thesis", "--rpm", "300", "--speed", "1.0"] + out, "one of them"),
         (model + ["--vessel", "thesis"] + out, "one of them"),
         (model + ["--vessel", "thesis", "--rpm", "300", "--step", "0"] + out, "step"),
@@ -127,6 +141,16 @@ def _bad_cases(tmp_path, identified):
         (["--model", str(latin1), "--vessel", "thesis", "--rpm", "300"] + out,
          "not a text file"),
         (["--model", str(armax), "--vessel", "thesis", "--rpm", "300"] + out, "armax"),
+        # crafted result.json files ended in AttributeError / RecursionError tracebacks, a
+        # FIFO blocked forever
+        (["--model", str(crafted("frozen", {"frozen": [1, 2]})), "--vessel", "thesis", "--rpm",
+          "300"] + out, "'frozen' in the identify result is a list, not a dict"),
+        (["--model", str(crafted("constants", {"constants": "L"})), "--vessel", "thesis",
+          "--rpm", "300"] + out, "'constants' in the identify result is a str, not a dict"),
+        (["--model", str(deep), "--vessel", "thesis", "--rpm", "300"] + out,
+         "nested too deeply"),
+        (["--model", str(fifo), "--vessel", "thesis", "--rpm", "300"] + out,
+         "not a regular file"),
         (model + ["--vessel", "mariner", "--rpm", "60"] + out, "no propeller"),
         (model + ["--vessel", "thesis", "--rpm", "300", "--out", str(a_file)], "is a file"),
         (model + ["--vessel", "thesis", "--rpm", "300", "--out", str(a_file / "sub")],
@@ -147,6 +171,29 @@ def test_bad_input_is_one_line_a_non_zero_exit_and_writes_nothing(identified, tm
         assert captured.out == ""
         assert sorted(p.name for p in tmp_path.rglob("*")) == before, args
     assert (tmp_path / "a_file").read_text() == "keep"
+
+
+def test_a_closed_loop_that_blew_up_exits_3_and_says_so(identified, tmp_path, capsys,
+                                                        monkeypatch):
+    """A run whose simulation did not stay finite (`success` false: the trust audit's
+    --speed 1e6, now refused before any work) is not a success: exit 3, and the report
+    says so first, under its title."""
+    evaluate = study.evaluate
+
+    def blown(*args, **kwargs):
+        evaluation = evaluate(*args, **kwargs)
+        evaluation.rows[0]["success"] = False
+        return evaluation
+
+    monkeypatch.setattr("jaxship.cli.autopilot_study.evaluate", blown)
+    out = tmp_path / "run"
+    assert main(["autopilot", "--model", str(identified), "--vessel", "thesis", "--rpm", "300",
+                 "--out", str(out), "--quiet"]) == 3
+    err = capsys.readouterr().err
+    assert "The closed loop blew up (not finite) for pid+ff at 300 rpm" in err
+    title, blank, first = (out / "report.md").read_text().splitlines()[:3]
+    assert title.startswith("#") and blank == "" and first.startswith("**The closed loop blew")
+    assert json.loads((out / "autopilot.json").read_text())["runs"]
 
 
 @pytest.mark.skipif(not os.path.isdir("/proc") or os.name != "posix", reason="needs /proc")

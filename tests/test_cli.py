@@ -3,6 +3,7 @@ bad input on every command is one line and a non-zero exit before any long work,
 are written whole or not at all, fits that do not converge say so and exit with 3."""
 
 import json
+import os
 import types
 
 import numpy as np
@@ -10,6 +11,7 @@ import optimistix as optx
 import pytest
 
 import jaxship as js
+from jaxship._foundation._files import MANIFEST
 from jaxship._foundation._params import parameter_fields, resolve_free
 from jaxship.cli import main
 from jaxship.identification.workflow import FitDivergedError, _convergence_problems
@@ -154,14 +156,17 @@ def test_simulate_failure_leaves_the_output_folder_untouched(tmp_path, capsys):
 def test_simulate_replaces_earlier_results_whole(tmp_path, capsys):
     out = tmp_path / "run"
     out.mkdir()
-    (out / "trial.csv").write_text("earlier run\n")
     (out / "notes.txt").write_text("mine\n")
+    assert main(["simulate", "--vessel", "mariner", "--manoeuvre", "turn:20", "--out",
+                 str(out)]) == 0  # an earlier run
     assert main(["simulate", "--vessel", "mariner", "--manoeuvre", "zigzag:10/10", "--out",
                  str(out)]) == 0
     assert "wrote" in capsys.readouterr().out
     names = {p.name for p in out.iterdir()}
     assert {"indices.json", "notes.txt", "trial.csv", "trial.png"} <= names
-    assert not [name for name in names if name.startswith(".")]  # no temporary files left
+    assert (out / "notes.txt").read_text() == "mine\n"
+    # no temporary files left; the manifest of jaxship's own files
+    assert [name for name in names if name.startswith(".")] == [MANIFEST]
     assert js.read_trial_csv(out / "trial.csv").num_samples > 100
     again = tmp_path / "again"  # same inputs, same numbers
     assert main(["simulate", "--vessel", "mariner", "--manoeuvre", "zigzag:10/10", "--out",
@@ -258,11 +263,17 @@ def test_identify_rejects_nonsense_numbers(record, tmp_path, capsys, args, messa
      "column 'delta [deg]', row 2 (line 3): cannot read 'zero' as a number"),
     ("dup.csv", "t [s],delta [deg],psi [deg]\n0,0,0\n0,0,0\n", "strictly increasing"),
     ("unit.csv", "t [s],delta [grad],psi [deg]\n0,0,0\n1,0,0\n", "unknown unit 'grad'"),
+    ("utf16.csv", "\ufefft [s],delta [deg],psi [deg]\n0,0,0\n1,0,0\n",
+     "the file is UTF-16 text; save it as UTF-8"),
+    ("fifo.csv", None, "is not a regular file (a pipe or a device)"),
 ])
 @pytest.mark.parametrize("command", ["identify", "discover"])
 def test_bad_records_are_one_line(tmp_path, capsys, command, name, content, message):
     path = tmp_path / name
-    path.write_bytes(content.encode("latin-1"))
+    if content is None:  # a FIFO that nothing writes to: reading it would block forever
+        os.mkfifo(path)
+    else:
+        path.write_bytes(content.encode("utf-16" if "utf16" in name else "latin-1"))
     assert main([command, str(path), "--model", "nomoto1", "--out", str(tmp_path / "o")]) == 2
     line = _error_line(capsys)
     assert str(path) in line and message in line
@@ -283,7 +294,30 @@ def test_identify_not_converged_exit_3_plain_sentence(record, tmp_path, capsys):
     result = json.loads((out / "result.json").read_text())
     assert not result["fit"]["success"]
     assert any("step limit (1)" in w for w in result["warnings"])
-    assert sorted(p.name for p in out.iterdir()) == ["result.json"]  # no temporary files
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "result.json"]  # no temporary files
+
+
+def test_identify_of_pure_noise_is_not_converged(tmp_path, capsys):
+    """The trust audit's case: Nomoto 1 on 300 s of pure noise at 1 s samples said
+    "converged in 30 steps" with a cost of 9.2e122 (one RK4 step per sample under a
+    start T of 0.31 s); now the step follows the start's time constant, nothing blows
+    up, and the optimiser, chasing the noise to ever shorter time constants, is not
+    converged: exit 3, the reason on stderr."""
+    rng = np.random.default_rng(0)
+    t = np.arange(0.0, 300.0, 1.0)
+    rows = np.column_stack([t, np.where((t // 30) % 2 == 0, 10.0, -10.0),
+                            rng.normal(0.0, 3.0, t.size), rng.normal(0.0, 0.6, t.size)])
+    path = tmp_path / "noise.csv"
+    np.savetxt(path, rows, delimiter=",", header="t [s],delta [deg],psi [deg],r [deg/s]",
+               comments="")
+    out = tmp_path / "fit"
+    code = main(["identify", str(path), "--model", "nomoto1", "--out", str(out),
+                 "--no-figures", "--quiet"])
+    captured = capsys.readouterr()
+    assert code == 3, captured.out + captured.err
+    assert "NOT converged" in captured.out and "did not converge properly" in captured.err
+    result = json.loads((out / "result.json").read_text())
+    assert not result["fit"]["success"] and result["fit"]["cost"] < 1e6
 
 
 def test_identify_flags_one_per_line(tmp_path, capsys):
@@ -334,14 +368,19 @@ def test_identify_is_repeatable(record, tmp_path, capsys):
 
 
 def test_identify_replaces_figures_whole(record, tmp_path, capsys):
+    """A figure of jaxship's earlier run (its manifest lists it) that this run does not
+    draw is removed; a figure of the user's in the same folder stays."""
     out = tmp_path / "fit"
     (out / "figures").mkdir(parents=True)
     (out / "figures" / "stale.png").write_bytes(b"old")
+    (out / "figures" / "mine.png").write_bytes(b"mine")
+    (out / MANIFEST).write_text(json.dumps({"files": ["figures/stale.png"]}))
     assert main(["identify", record, "--model", "nomoto1", "--out", str(out), "--quiet"]) == 0
     capsys.readouterr()
     figures = sorted(p.name for p in (out / "figures").iterdir())
     assert "stale.png" not in figures and "correlation.png" in figures
-    assert sorted(p.name for p in out.iterdir()) == ["figures", "result.json"]
+    assert "mine.png" in figures
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "figures", "result.json"]
 
 
 def test_exit_status_of_diverged_fits_file_system_errors_and_interrupts(

@@ -217,6 +217,27 @@ ERROR_CASES = {
         "t [s],delta [deg],psi [deg]\n0.0,0,0\n0.1,0\n",
         r"bad\.csv: row 2 \(line 3\) has 2 fields but the header has 3 columns",
     ),
+    # the trust audit: degrees labelled rad gave K 57 times too small, with exit 0
+    "rudder in degrees labelled rad": (
+        "t [s],delta [rad],psi [rad]\n0.0,0,0\n0.5,20,0.01\n",
+        r"bad\.csv: column 'delta \[rad\]', row 2 \(line 3\): 1146 deg is beyond a rudder "
+        r"angle of any ship \(at most 90 deg\); is the column in deg rather than rad\?",
+    ),
+    "yaw rate in degrees labelled rad/s": (
+        "t [s],delta [deg],r [rad/s]\n0.0,0,0\n0.5,20,1.5\n",
+        r"column 'r \[rad/s\]', row 2 \(line 3\): 85\.94 deg/s is beyond a ship's yaw rate.*"
+        r"in deg/s rather than rad/s",
+    ),
+    "propeller rate in rpm labelled rps": (
+        "t [s],delta [deg],psi [deg],n [rps]\n0.0,0,0,120\n0.5,20,1,120\n",
+        r"column 'n \[rps\]', row 1 \(line 2\): 7200 rpm is beyond a propeller rate.*rpm "
+        r"rather than rps",
+    ),
+    "speed in knots or km/h": (
+        "t [s],delta [deg],psi [deg],u [m/s]\n0.0,0,0,72\n0.5,20,1,72\n",
+        r"column 'u \[m/s\]', row 1 \(line 2\): 72 m/s is beyond a ship's speed.*check the "
+        r"column's unit",
+    ),
     "time not increasing": (
         "t [s],delta [deg],psi [deg]\n0.0,0,0\n0.1,0,0\n0.1,0,0\n0.2,0,0\n",
         r"bad\.csv: column 't \[s\]', row 3 \(line 4\): time 0\.1 is not greater",
@@ -668,4 +689,19 @@ def test_a_folder_with_a_record_in_the_wrong_dialect_says_so(tmp_path):
     (tmp_path / "b.csv").write_text(GOOD.replace(",", ";"))
     with pytest.raises(ValueError, match=r"b\.csv: header row \(line 1\): the columns are "
                                          r"separated by semicolons"):
+        read_experiments([tmp_path])
+
+
+def test_a_folder_reads_quoted_headers_and_refuses_utf16(tmp_path):
+    """The trust audit: a folder scan skipped a quoted CSV and a UTF-16 one in silence, so
+    a fit used fewer records than given. Quoted fields are valid CSV and are read; a
+    UTF-16 record is refused, naming its encoding."""
+    (tmp_path / "a.csv").write_text(GOOD)
+    quoted = GOOD.splitlines()
+    quoted[0] = ",".join(f'"{h}"' for h in quoted[0].split(","))
+    (tmp_path / "quoted.csv").write_text("\n".join(quoted) + "\n")
+    assert [e.name for e in read_experiments([tmp_path])] == ["a", "quoted"]
+    (tmp_path / "wide.csv").write_bytes(GOOD.encode("utf-16"))
+    with pytest.raises(ValueError, match=r"wide\.csv: the file is UTF-16 text; save it as "
+                                         r"UTF-8"):
         read_experiments([tmp_path])

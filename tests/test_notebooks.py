@@ -14,6 +14,9 @@ def test_notebook_runs(path):
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")
     notebook = nbformat.read(path, as_version=4)
+    # the kernel shares the test run's compilation cache ($JAXSHIP_CACHE_DIR, conftest)
+    notebook.cells.insert(0, nbformat.v4.new_code_cell(
+        "import jaxship\njaxship.enable_compilation_cache();"))
     client = nbclient.NotebookClient(
         notebook,
         timeout=900,

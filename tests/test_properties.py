@@ -5,13 +5,14 @@ each other to a few ulp, and time that is not strictly increasing is always reje
 at the first offending row."""
 
 import math
+import re
 
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, assume, given, settings, strategies as st
 
 import jaxship as js
-from jaxship._simulation._readers import _UNITS, _from_si, _to_si
+from jaxship._simulation._readers import _PLAUSIBLE, _UNITS, _from_si, _to_si
 
 
 SETTINGS = settings(max_examples=60, deadline=None, database=None,
@@ -28,7 +29,8 @@ def finite(limit=1e12):
 def experiments(draw, limit=1e12, both=False):
     """An `Experiment` with strictly increasing time and arbitrary finite values in a
     random subset of the channels (psi or r among them; both with `both`, so that none is
-    derived: a derivative of values near the float limit overflows)."""
+    derived: a derivative of values near the float limit overflows); values up to `limit`,
+    and up to what any ship logs in the channels the reader checks (`_PLAUSIBLE`)."""
     num = draw(st.integers(2, 25))
     t0 = draw(finite(1e6))
     steps = draw(st.lists(st.floats(1e-3, 1e3), min_size=num - 1, max_size=num - 1))
@@ -36,8 +38,9 @@ def experiments(draw, limit=1e12, both=False):
     assume(np.all(np.diff(t) > 0))
     chosen = draw(st.sets(st.sampled_from(OPTIONAL)))
     chosen.update(("psi", "r") if both else (draw(st.sampled_from(("psi", "r"))),))
-    column = st.lists(finite(limit), min_size=num, max_size=num).map(np.array)
-    values = {key: draw(column) for key in ("delta", *sorted(chosen))}
+    column = lambda key: st.lists(finite(min(limit, _PLAUSIBLE.get(key, (limit,))[0])),
+                                  min_size=num, max_size=num).map(np.array)
+    values = {key: draw(column(key)) for key in ("delta", *sorted(chosen))}
     return js.Experiment(t, name="prop", **values)
 
 
@@ -87,6 +90,27 @@ def test_huge_values_round_trip_or_are_refused_in_display_units(tmp_path_factory
         back = js.read_trial_csv(path)
         for key in experiment.channels:
             assert_close(getattr(back, key), getattr(experiment, key), key)
+
+
+@SETTINGS
+@given(experiments(), st.sampled_from(sorted(_PLAUSIBLE)), st.floats(1.0 + 1e-9, 1e6),
+       st.sampled_from(["display", "si"]))
+def test_values_beyond_any_ship_are_refused_naming_the_column(tmp_path_factory, experiment,
+                                                              key, factor, units):
+    """A channel the reader checks, beyond what any ship logs (degrees in a column
+    labelled rad, rpm labelled rps, ...) at one random sample: refused, naming the
+    column and that row."""
+    values = {k: np.array(getattr(experiment, k)) for k in experiment.channels}
+    values.setdefault(key, np.zeros(experiment.num_samples))
+    row = experiment.num_samples // 2
+    values[key][row] = _PLAUSIBLE[key][0] * factor
+    path = tmp_path_factory.mktemp("beyond") / "trial.csv"
+    js.write_trial_csv(path, js.Experiment(experiment.t, name="prop", **values), units=units)
+    header = next(h for h in path.read_text().splitlines()[0].split(",")
+                  if h.split(" [")[0] == key)
+    with pytest.raises(ValueError, match=rf"column '{re.escape(header)}', row {row + 1} "
+                                         rf"\(line {row + 2}\): .* is beyond"):
+        js.read_trial_csv(path)
 
 
 @given(st.floats(allow_nan=False, allow_infinity=False, min_value=-1e300, max_value=1e300))
@@ -156,3 +180,42 @@ def test_reader_rejects_shuffled_or_repeated_time(tmp_path_factory, case):
     assert "\n" not in str(error.value)
     with pytest.raises(ValueError, match="strictly increasing"):
         js.read_measured(path)
+
+
+VALID = ("t [s],delta [deg],psi [deg],r [deg/s],u [m/s]\n"
+         + "".join(f"{0.5 * k},{10 if k % 8 < 4 else -10},{k * 0.3},{0.6},{5.0}\n"
+                   for k in range(12))).encode()
+
+
+@st.composite
+def mutated(draw):
+    """The bytes of a valid trial CSV with random bytes overwritten, inserted or cut."""
+    data = bytearray(VALID)
+    for _ in range(draw(st.integers(1, 6))):
+        at = draw(st.integers(0, len(data)))
+        piece = draw(st.binary(min_size=0, max_size=4))
+        kind = draw(st.sampled_from(["overwrite", "insert", "cut"]))
+        if kind == "insert":
+            data[at:at] = piece
+        elif kind == "cut":
+            del data[at:at + len(piece) + 1]
+        else:
+            data[at:at + len(piece)] = piece
+    return bytes(data)
+
+
+@settings(max_examples=150, deadline=None, database=None,
+          suppress_health_check=[HealthCheck.too_slow])
+@given(st.one_of(st.binary(max_size=300), mutated()), st.sampled_from([".csv", ".dat", ".txt"]))
+def test_any_bytes_give_a_record_or_one_line_error(tmp_path_factory, data, suffix):
+    """Fuzzing the readers: random bytes, and random mutations of a valid file, are either
+    read into an `Experiment` or refused with a one-line `ValueError` naming the file;
+    never another exception."""
+    path = tmp_path_factory.mktemp("fuzz") / f"record{suffix}"
+    path.write_bytes(data)
+    try:
+        experiment = js.read_measured(path)
+    except ValueError as error:
+        assert "\n" not in str(error) and str(path) in str(error), str(error)
+    else:
+        assert experiment.num_samples >= 1 and np.all(np.isfinite(experiment.t))

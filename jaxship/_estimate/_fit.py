@@ -12,6 +12,7 @@ through the simulator's time loop (`_simulate.integrate`), computed once per eva
 """
 
 import abc
+import contextlib
 import dataclasses
 import math
 import warnings
@@ -32,7 +33,14 @@ from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
 from .._foundation._sharding import sharded_vmap
 from .._foundation._validate import validate
 from .._simulation._simulate import Simulator, integrate, replay_policy
-from ._lm import LevenbergMarquardt, blockwise_jacfwd, solve_least_squares, value_and_jacfwd
+from ._lm import (
+    RESULTS,
+    LevenbergMarquardt,
+    as_code,
+    blockwise_jacfwd,
+    solve_least_squares,
+    value_and_jacfwd,
+)
 from ._result import ConvergenceWarning, FitResult, IdentifiabilityWarning
 from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_data, to_timeline
 
@@ -148,6 +156,40 @@ def _predict(model, w: Windows, offsets=None):
     return jnp.moveaxis(out, -1, 0)
 
 
+def _field_jacobians(model, w: Windows):
+    """$\\partial f / \\partial y$ of the model's vector field at the start of each
+    experiment's first window, shape (E, n, n): its eigenvalues are the rates of the
+    model's modes there (a Nomoto 1's $-1/T$)."""
+    field = model.replay_field(w.servo)
+    holds = dict(w.holds)
+
+    def one(start, records, dt):
+        y0 = model.replay_state(start, w.servo)
+        inputs, _ = replay_policy(records, dt, holds)(0.0, y0, None, dt)
+        return jax.jacfwd(lambda y: field(0.0, y, inputs.at(0.0)))(y0)
+
+    first = lambda a: a[:, 0]
+    return jax.vmap(one)(jax.tree.map(first, w.start), jax.tree.map(first, w.records),
+                         w.dt[:, 0])
+
+
+def fastest_rate(jacobians, dt) -> float:
+    """The largest $|h\\lambda|$ over the decaying modes ($\\mathrm{Re}\\,\\lambda < 0$) of
+    the (n, n) Jacobians, $h$ = each one's sample interval `dt`: a Nomoto 1's
+    `dt / T`. Growing modes grow in the ship too and do not count."""
+    rates = [np.linalg.eigvals(np.asarray(j, dtype=np.float64)) * float(h)
+             for j, h in zip(jacobians, np.ravel(dt))]
+    rates = np.concatenate(rates)
+    rates = rates[np.isfinite(rates) & (rates.real < 0)]
+    return float(np.max(np.abs(rates), initial=0.0))
+
+
+# the largest |h lambda| of a decaying mode per RK4 step: inside RK4's stability region
+# (to 2.79 on the negative real axis, 2.83 on the imaginary; Hairer & Wanner, Solving
+# ODEs II, sec. IV.2), and one step's decay within a factor 2.5 of exp(h lambda)
+MAX_STEP_RATE = 2.0
+
+
 def _residuals(model, w: Windows, offsets=None):
     pred = _predict(model, w, offsets)
     diff = w.weights[:, None, None, None] * (w.targets - pred)
@@ -185,7 +227,14 @@ def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
         _residual_fn, solver, z0, (model, transform, windows, offset_scale), max_steps,
         physical, jacobian)
     pred = windows.targets - residual / windows.weights[:, None, None, None]
-    return z, result, steps, q[: len(transform.names)], pred, jac
+    p = q[: len(transform.names)]
+    modes = _field_jacobians(rebuild(model, transform.names, p), windows)
+    return z, result, steps, p, pred, jac, modes
+
+
+@eqx.filter_jit
+def _start_modes(p, model, transform, windows):
+    return _field_jacobians(rebuild(model, transform.names, p), windows)
 
 
 def _progress(**kwargs):
@@ -286,12 +335,26 @@ def _fit_prediction_error(estimator, model, dataset, free, verbose) -> FitResult
         offset_scale = jnp.asarray(_offset_scales(ds), dtype=float)
         z0 = np.concatenate([z0, np.zeros(windows.start.r.size * 2)])
     z0 = jnp.asarray(z0, dtype=float)
+    # the integration step follows the start model's fastest mode (one RK4 step per
+    # sample blows up a Nomoto 1 with T below about dt / 2.8)
+    start = jnp.asarray([s.start for s in specs], dtype=float)
+    rate = fastest_rate(_start_modes(start, base, transform, windows), windows.dt[:, 0])
+    steps = max(windows.substeps, math.ceil(rate / MAX_STEP_RATE))
+    if steps > 64:
+        raise ValueError(f"the start model {type(model).__name__} has a mode {rate:.3g} "
+                         "times faster than the sampling (more than 64 integration steps per "
+                         "sample): start from values with time constants of at least a 30th "
+                         "of the sample interval (e.g. jaxship.initial_estimate).")
+    windows = dataclasses.replace(windows, substeps=steps)
     solver = estimator.solver
     if verbose and hasattr(solver, "verbose"):
         solver = eqx.tree_at(lambda s: s.verbose, solver, verbose if callable(verbose)
                              else _progress)
-    z, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows, offset_scale,
-                                                solver, int(estimator.max_steps))
+    z, result, num_steps, p, pred, jac, modes = _solve(z0, base, transform, windows,
+                                                       offset_scale, solver,
+                                                       int(estimator.max_steps))
+    if fastest_rate(modes, windows.dt[:, 0]) > MAX_STEP_RATE * steps:
+        result = RESULTS.step_too_long  # the estimate is faster than the step it was fitted at
     out = _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
                   result, num_steps, estimate_starts=estimate_starts, verbose=verbose,
                   stacklevel=6)  # _report, this, PredictionError.fit, its wrapper, fit, caller
@@ -397,6 +460,26 @@ def _smoothed_starts(ds, smoothed) -> dict:
     return out
 
 
+def _verdict(result, specs, values, rows, jac, pred, targets, mask) -> RESULTS:
+    """The optimiser's code, unless the fit blew up (predictions not finite, or a
+    thousand times the measured range of a channel) or stopped as converged without
+    moving from a start where the cost is not stationary: the largest cosine between
+    the residuals and a Jacobian column (the scaled gradient) above 1e-3."""
+    size = [np.max(np.abs(t[mask])) + np.std(t[mask]) for t in targets]
+    blown = [np.max(np.abs(np.where(mask, p, 0.0))) > 1e3 * (s + 1e-9)
+             for p, s in zip(pred, size)]
+    if not np.all(np.isfinite(rows)) or not np.all(np.isfinite(jac)) or any(blown):
+        return RESULTS.simulation_blew_up
+    start = np.array([s.start for s in specs], dtype=np.float64)
+    unmoved = np.all(np.abs(values - start) <= 1e-10 * np.abs(start))
+    if result == RESULTS.successful and unmoved and rows.size:  # stopped as if converged
+        norms = np.linalg.norm(jac, axis=0) * np.linalg.norm(rows)
+        cosine = np.abs(rows @ jac) / np.where(norms > 0, norms, np.inf)
+        if np.max(cosine, initial=0.0) > 1e-3:
+            return RESULTS.did_not_move
+    return result
+
+
 def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac, result,
             num_steps, *, estimate_starts=False, verbose=False, stacklevel=2) -> FitResult:
     """The `FitResult` from the optimum: residuals, covariance, identifiability and
@@ -420,8 +503,13 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
     rows = np.concatenate([resid[c][mask] for c in range(len(channels))])
     jrows = np.concatenate([jac[c][mask][:, columns] for c in range(len(channels))])
     groups = np.concatenate([np.full(int(mask.sum()), c) for c in range(len(channels))])
-    cost = 0.5 * float(np.sum(rows**2))
-    full, null = least_squares_covariance(jrows, rows, groups)
+    result = _verdict(as_code(result), specs, values, rows, jrows[:, :d], pred, targets, mask)
+    blown = result == RESULTS.simulation_blew_up  # nothing below means anything: NaN
+    quiet = (lambda: np.errstate(all="ignore")) if blown else contextlib.nullcontext
+    with quiet():
+        cost = 0.5 * float(np.sum(rows**2))
+    nan = np.full((columns.shape[0],) * 2, np.nan)
+    full, null = (nan, []) if blown else least_squares_covariance(jrows, rows, groups)
     covariance = full[:d, :d]
     null = [v[:d] / np.linalg.norm(v[:d]) for v in null if np.linalg.norm(v[:d]) > 1e-3]
     flags = _excitation_flags(ds, estimator.rudder)
@@ -434,14 +522,18 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
         timeline, hit = to_timeline(pred[c], layout, shape)
         predictions[name] = timeline
         measured = np.asarray(getattr(ds, name), dtype=np.float64)
-        metrics[name] = validate(measured, timeline, hit, num_params=num_params, u=u,
-                                 max_lag=estimator.max_lag, channel=name)
+        with quiet():  # blown: on what stayed finite
+            metrics[name] = validate(measured, timeline, hit & np.isfinite(timeline),
+                                     num_params=num_params, u=u, max_lag=estimator.max_lag,
+                                     channel=name)
     # standard errors that do not assume white residuals, reported and flagged when the
     # residuals fail the whiteness test: clustered by prediction window when there are
     # enough windows (they restart from measurements), else Newey-West HAC in time
     white = all(m.white for m in metrics.values())
     windows_used = int(mask.any(axis=-1).sum())
-    if windows_used >= MIN_CLUSTERS:
+    if blown:
+        robust, lags, method = nan, None, "none (the simulation blew up)"
+    elif windows_used >= MIN_CLUSTERS:
         robust, _ = cluster_from_windows(jac[..., columns], resid, mask)
         lags, method = None, f"clustered by prediction window, {windows_used} windows"
     else:

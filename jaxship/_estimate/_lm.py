@@ -63,24 +63,51 @@ class LevenbergMarquardt(optx.AbstractGaussNewton):
         return y, new, aux
 
 
-class SolverOutcome(eqx.Module):
-    """Base of fit results: `success` and `message` from the optimistix `result`."""
+class RESULTS(optx.RESULTS):
+    """The outcome of a fit: optimistix's codes (`successful`, `max_steps_reached`,
+    `nonlinear_divergence`, `singular`, ...) and those only a fit can tell. `successful`
+    (converged) is the only success."""
 
-    result: eqx.AbstractVar[optx.RESULTS]
+    simulation_blew_up = ("the model's simulation blew up (values not finite, or a "
+                          "thousand times beyond the measurements): the estimates mean "
+                          "nothing")
+    step_too_long = ("the estimates have a mode faster than the integration step follows "
+                     "(a time constant below half a step): the fit follows the numerics, "
+                     "not the data (raise `substeps`, or fix the fastest time constant)")
+    did_not_move = ("the optimiser did not move from the start values although the cost "
+                    "is not stationary there (a start value far out of scale?): the "
+                    "estimates are the start values")
+
+
+def as_code(result) -> RESULTS:
+    """`result` (a `RESULTS` or optimistix `RESULTS` item) as a `RESULTS` item."""
+    return result if result._enumeration is RESULTS else RESULTS.promote(result)
+
+
+class SolverOutcome(eqx.Module):
+    """Base of fit results: `success` and `message` from the `result` code (`RESULTS`,
+    or an optimistix one)."""
+
+    result: eqx.AbstractVar[RESULTS]
+
+    @property
+    def code(self) -> RESULTS:
+        return as_code(self.result)
 
     @property
     def success(self) -> bool:
-        return bool(self.result == optx.RESULTS.successful)
+        return bool(self.code == RESULTS.successful)
 
     @property
     def message(self) -> str:
         """In plain words: "successful", or why the optimiser stopped."""
+        code = self.code
         if self.success:
             return "successful"
         for name, text in _PLAIN_RESULTS.items():
-            if self.result == getattr(optx.RESULTS, name, None):
+            if code == getattr(RESULTS, name):
                 return text
-        return optx.RESULTS[self.result].split("\n")[0]
+        return RESULTS[code].split("\n")[0]
 
 
 # the optimistix results a fit meets, in the words of a fit (not of a root-find)

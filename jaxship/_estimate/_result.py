@@ -3,14 +3,13 @@ warnings a fit gives."""
 
 import equinox as eqx
 import numpy as np
-import optimistix as optx
 from scipy.special import ndtri
 
 from .._foundation._covariance import ParameterReport
 from .._foundation._frames import fit_to_dataframe
 from .._foundation._params import get_path, parameter_fields
 from .._foundation._validate import _to_plain
-from ._lm import SolverOutcome
+from ._lm import RESULTS, SolverOutcome
 
 
 class IdentifiabilityWarning(UserWarning):
@@ -34,7 +33,9 @@ class FitResult(SolverOutcome):
     - `predictions`: `{channel: (E, N) array}` of model predictions at the dataset's
       samples; `predicted`: (E, N) mask of samples that were predicted (the first
       sample of each experiment is a start value, never predicted);
-    - `result`: the optimistix `RESULTS` code; `success`; `message`;
+    - `result`: the `jaxship.RESULTS` code (optimistix's, and `simulation_blew_up`,
+      `step_too_long`, `did_not_move`: a fit that blew up, followed the numerics or never
+      moved is not a success); `success` (converged); `message`;
     - `num_steps`: optimiser steps; `cost`: $\\frac12\\sum$ of the squared weighted
       residuals at the optimum;
     - `weights`: `{channel: weight}`; `window_samples`: samples per window for each
@@ -50,7 +51,7 @@ class FitResult(SolverOutcome):
     metrics: dict
     predictions: dict
     predicted: np.ndarray
-    result: optx.RESULTS
+    result: RESULTS
     num_steps: int
     cost: float
     weights: dict

@@ -262,7 +262,8 @@ def validate(y, yhat, mask=None, *, num_params: int = 0, u=None, max_lag: int = 
     loss = float(np.sum(e**2) / num)
     d = int(num_params)
     mean = float(np.sum(e) / num)
-    std = float(math.sqrt(max(loss - mean**2, 0.0)))
+    # (a prediction that blew up but stayed finite squares to inf: no OverflowError)
+    std = float(np.sqrt(max(loss - np.square(mean), 0.0)))
     log_loss = math.log(loss) if loss > 0 else -math.inf
     const = num * (math.log(2 * math.pi) + 1)
     per_experiment = np.array([

@@ -3,6 +3,7 @@
 `jaxship.Experiment` in SI units and jaxship's sign convention. The trial CSV format
 and the shared parsing helpers are in `_readers.py`."""
 
+import csv
 import itertools
 import math
 import os
@@ -255,6 +256,18 @@ def read_marin_kvlcc2(path, *, model_scale: bool = False, dt: float = MARIN_DT
     )
 
 
+UTF16_MARKS = (b"\xff\xfe", b"\xfe\xff")  # the byte-order marks of UTF-16 text
+
+
+def header_names(line: str) -> list[str]:
+    """The channel names of a CSV header line (`name [unit]` fields, quoted or not)."""
+    try:
+        fields = next(csv.reader([line]), [])
+    except csv.Error:  # not a CSV line (a stray carriage return): no names
+        return []
+    return [_HEADER.match(f).group(1) if _HEADER.match(f) else f.strip() for f in fields]
+
+
 def read_measured(path, **kwargs) -> Experiment:
     """Read any supported measurement file, recognised by extension and first line:
     MARIN (`.dat`, line 1 starts with 'MARIN') -> `read_marin_kvlcc2`; HSVA (line 1
@@ -266,6 +279,9 @@ def read_measured(path, **kwargs) -> Experiment:
         raise ValueError(f"{path} is a folder; pass one measurement file.")
     if not path.exists():
         raise ValueError(f"{path}: no such file.")
+    if not path.is_file():  # reading a FIFO or a device could block
+        raise ValueError(f"{path} is not a regular file (a pipe or a device); pass a "
+                         "measurement file.")
     try:
         with open(path, "rb") as f:
             first, number = b"", 0
@@ -276,6 +292,8 @@ def read_measured(path, **kwargs) -> Experiment:
                                      "(trial CSV, Esso Osaka CSV, HSVA or MARIN .dat).")
     except OSError as error:
         raise ValueError(f"{path}: cannot read the file ({error.strerror or error}).") from None
+    if first.lstrip(b"\n\r").startswith(UTF16_MARKS):
+        raise ValueError(f"{path}: the file is UTF-16 text; save it as UTF-8 (or ASCII) text.")
     first = first.decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
     suffix = path.suffix.lower()
     if first.startswith("MARIN"):
@@ -283,7 +301,7 @@ def read_measured(path, **kwargs) -> Experiment:
     if first.startswith("HSVA"):
         return read_hsva_kvlcc2(path, **kwargs)
     if suffix == ".csv" or ("[" in first and "," in first):
-        names = [_HEADER.match(s).group(1) if _HEADER.match(s) else s for s in first.split(",")]
+        names = header_names(first)
         if "psi_hat" in names or "delta_rudder" in names:
             return read_esso_osaka(path, **kwargs)
         if "t" in names:

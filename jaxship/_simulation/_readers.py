@@ -55,6 +55,18 @@ _UNITS = {
     "wind_dir": _ANGLE,
 }
 _DISPLAY_UNITS = {"rad": "deg", "rad/s": "deg/s", "rps": "rpm"}
+# what no ship logs, in SI, and the unit a column beyond it likely holds: a rudder beyond
+# 90 deg, a yaw rate beyond 60 deg/s (a 3 m model turns at about 10 deg/s), a speed beyond
+# 50 m/s (Fn 0.9 for a 320 m hull), a propeller beyond 3600 rpm, a wind from beyond a turn
+_PLAUSIBLE = {
+    "delta": (math.pi / 2, "a rudder angle", {"rad": "deg"}),
+    "delta_c": (math.pi / 2, "a rudder angle", {"rad": "deg"}),
+    "r": (math.radians(60.0), "a ship's yaw rate", {"rad/s": "deg/s"}),
+    "u": (50.0, "a ship's speed", {}),
+    "v": (50.0, "a ship's speed", {}),
+    "n": (60.0, "a propeller rate", {"rps": "rpm"}),
+    "wind_dir": (2 * math.pi + 1e-9, "a direction", {"rad": "deg"}),
+}
 _HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*\[([^\]]*)\]\s*$")
 
 
@@ -89,6 +101,9 @@ def _open_text(path: Path, encoding: str):
     one-line `ValueError`."""
     if path.is_dir():
         raise ValueError(f"{path} is a folder; pass one measurement file.")
+    if path.exists() and not path.is_file():  # reading a FIFO or a device could block
+        raise ValueError(f"{path} is not a regular file (a pipe or a device); pass a "
+                         "measurement file.")
     try:
         return open(path, newline="", encoding=encoding)
     except OSError as error:
@@ -101,6 +116,9 @@ def _not_text(path: Path, encoding: str) -> ValueError:
         data = path.read_bytes()
         data.decode(encoding)
     except UnicodeDecodeError as error:
+        if data[:2] in (b"\xff\xfe", b"\xfe\xff"):  # a UTF-16 byte-order mark
+            return ValueError(f"{path}: the file is UTF-16 text; save it as UTF-8 (or ASCII) "
+                              "text.")
         line = data.count(b"\n", 0, error.start) + 1
         return ValueError(f"{path}: line {line} is not {encoding.split('-sig')[0].upper()} text "
                           f"(byte 0x{data[error.start]:02x}); save the file as UTF-8 or ASCII "
@@ -319,12 +337,32 @@ def read_trial_csv(path, *, require_uniform: bool = False, allow_unknown: bool =
     j_t = columns["t"][0]
     _check_time(path, headers[j_t], data[:, j_t], lines, require_uniform, rtol)
     values = {key: _to_si(data[:, j], unit) for key, (j, unit) in columns.items()}
+    for key, (j, unit) in columns.items():
+        if key in _PLAUSIBLE:
+            _check_plausible(path, headers[j], key, unit, values[key], lines)
     return Experiment(
         name=path.stem if name is None else name,
         metadata={"file": str(path), "format": "trial csv"},
         extra={k: data[:, j] for k, j in extra_columns.items()},
         **values,
     )
+
+
+def _check_plausible(path, header, key, unit, si, lines):
+    """A `ValueError` naming the file, column, row and likely unit where a channel is
+    beyond what any ship logs (`_PLAUSIBLE`): e.g. degrees in a column labelled rad."""
+    limit, what, likely = _PLAUSIBLE[key]
+    beyond = np.nonzero(np.abs(si) > limit)[0]
+    if not beyond.size:
+        return
+    i = int(beyond[0])
+    shown = _DISPLAY_UNITS.get(next(u for u, f in _UNITS[key].items() if f == 1.0))
+    scale = (lambda x: x) if shown is None else (lambda x: float(_from_si(np.array(x), shown)))
+    hint = (f"; is the column in {likely[unit]} rather than {unit}?" if unit in likely else
+            "; check the column's unit.")
+    raise ValueError(f"{path}: column '{header}', row {i + 1} (line {lines[i]}): "
+                     f"{scale(abs(si[i])):.4g} {shown or unit} is beyond {what} of any ship "
+                     f"(at most {scale(limit):.4g} {shown or unit}){hint}")
 
 
 def write_trial_csv(path, data, units: str = "display") -> None:

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 import jaxship as js
+from jaxship._simulation._measured import UTF16_MARKS, header_names
 
 
 # file suffixes read from a folder (others, e.g. README.md, are skipped)
@@ -47,14 +48,16 @@ def is_measurement_file(path: Path) -> bool:
     `read_measured` rejects it with the reason."""
     try:
         with open(path, "rb") as f:
-            first = f.readline(4096).decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
+            raw = f.readline(4096)
     except OSError as error:
         raise ValueError(f"{path}: cannot read the file ({error.strerror or error}).") from None
+    if raw.startswith(UTF16_MARKS):  # read, so that `read_measured` says which encoding
+        return True
+    first = raw.decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
     if first.startswith(("MARIN", "HSVA")):
         return True
     if path.suffix.lower() == ".csv" or ("[" in first and "," in first):
-        names = {_HEADER.match(s).group(1) if _HEADER.match(s) else s for s in first.split(",")}
-        if names & {"t", "psi_hat", "delta_rudder"}:
+        if set(header_names(first)) & {"t", "psi_hat", "delta_rudder"}:
             return True
     # a header of `name [unit]` columns separated by semicolons or tabs: a record in the
     # wrong CSV dialect, read so that `read_measured` says so (not skipped in silence)

@@ -180,6 +180,10 @@ def model_from_report(report: dict):
         name = model_key(report["model"])
     except ValueError:
         raise ValueError(f"unknown model {report['model']!r} in the identify result.") from None
+    for key, kind in (("frozen", dict), ("constants", dict), ("notes", list)):
+        if report.get(key) is not None and not isinstance(report[key], kind):
+            raise ValueError(f"'{key}' in the identify result is a {type(report[key]).__name__}, "
+                             f"not a {kind.__name__}.")
     values = {}
     for key, entry in report["parameters"].items():
         values[key] = _number(key, entry.get("value") if isinstance(entry, dict) else entry)
@@ -227,6 +231,9 @@ def read_result(path) -> tuple[object, dict]:
     path = pathlib.Path(path)
     if path.is_dir():
         path = path / "result.json"
+    if path.exists() and not path.is_file():  # reading a FIFO or a device could block
+        raise ValueError(f"{path} is not a regular file (a pipe or a device); give the "
+                         "result.json that `jaxship identify` wrote.")
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as error:
@@ -239,6 +246,8 @@ def read_result(path) -> tuple[object, dict]:
     except json.JSONDecodeError as error:
         raise ValueError(f"{path} is not valid JSON ({error.msg}, line {error.lineno}).") \
             from None
+    except RecursionError:
+        raise ValueError(f"{path} is nested too deeply to be an identify result.") from None
     try:
         return model_from_report(report), report
     except ValueError as error:

@@ -23,7 +23,6 @@ from collections.abc import Callable
 
 import jax
 import numpy as np
-import optimistix as optx
 
 import jaxship as js
 
@@ -377,18 +376,21 @@ def _convergence_problems(result, max_steps: int, start, entry) -> list[str]:
     sit on a bound of their parameter (empty when neither)."""
     problems = []
     if not result.success:
-        code = result.result
-        if code in (optx.RESULTS.nonlinear_max_steps_reached, optx.RESULTS.max_steps_reached) \
+        code = result.code
+        if code in (js.RESULTS.simulation_blew_up, js.RESULTS.step_too_long,
+                    js.RESULTS.did_not_move):
+            problems.append(f"{result.message}.")
+        elif code in (js.RESULTS.nonlinear_max_steps_reached, js.RESULTS.max_steps_reached) \
                 or int(result.num_steps) >= max_steps:
             problems.append(f"the fit stopped at the step limit ({max_steps}) before "
                             "converging; the estimates are those of the last step, not an "
                             "optimum: raise --max-steps or check the data and the model.")
-        elif code == optx.RESULTS.nonlinear_divergence:
+        elif code == js.RESULTS.nonlinear_divergence:
             problems.append(f"the fit diverged after {int(result.num_steps)} steps (the "
                             "optimiser's steps grew without bound); the estimates mean "
                             "nothing: try a finite --horizon, --initial measured or another "
                             "model.")
-        elif code == optx.RESULTS.singular:
+        elif code == js.RESULTS.singular:
             problems.append(f"the fit stopped after {int(result.num_steps)} steps: the "
                             "optimiser's linear solve failed (a singular Jacobian: some "
                             "parameters do not change the outputs); see the identifiability "

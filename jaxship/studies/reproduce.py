@@ -23,11 +23,14 @@ family of chapter 4 run in a second process (2 cores; compiling dominates). `qui
 the reduced design of `QUICK_FAMILIES`, `QUICK_MODELS` and `QUICK_CASES` (CI runs it).
 """
 
+import contextlib
+import ctypes
 import json
 import multiprocessing
 import os
 import pathlib
 import platform
+import signal
 import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor
@@ -278,10 +281,18 @@ def _discovery(quick, out, say=None) -> dict:
 _QUEUE = None  # in the second process: where its progress messages go
 
 
-def _start_worker(queue, x64):
+def _start_worker(queue, x64, cache):
     global _QUEUE
     _QUEUE = queue
     jax.config.update("jax_enable_x64", x64)  # as the parent (the CLI: float64)
+    if cache:  # the parent's compilation cache
+        js.enable_compilation_cache(cache)
+    # the worker dies with its parent (Linux: PR_SET_PDEATHSIG = 1), so that a parent
+    # killed with SIGKILL leaves no orphan writing into its results; Ctrl-C is the
+    # parent's to handle (it ends the pool)
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _discovery_job(quick, out):
@@ -306,7 +317,8 @@ class _Worker:
         context = multiprocessing.get_context("spawn")
         self.queue = context.Queue()
         self.pool = ProcessPoolExecutor(1, mp_context=context, initializer=_start_worker,
-                                        initargs=(self.queue, bool(jax.config.jax_enable_x64)))
+                                        initargs=(self.queue, bool(jax.config.jax_enable_x64),
+                                                  jax.config.jax_compilation_cache_dir))
         self.pending, self.listeners = [], {}
 
     def submit(self, job, *args):

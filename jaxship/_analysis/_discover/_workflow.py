@@ -248,7 +248,18 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             """Refit with the candidates `keys` (one, or a joint union) from their probe values
             and apply the gates (module text) against the score threshold `limit`. Returns
             (one record per candidate, with `why` where the refit fails a gate; the fit;
-            its held-out check; whether that check alone failed)."""
+            its held-out check; whether that check alone failed). A refit that fails
+            numerically (an SVD that does not converge, an overflow) rejects these
+            candidates, not the run."""
+            try:
+                return attempt(keys, s, limit, p_value)
+            except (np.linalg.LinAlgError, OverflowError, FloatingPointError) as error:
+                why = [f"the refit failed numerically ({type(error).__name__}: {error})"]
+                return [{"id": k, "name": entry[k][0].name, "iteration": iteration + 1,
+                         "score": s.statistic, "parameters": {}, "rudder_equivalent_deg": None,
+                         "why": why} for k in keys], None, None, False
+
+        def attempt(keys, s, limit, p_value):
             start = augment(base, *effects, *(entry[k][1] for k in keys))
             for k in keys:
                 for field, value in entry[k][2].items():
@@ -326,8 +337,12 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         rival = min(vetoed, key=lambda pair: pair[1], default=None)
         contested = bool(rival and passed and rival[1] < min(row[1].cost for row in passed))
         if contested:
+            # the rival's whole class is named: its members tie on these data (a rudder
+            # offset and a yaw-moment bias on a Nomoto model), so which one was refitted
+            # hangs on rounding
+            rivals = " or ".join(sorted([rival[0], *classes[rival[0]]]))
             for records, _, _ in passed:
-                rejected.extend(r | {"why": [f"{rival[0]} explains the training data better "
+                rejected.extend(r | {"why": [f"{rivals} explains the training data better "
                                              "but fails on the held-out runs"]} for r in records)
             passed = []
         size = min(top, max_effects - len(accepted))

@@ -1,0 +1,119 @@
+"""Results folders: jaxship replaces only the files it wrote itself (its manifest), the
+whole new set appears or none of it, and files of its own earlier run that a new run does
+not write are removed."""
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from jaxship._foundation import _files
+from jaxship._foundation._files import MANIFEST, read_manifest, staged_folder
+from jaxship.cli import main
+
+
+def files(folder):
+    """{relative path: text} of the files under `folder`, the manifest and staging
+    folders left out."""
+    return {p.relative_to(folder).as_posix(): p.read_text() for p in folder.rglob("*")
+            if p.is_file() and p.name != MANIFEST and not any(
+                part.startswith(".jaxship.") for part in p.relative_to(folder).parts)}
+
+
+def write(out, contents):
+    with staged_folder(out) as stage:
+        for name, text in contents.items():
+            (stage / name).parent.mkdir(parents=True, exist_ok=True)
+            (stage / name).write_text(text)
+
+
+OLD = {"result.json": "old", "figures/a.png": "old a", "figures/b.png": "old b"}
+NEW = {"result.json": "new", "figures/a.png": "new a", "notes.txt": "new"}
+MINE = {"figures/mine.png": "the user's", "mine.txt": "the user's"}
+
+
+def test_a_run_replaces_its_own_files_and_nothing_else(tmp_path):
+    """The trust audit: `--out p` with the user's `p/figures/mine.png` deleted it (the
+    figures folder was replaced whole), and a figure of an earlier run stayed beside
+    results that had none."""
+    for name, text in MINE.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(text)
+    write(tmp_path, OLD)
+    assert files(tmp_path) == OLD | MINE
+    write(tmp_path, NEW)
+    assert files(tmp_path) == NEW | MINE  # b.png, of the earlier run only, is gone
+    assert sorted(read_manifest(tmp_path)) == sorted(NEW)
+    write(tmp_path, {"result.json": "newer"})
+    assert files(tmp_path) == {"result.json": "newer"} | MINE
+
+
+def test_a_file_of_the_users_in_the_way_is_refused_and_kept(tmp_path):
+    (tmp_path / "result.json").write_text("the user's")
+    with pytest.raises(ValueError, match="result.json exists and jaxship did not write it"):
+        write(tmp_path, NEW)
+    assert files(tmp_path) == {"result.json": "the user's"}
+    assert not list(tmp_path.glob(".jaxship.*"))
+
+
+@pytest.mark.parametrize("fail_at", range(8))
+def test_a_failure_at_any_step_of_the_commit_leaves_one_whole_set(tmp_path, monkeypatch,
+                                                                  fail_at):
+    """Fault injection: the k-th rename of the commit raises (every move, and the
+    manifest's own rename); afterwards `out` holds the whole old set with its manifest,
+    the user's files untouched, and no staging folder."""
+    for name, text in MINE.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(text)
+    write(tmp_path, OLD)
+    manifest = (tmp_path / MANIFEST).read_text()
+    calls = []
+    replace = os.replace
+
+    def failing(source, target):
+        calls.append(target)
+        if len(calls) == fail_at + 1:
+            raise OSError(28, "No space left on device")
+        return replace(source, target)
+
+    monkeypatch.setattr(_files.os, "replace", failing)
+    steps = len(OLD) + len(NEW) + 1  # old files aside, new ones in, the manifest
+    if fail_at < steps:
+        with pytest.raises(OSError, match="No space left"):
+            write(tmp_path, NEW)
+        assert files(tmp_path) == OLD | MINE
+        assert (tmp_path / MANIFEST).read_text() == manifest
+    else:  # no step left to fail
+        write(tmp_path, NEW)
+        assert files(tmp_path) == NEW | MINE
+    assert not list(tmp_path.glob(".jaxship.*"))
+
+
+def test_staging_folders_of_dead_runs_are_removed(tmp_path):
+    """A run killed with SIGKILL leaves its staging folder; the next run removes it (the
+    process that made it is gone) but not that of a run still going."""
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True).stdout.strip()
+    (tmp_path / f".jaxship.{dead}.abc").mkdir()
+    (tmp_path / f".jaxship.{os.getpid()}.xyz").mkdir()
+    write(tmp_path, {"result.json": "new"})
+    assert [p.name for p in tmp_path.glob(".jaxship.*")] == [f".jaxship.{os.getpid()}.xyz"]
+
+
+def test_identify_keeps_the_users_figure_and_drops_its_own_stale_ones(tmp_path, capsys):
+    """`jaxship identify` into a folder with the user's figure, then again with
+    `--no-figures`: its own figures of the first run go, the user's stays."""
+    (tmp_path / "trial").mkdir()
+    assert main(["simulate", "--vessel", "thesis", "--manoeuvre", "zigzag:20/20", "--duration",
+                 "60", "--out", str(tmp_path / "trial")]) == 0
+    out = tmp_path / "p"
+    (out / "figures").mkdir(parents=True)
+    (out / "figures" / "mine.png").write_text("keep")
+    assert main(["identify", str(tmp_path / "trial" / "trial.csv"), "--model", "nomoto1",
+                 "--out", str(out), "--quiet"]) == 0
+    assert (out / "figures" / "mine.png").read_text() == "keep"
+    assert main(["identify", str(tmp_path / "trial" / "trial.csv"), "--model", "nomoto1",
+                 "--out", str(out), "--quiet", "--no-figures"]) == 0
+    assert sorted(p.name for p in (out / "figures").iterdir()) == ["mine.png"]
+    capsys.readouterr()
