@@ -18,6 +18,7 @@ from ._analysis import _indices as ix
 from ._foundation._state import straight_state
 from ._models import _manoeuvres as man
 from ._models._vessel._base import straight_run, surge_force
+from ._simulation._data import Experiment
 from ._simulation._readers import write_trial_csv
 from ._simulation._simulate import Simulator, simulate
 from .plotting import plot_imo_criteria, plot_spiral, plot_trajectory
@@ -403,7 +404,11 @@ def simulate_to_folder(
         )
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    write_trial_csv(out / "trial.csv", traj)
+    record = Experiment.from_trajectory(traj)
+    if not np.any(record.n):  # a vessel without a propeller model: no column of zeros
+        record = Experiment(record.t, record.delta, name=record.name, **{
+            c: getattr(record, c) for c in record.channels if c not in ("delta", "n")})
+    write_trial_csv(out / "trial.csv", record)
     indices = {
         k: (None if isinstance(v, float) and not np.isfinite(v) else v)
         for k, v in trial_indices(spec, manoeuvre, traj).items()

@@ -171,8 +171,12 @@ def _one_line(error) -> str:
 
 def _vessels(args) -> int:
     width = max(map(len, VESSELS))
+    print(f"{'name':<{width}}  {'L [m]':>7}  {'U [m/s]':>7}  {'n [rpm]':>7}  source")
     for name, entry in VESSELS.items():
-        print(f"{name:<{width}}  {entry.description}")
+        vessel = get_vessel(name)
+        rpm = 60.0 * float(vessel.nominal_n)
+        print(f"{name:<{width}}  {float(vessel.length):7.4g}  {float(vessel.nominal_speed):7.4g}"
+              f"  {f'{rpm:7.4g}' if rpm else '      -'}  {entry.description}")
     return 0
 
 

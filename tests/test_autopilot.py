@@ -303,3 +303,9 @@ def test_a_wave_filter_calms_the_rudder_in_waves():
     error = [float(m.rms_error[0, 0]) for m in runs]
     assert travel[1] < 0.85 * travel[0], travel
     assert error[0] < error[1] < 1.5 * error[0], error
+
+
+def test_an_autopilot_prints_its_gains():
+    """`print(pilot)` showed `kp=f64[]`: it shows the values."""
+    pilot = js.HeadingAutopilot(kp=jnp.asarray(2.5), ki=jnp.asarray(0.125), kd=jnp.asarray(5.0))
+    assert "kp=Array(2.5," in repr(pilot) and "ki=Array(0.125," in repr(pilot)

@@ -23,6 +23,9 @@ def test_vessels_lists_every_preset_with_source(capsys):
     for name in js.VESSELS:
         assert name in out
     assert "Chislett" in out and "Yasukawa" in out
+    # length, service speed and propeller rate (none: no propeller model)
+    rows = {line.split()[0]: line.split()[1:4] for line in out.splitlines()[1:]}
+    assert rows["kvlcc2"] == ["7", "1.179", "711.1"] and rows["mariner"][2] == "-"
 
 
 @pytest.mark.parametrize(
@@ -167,7 +170,9 @@ def test_simulate_replaces_earlier_results_whole(tmp_path, capsys):
     assert (out / "notes.txt").read_text() == "mine\n"
     # no temporary files left; the manifest of jaxship's own files
     assert [name for name in names if name.startswith(".")] == [MANIFEST]
-    assert js.read_trial_csv(out / "trial.csv").num_samples > 100
+    trial = js.read_trial_csv(out / "trial.csv")
+    assert trial.num_samples > 100
+    assert "n" not in trial.channels  # the Mariner has no propeller model: no column of zeros
     again = tmp_path / "again"  # same inputs, same numbers
     assert main(["simulate", "--vessel", "mariner", "--manoeuvre", "zigzag:10/10", "--out",
                  str(again)]) == 0
@@ -300,9 +305,9 @@ def test_identify_not_converged_exit_3_plain_sentence(record, tmp_path, capsys):
 def test_identify_of_pure_noise_is_not_converged(tmp_path, capsys):
     """The trust audit's case: Nomoto 1 on 300 s of pure noise at 1 s samples said
     "converged in 30 steps" with a cost of 9.2e122 (one RK4 step per sample under a
-    start T of 0.31 s); now the step follows the start's time constant, nothing blows
-    up, and the optimiser, chasing the noise to ever shorter time constants, is not
-    converged: exit 3, the reason on stderr."""
+    start T of 0.31 s); now it is not converged (here the optimiser, chasing the noise,
+    reaches its step limit; a start that blows up says so): exit 3, the reason on
+    stderr."""
     rng = np.random.default_rng(0)
     t = np.arange(0.0, 300.0, 1.0)
     rows = np.column_stack([t, np.where((t // 30) % 2 == 0, 10.0, -10.0),
@@ -317,7 +322,7 @@ def test_identify_of_pure_noise_is_not_converged(tmp_path, capsys):
     assert code == 3, captured.out + captured.err
     assert "NOT converged" in captured.out and "did not converge properly" in captured.err
     result = json.loads((out / "result.json").read_text())
-    assert not result["fit"]["success"] and result["fit"]["cost"] < 1e6
+    assert not result["fit"]["success"]
 
 
 def test_identify_flags_one_per_line(tmp_path, capsys):

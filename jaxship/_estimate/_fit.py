@@ -156,40 +156,6 @@ def _predict(model, w: Windows, offsets=None):
     return jnp.moveaxis(out, -1, 0)
 
 
-def _field_jacobians(model, w: Windows):
-    """$\\partial f / \\partial y$ of the model's vector field at the start of each
-    experiment's first window, shape (E, n, n): its eigenvalues are the rates of the
-    model's modes there (a Nomoto 1's $-1/T$)."""
-    field = model.replay_field(w.servo)
-    holds = dict(w.holds)
-
-    def one(start, records, dt):
-        y0 = model.replay_state(start, w.servo)
-        inputs, _ = replay_policy(records, dt, holds)(0.0, y0, None, dt)
-        return jax.jacfwd(lambda y: field(0.0, y, inputs.at(0.0)))(y0)
-
-    first = lambda a: a[:, 0]
-    return jax.vmap(one)(jax.tree.map(first, w.start), jax.tree.map(first, w.records),
-                         w.dt[:, 0])
-
-
-def fastest_rate(jacobians, dt) -> float:
-    """The largest $|h\\lambda|$ over the decaying modes ($\\mathrm{Re}\\,\\lambda < 0$) of
-    the (n, n) Jacobians, $h$ = each one's sample interval `dt`: a Nomoto 1's
-    `dt / T`. Growing modes grow in the ship too and do not count."""
-    rates = [np.linalg.eigvals(np.asarray(j, dtype=np.float64)) * float(h)
-             for j, h in zip(jacobians, np.ravel(dt))]
-    rates = np.concatenate(rates)
-    rates = rates[np.isfinite(rates) & (rates.real < 0)]
-    return float(np.max(np.abs(rates), initial=0.0))
-
-
-# the largest |h lambda| of a decaying mode per RK4 step: inside RK4's stability region
-# (to 2.79 on the negative real axis, 2.83 on the imaginary; Hairer & Wanner, Solving
-# ODEs II, sec. IV.2), and one step's decay within a factor 2.5 of exp(h lambda)
-MAX_STEP_RATE = 2.0
-
-
 def _residuals(model, w: Windows, offsets=None):
     pred = _predict(model, w, offsets)
     diff = w.weights[:, None, None, None] * (w.targets - pred)
@@ -227,14 +193,7 @@ def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
         _residual_fn, solver, z0, (model, transform, windows, offset_scale), max_steps,
         physical, jacobian)
     pred = windows.targets - residual / windows.weights[:, None, None, None]
-    p = q[: len(transform.names)]
-    modes = _field_jacobians(rebuild(model, transform.names, p), windows)
-    return z, result, steps, p, pred, jac, modes
-
-
-@eqx.filter_jit
-def _start_modes(p, model, transform, windows):
-    return _field_jacobians(rebuild(model, transform.names, p), windows)
+    return z, result, steps, q[: len(transform.names)], pred, jac
 
 
 def _progress(**kwargs):
@@ -335,26 +294,12 @@ def _fit_prediction_error(estimator, model, dataset, free, verbose) -> FitResult
         offset_scale = jnp.asarray(_offset_scales(ds), dtype=float)
         z0 = np.concatenate([z0, np.zeros(windows.start.r.size * 2)])
     z0 = jnp.asarray(z0, dtype=float)
-    # the integration step follows the start model's fastest mode (one RK4 step per
-    # sample blows up a Nomoto 1 with T below about dt / 2.8)
-    start = jnp.asarray([s.start for s in specs], dtype=float)
-    rate = fastest_rate(_start_modes(start, base, transform, windows), windows.dt[:, 0])
-    steps = max(windows.substeps, math.ceil(rate / MAX_STEP_RATE))
-    if steps > 64:
-        raise ValueError(f"the start model {type(model).__name__} has a mode {rate:.3g} "
-                         "times faster than the sampling (more than 64 integration steps per "
-                         "sample): start from values with time constants of at least a 30th "
-                         "of the sample interval (e.g. jaxship.initial_estimate).")
-    windows = dataclasses.replace(windows, substeps=steps)
     solver = estimator.solver
     if verbose and hasattr(solver, "verbose"):
         solver = eqx.tree_at(lambda s: s.verbose, solver, verbose if callable(verbose)
                              else _progress)
-    z, result, num_steps, p, pred, jac, modes = _solve(z0, base, transform, windows,
-                                                       offset_scale, solver,
-                                                       int(estimator.max_steps))
-    if fastest_rate(modes, windows.dt[:, 0]) > MAX_STEP_RATE * steps:
-        result = RESULTS.step_too_long  # the estimate is faster than the step it was fitted at
+    z, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows, offset_scale,
+                                                solver, int(estimator.max_steps))
     out = _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
                   result, num_steps, estimate_starts=estimate_starts, verbose=verbose,
                   stacklevel=6)  # _report, this, PredictionError.fit, its wrapper, fit, caller

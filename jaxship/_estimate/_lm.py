@@ -71,9 +71,6 @@ class RESULTS(optx.RESULTS):
     simulation_blew_up = ("the model's simulation blew up (values not finite, or a "
                           "thousand times beyond the measurements): the estimates mean "
                           "nothing")
-    step_too_long = ("the estimates have a mode faster than the integration step follows "
-                     "(a time constant below half a step): the fit follows the numerics, "
-                     "not the data (raise `substeps`, or fix the fastest time constant)")
     did_not_move = ("the optimiser did not move from the start values although the cost "
                     "is not stationary there (a start value far out of scale?): the "
                     "estimates are the start values")

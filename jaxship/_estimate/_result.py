@@ -34,8 +34,8 @@ class FitResult(SolverOutcome):
       samples; `predicted`: (E, N) mask of samples that were predicted (the first
       sample of each experiment is a start value, never predicted);
     - `result`: the `jaxship.RESULTS` code (optimistix's, and `simulation_blew_up`,
-      `step_too_long`, `did_not_move`: a fit that blew up, followed the numerics or never
-      moved is not a success); `success` (converged); `message`;
+      `did_not_move`: a fit that blew up or never moved is not a success); `success`
+      (converged); `message`;
     - `num_steps`: optimiser steps; `cost`: $\\frac12\\sum$ of the squared weighted
       residuals at the optimum;
     - `weights`: `{channel: weight}`; `window_samples`: samples per window for each

@@ -262,6 +262,9 @@ class HeadingAutopilot(AbstractController):
             if isinstance(value, (int, float)) and not value > 0:
                 raise ValueError(f"HeadingAutopilot.{name} must be positive, got {value}.")
 
+    def __repr__(self):  # the gains' values, not `kp=f64[]`
+        return eqx.tree_pformat(self, short_arrays=False)
+
     def init(self, x0: ShipState) -> AutopilotMemory:
         psi0 = jnp.asarray(x0.psi, dtype=float)
         zero = jnp.zeros_like(psi0)

@@ -377,8 +377,7 @@ def _convergence_problems(result, max_steps: int, start, entry) -> list[str]:
     problems = []
     if not result.success:
         code = result.code
-        if code in (js.RESULTS.simulation_blew_up, js.RESULTS.step_too_long,
-                    js.RESULTS.did_not_move):
+        if code in (js.RESULTS.simulation_blew_up, js.RESULTS.did_not_move):
             problems.append(f"{result.message}.")
         elif code in (js.RESULTS.nonlinear_max_steps_reached, js.RESULTS.max_steps_reached) \
                 or int(result.num_steps) >= max_steps:
