@@ -39,8 +39,7 @@ from ._analysis._indices import (
     turning_indices as turning_indices,
     zigzag_indices as zigzag_indices,
 )
-from ._estimate._armax import ARMAX as ARMAX, ARMAXResult as ARMAXResult, fit_armax as fit_armax
-from ._estimate._discrete import fit_discrete_response as fit_discrete_response
+from ._estimate._armax import ARMAX as ARMAX
 from ._estimate._discrete_estimator import DiscreteResponse as DiscreteResponse
 from ._estimate._fit import (
     AbstractEstimator as AbstractEstimator,
@@ -54,25 +53,20 @@ from ._estimate._kalman import (
     rts_smoother as rts_smoother,
     smooth_states as smooth_states,
 )
-from ._estimate._likelihood import Innovations as Innovations, fit_ml as fit_ml
-from ._estimate._linear import (
-    initial_estimate as initial_estimate,
-    ross_initial_estimate as ross_initial_estimate,
-)
+from ._estimate._likelihood import Innovations as Innovations
+from ._estimate._linear import LinearStart as LinearStart
 from ._estimate._lm import RESULTS as RESULTS, LevenbergMarquardt as LevenbergMarquardt
 from ._estimate._predict import predict as predict
-from ._estimate._result import (
-    ConvergenceWarning as ConvergenceWarning,
-    FitResult as FitResult,
-    IdentifiabilityWarning as IdentifiabilityWarning,
-)
+from ._estimate._result import FitError as FitError, FitResult as FitResult
 from ._foundation._cache import (
     compilation_cache_dir as compilation_cache_dir,
     enable_compilation_cache as enable_compilation_cache,
 )
+from ._foundation._contract import AbstractModel as AbstractModel
 from ._foundation._covariance import parameter_report as parameter_report
 from ._foundation._kinematics import body_to_earth as body_to_earth, ssa as ssa
 from ._foundation._params import Free as Free, default_free as default_free, param as param
+from ._foundation._progress import Progress as Progress
 from ._foundation._state import (
     Command as Command,
     ShipState as ShipState,

@@ -7,7 +7,6 @@ import math
 import pathlib
 import sys
 import tempfile
-import warnings
 
 import jax
 import matplotlib
@@ -18,7 +17,6 @@ matplotlib.use("Agg")  # the command writes files; it never opens a window
 
 import matplotlib.pyplot as plt  # noqa: E402
 
-from ._estimate._result import ConvergenceWarning  # noqa: E402
 from ._foundation._cache import enable_compilation_cache  # noqa: E402
 from ._foundation._files import staged_folder  # noqa: E402
 from ._models._vessel._base import surge_force  # noqa: E402
@@ -280,11 +278,9 @@ def _identify(args) -> int:
     held_out = None if args.validate is None else read_experiments(args.validate,
                                                                    role="validation")
     bar = _ProgressBar(not args.quiet)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        result = identify(train, model=args.model, horizon=horizon, validate=held_out,
-                          rudder=args.rudder, channels=args.channels, initial=args.initial,
-                          max_steps=args.max_steps, progress=bar)
+    result = identify(train, model=args.model, horizon=horizon, validate=held_out,
+                      rudder=args.rudder, channels=args.channels, initial=args.initial,
+                      max_steps=args.max_steps, progress=bar)
     written = ["result.json"]
     with staged_folder(args.out) as stage:
         if not args.no_figures:
@@ -298,15 +294,13 @@ def _identify(args) -> int:
     print("\n".join([head, *lines]))
     for note in result.notes:
         print(f"note: {note}")
-    failed = False
-    for w in caught:
-        failed = failed or issubclass(w.category, ConvergenceWarning)
-    for message in dict.fromkeys(str(w.message) for w in caught):
+    for message in dict.fromkeys(result.warnings):
         print(f"jaxship: warning: {_one_line(message)}", file=sys.stderr)
     print(f"wrote {args.out}/" + f", {args.out}/".join(written))
-    if failed:
-        print("jaxship: the fit did not converge properly (see the warnings above); the "
-              "results were written for inspection.", file=sys.stderr)
+    if not result.fit.success:
+        print(f"jaxship: the fit is not a converged estimate ({result.fit.code_name}: see "
+              "the warnings above); the results were written for inspection.",
+              file=sys.stderr)
         return 3
     return 0
 
@@ -377,10 +371,8 @@ def _discover(args) -> int:
     _check_out(args.out)  # before any long work
     say = (lambda message: None) if args.quiet else (
         lambda message: tqdm.write(f"jaxship: {message} ...", file=sys.stderr))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the report says what matters
-        report = run_discovery(args.train, args.holdout, model=args.model, out=args.out,
-                               max_effects=args.max_effects, alpha=args.alpha, progress=say)
+    report = run_discovery(args.train, args.holdout, model=args.model, out=args.out,
+                           max_effects=args.max_effects, alpha=args.alpha, progress=say)
     print(report.to_markdown())
     print(f"wrote {args.out}/discovery.json, {args.out}/report.md, {args.out}/figures/")
     return 0

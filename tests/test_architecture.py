@@ -136,3 +136,39 @@ def test_the_top_level_holds_only_the_application():
                                                     if (p / "__init__.py").exists()}
     library = set(top) - set(LAYERS["application"])
     assert library == {n for layer in list(LAYERS.values())[:-1] for n in layer}, library
+
+
+def calls(path: pathlib.Path):
+    """(dotted name, line) of every call in the module at `path`."""
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Call):
+            yield ast.unparse(node.func), node.lineno
+
+
+def test_no_hasattr_in_the_package():
+    """Models are told apart by the contract (`AbstractModel` and its subclasses),
+    never by the attributes they happen to have."""
+    found = [f"{m}:{line}" for m, path in modules() for name, line in calls(path)
+             if name == "hasattr"]
+    assert not found, "\n".join(found)
+
+
+def test_the_library_never_prints_or_warns():
+    """Outcomes are result codes and progress goes to a callable the caller passes: no
+    print, warnings.warn or jax.debug.print below the application layer."""
+    banned = {"print", "warnings.warn", "warnings.warn_explicit", "jax.debug.print"}
+    found = [f"{m}:{line} calls {name}" for m, path in modules()
+             if rank(m) < RANK["cli"] or m.split(".")[1] == "plotting"
+             for name, line in calls(path) if name in banned]
+    assert not found, "\n".join(found)
+
+
+def test_every_model_implements_the_one_contract():
+    """Every public vessel and steering model class derives from the one contract,
+    `jaxship.AbstractModel` (tests/test_contracts.py runs each through it)."""
+    import jaxship as js
+
+    classes = [v for v in vars(js).values() if isinstance(v, type)
+               and issubclass(v, (js.AbstractSteeringModel, js.AbstractVessel))]
+    assert len(classes) >= 15
+    assert all(issubclass(c, js.AbstractModel) for c in classes)

@@ -102,7 +102,7 @@ def test_fit_with_the_armax_estimator_gives_a_fit_result():
     a, b, c = [1.0, -1.5, 0.56], [0.0, 0.02, 0.015], [1.0, 0.3, 0.1]
     y = lfilter(b, a, u) + lfilter(c, a, e)
     data = js.Experiment(0.5 * np.arange(u.size), u, r=y, psi=np.cumsum(y) * 0.5)
-    direct = js.fit_armax(y, u, dt=0.5, na=2, nb=2, nc=2, nk=1)
+    direct = fit_armax(y, u, dt=0.5, na=2, nb=2, nc=2, nk=1)
     res = js.fit(js.ARMAXModel(), data, estimator=js.ARMAX())
     assert isinstance(res, js.FitResult) and res.success
     np.testing.assert_allclose(res.values, np.concatenate([direct.A[1:], direct.B,

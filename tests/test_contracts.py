@@ -12,6 +12,7 @@ import pytest
 
 import jaxship as js
 from jaxship._foundation._params import default_free, get_path, rebuild
+from jaxship._models._steering._base import WindowStart
 
 
 DEG = np.pi / 180
@@ -27,6 +28,31 @@ STEERING = {
     "norrbin_crossflow": js.NorrbinCrossFlow.from_vessel(js.vessel("sea_stratus_nonlinear")),
     "low_speed_sway_yaw": js.LowSpeedSwayYaw(),
 }
+
+
+@pytest.mark.parametrize("name", sorted(STEERING) + VESSELS)
+def test_every_model_meets_the_contract_through_its_base(name):
+    """Every vessel preset and steering model is a `jaxship.AbstractModel`: its replay
+    state and field give a derivative of the state's shape, its outputs psi and r have
+    a place, and its default free parameters resolve and rebuild it."""
+    model = STEERING[name] if name in STEERING else js.vessel(name)
+    assert isinstance(model, js.AbstractModel)
+    aux = js.AuxInputs(u=1.0, v=0.0, n=1.0)
+    start = WindowStart(r=0.01, psi=0.1, delta=0.05, r_first=0.0, psi_first=0.0,
+                        delta_integral=0.0, elapsed=0.0, aux=aux, rudder_angle=0.05)
+    y = model.replay_state(start)
+    inputs = {"delta": 0.05, "u": 1.0, "v": 0.0, "n": 1.0}
+    dy = model.replay_field()(0.0, y, inputs)
+    assert dy.shape == y.shape and bool(jnp.all(jnp.isfinite(dy)))
+    for channel in model.default_channels:
+        assert 0 <= model.channel_index(channel) < y.shape[0]
+    assert float(y[model.channel_index("psi")]) == 0.1
+    free = default_free(model)
+    values = [2.0 * float(get_path(model, n)) + 1.0 for n in free]
+    rebuilt = rebuild(model, free, values)
+    assert [float(get_path(rebuilt, n)) for n in free] == pytest.approx(values)
+
+
 # effect, a parameter name, a non-zero value of realistic size for the Mariner and
 # Nomoto 1 (K = 0.06 1/s, T = 25 s) -- one number, or one per family where the units
 # differ -- and the families it acts on

@@ -93,14 +93,14 @@ def test_a_refit_that_fails_numerically_rejects_that_candidate_not_the_run(monke
     same iteration, so nothing is named)."""
     from jaxship._analysis._discover import _workflow
 
-    quiet_fit = _workflow._quiet_fit
+    fit = _workflow.fit
 
     def failing(model, *args, **kwargs):
         if "rudder_offset" in {e.id for e in getattr(model, "effects", ())}:
             raise np.linalg.LinAlgError("SVD did not converge")
-        return quiet_fit(model, *args, **kwargs)
+        return fit(model, *args, **kwargs)
 
-    monkeypatch.setattr(_workflow, "_quiet_fit", failing)
+    monkeypatch.setattr(_workflow, "fit", failing)
     report = run(js.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
     failed = [r for r in report.rejected if r["id"] == "rudder_offset"]
     assert failed and failed[0]["why"] == [
@@ -482,14 +482,15 @@ def test_an_estimate_pinned_at_its_plausible_bound_is_at_the_edge():
     """A 0.15 rad rudder offset lies beyond RudderOffset's +-0.1 rad range: the fit pins
     the estimate at the bound (the sigmoid leaves it about 1e-6 of the span short),
     which the refit gate reads as at the edge; a 0.05 rad offset is inside."""
-    from jaxship._analysis._discover._workflow import _at_edge, _quiet_fit
+    from jaxship._analysis._discover._workflow import _at_edge
 
     def fitted(delta0):
         truth = js.augment(js.Nomoto1(K=K, T=25.0), js.RudderOffset(delta0=delta0))
         train, _ = hidden_effect_records(truth, 0)
-        return _quiet_fit(js.augment(js.Nomoto1(K=0.05, T=20.0), js.RudderOffset()), train)
+        return js.fit(js.augment(js.Nomoto1(K=0.05, T=20.0), js.RudderOffset()), train)
 
     pinned, inside = fitted(0.15), fitted(0.05)
+    assert pinned.code == js.RESULTS.at_bound and inside.success
     assert 0 < 0.1 - pinned.values[-1] < 1e-4
     assert _at_edge(pinned, pinned.names) == ("rudder_offset.delta0",)
     assert _at_edge(inside, inside.names) == ()

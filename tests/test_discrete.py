@@ -4,12 +4,13 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship import Experiment, Nomoto1, Nomoto2, fit_discrete_response, simulate_steering
+from jaxship import Experiment, Nomoto1, Nomoto2, simulate_steering
 from jaxship._estimate._discrete import (
     COEFFICIENTS,
     DiscreteResponseFit,
     continuous_parameters,
     discretise,
+    fit_discrete_response,
     regressors,
 )
 

@@ -3,7 +3,6 @@ data, interval coverage under noise, merged experiments, bad data, no retracing.
 
 import json
 import math
-import warnings
 
 import equinox as eqx
 import jax.numpy as jnp
@@ -14,8 +13,6 @@ import jaxship as js
 from jaxship import Nomoto1, Nomoto2, NonlinearNomoto, simulate_steering
 from jaxship._estimate import _fit
 from jaxship._estimate._fit import (
-    ConvergenceWarning,
-    IdentifiabilityWarning,
     PredictionError,
     fit,
 )
@@ -44,13 +41,6 @@ def record(model, delta, dt=DT, *, name="synthetic", n=None, substeps=1):
     extra = {} if n is None else {"n": np.full(delta.shape[0], n)}
     return js.Experiment(np.asarray(tr.t), delta, psi=np.asarray(tr.psi), r=np.asarray(tr.r),
                          name=name, **extra)
-
-
-def quiet_fit(*args, **kwargs):
-    """`fit` with identifiability warnings silenced (correlated but exact estimates)."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", IdentifiabilityWarning)
-        return fit(*args, **kwargs)
 
 
 NOMOTO1 = Nomoto1(K=0.06, T=25.0, delta0=0.6 * DEG)
@@ -109,7 +99,7 @@ def test_nomoto1_recovers_with_every_horizon(horizon):
 def test_nomoto2_recovers(horizon):
     truth = Nomoto2(K=0.06, T1=25.0, T2=3.0, T3=5.0)
     data = record(truth, zigzag_like(600, 1, amplitudes=(10.0, 20.0)))
-    res = quiet_fit(Nomoto2(K=0.05, T1=20.0, T2=2.0, T3=3.0), data,
+    res = fit(Nomoto2(K=0.05, T1=20.0, T2=2.0, T3=3.0), data,
                     estimator=PredictionError(horizon=horizon))
     assert res.success
     np.testing.assert_allclose(res.values, [0.06, 25.0, 3.0, 5.0], rtol=1e-6)
@@ -121,7 +111,7 @@ def test_nonlinear_nomoto_recovers_from_least_squares_start():
     data = record(truth, zigzag_like(800, 2, amplitudes=(5.0, 15.0, 30.0)))
     start = initial_estimate(NonlinearNomoto(K=1.0, T=1.0), data)
     np.testing.assert_allclose([start.K, start.T, start.n3], [0.06, 25.0, 300.0], rtol=1e-2)
-    res = quiet_fit(start, data)
+    res = fit(start, data)
     np.testing.assert_allclose(res.values, [0.06, 25.0, 300.0], rtol=1e-6)
     assert res.model.n1 == 1.0  # frozen
 
@@ -212,12 +202,14 @@ def test_nan_in_data_is_an_error_naming_the_experiment():
 
 
 def test_no_excitation_is_flagged_not_silent():
-    """A record with the rudder held at zero: a warning, flags naming the missing
-    excitation, and infinite standard errors instead of a confident answer."""
+    """A record with the rudder held at zero: the code `poorly_determined` (not a
+    success), flags naming the missing excitation, and infinite standard errors instead
+    of a confident answer; `throw=True` raises with the reason."""
     data = js.Experiment(DT * np.arange(600), np.zeros(600), psi=np.full(600, 0.1),
                          r=np.zeros(600), name="straight")
-    with pytest.warns(IdentifiabilityWarning, match="constant in every experiment"):
-        res = fit(Nomoto1(K=0.05, T=20.0), data)
+    res = fit(Nomoto1(K=0.05, T=20.0), data)
+    assert res.result == js.RESULTS.poorly_determined and not res.success
+    assert any("constant in every experiment" in f for f in res.parameters.undetermined)
     assert not res.parameters.identifiable
     assert np.all(np.isinf(res.std))
     assert any("does not affect" in f or "do not determine" in f for f in res.flags)
@@ -240,11 +232,12 @@ def test_other_bad_inputs():
         initial_estimate(Nomoto2(K=0.05, T1=20.0, T2=2.0, T3=3.0), data)
 
 
-def test_non_convergence_warns():
-    with pytest.warns(ConvergenceWarning, match="maximum number of steps"):
-        res = fit(Nomoto1(K=0.03, T=10.0), NOMOTO1_DATA,
-                  estimator=PredictionError(horizon=None, max_steps=2))
-    assert not res.success
+def test_non_convergence_is_a_code_and_throw_raises():
+    estimator = PredictionError(horizon=None, max_steps=2)
+    res = fit(Nomoto1(K=0.03, T=10.0), NOMOTO1_DATA, estimator=estimator)
+    assert res.result == js.RESULTS.nonlinear_max_steps_reached and not res.success
+    with pytest.raises(js.FitError, match="Nomoto1: stopped at the maximum number of steps"):
+        fit(Nomoto1(K=0.03, T=10.0), NOMOTO1_DATA, estimator=estimator, throw=True)
     # issue 13: in a fit's words, not optimistix's ("Try increasing `max_steps`.")
     assert res.message.startswith("stopped at the maximum number of steps")
     assert "`max_steps`" not in res.summary() and res.message in res.summary()

@@ -2,7 +2,6 @@
 inputs replayed as they were between samples (issue "One model layer ...", must-show)."""
 
 import json
-import warnings
 
 import numpy as np
 import pytest
@@ -67,10 +66,8 @@ def test_nomoto2_recovered_from_a_rate_limited_rudder_logged_at_2_hz():
     truth = js.Nomoto2(K=0.06, T1=25.0, T2=3.0, T3=5.0)
     data = logged_zigzags(truth, 5 * DEG, 0.5)
     start = js.Nomoto2(K=0.05, T1=20.0, T2=2.0, T3=3.0)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", js.IdentifiabilityWarning)
-        res = js.fit(start, data, estimator=js.PredictionError(horizon=20.0))
-        held = js.fit(start, data, estimator=js.PredictionError(horizon=20.0, hold="zoh"))
+    res = js.fit(start, data, estimator=js.PredictionError(horizon=20.0))
+    held = js.fit(start, data, estimator=js.PredictionError(horizon=20.0, hold="zoh"))
     assert res.success
     np.testing.assert_allclose(res.values, [0.06, 25.0, 3.0, 5.0], rtol=0.01)
     # the held replay is biased by more than its own reported uncertainty
@@ -87,10 +84,8 @@ def test_nomoto2_with_noise_inside_its_reported_intervals():
                           psi=e.psi + 0.05 * DEG * rng.standard_normal(e.num_samples),
                           r=e.r + 0.01 * DEG * rng.standard_normal(e.num_samples))
             for e in logged_zigzags(truth, 5 * DEG, 0.5)]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", js.IdentifiabilityWarning)
-        res = js.fit(js.Nomoto2(K=0.05, T1=20.0, T2=2.0, T3=3.0), data,
-                     estimator=js.PredictionError(horizon=None, initial="estimate"))
+    res = js.fit(js.Nomoto2(K=0.05, T1=20.0, T2=2.0, T3=3.0), data,
+                 estimator=js.PredictionError(horizon=None, initial="estimate"))
     std = res.std if res.parameters.residuals_white else np.fmax(res.std,
                                                                  res.parameters.std_robust)
     error = np.abs(res.values - [0.06, 25.0, 3.0, 5.0])

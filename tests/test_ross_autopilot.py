@@ -2,7 +2,6 @@
 on its own noise-free data, recovery from the thesis vessel, gradients against finite
 differences and no retracing on new values."""
 
-import warnings
 
 import equinox as eqx
 import jax
@@ -16,13 +15,13 @@ from jaxship import (
     ROSS_FREE,
     SPEED_RUDDER,
     AuxInputs,
-    IdentifiabilityWarning,
+    LinearStart,
     PredictionError,
     RossAutopilot,
     fit,
-    ross_initial_estimate,
     simulate_steering,
 )
+from jaxship._estimate._linear import initial_estimate
 from jaxship._foundation._params import parameter_fields
 from jaxship._models._steering.ross import HULL_TERMS
 from jaxship.studies import thesis as ti
@@ -65,12 +64,6 @@ def record(model, num, seed, rpm, *, name="synthetic"):
 
 
 DATA = [record(TRUTH, 500, 0, 500.0, name="fast"), record(TRUTH, 500, 1, 200.0, name="slow")]
-
-
-def quiet_fit(*args, **kwargs):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", IdentifiabilityWarning)
-        return fit(*args, **kwargs)
 
 
 # -- the equation ---------------------------------------------------------------------
@@ -122,28 +115,28 @@ def test_least_squares_start_is_close_and_fit_recovers_to_1e6():
     so v'^3 and v'^2 r' are small signals; the error is the trapezoid/midpoint
     discretisation of the regression), and the prediction-error fit of all 16
     coefficients recovers them to 1e-6 relative."""
-    start = ross_initial_estimate(RossAutopilot(**SCALES), DATA, free=SPEED_RUDDER, hold="zoh")
+    start = initial_estimate(RossAutopilot(**SCALES), DATA, free=SPEED_RUDDER, hold="zoh")
     truth = np.array([getattr(TRUTH, n) for n in SPEED_RUDDER])
     got = np.array([getattr(start, n) for n in SPEED_RUDDER])
     weak = np.isin(SPEED_RUDDER, ("n_vvv", "n_vvr"))
     np.testing.assert_allclose(got[~weak], truth[~weak], rtol=2e-2, atol=2e-2)
     np.testing.assert_allclose(got[weak], truth[weak], rtol=0.1)
-    res = quiet_fit(start, DATA, free=SPEED_RUDDER,
-                    estimator=PredictionError(horizon=2.0, channels=("psi", "r"), hold="zoh"))
+    # the same start as the estimator's strategy, then the fit: one door
+    res = fit(RossAutopilot(**SCALES), DATA, free=SPEED_RUDDER,
+                    estimator=PredictionError(horizon=2.0, channels=("psi", "r"), hold="zoh",
+                                              start=LinearStart(hold="zoh")))
     assert res.success and res.names == SPEED_RUDDER
     np.testing.assert_allclose(res.values, truth, rtol=1e-6)
     assert res.metrics["r"].fit_percent > 100 - 1e-6
 
 
 def test_frozen_terms_enter_the_start_as_known():
-    start = ross_initial_estimate(RossAutopilot(**SCALES, n_delta_nn=0.9, n_delta3=-0.8,
-                                                n_delta3_nn=-0.3), DATA, hold="zoh")
+    start = initial_estimate(RossAutopilot(**SCALES, n_delta_nn=0.9, n_delta3=-0.8,
+                                           n_delta3_nn=-0.3), DATA, hold="zoh")
     assert (start.n_delta_nn, start.n_delta3, start.n_delta3_nn) == (0.9, -0.8, -0.3)
     np.testing.assert_allclose([start.n_ur, start.n_delta], [-4.0, 2.5], rtol=2e-2)
     with pytest.raises(ValueError, match="span"):
-        ross_initial_estimate(TRUTH, DATA, span=0)
-    with pytest.raises(ValueError, match="RossAutopilot"):
-        ross_initial_estimate(js.Nomoto1(K=0.1, T=1.0), DATA)
+        initial_estimate(TRUTH, DATA, span=0)
 
 
 # -- gradients, no retracing ----------------------------------------------------------

@@ -39,7 +39,7 @@ def results() -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         nomoto = js.fit(start, records, estimator=js.PredictionError(horizon=9.5))
-        ml = js.fit_ml(start, records, max_steps=64)
+        ml = js.fit(start, records, estimator=js.Innovations(max_steps=64))
         thesis = get_vessel("thesis")
         n = 500 / 60
         x0 = js.straight_run(thesis, n=n)

@@ -3,7 +3,6 @@ coefficients on noise-free data of `jaxship.simulate`, merged experiments of dif
 lengths and rates, the u/v channels, bad data."""
 
 import json
-import warnings
 
 import equinox as eqx
 import jax.numpy as jnp
@@ -12,7 +11,7 @@ import pytest
 
 import jaxship as js
 from jaxship._estimate import _fit
-from jaxship._estimate._fit import IdentifiabilityWarning, PredictionError, fit
+from jaxship._estimate._fit import PredictionError, fit
 from jaxship._foundation._params import Free, default_free, parameter_fields, resolve_free
 from jaxship._models._steering._base import AbstractSteeringModel
 
@@ -32,12 +31,6 @@ def perturbed(vessel, names, factors):
     for name, f in zip(names, factors):
         vessel = eqx.tree_at(lambda m: getattr(m, name), vessel, getattr(vessel, name) * f)
     return vessel
-
-
-def quiet_fit(*args, **kwargs):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", IdentifiabilityWarning)
-        return fit(*args, **kwargs)
 
 
 @pytest.fixture(scope="module")
@@ -68,7 +61,7 @@ def test_recovers_thesis_coefficients_from_merged_experiments(two_trials):
     sizes = []
     for trial_no in range(2):
         factors = 1 + rng.choice([-1, 1], len(names)) * rng.uniform(0.1, 0.25, len(names))
-        res = quiet_fit(perturbed(THESIS, names, factors), two_trials, estimator=ESTIMATOR)
+        res = fit(perturbed(THESIS, names, factors), two_trials, estimator=ESTIMATOR)
         sizes.append(_fit._solve._cached._cache_size())
         assert res.success, res.message
         np.testing.assert_allclose(res.values, truth, rtol=1e-6)
@@ -101,7 +94,7 @@ def test_channel_subset_and_weights(two_trials):
     too; the weights are 1/std of the measured channels."""
     names = ("y_uv", "n_ur", "rudder_area")
     est = PredictionError(horizon=10.0, rudder="delta_c", channels=("psi", "r"))
-    res = quiet_fit(perturbed(THESIS, names, (1.2, 0.85, 1.1)), two_trials, estimator=est,
+    res = fit(perturbed(THESIS, names, (1.2, 0.85, 1.1)), two_trials, estimator=est,
                     free=names)
     assert res.success
     np.testing.assert_allclose(res.values, [getattr(THESIS, n) for n in names], rtol=1e-6)
@@ -169,7 +162,7 @@ def test_v_channel_for_steering_models_with_a_v_state():
     data = js.Experiment(np.asarray(tr.t), delta, psi=np.asarray(tr.psi), r=np.asarray(tr.r),
                          v=v)
     start = eqx.tree_at(lambda m: (m.a11, m.b1), truth, (-0.4, 0.12))
-    res = quiet_fit(start, data, estimator=PredictionError(horizon=5.0, channels=("r", "v")),
+    res = fit(start, data, estimator=PredictionError(horizon=5.0, channels=("r", "v")),
                     free=("a11", "b1"))
     np.testing.assert_allclose(res.values, [-0.5, 0.15], rtol=1e-6)
     assert set(res.metrics) == {"r", "v"}
@@ -191,7 +184,7 @@ def test_fitting_the_positions_recovers_a_current():
     res = fit(start, train[:2], estimator=track, free=free)
     assert set(res.metrics) == {"psi", "r", "u", "v", "x", "y"}
     assert np.all(np.abs(res.values - [0.3, -0.2]) < 3 * res.parameters.std_robust), res.values
-    blind = quiet_fit(start, train[:2], estimator=PredictionError(horizon=60.0), free=free)
+    blind = fit(start, train[:2], estimator=PredictionError(horizon=60.0), free=free)
     np.testing.assert_allclose(blind.values, 0.0, atol=1e-9)
     with pytest.raises(ValueError, match="unknown output channel 'x' for Nomoto1"):
         fit(js.Nomoto1(K=0.05, T=10.0), train[0],
@@ -254,7 +247,7 @@ def test_recovers_twenty_coefficients_with_wind_and_a_zero_start():
     start = perturbed(truth, names, 1 + rng.uniform(-0.2, 0.2, len(names)))
     start = eqx.tree_at(lambda m: m.y_uuv, start, 0.0)
     est = PredictionError(horizon=10.0, rudder="delta_c", wind=True, max_steps=400)
-    res = quiet_fit(start, data, estimator=est, free=names)
+    res = fit(start, data, estimator=est, free=names)
     assert res.success, res.message
     assert sorted(res.names) == sorted(names)  # reported in the vessel's field order
     np.testing.assert_allclose(res.values, [getattr(truth, n) for n in res.names], rtol=1e-6)

@@ -30,7 +30,7 @@ from .._foundation._params import parameter_fields
 from .._foundation._validate import validate
 from .._models._armax_model import ARMAX_NAMES, ARMAX_ORDERS, ARMAXModel
 from ._discrete import continuous_parameters
-from ._fit import AbstractEstimator
+from ._fit import AbstractEstimator, excitation_flags
 from ._result import FitResult
 from ._windows import as_dataset, check_data
 
@@ -236,7 +236,7 @@ class ARMAX(AbstractEstimator):
     max_iter: int = 100
     max_lag: int = 25
 
-    def fit(self, model, dataset, free=None, verbose=False) -> FitResult:
+    def fit(self, model, dataset, free=None, progress=None) -> FitResult:
         if not isinstance(model, ARMAXModel):
             raise ValueError(f"the ARMAX estimator fits an ARMAXModel, got "
                              f"{type(model).__name__}.")
@@ -256,8 +256,11 @@ class ARMAX(AbstractEstimator):
         fitted = ARMAXModel.from_result(res, dt)
         fields = parameter_fields(fitted)
         values = np.array([float(getattr(fitted, k)) for k in ARMAX_NAMES])
+        flags, no_excitation = excitation_flags(ds, self.rudder)
         report = parameter_report(ARMAX_NAMES, values, np.asarray(res.covariance),
-                                  units=tuple(fields[k].unit for k in ARMAX_NAMES))
+                                  units=tuple(fields[k].unit for k in ARMAX_NAMES),
+                                  extra_flags=flags,
+                                  undetermined_flags=flags if no_excitation else ())
         first = max(ARMAX_ORDERS["na"], ARMAX_ORDERS["nk"] + ARMAX_ORDERS["nb"] - 1,
                     ARMAX_ORDERS["nc"], 1)  # the first sample of fit_armax's loss
         eps = res.residuals(y, u)

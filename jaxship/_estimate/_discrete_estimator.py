@@ -78,7 +78,7 @@ class DiscreteResponse(AbstractEstimator):
     epsilon: float = 0.0
     max_lag: int = 25
 
-    def fit(self, model, dataset, free=None, verbose=False) -> FitResult:
+    def fit(self, model, dataset, free=None, progress=None) -> FitResult:
         structure = structure_of(model)
         if free is not None:
             raise ValueError("the DiscreteResponse estimator fits every parameter of its "

@@ -15,7 +15,6 @@ import abc
 import contextlib
 import dataclasses
 import math
-import warnings
 
 import equinox as eqx
 import jax
@@ -23,6 +22,7 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
+from .._foundation._contract import AbstractModel
 from .._foundation._covariance import (
     cluster_from_windows,
     hac_from_windows,
@@ -30,9 +30,12 @@ from .._foundation._covariance import (
     parameter_report,
 )
 from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
+from .._foundation._progress import ProgressCallback, reporting_steps, step_hook
 from .._foundation._sharding import sharded_vmap
 from .._foundation._validate import validate
 from .._simulation._simulate import Simulator, integrate, replay_policy
+from ._kalman import SmoothedStates
+from ._linear import LinearStart
 from ._lm import (
     RESULTS,
     LevenbergMarquardt,
@@ -41,7 +44,7 @@ from ._lm import (
     solve_least_squares,
     value_and_jacfwd,
 )
-from ._result import ConvergenceWarning, FitResult, IdentifiabilityWarning
+from ._result import FitError, FitResult
 from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_data, to_timeline
 
 
@@ -52,13 +55,13 @@ MIN_CLUSTERS = 20
 
 class AbstractEstimator(eqx.Module):
     """A strategy of `fit`: how the model is compared with the data and the comparison
-    minimised. Subclasses implement `fit(model, dataset, free, verbose) -> FitResult`:
+    minimised. Subclasses implement `fit(model, dataset, free, progress) -> FitResult`:
     `PredictionError` (output error, equation error and every horizon between),
     `Innovations` (the Kalman filter's one-step-ahead errors, by prediction error or
     maximum likelihood with estimated noise) and `ARMAX` (for `ARMAXModel`)."""
 
     @abc.abstractmethod
-    def fit(self, model, dataset, free, verbose) -> "FitResult":
+    def fit(self, model, dataset, free, progress) -> "FitResult":
         """Estimate the free parameters of `model` from `dataset` (see `jaxship.fit`)."""
 
 
@@ -92,7 +95,10 @@ class PredictionError(AbstractEstimator):
       `LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-10)`: optimistix's solver that
       also stops, like MINPACK, once an accepted step lowers the cost by at most
       `ftol` relative (`jaxship/_estimate/_lm.py`).
-    - `max_steps`: optimiser step limit.
+    - `max_steps`: optimiser step limit (0: the start values are the estimates).
+    - `start`: a start-value strategy run before the optimiser, `LinearStart()` (the
+      equation-error least-squares estimates of the free parameters of `Nomoto1`,
+      `NonlinearNomoto` and `RossAutopilot`); None (default): the model's values.
     - `max_lag`: largest lag of the residual correlation tests [samples].
     - `initial`: `"measured"` (default) starts each window from the measured r and
       psi as they are; `"estimate"` adds corrections of the start r and psi of every
@@ -121,13 +127,14 @@ class PredictionError(AbstractEstimator):
     substeps: int = 1
     solver: optx.AbstractLeastSquaresSolver = LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-10)
     max_steps: int = 256
+    start: LinearStart | None = None
     max_lag: int = 25
     initial: str | list = "measured"
     wind: bool = False
     hold: str | dict | None = None
 
-    def fit(self, model, dataset, free=None, verbose=False) -> "FitResult":
-        return _fit_prediction_error(self, model, dataset, free, verbose)
+    def fit(self, model, dataset, free=None, progress=None) -> "FitResult":
+        return _fit_prediction_error(self, model, dataset, free, progress)
 
 
 def _predict(model, w: Windows, offsets=None):
@@ -196,11 +203,6 @@ def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
     return z, result, steps, q[: len(transform.names)], pred, jac
 
 
-def _progress(**kwargs):
-    jax.debug.print("step {}: trial cost {}, accepted cost {}", kwargs["num_steps"][1],
-                    kwargs["loss_this_step"][1], kwargs["loss_last_accepted_step"][1])
-
-
 def _offset_scales(ds) -> np.ndarray:
     """Scales of the start corrections (r, psi): 1 % of each channel's spread."""
     mask = np.asarray(ds.mask)
@@ -214,7 +216,8 @@ def _offset_scales(ds) -> np.ndarray:
     return np.array(out)
 
 
-def _excitation_flags(ds, rudder) -> list[str]:
+def excitation_flags(ds, rudder) -> tuple[list[str], bool]:
+    """Flags of experiments whose rudder never moves, and whether that is all of them."""
     flags, constant = [], []
     for i, name in enumerate(ds.names):
         d = np.asarray(getattr(ds, rudder))[i, : ds.lengths[i]]
@@ -229,55 +232,103 @@ def _excitation_flags(ds, rudder) -> list[str]:
     elif constant:
         flags.append(f"the rudder input is constant in experiment(s) {', '.join(constant)}: "
                      "they add no excitation.")
-    return flags
+    return flags, bool(constant) and len(constant) == ds.num_experiments
 
 
 def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), free=None,
-        verbose=False) -> FitResult:
+        progress: ProgressCallback | None = None, throw: bool = False) -> FitResult:
     """Estimate the free parameters of a steering model or a vessel from measured data.
 
     **Arguments:**
 
     - `model`: any model of the shared contract, a steering model
       (`AbstractSteeringModel`) or a 3-DOF vessel (`AbstractVessel`), whose field
-      values are the start values (e.g. from `initial_estimate`) and the values of
-      frozen parameters.
+      values are the start values and the values of frozen parameters.
     - `dataset`: a `Dataset`, an `Experiment` or a list of experiments (merged:
       different lengths, sample intervals and propeller rates are fine). Each needs
       a measured rudder and uniform sampling; r and psi are measured or derived; a
       vessel's windows start from the measured u and v too.
     - `estimator`: the strategy (`AbstractEstimator`): `PredictionError` (horizon,
-      channels, weights, holds, solver; the default) or `Innovations` (the Kalman
-      filter's innovations, maximum likelihood with the noise).
+      channels, weights, holds, solver; the default), `Innovations` (the Kalman
+      filter's innovations, maximum likelihood with the noise), `ARMAX`,
+      `DiscreteResponse` or `LinearRegression` (start values by least squares).
     - `free`: which parameters to estimate: `None` (the model's defaults: its `param`
       fields declared free, or a vessel's `free_by_default`), a sequence of field
       names, or `{name: Free(value, lower=, upper=, scale=) or None}`.
-    - `verbose`: print the optimiser's progress (True, or a callable taking the
-      optimistix verbose keyword arguments).
+    - `progress`: a callable receiving a `Progress` report per optimiser step (the
+      library never prints).
+    - `throw`: raise `FitError` (the code's sentence) unless the fit converged. Default
+      False: the outcome is `FitResult.result`, for batches of fits.
 
-    **Returns:** a `FitResult`. The covariance is $\\hat\\sigma^2(J^TJ)^{-1}$ in the
-    physical parameters (per-channel noise variances: see
-    `jaxship._foundation._covariance.least_squares_covariance`), which is right for white
-    residuals: output error with measurement noise only, or a horizon that makes the
-    residuals white. Check `metrics[c].white`.
+    **Returns:** a `FitResult` whose `result` code (`jaxship.RESULTS`) says what the fit
+    knows: `successful` only when the optimiser converged, the simulation stayed finite,
+    the estimates moved from a start where the cost was not stationary, no estimate sits
+    on a bound (`at_bound`) and the data determine every combination of the parameters
+    (`poorly_determined`); the flags of `parameters` say which. The covariance is
+    $\\hat\\sigma^2(J^TJ)^{-1}$ in the physical parameters (per-channel noise variances:
+    see `jaxship._foundation._covariance.least_squares_covariance`), which is right for
+    white residuals: output error with measurement noise only, or a horizon that makes
+    the residuals white. Check `metrics[c].white`.
 
     **Raises:** `ValueError` for bad data (non-finite values, naming the experiment,
     channel and sample; no rudder record; non-uniform sampling; a channel the model
     needs but the record lacks), unknown parameter names or start values outside the
-    bounds.
-
-    **Warns:** `IdentifiabilityWarning` when the parameter report has flags (strong
-    correlations, large relative errors, undetermined combinations, no excitation);
-    `ConvergenceWarning` when the optimiser did not converge.
+    bounds; `FitError` with `throw=True` when the fit did not converge.
     """
     if not isinstance(estimator, AbstractEstimator):
         raise ValueError(f"`estimator` must be a jaxship estimator (PredictionError, "
-                         f"Innovations), got {type(estimator).__name__}.")
-    return estimator.fit(model, dataset, free, verbose)
+                         f"Innovations, ARMAX, DiscreteResponse, LinearRegression), got "
+                         f"{type(estimator).__name__}.")
+    out = _final_verdict(estimator.fit(model, dataset, free, progress), model, free)
+    if throw and not out.success:
+        raise FitError(f"fit of {type(model).__name__}: {out.message}"
+                       + "".join(f" {f}" for f in out.parameters.undetermined
+                                 + out.parameters.bound_flags))
+    return out
 
 
-def _fit_prediction_error(estimator, model, dataset, free, verbose) -> FitResult:
+# the optimiser's codes that an estimate on a bound explains: it crawls towards the
+# bound (softplus transform) until it settles or meets the step limit
+_BOUND_EXPLAINS = (RESULTS.successful, RESULTS.nonlinear_max_steps_reached,
+                   RESULTS.max_steps_reached)
+
+
+def _final_verdict(out: FitResult, model, free) -> FitResult:
+    """`at_bound` when an estimate ended within 1e-4 of its bound span (or scale) from a
+    bound, the optimiser having converged or crawled to its step limit; for a converged
+    fit `poorly_determined` when the data leave a combination of the parameters
+    undetermined; the sentences join the parameter flags. Any other code stands as the
+    estimator gave it."""
+    if out.code not in _BOUND_EXPLAINS:
+        return out
+    values = dict(zip(out.names, np.asarray(out.values, dtype=np.float64)))
+    hits = []
+    for spec in resolve_free(model, free):
+        value = values.get(spec.name)
+        if value is None:
+            continue
+        span = spec.upper - spec.lower if math.isfinite(spec.upper - spec.lower) else spec.scale
+        tol = 1e-4 * (span if span > 0 else 1.0)
+        for side, bound in (("lower", spec.lower), ("upper", spec.upper)):
+            if math.isfinite(bound) and abs(value - bound) <= tol:
+                unit = f" {spec.unit}" if spec.unit and spec.unit != "-" else ""
+                hits.append(f"{spec.name} = {value:.4g}{unit} ended on its {side} bound "
+                            f"{bound:g}{unit}: the data pull it beyond the bound, so the fit "
+                            "is not a proper optimum and its standard error means nothing.")
+    report = out.parameters
+    if hits:
+        report = dataclasses.replace(report, flags=report.flags + tuple(hits),
+                                     bound_flags=tuple(hits))
+        return dataclasses.replace(out, parameters=report, result=RESULTS.at_bound)
+    if out.code == RESULTS.successful and report.undetermined:
+        return dataclasses.replace(out, result=RESULTS.poorly_determined)
+    return out
+
+
+def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResult:
     """`PredictionError.fit`: windows, Levenberg-Marquardt, the report."""
+    if estimator.start is not None:
+        model = estimator.start(model, dataset, free, estimator.rudder)
     ds, windows, layout = _prepare(model, dataset, estimator)
     specs = resolve_free(model, free)
     estimate_starts = estimator.initial == "estimate"
@@ -295,14 +346,16 @@ def _fit_prediction_error(estimator, model, dataset, free, verbose) -> FitResult
         z0 = np.concatenate([z0, np.zeros(windows.start.r.size * 2)])
     z0 = jnp.asarray(z0, dtype=float)
     solver = estimator.solver
-    if verbose and hasattr(solver, "verbose"):
-        solver = eqx.tree_at(lambda s: s.verbose, solver, verbose if callable(verbose)
-                             else _progress)
-    z, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows, offset_scale,
-                                                solver, int(estimator.max_steps))
-    out = _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
-                  result, num_steps, estimate_starts=estimate_starts, verbose=verbose,
-                  stacklevel=6)  # _report, this, PredictionError.fit, its wrapper, fit, caller
+    if progress is not None and isinstance(solver, LevenbergMarquardt):
+        solver = eqx.tree_at(lambda s: s.verbose, solver, step_hook)
+    with reporting_steps(progress, f"fitting {type(model).__name__}",
+                         int(estimator.max_steps)) as finish:
+        z, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows,
+                                                    offset_scale, solver,
+                                                    int(estimator.max_steps))
+        out = _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
+                      result, num_steps, estimate_starts=estimate_starts)
+        finish(out.num_steps, out.cost)
     if estimate_starts:
         offsets = _split(z, transform, windows, offset_scale)[1]
         out = dataclasses.replace(out, start_offsets=np.asarray(offsets, dtype=np.float64))
@@ -312,7 +365,7 @@ def _fit_prediction_error(estimator, model, dataset, free, verbose) -> FitResult
 def _prepare(model, dataset, estimator):
     """Check the model, data and estimator and build the windows: `(ds, windows,
     layout)`, shared by `fit` and `predict`."""
-    if not all(hasattr(model, m) for m in ("replay_field", "replay_state", "channel_index")):
+    if not isinstance(model, AbstractModel):
         raise ValueError(f"`model` must be a jaxship steering model (AbstractSteeringModel) "
                          f"or vessel (AbstractVessel), got {type(model).__name__}.")
     ds = as_dataset(dataset)
@@ -389,7 +442,8 @@ def _smoothed_starts(ds, smoothed) -> dict:
     experiment of `ds`, e.g. from `jaxship.smooth_states`), and `"u"`, `"v"` where
     they are smoothed states (a vessel's)."""
     smoothed = list(smoothed)
-    if len(smoothed) != ds.num_experiments or not all(hasattr(s, "state") for s in smoothed):
+    if len(smoothed) != ds.num_experiments or not all(isinstance(s, SmoothedStates)
+                                                      for s in smoothed):
         raise ValueError(f"`initial` as smoothed states needs one SmoothedStates per "
                          f"experiment ({ds.num_experiments}), got {len(smoothed)} items.")
     out = {}
@@ -426,7 +480,7 @@ def _verdict(result, specs, values, rows, jac, pred, targets, mask) -> RESULTS:
 
 
 def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac, result,
-            num_steps, *, estimate_starts=False, verbose=False, stacklevel=2) -> FitResult:
+            num_steps, *, estimate_starts=False) -> FitResult:
     """The `FitResult` from the optimum: residuals, covariance, identifiability and
     validation metrics on the host (shared by steering-model and vessel fits)."""
     channels = windows.channels
@@ -457,7 +511,7 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
     full, null = (nan, []) if blown else least_squares_covariance(jrows, rows, groups)
     covariance = full[:d, :d]
     null = [v[:d] / np.linalg.norm(v[:d]) for v in null if np.linalg.norm(v[:d]) > 1e-3]
-    flags = _excitation_flags(ds, estimator.rudder)
+    flags, no_excitation = excitation_flags(ds, estimator.rudder)
     num_params = columns.shape[0]
 
     shape = (ds.num_experiments, ds.num_samples)
@@ -488,6 +542,7 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
     report = parameter_report(transform.names, values, covariance,
                               units=tuple(s.unit for s in specs), null_directions=null,
                               extra_flags=flags, robust_covariance=robust[:d, :d],
+                              undetermined_flags=flags[:1] if no_excitation else (),
                               white=white, hac_lags=lags, robust_method=method)
     out = FitResult(
         model=fitted, parameters=report, metrics=metrics, predictions=predictions,
@@ -496,12 +551,4 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
         window_samples=tuple(layout["lengths"]), horizon=estimator.horizon,
         experiment_names=tuple(ds.names),
     )
-    if verbose:
-        print(out.summary())
-    if not out.success:
-        warnings.warn(f"fit of {type(model).__name__}: the optimiser stopped without "
-                      f"converging ({out.message}).", ConvergenceWarning, stacklevel=stacklevel)
-    if not report.identifiable:
-        warnings.warn(f"fit of {type(model).__name__}: " + " ".join(report.flags),
-                      IdentifiabilityWarning, stacklevel=stacklevel)
     return out

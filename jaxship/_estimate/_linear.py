@@ -61,13 +61,30 @@ def _lstsq(x, y, names, what):
     return coef / norms
 
 
-def initial_estimate(model, dataset, *, free=None, rudder: str = "delta", hold=None):
+class LinearStart(eqx.Module):
+    """The start-value strategy of `PredictionError(start=LinearStart())`: before the
+    optimiser runs, the free parameters get their equation-error least-squares
+    estimates (`initial_estimate`; frozen ones enter as known). `span`: sample
+    intervals per regression row of `RossAutopilot` (longer averages the noise on r);
+    `hold` as `PredictionError(hold=...)`. `fit(model, data, estimator=
+    PredictionError(start=LinearStart(), max_steps=0)).model` is the start itself."""
+
+    span: int = 1
+    hold: str | dict | None = None
+
+    def __call__(self, model, dataset, free, rudder: str):
+        return initial_estimate(model, dataset, free=free, rudder=rudder, hold=self.hold,
+                                span=self.span)
+
+
+def initial_estimate(model, dataset, *, free=None, rudder: str = "delta", hold=None,
+                     span: int = 1):
     """Equation-error least-squares start values for `model`'s free parameters
     (`free` as in `fit`); frozen parameters keep their values and enter the
     regression as known. Supported: `Nomoto1`, `NonlinearNomoto`, `RossAutopilot`
-    (`ross_initial_estimate`, one-interval span). `hold`: the
-    rudder between samples, as `PredictionError(hold=...)` (default: linear for the
-    measured angle `delta`, held for the command `delta_c`).
+    (`_ross`, over `span` sample intervals). `hold`: the rudder between samples, as
+    `PredictionError(hold=...)` (default: linear for the measured angle `delta`, held
+    for the command `delta_c`).
 
     **Returns:** a model of the same type with the estimates.
 
@@ -83,7 +100,7 @@ def initial_estimate(model, dataset, *, free=None, rudder: str = "delta", hold=N
     if isinstance(model, NonlinearNomoto):
         return _midpoint(model, ds, names, rudder, foh)
     if isinstance(model, RossAutopilot):
-        return ross_initial_estimate(model, ds, free=free, rudder=rudder, hold=hold)
+        return _ross(model, ds, free=free, rudder=rudder, hold=hold, span=span)
     raise ValueError(f"no linear least-squares start for {type(model).__name__}; supported: "
                      "Nomoto1, NonlinearNomoto, RossAutopilot (start Nomoto2 from a fitted "
                      "Nomoto1).")
@@ -145,8 +162,8 @@ def _replace(model, values):
                        tuple(float(values[n]) for n in names))
 
 
-def ross_initial_estimate(model: RossAutopilot, dataset, *, free=None, rudder: str = "delta",
-                          span: int = 1, hold=None) -> RossAutopilot:
+def _ross(model: RossAutopilot, dataset, *, free=None, rudder: str = "delta", span: int = 1,
+          hold=None) -> RossAutopilot:
     """Equation-error least-squares start values of `RossAutopilot` (`free` as in
     `fit`; frozen parameters enter as known).
 

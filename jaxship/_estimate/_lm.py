@@ -74,6 +74,11 @@ class RESULTS(optx.RESULTS):
     did_not_move = ("the optimiser did not move from the start values although the cost "
                     "is not stationary there (a start value far out of scale?): the "
                     "estimates are the start values")
+    at_bound = ("an estimate ended on a bound of its parameter: the data pull it beyond, "
+                "so the fit is not a proper optimum (see the parameter flags)")
+    poorly_determined = ("the data do not determine a combination of the parameters (a "
+                         "singular information matrix, or no excitation): only other "
+                         "combinations are identified (see the parameter flags)")
 
 
 def as_code(result) -> RESULTS:
@@ -94,6 +99,12 @@ class SolverOutcome(eqx.Module):
     @property
     def success(self) -> bool:
         return bool(self.code == RESULTS.successful)
+
+    @property
+    def code_name(self) -> str:
+        """The code's name, e.g. `"successful"`, `"at_bound"` (as in `result.json`)."""
+        code = self.code
+        return next(n for n, item in RESULTS._name_to_item.items() if code == item)
 
     @property
     def message(self) -> str:
@@ -183,6 +194,10 @@ def solve_least_squares(fn, solver, z0, args, max_steps, to_physical,
     of the forward pass); other solvers evaluate them once more. `jacobian(f, z)`
     computes `(f, J)` (default `value_and_jacfwd`; `blockwise_jacfwd`). Call under jit."""
     fn = stored_jacobian(fn, jacobian)
+    if max_steps == 0:  # the start is the estimate: no optimiser state to read
+        residual, jac = fn(z0, args)
+        q, dq_dz = jax.jvp(to_physical, (z0,), (jnp.ones_like(z0),))
+        return z0, RESULTS.nonlinear_max_steps_reached, jnp.array(0), q, residual, jac / dq_dz
     sol = optx.least_squares(fn, solver, z0, args=args, options=dict(jac="fwd"),
                              has_aux=True, max_steps=max_steps, throw=False)
     info = getattr(sol.state, "f_info", None)

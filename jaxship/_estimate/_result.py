@@ -1,5 +1,5 @@
-"""`FitResult`, the one result type of `jaxship.fit` whatever the estimator, and the
-warnings a fit gives."""
+"""`FitResult`, the one result type of `jaxship.fit` whatever the estimator, and
+`FitError`, raised by `fit(..., throw=True)` when a fit did not converge."""
 
 import equinox as eqx
 import numpy as np
@@ -12,13 +12,9 @@ from .._foundation._validate import _to_plain
 from ._lm import RESULTS, SolverOutcome
 
 
-class IdentifiabilityWarning(UserWarning):
-    """The data do not determine some estimated parameters well (see the flags of
-    `FitResult.parameters`)."""
-
-
-class ConvergenceWarning(UserWarning):
-    """The optimiser stopped without meeting its tolerances."""
+class FitError(RuntimeError):
+    """`fit(..., throw=True)`: the fit's result code is not `successful` (the message
+    says which and why)."""
 
 
 class FitResult(SolverOutcome):
@@ -34,8 +30,9 @@ class FitResult(SolverOutcome):
       samples; `predicted`: (E, N) mask of samples that were predicted (the first
       sample of each experiment is a start value, never predicted);
     - `result`: the `jaxship.RESULTS` code (optimistix's, and `simulation_blew_up`,
-      `did_not_move`: a fit that blew up or never moved is not a success); `success`
-      (converged); `message`;
+      `did_not_move`, `at_bound`, `poorly_determined`: a fit that blew up, never moved,
+      ended on a bound or left a combination undetermined is not a success);
+      `success` (converged); `message`;
     - `num_steps`: optimiser steps; `cost`: $\\frac12\\sum$ of the squared weighted
       residuals at the optimum;
     - `weights`: `{channel: weight}`; `window_samples`: samples per window for each
@@ -133,6 +130,7 @@ class FitResult(SolverOutcome):
             "condition_number": _to_plain(self.parameters.condition_number),
             "flags": list(self.flags),
             "result": self.message,
+            "code": self.code_name,
             "success": self.success,
             "num_steps": int(self.num_steps),
             "cost": float(self.cost),

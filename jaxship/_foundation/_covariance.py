@@ -319,6 +319,10 @@ class ParameterReport:
     - `hac_lags`: the number of lags of `std_robust` (None: not computed);
     - `uncertainty_flags`: the flags (also in `flags`) about the standard errors
       rather than about identifiability; `identifiable` ignores them.
+    - `undetermined`: the flags (also in `flags`) of what the data do not determine at
+      all (a singular information matrix, no excitation): a fit with any is
+      `RESULTS.poorly_determined`; `bound_flags`: those of estimates that ended on a
+      bound (`RESULTS.at_bound`).
 
     `std`, `covariance` and `correlation` are the usual white-noise ones; when
     `residuals_white` is False they understate the uncertainty and `std_robust` is
@@ -337,6 +341,8 @@ class ParameterReport:
     residuals_white: bool | None = None
     hac_lags: int | None = None
     uncertainty_flags: tuple[str, ...] = ()
+    undetermined: tuple[str, ...] = ()
+    bound_flags: tuple[str, ...] = ()
 
     def __post_init__(self):
         if self.std_robust is None:
@@ -385,13 +391,14 @@ def _combination(names, vector):
 def parameter_report(names, values, covariance, *, units=(), corr_threshold: float = 0.95,
                      rel_std_threshold: float = 0.5, null_directions=(),
                      extra_flags=(), robust_covariance=None, white: bool | None = None,
-                     hac_lags: int | None = None,
-                     robust_method: str | None = None) -> ParameterReport:
+                     hac_lags: int | None = None, robust_method: str | None = None,
+                     undetermined_flags=()) -> ParameterReport:
     """Standard errors, correlation matrix, condition number and identifiability
     flags of estimates `values` with `covariance` (see `ParameterReport`).
 
     `null_directions` (from `least_squares_covariance`) are reported as combinations
-    the data do not determine; `extra_flags` are appended as they are.
+    the data do not determine; `extra_flags` are appended as they are, and those of
+    them in `undetermined_flags` (e.g. no excitation) count as undetermined too.
 
     `robust_covariance` (d, d), e.g. from `hac_covariance` with its `hac_lags` or
     `cluster_from_windows`, gives `std_robust`; `robust_method` names it in the flag.
@@ -429,6 +436,7 @@ def parameter_report(names, values, covariance, *, units=(), corr_threshold: flo
             flags.append(f"the data do not determine the combination {_combination(names, v)} "
                          f"of {', '.join(involved)} (information matrix singular): only other "
                          "combinations of these parameters are identifiable.")
+    null_flags = tuple(flags)
     for i in range(d):
         for j in range(i + 1, d):
             rho = corr[i, j]
@@ -453,6 +461,7 @@ def parameter_report(names, values, covariance, *, units=(), corr_threshold: flo
             flags.append(f"{names[i]} = {values[i]:.4g} is poorly determined: {kind} "
                          f"{judged[i]:.3g} is {percent} of the value (threshold "
                          f"{100 * rel_std_threshold:.0f} %).")
+    undetermined = null_flags + tuple(f for f in extra_flags if f in undetermined_flags)
     flags.extend(extra_flags)
     uncertainty = ()
     if white is False:
@@ -461,7 +470,8 @@ def parameter_report(names, values, covariance, *, units=(), corr_threshold: flo
     return ParameterReport(names, values, std, cov, corr, condition, tuple(flags), tuple(units),
                            std_robust=std_robust, residuals_white=None if white is None
                            else bool(white), hac_lags=None if hac_lags is None
-                           else int(hac_lags), uncertainty_flags=uncertainty)
+                           else int(hac_lags), uncertainty_flags=uncertainty,
+                           undetermined=undetermined)
 
 
 def _not_white_flag(names, std, std_robust, hac_lags, robust_method=None) -> str:

@@ -30,6 +30,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ._contract import AbstractComposite, AbstractModel
+
 
 _KEY = "jaxship_parameter"
 
@@ -84,16 +86,17 @@ def parameter_fields(model) -> dict[str, ParameterInfo]:
     declared with `param`, or, for a vessel (whose coefficient tables are plain
     floats), every scalar float field, free when named in its `free_by_default`, with
     its unit from the class's `units` mapping if it has one; for a model with effects,
-    the base's and each effect's as `"<effect id>.<field>"`."""
-    if hasattr(model, "lookup"):  # a model with effects: the base's and "<id>.<field>"
+    the base's and each effect's as `"<effect id>.<field>"` (the model contract,
+    `_contract.AbstractModel`)."""
+    if isinstance(model, AbstractComposite):  # the base's and "<id>.<field>"
         out = dict(parameter_fields(model.base))
         for effect in model.effects:
             out.update({f"{effect.id}.{k}": v for k, v in parameter_fields(effect).items()})
         return out
     fields = {f.name: f.metadata[_KEY] for f in dataclasses.fields(model) if _KEY in f.metadata}
-    if fields or not hasattr(model, "free_by_default"):
+    if fields or not isinstance(model, AbstractModel):
         return fields
-    default, units = model.free_by_default, getattr(model, "units", {})
+    default, units = model.free_by_default, model.units
     out = {}
     for f in dataclasses.fields(model):
         value = getattr(model, f.name, None)
@@ -274,7 +277,7 @@ class Transform(eqx.Module):
 def get_path(model, name: str):
     """The parameter `name` of `model`: a field, or `"<effect id>.<field>"`."""
     for part in name.split("."):
-        model = model.lookup(part) if hasattr(model, "lookup") else getattr(model, part)
+        model = model.lookup(part) if isinstance(model, AbstractModel) else getattr(model, part)
     return model
 
 

@@ -43,6 +43,7 @@ import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
+from .._foundation._contract import AbstractComposite
 from .._foundation._params import param
 from .._foundation._state import STATE_FIELDS
 from ._steering._base import AbstractSteeringModel
@@ -282,20 +283,9 @@ class RecordedDisturbance(AbstractEffect):
         return jnp.stack([0.0 * u, self.sway_force[k] + 0.0 * u, self.yaw_moment[k] + 0.0 * u])
 
 
-class _Augmented(eqx.Module):
-    """What both augmented models share: the base, the effects, the parameter names
-    `"<effect id>.<field>"` of the effects and the effects' own states."""
-
-    base: eqx.AbstractVar[eqx.Module]
-    effects: eqx.AbstractVar[tuple[AbstractEffect, ...]]
-
-    def lookup(self, name: str):
-        """The base's field `name`, or the effect with the id `name`."""
-        # `eqx.tree_at` wraps an empty `effects` tuple while it looks paths up
-        for effect in self.effects if isinstance(self.effects, tuple) else ():
-            if effect.id == name:
-                return effect
-        return getattr(self.base, name)
+class _Augmented(AbstractComposite):
+    """What both augmented models share: the base, the effects (the parameter names
+    `"<effect id>.<field>"` of `AbstractComposite`) and the effects' own states."""
 
     @property
     def effect_state_size(self) -> int:

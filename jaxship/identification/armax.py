@@ -4,13 +4,11 @@
 
 from __future__ import annotations
 
-import dataclasses
-import warnings
-
 import numpy as np
 
 import jaxship as js
 
+from .._estimate._armax import fit_armax
 from .._models._armax_model import ARMAX_ORDERS, ARMAXModel
 from .starts import StartContext
 
@@ -31,19 +29,9 @@ def _record(train: js.Dataset, rudder: str):
 def _fit_raw(train: js.Dataset, rudder: str, **kwargs):
     y, u, dt, source = _record(train, rudder)
     try:
-        return js.fit_armax(y, u, dt=dt, **ARMAX_ORDERS, **kwargs), y, u, dt
+        return fit_armax(y, u, dt=dt, **ARMAX_ORDERS, **kwargs), y, u, dt
     except ValueError as error:
         raise ValueError(f"{source}: armax: {error}") from None
-
-
-def _excitation_flags(train: js.Dataset, rudder: str) -> list[str]:
-    """A flag when the rudder of the training record never moves."""
-    d = np.asarray(getattr(train, rudder))[0, : train.lengths[0]]
-    if np.ptp(d) > 0.0:
-        return []
-    return [f"the rudder input is constant in every experiment ({train.names[0]}): the data "
-            "contain no excitation, so the steering parameters cannot be identified; use a "
-            "zig-zag, PRBS or turning record."]
 
 
 def start_armax(train: js.Dataset, context: StartContext) -> ARMAXModel:
@@ -66,12 +54,4 @@ def fit_armax_entry(start: ARMAXModel, train: js.Dataset, context: StartContext)
         result = js.fit(start, train, estimator=estimator)
     except ValueError as error:
         raise ValueError(f"{_record(train, context.rudder)[3]}: armax: {error}") from None
-    flags = _excitation_flags(train, context.rudder)
-    if flags:
-        report = js.parameter_report(result.names, result.values, result.covariance,
-                                     units=result.parameters.units, extra_flags=flags)
-        result = dataclasses.replace(result, parameters=report)
-    if result.parameters.flags:
-        warnings.warn("fit of ARMAX: " + " ".join(result.parameters.flags),
-                      js.IdentifiabilityWarning, stacklevel=2)
     return result

@@ -11,6 +11,7 @@ import pathlib
 import re
 
 import equinox as eqx
+import jax
 import numpy as np
 
 import jaxship as js
@@ -110,7 +111,7 @@ class IdentificationResult:
             "parameters": parameters,
             "frozen": fitted["frozen"],
             "constants": _constants(self.model),
-            "fit": {k: fitted[k] for k in ("success", "result", "num_steps", "cost",
+            "fit": {k: fitted[k] for k in ("success", "code", "result", "num_steps", "cost",
                                           "window_samples", "weights")},
             "train": self.train.to_dict(),
             "train_simulation": self.train_simulation.to_dict(),
@@ -143,7 +144,7 @@ def _constants(model) -> dict:
         value = getattr(model, field.name, None)
         if field.name in names or isinstance(value, bool) or np.ndim(value) != 0:
             continue
-        if isinstance(value, (int, float, np.number, np.ndarray)) or hasattr(value, "dtype"):
+        if isinstance(value, (int, float, np.number, np.ndarray, jax.Array)):
             out[field.name] = _to_plain(float(value))
     return out
 

@@ -9,24 +9,22 @@ standard errors, the correlation matrix and plain-language identifiability flags
 in an `IdentificationResult`.
 
 The library stays quiet: progress goes to the `progress` callable (see `Progress`),
-which the `jaxship identify` command turns into a tqdm bar; identifiability and
-convergence problems are `IdentifiabilityWarning`/`ConvergenceWarning` and flags in
-the result.
+which the `jaxship identify` command turns into a tqdm bar; the fit's result code says
+whether it converged, and its problems are plain sentences in the result's `warnings`.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-import warnings
 from collections.abc import Callable
 
-import jax
 import numpy as np
 
 import jaxship as js
 
-from .._foundation._params import parameter_fields, resolve_free
+from .._foundation._params import parameter_fields
+from .._foundation._progress import Progress
 from .assessment import assess
 from .data import as_experiments, check_experiments, valid_samples
 from .registry import MODELS, model_key
@@ -35,48 +33,9 @@ from .simulation import simulate_records
 from .starts import StartContext
 
 
-@dataclasses.dataclass(frozen=True)
-class Progress:
-    """A progress report of `identify`, passed to its `progress` callable.
-
-    - `stage`: `"start"` (start values), `"fit"` (an optimisation), `"validate"`
-      (simulation on the data);
-    - `message`: what is being done, in words;
-    - `step`: the optimiser's step count during a fit (None for stage messages);
-    - `total`: the step limit of the fit;
-    - `cost`: the cost $\\frac12\\sum\\varepsilon^2$ of the last accepted step;
-    - `done`: True for the last report of a stage.
-    """
-
-    stage: str
-    message: str
-    step: int | None = None
-    total: int | None = None
-    cost: float | None = None
-    done: bool = False
-
-
 class FitDivergedError(ValueError):
     """`identify`'s fit diverged: the model's outputs became non-finite from every start
     tried (the `jaxship identify` command exits with status 3)."""
-
-
-# The host-side receivers of the optimiser's step reports. The solver's verbose hook
-# is one module-level function (so that a new `progress` never recompiles the fit);
-# it sends each step through `jax.debug.callback` to the receiver of the `identify`
-# call that is running, pushed here for the duration of its fits.
-_RECEIVERS: list = []
-
-
-def _receive_step(step, cost):
-    if _RECEIVERS:
-        step = int(step)  # before the first step the accepted cost is not yet known
-        _RECEIVERS[-1](step, float(cost) if step > 0 else None)
-
-
-def _verbose_hook(**kwargs):
-    jax.debug.callback(_receive_step, kwargs["num_steps"][1],
-                       kwargs["loss_last_accepted_step"][1])
 
 
 def _values_text(model) -> str:
@@ -209,38 +168,25 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     channels = _derived_notes(train_exps, held_out, channels, default_channels, notes)
 
     report = progress if progress is not None else (lambda event: None)
-    solver = js.LevenbergMarquardt(rtol=1e-9, atol=1e-9, verbose=_verbose_hook)
+    solver = js.LevenbergMarquardt(rtol=1e-9, atol=1e-9)
     estimator = js.PredictionError(horizon=horizon, channels=channels, rudder=rudder,
                                 substeps=int(substeps), solver=solver,
                                 max_steps=int(max_steps), initial=initial)
 
     def run_fit(start_model, *, free=None, stage="fitting", custom=None):
-        total = int(max_steps)
-        report(Progress("fit", stage, step=0, total=total))
-        _RECEIVERS.append(lambda step, cost: report(Progress("fit", stage, step=step,
-                                                             total=total, cost=cost)))
-        try:
-            with warnings.catch_warnings(record=True) as got:
-                warnings.simplefilter("always")
-                if custom is None:
-                    result = js.fit(start_model, train_ds, estimator=estimator, free=free)
-                else:  # an entry's own estimator (e.g. ARMAX)
-                    result = custom(start_model, train_ds, context)
-        finally:
-            _RECEIVERS.pop()
-        report(Progress("fit", stage, step=int(result.num_steps), total=total,
-                        cost=float(result.cost), done=True))
-        return result, got
-
-    def nested_fit(start_model, *, free=None, stage="fitting"):
-        result, got = run_fit(start_model, free=free, stage=stage)
-        for w in got:  # the nested fit's problems are reported by the main fit, if at all
-            if not issubclass(w.category, (js.IdentifiabilityWarning, js.ConvergenceWarning)):
-                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        relay = lambda event: report(dataclasses.replace(event, message=stage))
+        if custom is None:
+            return js.fit(start_model, train_ds, estimator=estimator, free=free,
+                          progress=relay)
+        total = int(max_steps)  # an entry's own estimator (e.g. ARMAX): no steps to show
+        relay(Progress("fit", stage, step=0, total=total))
+        result = custom(start_model, train_ds, context)
+        relay(Progress("fit", stage, step=int(result.num_steps), total=total,
+                       cost=float(result.cost), done=True))
         return result
 
     context = StartContext(rudder=rudder, channels=channels, estimator=estimator,
-                           fit=nested_fit, note=notes.append)
+                           fit=run_fit, note=notes.append)
     report(Progress("start", "start values"))
     try:
         start = entry.start(train_ds, context)
@@ -262,8 +208,8 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
             outcome = run_fit(start_model, stage=f"fitting {name}", custom=entry.fit)
         except np.linalg.LinAlgError as error:  # NaN residuals: the simulation blew up
             return None, str(error)
-        if not math.isfinite(outcome[0].cost):
-            return None, f"cost {outcome[0].cost}"
+        if not math.isfinite(outcome.cost):
+            return None, f"cost {outcome.cost}"
         return outcome, ""
 
     outcome, why = attempt(start)
@@ -279,11 +225,8 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
             f"the start {_values_text(start)}; try a finite --horizon, --initial measured or "
             "another model."
         )
-    result, got = outcome
-    for w in got:  # the fit's own convergence and identifiability texts are replaced below
-        if not issubclass(w.category, (js.IdentifiabilityWarning, js.ConvergenceWarning)):
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    problems = _convergence_problems(result, int(max_steps), start, entry)
+    result = outcome
+    problems = _convergence_problems(result, int(max_steps))
     caught.extend(problems)
     caught.extend(result.flags)
 
@@ -333,10 +276,6 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
                  "initial": initial, "max_steps": int(max_steps), "substeps": int(substeps)},
         notes=tuple(notes), warnings=tuple(caught),
     )
-    for problem in problems:
-        warnings.warn(f"identify {name}: {problem}", js.ConvergenceWarning, stacklevel=2)
-    for flag in result.flags:  # one warning per flag: one line each
-        warnings.warn(f"identify {name}: {flag}", js.IdentifiabilityWarning, stacklevel=2)
     return out
 
 
@@ -371,47 +310,27 @@ def _derived_notes(train, held_out, channels, default_channels, notes) -> tuple[
     return channels
 
 
-def _convergence_problems(result, max_steps: int, start, entry) -> list[str]:
-    """Plain sentences for a fit that stopped without converging or whose estimates
-    sit on a bound of their parameter (empty when neither)."""
-    problems = []
-    if not result.success:
-        code = result.code
-        if code in (js.RESULTS.simulation_blew_up, js.RESULTS.did_not_move):
-            problems.append(f"{result.message}.")
-        elif code in (js.RESULTS.nonlinear_max_steps_reached, js.RESULTS.max_steps_reached) \
-                or int(result.num_steps) >= max_steps:
-            problems.append(f"the fit stopped at the step limit ({max_steps}) before "
-                            "converging; the estimates are those of the last step, not an "
-                            "optimum: raise --max-steps or check the data and the model.")
-        elif code == js.RESULTS.nonlinear_divergence:
-            problems.append(f"the fit diverged after {int(result.num_steps)} steps (the "
-                            "optimiser's steps grew without bound); the estimates mean "
-                            "nothing: try a finite --horizon, --initial measured or another "
-                            "model.")
-        elif code == js.RESULTS.singular:
-            problems.append(f"the fit stopped after {int(result.num_steps)} steps: the "
-                            "optimiser's linear solve failed (a singular Jacobian: some "
-                            "parameters do not change the outputs); see the identifiability "
-                            "flags.")
-        else:
-            problems.append(f"the fit stopped after {int(result.num_steps)} steps without "
-                            f"converging ({result.message.splitlines()[0]}).")
-    if entry.fit is None:  # `jaxship.fit` with the default free set: the bounds it used
-        values = dict(zip(result.names, np.asarray(result.values, dtype=np.float64)))
-        for spec in resolve_free(start):
-            value = values.get(spec.name)
-            if value is None:
-                continue
-            span = spec.upper - spec.lower if math.isfinite(spec.upper - spec.lower) else \
-                spec.scale
-            tol = 1e-4 * (span if span > 0 else 1.0)
-            for side, bound in (("lower", spec.lower), ("upper", spec.upper)):
-                if math.isfinite(bound) and abs(value - bound) <= tol:
-                    unit = f" {spec.unit}" if spec.unit and spec.unit != "-" else ""
-                    problems.append(
-                        f"{spec.name} = {value:.4g}{unit} ended on its {side} bound "
-                        f"{bound:g}{unit}: the data pull it beyond the bound, so the fit is "
-                        "not a proper optimum and its standard error means nothing; check the "
-                        "model choice and the data.")
-    return problems
+def _convergence_problems(result, max_steps: int) -> list[str]:
+    """A plain sentence for a fit that stopped without converging (none when it did, or
+    when its parameter flags already say why: an estimate on a bound, a combination the
+    data do not determine)."""
+    code = result.code
+    if result.success or code in (js.RESULTS.at_bound, js.RESULTS.poorly_determined):
+        return []
+    if code in (js.RESULTS.simulation_blew_up, js.RESULTS.did_not_move):
+        return [f"{result.message}."]
+    if code in (js.RESULTS.nonlinear_max_steps_reached, js.RESULTS.max_steps_reached) \
+            or int(result.num_steps) >= max_steps:
+        return [f"the fit stopped at the step limit ({max_steps}) before converging; the "
+                "estimates are those of the last step, not an optimum: raise --max-steps or "
+                "check the data and the model."]
+    if code == js.RESULTS.nonlinear_divergence:
+        return [f"the fit diverged after {int(result.num_steps)} steps (the optimiser's steps "
+                "grew without bound); the estimates mean nothing: try a finite --horizon, "
+                "--initial measured or another model."]
+    if code == js.RESULTS.singular:
+        return [f"the fit stopped after {int(result.num_steps)} steps: the optimiser's linear "
+                "solve failed (a singular Jacobian: some parameters do not change the "
+                "outputs); see the identifiability flags."]
+    return [f"the fit stopped after {int(result.num_steps)} steps without converging "
+            f"({result.message.splitlines()[0]})."]

@@ -23,7 +23,6 @@ error with a suitable horizon is superior to output error under disturbances.
 
 import dataclasses
 import math
-import warnings
 
 import equinox as eqx
 import jax
@@ -170,10 +169,7 @@ def astrom_kallstrom(*, noise: NoiseLevels = NoiseLevels(), seed: int = 0, dt: f
         for method, h in (("output error", None), (f"PE T_p = {horizon:g} s", horizon)):
             est = js.PredictionError(horizon=h, channels=("psi", "r", "v"),
                                      max_steps=max_steps)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", js.IdentifiabilityWarning)
-                warnings.simplefilter("ignore", js.ConvergenceWarning)
-                res = js.fit(start_model, ds, estimator=est, free=FREE)
+            res = js.fit(start_model, ds, estimator=est, free=FREE)
             robust = res.parameters.std_robust
             sim = [_simulate_fit(res.model, e) for e in exps]
             rows.append(AstromRow(

@@ -24,13 +24,13 @@ keep the fits fast; the raw data are 10 Hz (Esso Osaka) and 20 Hz (HSVA).
 """
 
 import dataclasses
-import warnings
 from pathlib import Path
 
 import numpy as np
 import optimistix as optx
 
 import jaxship as js
+from jaxship._estimate._linear import initial_estimate
 
 
 ESSO_TEST = ("random_06-Aug-2020_16_24_25_3", "turn_14-Oct-2020_15_06_53",
@@ -163,20 +163,14 @@ def _validate(model, test, estimator, horizons):
     return out
 
 
-def _quiet_fit(*args, **kwargs):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return js.fit(*args, **kwargs)
-
-
 def _nomoto_models(train, test, estimator, horizons):
     """Nomoto1 from the ARX start, then Nomoto2 from the fitted Nomoto1."""
     est = dataclasses.replace(estimator, channels=("psi", "r"), wind=False)
-    start1 = js.initial_estimate(js.Nomoto1(K=0.1, T=10.0), train)
-    fit1 = _quiet_fit(start1, train, estimator=est)
+    start1 = initial_estimate(js.Nomoto1(K=0.1, T=10.0), train)
+    fit1 = js.fit(start1, train, estimator=est)
     K, T = float(fit1.model.K), float(fit1.model.T)
     start2 = js.Nomoto2(K=K, T1=T, T2=0.1 * T, T3=0.05 * T)
-    fit2 = _quiet_fit(start2, train, estimator=est)
+    fit2 = js.fit(start2, train, estimator=est)
     return (Identified("Nomoto1", fit1, _validate(fit1.model, test, est, horizons)),
             Identified("Nomoto2", fit2, _validate(fit2.model, test, est, horizons)))
 
@@ -205,7 +199,7 @@ def identify_esso_osaka(root=None, *, factor: int = 5, horizon: float = 20.0,
                           solver=solver)
     horizons = (horizon, None)
     baseline = _validate(vessel, test, est, horizons)
-    res = _quiet_fit(vessel, train, estimator=est, free=free)
+    res = js.fit(vessel, train, estimator=est, free=free)
     models = [Identified("3-DOF esso_osaka", res, _validate(res.model, test, est, horizons))]
     if nomoto:
         models.extend(_nomoto_models(train, test, est, horizons))
@@ -279,7 +273,7 @@ def esso_osaka_low_speed_sway_yaw(root=None, *, factor: int = 5) -> RealDataRepo
     nomoto = dataclasses.replace(_low_speed_nomoto(train, test)[-1],
                                  label="speed-scaled Nomoto 1 + all terms, exponents free")
     est = js.PredictionError(horizon=None, channels=("r", "v"), wind=True, max_steps=400)
-    fit = _quiet_fit(js.augment(js.LowSpeedSwayYaw(), js.RudderOffset()), train, estimator=est)
+    fit = js.fit(js.augment(js.LowSpeedSwayYaw(), js.RudderOffset()), train, estimator=est)
     sway_yaw = Identified("low-speed sway-yaw + offset", fit, _validate(
         fit.model, test, dataclasses.replace(est, channels=("psi", "r", "v")), (None,)))
     return RealDataReport("Esso Osaka FRT, zig-zag split with turns", (nomoto, sway_yaw),
@@ -290,13 +284,13 @@ def _low_speed_nomoto(train, test) -> tuple[Identified, ...]:
     """The three fits of `esso_osaka_low_speed_steering`, each from the last."""
     base, free = _speed_scaled_nomoto(train)
     est = js.PredictionError(horizon=None, channels=("r",), max_steps=400)
-    fit0 = _quiet_fit(base, train, estimator=est, free=free)
+    fit0 = js.fit(base, train, estimator=est, free=free)
     full = js.augment(fit0.model.base, *fit0.model.effects, js.PropellerRace(),
                       js.ApparentWind(), js.YawQuadraticDamping())
     windy = dataclasses.replace(est, wind=True)
     terms = ("propeller_race.gain", "wind.c1", "wind.c2", "yaw_quadratic_damping.beta")
-    fit1 = _quiet_fit(full, train, estimator=windy, free=free + terms)
-    fit2 = _quiet_fit(fit1.model, train, estimator=windy, free=free + terms + (
+    fit1 = js.fit(full, train, estimator=windy, free=free + terms)
+    fit2 = js.fit(fit1.model, train, estimator=windy, free=free + terms + (
         "speed_dependent_rudder.kappa", "speed_dependent_damping.kappa"))
     shown = lambda e: dataclasses.replace(e, channels=("psi", "r"))
     return (Identified("speed-scaled Nomoto 1 + offset", fit0,

@@ -31,8 +31,8 @@ import os
 import pathlib
 import platform
 import signal
+import sys
 import time
-import warnings
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 
@@ -117,7 +117,7 @@ def _run(out, quick, progress, identification, closed_loop, discover, parallel) 
     """`reproduce` into the folder `out`."""
     (out / "trials").mkdir(parents=True, exist_ok=True)
     (out / "figures").mkdir(exist_ok=True)
-    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
+    load = os.getloadavg()[0] if sys.platform != "win32" else None
     began, cpu0 = time.perf_counter(), time.process_time()
     timings, cpu, results, sections = {}, {}, {}, []
     vessel = js.vessel("thesis")
@@ -263,10 +263,8 @@ def _discovery(quick, out, say=None) -> dict:
     hidden = js.YawCubicDamping(beta=DISCOVERY_HIDDEN)
     say("simulating the records")
     train, holdout = discovery.hidden_effect_records(js.augment(base, hidden), DISCOVERY_SEED)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the report says what matters
-        report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout,
-                             max_effects=1 if quick else 3, progress=say)
+    report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout,
+                         max_effects=1 if quick else 3, progress=say)
     say("drawing the held-out records")
     discovery_figure(report, holdout, pathlib.Path(out) / "figures" / "discovery_holdout.png")
     case = {"truth": "Nomoto1(K=0.06 1/s, T=25 s) + YawCubicDamping(beta=300)",

@@ -16,6 +16,7 @@ import equinox as eqx
 import numpy as np
 
 import jaxship as js
+from jaxship._estimate._discrete import fit_discrete_response
 
 
 DEG = np.pi / 180.0
@@ -110,7 +111,7 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
     for method in methods:
         opts = dict(svr_options or {}) if method == "svr" else {}
         for s in STRUCTURES:
-            fits[(s, method)] = js.fit_discrete_response(s, train, method=method, **opts)
+            fits[(s, method)] = fit_discrete_response(s, train, method=method, **opts)
     test = records["zigzag 20/20"]
     table1 = [("test",) + _overshoots(test.t, test.psi, test.delta, 20 * DEG)]
     table1_discrete = []
@@ -160,8 +161,8 @@ def design_study(vessel="thesis", *, rpm=500.0, dt=0.5, noise_r=0.05 * DEG, dura
     rate = float(v.rudder.max_rate)
     rec = [_run(v, js.ZigZag(20 * DEG, 20 * DEG, duration=600.0, dt=dt), x0),
            _run(v, thesis, x0)]
-    n1 = js.fit_discrete_response("linear1", rec).to_steering()
-    n2 = js.fit_discrete_response("linear2", rec).to_steering()
+    n1 = fit_discrete_response("linear1", rec).to_steering()
+    n2 = fit_discrete_response("linear2", rec).to_steering()
     n1 = eqx.tree_at(lambda m: m.delta0, n1, 0.0)
     n2 = eqx.tree_at(lambda m: m.delta0, n2, 0.0)
     manoeuvres = {

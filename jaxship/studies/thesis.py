@@ -28,11 +28,11 @@ here.
 
 import dataclasses
 import math
-import warnings
 
 import numpy as np
 
 import jaxship as js
+from jaxship._estimate._linear import initial_estimate
 
 
 DEG = math.pi / 180.0
@@ -206,13 +206,6 @@ def nomoto_start(nomoto: js.Nomoto1, scales: dict) -> js.RossAutopilot:
     return js.RossAutopilot(**scales, n_ur=-L / (U * T), n_delta=K * L**2 / (T * U**2))
 
 
-def _quiet_fit(*args, **kwargs):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", js.IdentifiabilityWarning)
-        warnings.simplefilter("ignore", js.ConvergenceWarning)
-        return js.fit(*args, **kwargs)
-
-
 def _estimators(settings: Settings):
     solver = js.LevenbergMarquardt(rtol=settings.tolerance, atol=settings.tolerance)
     common = dict(channels=("r",), substeps=settings.substeps, solver=solver,
@@ -225,7 +218,7 @@ def _safe_fit(model, records, free, estimator):
     """`fit`, or None when the model diverges on the data (non-finite cost)."""
     try:
         with np.errstate(over="ignore", invalid="ignore"):  # residuals of a diverged model
-            result = _quiet_fit(model, records, free=free, estimator=estimator)
+            result = js.fit(model, records, free=free, estimator=estimator)
     except (ValueError, np.linalg.LinAlgError):  # NaN residuals of an unstable model
         return None
     return result if np.isfinite(result.cost) else None
@@ -251,12 +244,12 @@ def identify(model_name, records, vessel, *, settings: Settings = Settings(), no
     """
     pe, oe = _estimators(settings)
     if nomoto is None or model_name == "nomoto":
-        nomoto = js.initial_estimate(js.Nomoto1(K=0.1, T=5.0), records)
-        nomoto = _quiet_fit(nomoto, records, free=("K", "T"), estimator=pe).model
+        nomoto = initial_estimate(js.Nomoto1(K=0.1, T=5.0), records)
+        nomoto = js.fit(nomoto, records, free=("K", "T"), estimator=pe).model
     if model_name == "nomoto":
         if not settings.output_error:
-            return _quiet_fit(nomoto, records, free=("K", "T"), estimator=pe)
-        return _quiet_fit(nomoto, records, free=("K", "T"), estimator=oe)
+            return js.fit(nomoto, records, free=("K", "T"), estimator=pe)
+        return js.fit(nomoto, records, free=("K", "T"), estimator=oe)
     free = js.ROSS_FREE if model_name == "ross" else js.SPEED_RUDDER
     scales = reference_scales(vessel)
     if model_name == "ross_speed_rudder" and base is not None:
@@ -264,7 +257,7 @@ def identify(model_name, records, vessel, *, settings: Settings = Settings(), no
     else:
         starts = [nomoto_start(nomoto, scales)]
         try:
-            starts.append(js.ross_initial_estimate(js.RossAutopilot(**scales), records, free=free,
+            starts.append(initial_estimate(js.RossAutopilot(**scales), records, free=free,
                                                 span=settings.span))
         except ValueError:  # singular regression: the Nomoto start only
             pass

@@ -8,6 +8,7 @@ import numpy as np
 from ..._estimate._fit import PredictionError
 from ..._estimate._predict import predict
 from ..._estimate._windows import as_dataset
+from ..._models._vessel._base import AbstractVessel
 from ._forces import LOADS, residual_loads, smoothed_vessel_states
 
 
@@ -87,7 +88,7 @@ def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 6
     """
     ds = as_dataset(data)
     channels = tuple(c for c in channels if all(c in h for h in ds.experiment_channels))
-    vessel = hasattr(model, "mass_matrix")
+    vessel = isinstance(model, AbstractVessel)
     smoothed = (smoothed_vessel_states(model, ds) if vessel and not all(
         "v" in h for h in ds.experiment_channels) else None)
     out = predict(model, ds, estimator=PredictionError(

@@ -2,6 +2,8 @@
 `jaxship discover`) and as a page (`to_markdown`)."""
 
 import equinox as eqx
+import jax
+import numpy as np
 
 
 class DiscoveryReport(eqx.Module):
@@ -176,6 +178,6 @@ def _plain(x):
         return {str(k): _plain(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
         return [_plain(v) for v in x]
-    if hasattr(x, "item") and getattr(x, "ndim", 1) == 0:
+    if isinstance(x, (np.generic, np.ndarray, jax.Array)) and np.ndim(x) == 0:
         return x.item()
     return x

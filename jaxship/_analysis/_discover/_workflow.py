@@ -34,15 +34,15 @@ One iteration (design: ../shared/reference/discovery-design.md, sec. 4):
 
 import dataclasses
 import math
-import warnings
 
 import numpy as np
 from scipy import stats
 
 from ..._estimate._fit import PredictionError, fit
-from ..._estimate._result import ConvergenceWarning, IdentifiabilityWarning
+from ..._estimate._lm import RESULTS
 from ..._estimate._sensitivity import sensitivities
 from ..._estimate._windows import as_dataset
+from ..._foundation._contract import AbstractComposite
 from ..._foundation._params import default_free, parameter_fields, rebuild
 from ..._models._effects import augment
 from ._catalogue import DISCOVERY_CATALOGUE, applicable
@@ -69,7 +69,7 @@ REFIT_STEPS = 100
 
 def _split(model):
     """(base, effects) of a model with or without effects."""
-    if hasattr(model, "effects") and hasattr(model, "base"):
+    if isinstance(model, AbstractComposite):
         return model.base, tuple(model.effects)
     return model, ()
 
@@ -133,12 +133,9 @@ def _has_output(model, channel) -> bool:
     return True
 
 
-def _quiet_fit(*args, **kwargs):
-    """`fit` without its identifiability and convergence warnings: every candidate's
-    refit is judged by the report's gates, which say why one is rejected."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", (IdentifiabilityWarning, ConvergenceWarning))
-        return fit(*args, **kwargs)
+# refit outcomes the gates below judge themselves (a bound: the edge gate; an
+# undetermined combination: the confidence-interval gate)
+_JUDGED_BY_GATES = (RESULTS.successful, RESULTS.at_bound, RESULTS.poorly_determined)
 
 
 def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
@@ -208,7 +205,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                              window=estimator.horizon, initial=held_start)
 
     say("fitting the base model")
-    base_fit = _quiet_fit(model, train, estimator=loss(model), free=free)
+    base_fit = fit(model, train, estimator=loss(model), free=free)
     channels = tuple(base_fit.metrics)
     current, theta, cost = base_fit, free, base_fit.cost
     before = held = check(base_fit.model) if holdout else None
@@ -267,12 +264,12 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             free = sum((names[k] for k in keys), ())
             refit = dataclasses.replace(loss(start), max_steps=min(estimator.max_steps,
                                                                    REFIT_STEPS))
-            trial = _quiet_fit(start, train, estimator=refit, free=theta + free)
+            trial = fit(start, train, estimator=refit, free=theta + free)
             lr = 2 * (cost - trial.cost) / sigma2 / max(s.inflation, 1.0)
             z = float(stats.norm.isf(level / 2))
             params = {k: _parameters(trial, names[k]) for k in keys}
             why = []
-            if not trial.success:
+            if trial.code not in _JUDGED_BY_GATES:
                 why.append(f"the refit did not converge ({trial.message})")
             if lr <= limit:
                 why.append(f"likelihood ratio {lr:.3g} (robust) below the threshold {limit:.3g}")

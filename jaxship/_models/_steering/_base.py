@@ -16,6 +16,8 @@ import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
+from ..._foundation._contract import AbstractModel
+
 
 class AuxInputs(eqx.Module):
     """Measured quantities a response model may use besides the rudder, at the time the
@@ -57,7 +59,7 @@ class WindowStart(eqx.Module):
     y: ArrayLike | None = None
 
 
-class AbstractSteeringModel(eqx.Module):
+class AbstractSteeringModel(AbstractModel):
     """A response model $\\dot x = f(x, \\delta, a)$, $r = h(x)$, $\\dot\\psi = r$.
 
     Subclasses (final) declare their coefficients as fields with
@@ -80,15 +82,12 @@ class AbstractSteeringModel(eqx.Module):
     """
 
     state_names: eqx.AbstractClassVar[tuple[str, ...]]
-    # the model contract shared with vessels (see `jaxship.fit`): fitted outputs by
-    # default, channels every window starts from, wind loads, a rudder servo; and
-    # the ids of the discovery catalogue's effects its own equations already carry
-    # (`jaxship.discover` does not offer them again)
+    # the model contract (`AbstractModel`): psi and r fitted by default, no measured
+    # channel needed at a window start, no wind loads, no rudder servo
     default_channels: ClassVar[tuple[str, ...]] = ("psi", "r")
     start_channels: ClassVar[tuple[str, ...]] = ()
     wind_loads: ClassVar[bool] = False
     has_servo: ClassVar[bool] = False
-    built_in_effects: ClassVar[tuple[str, ...]] = ()
 
     @abc.abstractmethod
     def rhs(self, state: Array, delta: ArrayLike, aux: AuxInputs) -> Array:
@@ -124,11 +123,6 @@ class AbstractSteeringModel(eqx.Module):
             return self.state_names.index(channel)
         raise ValueError(f"{type(self).__name__} has no output {channel!r}; its outputs are "
                          f"psi and its states {self.state_names}.")
-
-    def measure(self, channel: str, value):
-        """What the sensor of `channel` reports for the true `value` (exact here;
-        sensor effects change it)."""
-        return value
 
     def replay_state(self, start: WindowStart, servo: bool = False) -> Array:
         """$y = (x, \\psi)$ at a window start, `x` from `window_state`."""

@@ -81,7 +81,7 @@ class RossAutopilot(AbstractSteeringModel):
     expansion of $C_N(\\delta)$, e.g. Fossen 2021, sec. 6.7 on stall). The extra terms
     are frozen at 0 by default, so the default model is Ross' own.
 
-    All terms are linear in the parameters: `ross_initial_estimate` gives start
+    All terms are linear in the parameters: `LinearStart` gives start
     values by linear least squares. The model is port/starboard symmetric (every
     term is odd in $(v, r, \\delta)$).
     """

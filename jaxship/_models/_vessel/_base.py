@@ -8,6 +8,7 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array
 
+from ..._foundation._contract import AbstractModel
 from ..._foundation._state import (
     STATE_FIELDS,
     Command,
@@ -20,7 +21,7 @@ from .._actuators import RudderServo, Shaft
 from .._environment import Environment, Wind
 
 
-class AbstractVessel(eqx.Module):
+class AbstractVessel(AbstractModel):
     """A 3-DOF (surge, sway, yaw) vessel model.
 
     The equations of motion are $M \\dot\\nu = \\tau(\\nu, \\delta, n) + \\tau_{env}$ with
@@ -41,10 +42,9 @@ class AbstractVessel(eqx.Module):
     frontal_wind_area: eqx.AbstractVar[float]  # A_F [m^2], 0 for no windage
     lateral_wind_area: eqx.AbstractVar[float]  # A_L [m^2]
 
-    # coefficients `jaxship.fit` estimates with `free=None` (field names)
-    free_by_default: ClassVar[tuple[str, ...]] = ()
-    # the model contract shared with steering models (see `jaxship.fit`): fitted outputs
-    # by default, channels every window starts from, wind loads, a rudder servo
+    # the model contract (`AbstractModel`): fitted outputs by default, channels every
+    # window starts from, wind loads, a rudder servo; its coefficient table's scalar
+    # fields are its parameters, `free_by_default` those `jaxship.fit` estimates
     default_channels: ClassVar[tuple[str, ...]] = ("psi", "r", "u", "v")
     start_channels: ClassVar[tuple[str, ...]] = ("u", "v")
     wind_loads: ClassVar[bool] = True
@@ -80,11 +80,6 @@ class AbstractVessel(eqx.Module):
         """Where an output channel (`"psi"`, `"r"`, `"u"`, `"v"`, `"x"`, `"y"`) sits in the
         state vector."""
         return STATE_FIELDS.index(channel)
-
-    def measure(self, channel: str, value):
-        """What the sensor of `channel` reports for the true `value` (exact here;
-        sensor effects change it)."""
-        return value
 
     def replay_state(self, start, servo: bool = False) -> Array:
         """The state vector at a window start (`WindowStart`) of a measured record:

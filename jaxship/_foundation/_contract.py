@@ -1,0 +1,73 @@
+"""The one model contract: what `fit`, `predict` and `discover` ask of a vessel
+(`AbstractVessel`) and of a steering model (`AbstractSteeringModel`) alike.
+
+A model is replayed against a measured record: every prediction window starts from a
+state built from the record (`replay_state`) and runs the model's field with the
+record's inputs replayed (`replay_field`); `channel_index` and `measure` say where an
+output sits in the state and what its sensor reports. Its parameters are its `param`
+fields, or, for a vessel's coefficient table, its scalar fields with `free_by_default`
+(`jaxship._foundation._params.parameter_fields`), addressed by name (`lookup`); a
+model with effects (`AbstractComposite`) adds each effect's as `"<effect id>.<field>"`.
+"""
+
+import abc
+from typing import ClassVar
+
+import equinox as eqx
+
+
+class AbstractModel(eqx.Module):
+    """The contract of every model `jaxship.fit` estimates and `jaxship.discover` extends.
+
+    Class variables: `default_channels` (outputs fitted by default), `start_channels`
+    (measured channels every window starts from), `wind_loads` (feels the replayed
+    wind), `has_servo` (a rudder servo that can replay the command) and
+    `built_in_effects` (ids of catalogue effects its own equations carry).
+    """
+
+    default_channels: eqx.AbstractClassVar[tuple[str, ...]]
+    start_channels: eqx.AbstractClassVar[tuple[str, ...]]
+    wind_loads: eqx.AbstractClassVar[bool]
+    has_servo: eqx.AbstractClassVar[bool]
+    built_in_effects: ClassVar[tuple[str, ...]] = ()
+    # a coefficient table (vessels): its scalar fields are its parameters, these free
+    # by default, with the units of `units`
+    free_by_default: ClassVar[tuple[str, ...]] = ()
+    units: ClassVar[dict[str, str]] = {}
+
+    @abc.abstractmethod
+    def channel_index(self, channel: str) -> int:
+        """Where output `channel` sits in the replayed state vector."""
+
+    @abc.abstractmethod
+    def replay_state(self, start, servo: bool = False):
+        """The state vector at a window start (`WindowStart`) of a measured record."""
+
+    @abc.abstractmethod
+    def replay_field(self, servo: bool = False):
+        """`f(t, y, inputs)`: the state derivative with the record's inputs replayed."""
+
+    def measure(self, channel: str, value):
+        """What the sensor of `channel` reports for the true `value` (exact here;
+        sensor effects change it)."""
+        return value
+
+    def lookup(self, name: str):
+        """The parameter (or part) called `name`: a field here."""
+        return getattr(self, name)
+
+
+class AbstractComposite(AbstractModel):
+    """A model with effects (`jaxship.AugmentedSteering`, `jaxship.AugmentedVessel`):
+    the `base` model's parameters and each effect's as `"<effect id>.<field>"`."""
+
+    base: eqx.AbstractVar[AbstractModel]
+    effects: eqx.AbstractVar[tuple]
+
+    def lookup(self, name: str):
+        """The base's field `name`, or the effect with the id `name`."""
+        # `eqx.tree_at` wraps an empty `effects` tuple while it looks paths up
+        for effect in self.effects if isinstance(self.effects, tuple) else ():
+            if effect.id == name:
+                return effect
+        return getattr(self.base, name)
