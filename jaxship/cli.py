@@ -289,8 +289,8 @@ def _identify(args) -> int:
         (stage / "result.json").write_text(result.to_json() + "\n")
     head, *lines = result.summary().splitlines()
     if not result.fit.success:  # the optimiser's own words are on stderr, in plain ones
-        head = (f"{result.model_name}: {type(result.model).__name__}, NOT converged (stopped "
-                f"after {result.fit.num_steps} steps)")
+        head = (f"{result.model_name}: {type(result.model).__name__}, NOT converged "
+                f"({result.fit.code_name}, after {result.fit.num_steps} steps)")
     print("\n".join([head, *lines]))
     for note in result.notes:
         print(f"note: {note}")

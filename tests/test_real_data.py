@@ -92,11 +92,17 @@ def test_esso_osaka_low_speed_terms_beat_the_speed_scaled_nomoto_on_held_out_run
     speed-scaled Nomoto 1 with offset raise the simulated held-out r on both runs, and
     on the zig-zag clear the 62.4 % of the issue's SciPy anchor (the same base model)
     by 10 points; with the speed exponents free too, the zig-zag's r passes the issue's
-    85 % goal. Measured: zig-zag 58.4 -> 78.5 -> 87.3 %, turn 29.6 -> 63.5 -> 61.4 %."""
+    85 % goal. Measured: zig-zag 58.4 -> 78.5 -> 87.3 %, turn 29.6 -> 63.5 -> 61.4 %.
+    The two larger models are not converged estimates: their rudder offset ends on its
+    -0.1 rad bound (the result code `at_bound`, which a fit once called a success)."""
     report = esso_osaka_low_speed_steering()
     base, full, kappas = (m.validation["simulation"].fit_per_experiment()
                           for m in report.models)
-    assert report.models[1].result.success and report.models[2].result.success
+    assert report.models[0].result.success
+    for model in report.models[1:]:
+        assert model.result.code == js.RESULTS.at_bound
+        assert model.result.parameters.bound_flags[0].startswith(
+            "rudder_offset.delta0 = -0.1 rad ended on its lower bound")
     for run in ("zigzag_31-Jul-2020_13_42_53", "turn_14-Oct-2020_15_06_53"):
         assert full[run]["r"] > base[run]["r"] + 10.0, (run, base[run], full[run])
         assert kappas[run]["r"] > base[run]["r"] + 10.0, (run, base[run], kappas[run])
