@@ -492,8 +492,11 @@ def smooth_states(model: AbstractSteeringModel | AbstractVessel, data, *, proces
 
     **Returns:** a list of `SmoothedStates`, one per experiment, cut to its length.
     """
-    ds, rec, Q, q, R, P0 = _prepare(model, data, channels, rudder, substeps, process_noise,
-                                    measurement_noise, initial_covariance, hold)
+    # padded to a bucket length: records of nearby lengths share the compiled smoother
+    # (padded samples are predicted without update, so the smoothed states are the same)
+    ds, rec, Q, q, R, P0 = _prepare(model, as_dataset(data).bucketed(), channels, rudder,
+                                    substeps, process_noise, measurement_noise,
+                                    initial_covariance, hold)
     _, zs, Ps = _smooth_jit(as_arrays(model), rec, Q, q, R, P0)
     zs, Ps = np.asarray(zs), np.asarray(Ps)
     names = _augmented_names(model)

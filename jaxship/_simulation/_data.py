@@ -321,6 +321,19 @@ class Dataset(eqx.Module):
             experiment_metadata=tuple(e.metadata for e in experiments),
         )
 
+    def bucketed(self) -> "Dataset":
+        """The dataset padded (masked) to the next of the lengths $\\{4, 5, 6, 7\\}\\cdot 2^k$
+        at or above its own (at most 25 % more samples), so that records of nearby
+        lengths share one compiled program (a filter that skips masked samples gives the
+        same result)."""
+        n = self.num_samples
+        k = max(n.bit_length() - 3, 0)
+        length = min(m << k for m in (4, 5, 6, 7, 8) if m << k >= n) if n > 4 else n
+        if length == n:
+            return self
+        return Dataset.from_experiments([self.experiment(i) for i in
+                                         range(self.num_experiments)], num_samples=length)
+
     @property
     def num_experiments(self) -> int:
         return len(self.lengths)
