@@ -266,6 +266,10 @@ class _ProgressBar:
                        file=sys.stderr)
 
 
+def _note(sentence: str) -> None:
+    print(f"jaxship: note: {sentence}", file=sys.stderr)
+
+
 def _identify(args) -> int:
     # every check before the fit; the files appear in --out only when all are written
     get_model_entry(args.model)  # unknown models fail before reading any file
@@ -274,9 +278,9 @@ def _identify(args) -> int:
         raise ValueError(f"--max-steps {args.max_steps}: give a positive number of optimiser "
                          "steps (default 256).")
     _check_out(args.out)
-    train = read_experiments(args.train, role="training")
-    held_out = None if args.validate is None else read_experiments(args.validate,
-                                                                   role="validation")
+    train = read_experiments(args.train, role="training", note=_note)
+    held_out = None if args.validate is None else read_experiments(
+        args.validate, role="validation", note=_note)
     bar = _ProgressBar(not args.quiet)
     result = identify(train, model=args.model, horizon=horizon, validate=held_out,
                       rudder=args.rudder, channels=args.channels, initial=args.initial,

@@ -152,8 +152,9 @@ def test_no_excitation_is_not_a_success_exit_3(files, tmp_path, capsys):
 
 
 def test_folder_delta_c_horizon_and_channels(tmp_path, capsys):
-    """A folder of records (other files skipped), the commanded rudder, a finite
-    horizon and one fitted channel: the nonlinear Nomoto model is recovered."""
+    """A folder of records (other files skipped, the data-like ones named in a note),
+    the commanded rudder, a finite horizon and one fitted channel: the nonlinear Nomoto
+    model is recovered."""
     truth = NonlinearNomoto(K=0.06, T=25.0, n3=300.0)
     folder = tmp_path / "records"
     folder.mkdir()
@@ -170,6 +171,7 @@ def test_folder_delta_c_horizon_and_channels(tmp_path, capsys):
                         "--horizon", "10", "--channels", "r", "--out", str(out),
                         "--no-figures"], capsys)
     assert code == 0, err
+    assert "skipped 1 file(s) whose format is not a measurement record: open_water.csv" in err
     result = json.loads((out / "result.json").read_text())
     values = {k: v["value"] for k, v in result["parameters"].items()}
     np.testing.assert_allclose([values["K"], values["T"], values["n3"]], [0.06, 25.0, 300.0],

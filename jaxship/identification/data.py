@@ -70,14 +70,16 @@ def _renamed(e: js.Experiment, name: str) -> js.Experiment:
     return js.Experiment(e.t, name=name, metadata=e.metadata, extra=e.extra, **measured)
 
 
-def read_experiments(paths, *, role: str = "training") -> list[js.Experiment]:
+def read_experiments(paths, *, role: str = "training", note=None) -> list[js.Experiment]:
     """Read measurement files and folders into experiments.
 
     A file is read with `read_measured` (trial CSV, Esso Osaka CSV, HSVA and MARIN
     .dat); a folder contributes every file in it (not its subfolders) with a
     `.csv`, `.dat` or `.txt` suffix whose format `read_measured` recognises
-    (others, such as a propeller open-water table, are skipped), in name order.
-    Experiments with equal names get their folder as a prefix.
+    (others, such as a propeller open-water table, are skipped and named in one
+    sentence to `note`, a callable, so that a fit never uses fewer records than the
+    user meant without saying so), in name order. Experiments with equal names get
+    their folder as a prefix.
 
     **Raises:** `ValueError` naming the file: missing, unreadable or malformed
     (the readers' messages name the column and row), or a folder with no records.
@@ -88,8 +90,13 @@ def read_experiments(paths, *, role: str = "training") -> list[js.Experiment]:
     for path in paths:
         path = Path(path)
         if path.is_dir():
-            found = [item for item in sorted(path.iterdir()) if item.is_file()
-                     and item.suffix.lower() in DATA_SUFFIXES and is_measurement_file(item)]
+            candidates = [item for item in sorted(path.iterdir()) if item.is_file()
+                          and item.suffix.lower() in DATA_SUFFIXES]
+            found = [item for item in candidates if is_measurement_file(item)]
+            skipped = [item.name for item in candidates if item not in found]
+            if skipped and note is not None:
+                note(f"{path}: skipped {len(skipped)} file(s) whose format is not a "
+                     f"measurement record: {', '.join(skipped)}.")
             if not found:
                 raise ValueError(f"{path}: the {role} folder holds no measurement file "
                                  "(trial CSV, Esso Osaka CSV, HSVA or MARIN .dat).")

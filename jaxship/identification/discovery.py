@@ -27,8 +27,9 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
         raise ValueError(f"--max-effects must be at least 1, got {max_effects}.")
     if not 0 < alpha < 1:
         raise ValueError(f"--alpha must be between 0 and 1, got {alpha}.")
-    train = read_experiments(train_paths, role="training")
-    holdout = read_experiments(holdout_paths, role="held-out") if holdout_paths else None
+    train = read_experiments(train_paths, role="training", note=say)
+    holdout = read_experiments(holdout_paths, role="held-out", note=say) if holdout_paths \
+        else None
     say(f"start values: identify {model} on {len(train)} training records")
     start = identify(train, model=model).fit.model
     report = js.discover(start, train, holdout, max_effects=max_effects, alpha=alpha,
