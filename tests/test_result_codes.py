@@ -22,23 +22,25 @@ def zigzag_record(dt, *, model=js.Nomoto1(K=0.06, T=25.0), duration=300.0, noise
                          r=np.asarray(out.r) + rng.normal(0, noise / 10, t.size))
 
 
-def test_pure_noise_fitted_at_one_second_is_not_converged():
+def test_the_step_follows_the_start_models_fastest_mode():
     """The trust audit's case: Nomoto 1 on 300 s of pure noise at 1 s samples, started at
     T = 0.31 s (what the linear start gives there). One RK4 step per sample is unstable
-    for that T (|dt/T| = 3.2, beyond RK4's 2.79), the simulation blows up, and the fit
-    said "converged" with a cost of 1e122; now its code says it blew up."""
+    for that T (dt/T = 3.2, beyond RK4's 2.79): the simulation blew up and the fit said
+    "converged" with a cost of 1e122. Now the fit takes two steps per sample (dt/T/2 =
+    1.6) and finds what noise holds: no rudder response (K near zero), a finite cost,
+    the same estimate as with `substeps=2` asked for. A time constant the samples cannot
+    resolve at all is refused."""
     rng = np.random.default_rng(0)
     t = np.arange(0.0, 300.0, 1.0)
     noise = js.Experiment(t, np.where((t // 30) % 2 == 0, 10 * DEG, -10 * DEG),
                           psi=rng.normal(0, 0.05, t.size), r=rng.normal(0, 0.01, t.size))
     res = js.fit(js.Nomoto1(K=0.1, T=0.31), noise)
-    assert not res.success and res.code == js.RESULTS.simulation_blew_up
-    assert "blew up" in res.message and res.to_dict()["success"] is False
-    assert res.to_dict()["code"] == res.code_name == "simulation_blew_up"
-    # the same start on records at 0.1 s is stable and fits (the noise: K near zero)
-    fine = js.Experiment(t[:100] / 10, noise.delta[:100], psi=noise.psi[:100],
-                         r=noise.r[:100])
-    assert js.fit(js.Nomoto1(K=0.1, T=0.31), fine).code != js.RESULTS.simulation_blew_up
+    assert res.success and abs(res.model.K) < 0.01, res.message
+    assert res.cost < 1e3 and np.all(np.isfinite(res.predictions["psi"]))
+    asked = js.fit(js.Nomoto1(K=0.1, T=0.31), noise, estimator=js.PredictionError(substeps=2))
+    np.testing.assert_allclose(asked.values, res.values, rtol=1e-9)
+    with pytest.raises(ValueError, match="time constant of 0.001 s, too short"):
+        js.fit(js.Nomoto1(K=0.1, T=1e-3), noise)
 
 
 def test_a_start_that_never_moves_is_not_converged():
@@ -60,6 +62,7 @@ def test_a_simulation_that_blows_up_is_not_converged():
     start = js.NonlinearNomoto(K=0.06, T=25.0, n1=-1.0, n3=-50.0)
     res = js.fit(start, data, free=("K", "T"))
     assert not res.success and res.code == js.RESULTS.simulation_blew_up, res.message
+    assert "blew up" in res.message and res.to_dict()["code"] == "simulation_blew_up"
 
 
 def test_an_estimate_on_its_bound_is_not_converged():

@@ -90,7 +90,10 @@ class PredictionError(AbstractEstimator):
       dimensionless.
     - `rudder`: the replayed rudder channel, `"delta"` (measured angle) or
       `"delta_c"` (command).
-    - `substeps`: solver steps per sample interval.
+    - `substeps`: solver steps per sample interval, at least: a start model whose
+      fastest mode (the largest eigenvalue modulus $\\rho$ of its field's Jacobian at
+      the first window start) makes one RK4 step unstable gets more, so that
+      $\\rho\\,dt/\\text{substeps} \\le 2.5$ (RK4 is stable to 2.785 on the real axis).
     - `solver`: an `optimistix` least-squares solver; by default jaxship's
       `LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-10)`: optimistix's solver that
       also stops, like MINPACK, once an accepted step lowers the cost by at most
@@ -337,6 +340,9 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
                          "sample the estimated start explains every residual); use a longer "
                          "`horizon` or initial='measured'.")
     base = as_arrays(model)
+    needed = _stable_substeps(base, windows)
+    if needed > windows.substeps:  # the step follows the start model's fastest mode
+        windows = dataclasses.replace(windows, substeps=needed)
     specs = _jacobian_scales(specs, base, windows)
     transform = Transform.from_specs(specs)
     z0 = transform.to_unconstrained(np.array([s.start for s in specs]))
@@ -350,9 +356,15 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
         solver = eqx.tree_at(lambda s: s.verbose, solver, step_hook)
     with reporting_steps(progress, f"fitting {type(model).__name__}",
                          int(estimator.max_steps)) as finish:
-        z, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows,
-                                                    offset_scale, solver,
-                                                    int(estimator.max_steps))
+        for _ in range(3):  # and the estimate's: refitted with the steps it needs
+            z, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows,
+                                                        offset_scale, solver,
+                                                        int(estimator.max_steps))
+            fitted = rebuild(base, transform.names, p)
+            needed = _stable_substeps(fitted, windows, refuse=False)
+            if needed <= windows.substeps or needed > MAX_SUBSTEPS:
+                break
+            windows, z0 = dataclasses.replace(windows, substeps=needed), z
         out = _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
                       result, num_steps, estimate_starts=estimate_starts)
         finish(out.num_steps, out.cost)
@@ -409,6 +421,39 @@ def _prepare(model, dataset, estimator):
                                     substeps=int(estimator.substeps), starts=starts,
                                     hold=estimator.hold, wind=bool(estimator.wind))
     return ds, windows, layout
+
+
+# the most substeps the start model may ask for: beyond, a time constant that short is
+# no steering dynamics the samples can show
+MAX_SUBSTEPS = 64
+
+
+def _stable_substeps(model, windows, refuse: bool = True) -> int:
+    """RK4 steps per sample interval that keep `model`'s fastest mode stable:
+    $\\lceil \\rho\\,dt / 2.5 \\rceil$, $\\rho$ the largest eigenvalue modulus of the
+    field's Jacobian at the first window start (`ValueError` beyond `MAX_SUBSTEPS`, with
+    `refuse`)."""
+    start = jax.tree.map(lambda a: a[0, 0], windows.start)  # the first window's start
+    inputs = {k: a[0, 0, 0] for k, a in windows.records.items()}
+    rho = float(_fastest_rate(model, start, inputs, windows.servo))
+    dt = float(np.max(np.asarray(windows.dt)))
+    needed = max(1, math.ceil(rho * dt / 2.5)) if math.isfinite(rho) else MAX_SUBSTEPS + 1
+    if needed > MAX_SUBSTEPS and refuse:
+        raise ValueError(f"the start {type(model).__name__} has a time constant of "
+                         f"{1 / rho:.3g} s, too short to simulate over samples {dt:g} s "
+                         f"apart (it needs {needed} steps per sample); start from values "
+                         "whose time constants the samples can resolve.")
+    return needed
+
+
+@eqx.filter_jit
+def _fastest_rate(model, start, inputs, servo: bool):
+    """The largest eigenvalue modulus [1/s] of the replay field's Jacobian at a window
+    `start` with the replayed `inputs` there (one compilation per model type)."""
+    y0 = model.replay_state(start, servo)
+    field = model.replay_field(servo)
+    jac = jax.jacfwd(lambda y: field(0.0, y, inputs))(y0)
+    return jnp.max(jnp.abs(jnp.linalg.eigvals(jac)))
 
 
 def _jacobian_scales(specs, model, windows):

@@ -14,7 +14,7 @@ import numpy as np
 
 from .._foundation._params import as_arrays
 from .._foundation._validate import ValidationReport, validate
-from ._fit import PredictionError, _predict, _prepare
+from ._fit import MAX_SUBSTEPS, PredictionError, _predict, _prepare, _stable_substeps
 from ._windows import to_timeline
 
 
@@ -48,15 +48,20 @@ class Prediction:
 def predict(model, dataset, *, estimator: PredictionError = PredictionError()) -> Prediction:
     """Predict the measured outputs of `dataset` with `model` (a steering model or a
     vessel) as `fit` does with `estimator`, and validate them (see `Prediction`).
-
+    vessel) as `fit` does with `estimator`, and validate them (see `Prediction`); the
+    integration step follows the model's fastest mode, as in `fit`.
     Raises `ValueError` for bad data as `fit` does.
     """
     if not isinstance(estimator, PredictionError):
         raise ValueError(f"`estimator` must be a PredictionError, got "
                          f"{type(estimator).__name__}.")
     ds, windows, layout = _prepare(model, dataset, estimator)
+    model = as_arrays(model)
+    needed = min(_stable_substeps(model, windows, refuse=False), MAX_SUBSTEPS)
+    if needed > windows.substeps:  # the step follows the model's fastest mode, as in `fit`
+        windows = dataclasses.replace(windows, substeps=needed)
     channels = windows.channels
-    pred = _predict_jit(as_arrays(model), windows)
+    pred = _predict_jit(model, windows)
     pred = np.asarray(pred, dtype=np.float64)
     shape = (ds.num_experiments, ds.num_samples)
     u = np.asarray(getattr(ds, estimator.rudder), dtype=np.float64)
