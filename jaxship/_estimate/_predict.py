@@ -47,9 +47,9 @@ class Prediction:
 
 def predict(model, dataset, *, estimator: PredictionError = PredictionError()) -> Prediction:
     """Predict the measured outputs of `dataset` with `model` (a steering model or a
-    vessel) as `fit` does with `estimator`, and validate them (see `Prediction`).
     vessel) as `fit` does with `estimator`, and validate them (see `Prediction`); the
     integration step follows the model's fastest mode, as in `fit`.
+
     Raises `ValueError` for bad data as `fit` does.
     """
     if not isinstance(estimator, PredictionError):
