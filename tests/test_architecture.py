@@ -172,3 +172,17 @@ def test_every_model_implements_the_one_contract():
                and issubclass(v, (js.AbstractSteeringModel, js.AbstractVessel))]
     assert len(classes) >= 15
     assert all(issubclass(c, js.AbstractModel) for c in classes)
+
+
+def test_each_command_is_one_module_that_main_only_registers():
+    """`jaxship/cli/<command>.py` owns its parser (`register`) and its `run`; the
+    package's `main` registers them and maps errors to exit statuses."""
+    from jaxship import cli
+
+    assert {c.__name__.rsplit(".", 1)[1] for c in cli.COMMANDS} == {
+        "vessels", "simulate", "reproduce", "identify", "autopilot", "discover"}
+    for command in cli.COMMANDS:
+        assert callable(command.register) and callable(command.run)
+    main = [name for name, _ in calls(PACKAGE / "cli" / "__init__.py")]
+    assert "parser.add_argument" in main and not any(
+        name.endswith(".add_argument") and name != "parser.add_argument" for name in main)

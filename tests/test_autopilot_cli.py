@@ -185,7 +185,7 @@ def test_a_closed_loop_that_blew_up_exits_3_and_says_so(identified, tmp_path, ca
         evaluation.rows[0]["success"] = False
         return evaluation
 
-    monkeypatch.setattr("jaxship.cli.autopilot_study.evaluate", blown)
+    monkeypatch.setattr("jaxship.cli.autopilot.autopilot_study.evaluate", blown)
     out = tmp_path / "run"
     assert main(["autopilot", "--model", str(identified), "--vessel", "thesis", "--rpm", "300",
                  "--out", str(out), "--quiet"]) == 3

@@ -215,8 +215,9 @@ def test_out_that_is_a_file_is_refused_first(command, record, fitted, tmp_path, 
     def no_work(*args, **kwargs):
         raise AssertionError("long work started before --out was checked")
 
-    for name in ("simulate_to_folder", "identify", "read_experiments", "run_discovery",
-                 "reproduce", "autopilot_study.evaluate"):
+    for name in ("simulate.simulate_to_folder", "identify.identify",
+                 "identify.read_experiments", "discover.run_discovery",
+                 "reproduce.reproduce", "autopilot.autopilot_study.evaluate"):
         monkeypatch.setattr(f"jaxship.cli.{name}", no_work)
     target = tmp_path / "taken"
     target.write_text("a file\n")
@@ -229,7 +230,7 @@ def test_out_that_is_a_file_is_refused_first(command, record, fitted, tmp_path, 
     def refuse(*args, **kwargs):
         raise PermissionError(13, "Permission denied")
 
-    monkeypatch.setattr("jaxship.cli.tempfile.TemporaryFile", refuse)
+    monkeypatch.setattr("jaxship.cli._common.tempfile.TemporaryFile", refuse)
     assert main(_command(command, record, fitted, tmp_path / "new")) == 2
     line = _error_line(capsys)
     assert f"--out {tmp_path / 'new'}: cannot write in {tmp_path} (Permission denied)" in line
@@ -292,7 +293,7 @@ def test_identify_not_converged_exit_3_plain_sentence(record, tmp_path, capsys):
     captured = capsys.readouterr()
     assert code == 3
     assert "the fit stopped at the step limit (1) before converging" in captured.err
-    assert "NOT converged (stopped after 1 steps)" in captured.out
+    assert "NOT converged (nonlinear_max_steps_reached, after 1 steps)" in captured.out
     assert "root-find" not in captured.out + captured.err
     result = json.loads((out / "result.json").read_text())
     assert not result["fit"]["success"]
@@ -394,7 +395,7 @@ def test_exit_status_of_diverged_fits_file_system_errors_and_interrupts(
         raise FitDivergedError("the fit of nomoto1 diverged: the model's outputs became "
                                "non-finite")
 
-    monkeypatch.setattr("jaxship.cli.identify", diverge)
+    monkeypatch.setattr("jaxship.cli.identify.identify", diverge)
     out = tmp_path / "fit"
     assert main(["identify", record, "--model", "nomoto1", "--out", str(out)]) == 3
     assert "diverged" in _error_line(capsys)
@@ -403,7 +404,7 @@ def test_exit_status_of_diverged_fits_file_system_errors_and_interrupts(
     def disk_full(*args, **kwargs):
         raise OSError(28, "No space left on device", str(tmp_path / "run" / "trial.png"))
 
-    monkeypatch.setattr("jaxship.cli.simulate_to_folder", disk_full)
+    monkeypatch.setattr("jaxship.cli.simulate.simulate_to_folder", disk_full)
     args = ["simulate", "--vessel", "mariner", "--manoeuvre", "turn:35", "--out",
             str(tmp_path / "run")]
     assert main(args) == 1
@@ -413,7 +414,7 @@ def test_exit_status_of_diverged_fits_file_system_errors_and_interrupts(
     def interrupt(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr("jaxship.cli.simulate_to_folder", interrupt)
+    monkeypatch.setattr("jaxship.cli.simulate.simulate_to_folder", interrupt)
     assert main(args) == 130
     assert "interrupted" in capsys.readouterr().err
     assert not (tmp_path / "run").exists()

@@ -1,0 +1,104 @@
+"""What the commands share: one-line errors, checks of arguments and of `--out`, the
+progress bar of a fit and notes on stderr."""
+
+import math
+import pathlib
+import sys
+import tempfile
+
+from tqdm.auto import tqdm
+
+from .._models._vessel._base import surge_force
+
+
+def one_line(error) -> str:
+    return " ".join(str(error).split())
+
+
+def check_operating_point(vessel, name, speeds, rpms):
+    """Approach speeds [m/s] and propeller rates [rpm] a vessel can sail at: at most 10
+    times its service speed and rate, and a rate only where it has a propeller model."""
+    nominal = float(vessel.nominal_speed)
+    for speed in speeds:
+        if speed > 10 * nominal:
+            raise ValueError(f"--speed {speed:g} m/s: more than 10 times the service speed "
+                             f"of {name} ({nominal:.3g} m/s); give an approach speed in m/s.")
+    if rpms and float(surge_force(vessel, nominal, 1.0)
+                      - surge_force(vessel, nominal, 0.0)) == 0.0:
+        raise ValueError(f"--rpm: {name} has no propeller model, so the propeller rate "
+                         "does nothing; give --speed instead.")
+    service = 60.0 * float(vessel.nominal_n)
+    for rpm in rpms:
+        if rpm > 10 * service:
+            raise ValueError(f"--rpm {rpm:g}: more than 10 times the service propeller rate "
+                             f"of {name} ({service:.4g} rpm).")
+
+
+def positive(option, value):
+    """`value` (a float or None) checked: finite and positive."""
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{option} {value:g}: must be a positive number.")
+    return value
+
+
+def numbers(option, texts) -> list[float]:
+    values = []
+    for text in texts:
+        try:
+            value = float(text)
+        except ValueError:
+            raise ValueError(f"{option} {text!r}: not a number.") from None
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{option} {text!r}: must be a positive number.")
+        values.append(value)
+    return values
+
+
+def check_out(out: pathlib.Path):
+    """`ValueError` unless `out` is (or can be made) a folder we can write into;
+    writes nothing that stays."""
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out} is a file, not a folder; give a folder (it is made if "
+                         "need be).")
+    parent = out
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise ValueError(f"--out {out}: {parent} is a file, not a folder.")
+    try:
+        with tempfile.TemporaryFile(dir=parent):
+            pass
+    except OSError as error:
+        raise ValueError(f"--out {out}: cannot write in {parent} "
+                         f"({error.strerror or error}).") from None
+
+
+def note(sentence: str) -> None:
+    print(f"jaxship: note: {sentence}", file=sys.stderr)
+
+
+class ProgressBar:
+    """Turns `identify`'s `Progress` reports into tqdm bars on stderr."""
+
+    def __init__(self, enabled):
+        self.enabled, self.bar = enabled, None
+
+    def __call__(self, event):
+        if not self.enabled:
+            return
+        if event.stage != "fit":
+            if not event.done:
+                tqdm.write(f"jaxship: {event.message} ...", file=sys.stderr)
+            return
+        if self.bar is None:
+            self.bar = tqdm(total=event.total, desc=event.message, unit="step", leave=False,
+                            file=sys.stderr)
+        self.bar.n = min(int(event.step), event.total)
+        if event.cost is not None:
+            self.bar.set_postfix(cost=f"{event.cost:.5g}", refresh=False)
+        self.bar.refresh()
+        if event.done:
+            self.bar.close()
+            self.bar = None
+            tqdm.write(f"jaxship: {event.message}: {event.step} steps, cost {event.cost:.6g}",
+                       file=sys.stderr)

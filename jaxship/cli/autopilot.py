@@ -1,0 +1,130 @@
+"""`jaxship autopilot`: design a heading autopilot from an identified model and run it
+on a vessel preset."""
+
+import json
+import pathlib
+import sys
+
+import matplotlib.pyplot as plt
+from tqdm.auto import tqdm
+
+from .._foundation._files import staged_folder
+from .._models._vessel.catalogue import get_vessel
+from ..identification import read_result
+from ..plotting import plot_autopilot
+from ..studies import autopilot as autopilot_study
+from ._common import check_operating_point, check_out, numbers
+
+
+def register(sub) -> None:
+    auto = sub.add_parser(
+        "autopilot", help="design a heading autopilot from an identified model and run it",
+        description="Design a PID heading autopilot with reference feed-forward from the model "
+        "of an `identify` result (pole placement, thesis eq. 5.1-5.7), run it on a vessel "
+        "preset from straight runs at each --rpm or --speed with feed-forward (pid+ff), "
+        "without (pid) and, with --tune, with gains tuned on the vessel (tuned); writes "
+        "autopilot.json, report.md and figures/ into --out.")
+    auto.add_argument("--model", required=True, type=pathlib.Path,
+                      help="result.json written by `jaxship identify`")
+    auto.add_argument("--vessel", required=True, help="the vessel steered (see `jaxship "
+                      "vessels`)")
+    auto.add_argument("--rpm", nargs="+", default=None, help="propeller rates of the runs")
+    auto.add_argument("--speed", nargs="+", default=None, help="approach speeds [m/s]")
+    auto.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
+    auto.add_argument("--step", default="45", help="heading step [deg] at 100 s (default 45)")
+    auto.add_argument("--tune", action="store_true",
+                      help="also tune the gains on the vessel at the given rpm/speeds")
+    auto.add_argument("--natural-frequency", default="0.5",
+                      help="the controller's omega_n [rad/s] (default 0.5)")
+    auto.add_argument("--damping", default="1.0", help="the controller's zeta (default 1.0)")
+    auto.add_argument("--quiet", action="store_true", help="no progress bar")
+    auto.set_defaults(run=run)
+
+
+def _point_name(row, by_rpm) -> str:
+    return f"{row['rpm']:g}rpm" if by_rpm else f"{row['speed']:g}mps"
+
+
+def run(args) -> int:
+    # every check before the long work; nothing is written until the runs are done
+    if (args.rpm is None) == (args.speed is None):
+        raise ValueError("give --rpm or --speed (one of them).")
+    by_rpm = args.rpm is not None
+    values = numbers("--rpm" if by_rpm else "--speed", args.rpm if by_rpm else args.speed)
+    try:
+        step = float(args.step)
+        design = autopilot_study.Design(step=step,
+                                        natural_frequency=float(args.natural_frequency),
+                                        damping=float(args.damping))
+    except ValueError:
+        raise ValueError("--step, --natural-frequency and --damping take numbers.") from None
+    design.check()
+    vessel = get_vessel(args.vessel)
+    check_operating_point(vessel, args.vessel, [] if by_rpm else values,
+                           values if by_rpm else [])
+    model, report = read_result(args.model)
+    check_out(args.out)
+
+    bar = tqdm(total=2 + 2 * int(args.tune), desc="autopilot", unit="stage", leave=False,
+               file=sys.stderr, disable=args.quiet)
+    started = []
+
+    def progress(message):  # a stage starts: the one before it is done
+        if started:
+            bar.update()
+        started.append(message)
+        bar.set_postfix_str(message)
+
+    kw = {"rpm": values} if by_rpm else {"speeds": values}
+    evaluation = autopilot_study.evaluate(model, vessel, design=design, tune=args.tune,
+                                          progress=progress, **kw)
+    bar.update(bar.total - bar.n)
+    bar.close()
+
+    names = list(evaluation.runs)
+    loops = [evaluation.runs[n] for n in names]
+    failed = [f"{row['controller']} at {row['rpm']:.4g} rpm, {row['speed']:.3g} m/s"
+              for row in evaluation.rows if not row["success"]]
+    failure = (f"The closed loop blew up (not finite) for {'; '.join(failed)}: those runs "
+               "have no metrics and say nothing about the autopilot." if failed else "")
+    with staged_folder(args.out) as stage:  # the whole set appears, or none of it
+        (stage / "figures").mkdir()
+        figures = []
+        for j, row in enumerate(evaluation.rows[:len(values)]):
+            fig = plot_autopilot(
+                loops[0], index=j, others=loops[1:], labels=names,
+                max_angle=float(vessel.rudder.max_angle),
+                window=(design.step_time - 10.0, design.duration),
+                title=f"{report['model']} autopilot on {args.vessel} at {row['rpm']:.0f} rpm, "
+                f"{row['speed']:.3g} m/s")
+            name = f"figures/heading_{_point_name(row, by_rpm)}.png"
+            fig.savefig(stage / name, dpi=100, format="png")
+            plt.close(fig)
+            figures.append(name)
+        result = {
+            "model": {"file": str(args.model), "name": report["model"],
+                      "class": type(model).__name__,
+                      "parameters": {k: e["value"] for k, e in report["parameters"].items()}},
+            "vessel": args.vessel,
+            **evaluation.to_dict(),
+            "figures": figures,
+        }
+        (stage / "autopilot.json").write_text(json.dumps(result, indent=2) + "\n")
+        parameters = ", ".join(f"{k} = {float(v):.4g}"
+                               for k, v in result["model"]["parameters"].items())
+        page = autopilot_study.evaluation_report(
+            evaluation, title=f"Heading autopilot: {report['model']} on {args.vessel}",
+            model_text=f"Model: {report['model']} ({type(model).__name__}) from "
+            f"`{args.model}`: {parameters}.", figures=figures)
+        if failure:  # first, under the title
+            title, _, rest = page.partition("\n")
+            page = f"{title}\n\n**{failure}**\n{rest}"
+        (stage / "report.md").write_text(page)
+    print(autopilot_study.gains_table(evaluation.gains()))
+    print(autopilot_study.runs_table(evaluation.rows))
+    print(f"wrote {args.out}/autopilot.json, {args.out}/report.md, {args.out}/figures/ "
+          f"({len(figures)} figures)")
+    if failure:
+        print(f"jaxship: {failure}", file=sys.stderr)
+        return 3
+    return 0

@@ -1,0 +1,41 @@
+"""`jaxship discover`: find, name and add the effect a model is missing."""
+
+import pathlib
+import sys
+
+from tqdm.auto import tqdm
+
+from ..identification.discovery import run_discovery
+from ._common import check_out
+
+
+def register(sub) -> None:
+    disc = sub.add_parser(
+        "discover", help="find, name and add the effect a model is missing",
+        description="Fit a registered model to the training records (as `identify` does), "
+        "score the catalogue of physically named effects at the fit, add those that pass "
+        "calibrated tests and improve the held-out records, and report; writes "
+        "discovery.json, report.md and figures/ into --out.")
+    disc.add_argument("train", nargs="+", type=pathlib.Path,
+                      help="training records: trial CSV or measurement files, or folders")
+    disc.add_argument("--holdout", nargs="+", type=pathlib.Path, default=None, metavar="TEST",
+                      help="held-out records (other manoeuvres) the effects must improve")
+    disc.add_argument("--model", required=True, help="a registered model (see `jaxship "
+                      "identify --help`)")
+    disc.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
+    disc.add_argument("--max-effects", type=int, default=3, help="most effects added (3)")
+    disc.add_argument("--alpha", type=float, default=0.01,
+                      help="family-wise false-alarm rate (0.01)")
+    disc.add_argument("--quiet", action="store_true", help="no progress messages")
+    disc.set_defaults(run=run)
+
+
+def run(args) -> int:
+    check_out(args.out)  # before any long work
+    say = (lambda message: None) if args.quiet else (
+        lambda message: tqdm.write(f"jaxship: {message} ...", file=sys.stderr))
+    report = run_discovery(args.train, args.holdout, model=args.model, out=args.out,
+                           max_effects=args.max_effects, alpha=args.alpha, progress=say)
+    print(report.to_markdown())
+    print(f"wrote {args.out}/discovery.json, {args.out}/report.md, {args.out}/figures/")
+    return 0

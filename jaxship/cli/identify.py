@@ -1,0 +1,99 @@
+"""`jaxship identify`: estimate a registered model from measured records and validate
+it."""
+
+import argparse
+import math
+import pathlib
+import sys
+
+from .._foundation._files import staged_folder
+from ..identification import MODELS, get_model_entry, identify, read_experiments
+from ..plotting import save_identification_figures
+from ._common import ProgressBar, check_out, note, one_line
+
+
+def register(sub) -> None:
+    ident = sub.add_parser(
+        "identify", help="estimate a steering model from measured trials and validate it",
+        description="Estimate a steering model from training records (trial CSV files, "
+        "measurement files or folders of them) and validate it; writes result.json and "
+        "figures into --out.",
+        epilog="models (--model):\n" + "\n".join(
+            f"  {name:<24} {entry.description}" for name, entry in MODELS.items()),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    ident.add_argument("train", nargs="+", type=pathlib.Path,
+                       help="training records: trial CSV or measurement files, or folders")
+    ident.add_argument("--model", required=True,
+                       help="a registered model (listed below): a steering model, armax or a "
+                       "vessel preset name")
+    ident.add_argument("--horizon", default=None,
+                       help="prediction horizon [s]; 'none' (default): output error, "
+                       "0: equation error")
+    ident.add_argument("--validate", nargs="+", type=pathlib.Path, default=None,
+                       metavar="TEST", help="held-out records to validate on")
+    ident.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
+    ident.add_argument("--rudder", default="delta", help="replayed rudder: delta or delta_c")
+    ident.add_argument("--channels", default=None,
+                       help="fitted outputs, e.g. psi,r or r, or psi,r,u,v,x,y to fit a "
+                       "vessel's track (default: psi,r; psi,r,u,v for vessel presets; r for "
+                       "armax)")
+    ident.add_argument("--initial", default="auto",
+                       help="window start states: measured, estimate or auto (default: "
+                       "estimate for output error, else measured)")
+    ident.add_argument("--max-steps", type=int, default=256, help="optimiser step limit")
+    ident.add_argument("--no-figures", action="store_true", help="write result.json only")
+    ident.add_argument("--quiet", action="store_true", help="no progress bar")
+    ident.set_defaults(run=run)
+
+
+def _horizon(text):
+    if text is None or text.strip().lower() in ("none", "oe", "output-error"):
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value >= 0):
+        raise ValueError(f"--horizon {text!r}: the horizon must be a non-negative number of "
+                         "seconds (e.g. 10; 0: equation error) or 'none' (output error).")
+    return value
+
+
+def run(args) -> int:
+    # every check before the fit; the files appear in --out only when all are written
+    get_model_entry(args.model)  # unknown models fail before reading any file
+    horizon = _horizon(args.horizon)
+    if args.max_steps < 1:
+        raise ValueError(f"--max-steps {args.max_steps}: give a positive number of optimiser "
+                         "steps (default 256).")
+    check_out(args.out)
+    train = read_experiments(args.train, role="training", note=note)
+    held_out = None if args.validate is None else read_experiments(
+        args.validate, role="validation", note=note)
+    bar = ProgressBar(not args.quiet)
+    result = identify(train, model=args.model, horizon=horizon, validate=held_out,
+                      rudder=args.rudder, channels=args.channels, initial=args.initial,
+                      max_steps=args.max_steps, progress=bar)
+    written = ["result.json"]
+    with staged_folder(args.out) as stage:
+        if not args.no_figures:
+            paths = save_identification_figures(result, stage / "figures")
+            written.append(f"figures/ ({len(paths)} figures)")
+        (stage / "result.json").write_text(result.to_json() + "\n")
+    head, *lines = result.summary().splitlines()
+    if not result.fit.success:  # the optimiser's own words are on stderr, in plain ones
+        head = (f"{result.model_name}: {type(result.model).__name__}, NOT converged "
+                f"({result.fit.code_name}, after {result.fit.num_steps} steps)")
+    print("\n".join([head, *lines]))
+    for text in result.notes:
+        print(f"note: {text}")
+    for message in dict.fromkeys(result.warnings):
+        print(f"jaxship: warning: {one_line(message)}", file=sys.stderr)
+    print(f"wrote {args.out}/" + f", {args.out}/".join(written))
+    if not result.fit.success:
+        print(f"jaxship: the fit is not a converged estimate ({result.fit.code_name}: see "
+              "the warnings above); the results were written for inspection.",
+              file=sys.stderr)
+        return 3
+    return 0

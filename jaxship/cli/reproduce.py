@@ -1,0 +1,19 @@
+"""`jaxship reproduce`: the thesis pipeline end to end on the built-in thesis vessel."""
+
+import pathlib
+
+from ..studies.reproduce import reproduce
+from ._common import check_out
+
+
+def register(sub) -> None:
+    rep = sub.add_parser("reproduce", help="the thesis pipeline on the built-in thesis vessel")
+    rep.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/reproduce"))
+    rep.add_argument("--quick", action="store_true", help="fewer trials (for smoke tests)")
+    rep.set_defaults(run=run)
+
+
+def run(args) -> int:
+    check_out(args.out)
+    reproduce(args.out, quick=args.quick, progress=True)
+    return 0
