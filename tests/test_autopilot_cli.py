@@ -310,3 +310,40 @@ def test_chapter_5_study_has_every_table_row(tmp_path):
     assert "sampled every 1 s over 100-200 s" in section
     json.dumps(study.to_json(result))  # JSON-ready
     pathlib.Path(tmp_path / "section.md").write_text(section)
+
+
+def test_the_default_design_follows_the_models_time_constant():
+    """The trust audit's Mariner case: omega_n = 0.5 rad/s (the 4 m thesis model's) put a
+    160 m ship's rudder on its limits. `auto` takes omega_n = 1.25 / T from the model's
+    yaw time constant, capped at half the servo bandwidth, and scales the reference and
+    the timing with it; on the thesis vessel it gives the thesis' own numbers."""
+    mariner, thesis = js.vessel("mariner"), js.vessel("thesis")
+    omega, basis = study.natural_frequency_for(js.Nomoto1(K=0.033, T=21.0), mariner,
+                                               speed=7.7, n=0.0)
+    assert omega == pytest.approx(1.25 / 21.0) and "T = 21 s" in basis
+    design = study.Design.scaled(omega, basis=basis)
+    assert design.reference_frequency == pytest.approx(0.4 * omega)
+    assert (design.step_time, design.duration) == (840.0, 1680.0)
+    omega, basis = study.natural_frequency_for(js.Nomoto1(K=0.2, T=2.0), thesis,
+                                               speed=1.5, n=6.0)
+    assert omega == 0.5 and "half the servo bandwidth" in basis
+    default = study.Design()
+    scaled = study.Design.scaled(0.5)
+    assert (scaled.reference_frequency, scaled.step_time, scaled.duration) == (
+        default.reference_frequency, default.step_time, default.duration)
+
+
+def test_a_rudder_on_its_limits_is_a_code_and_a_sentence(identified, tmp_path, capsys):
+    """omega_n = 5 rad/s and a 180 deg step on the thesis vessel: the ship cannot turn
+    that fast and the rudder sits at its limit for most of the window; each such run
+    has the code rudder_saturated, the report says so first and stderr warns (exit 0:
+    the runs are finite)."""
+    out = tmp_path / "fast"
+    assert main(["autopilot", "--model", str(identified), "--vessel", "thesis", "--rpm",
+                 "400", "--natural-frequency", "5", "--step", "180", "--out", str(out),
+                 "--quiet"]) == 0
+    runs = json.loads((out / "autopilot.json").read_text())["runs"]
+    assert {r["code"] for r in runs} == {"rudder_saturated"}
+    assert all(r["time_saturated_s"] > 0.5 * 10.0 for r in runs)  # window 10-20 s
+    assert "rudder_saturated" in (out / "report.md").read_text().split("##")[0]
+    assert "warning: The rudder sat at its limit" in capsys.readouterr().err

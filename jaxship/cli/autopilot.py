@@ -31,11 +31,15 @@ def register(sub) -> None:
     auto.add_argument("--rpm", nargs="+", default=None, help="propeller rates of the runs")
     auto.add_argument("--speed", nargs="+", default=None, help="approach speeds [m/s]")
     auto.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
-    auto.add_argument("--step", default="45", help="heading step [deg] at 100 s (default 45)")
+    auto.add_argument("--step", default="45", help="heading step [deg] (default 45), at "
+                      "50 / omega_n s (100 s for 0.5 rad/s)")
     auto.add_argument("--tune", action="store_true",
                       help="also tune the gains on the vessel at the given rpm/speeds")
-    auto.add_argument("--natural-frequency", default="0.5",
-                      help="the controller's omega_n [rad/s] (default 0.5)")
+    auto.add_argument("--natural-frequency", default="auto",
+                      help="the controller's omega_n [rad/s]; auto (default): 1.25 / T from "
+                      "the model's yaw time constant T, at most half the rudder servo's "
+                      "bandwidth (0.5 rad/s on the thesis vessel); the reference model, step "
+                      "time and window follow it in the thesis' proportions")
     auto.add_argument("--damping", default="1.0", help="the controller's zeta (default 1.0)")
     auto.add_argument("--quiet", action="store_true", help="no progress bar")
     auto.set_defaults(run=run)
@@ -51,19 +55,25 @@ def run(args) -> int:
         raise ValueError("give --rpm or --speed (one of them).")
     by_rpm = args.rpm is not None
     values = numbers("--rpm" if by_rpm else "--speed", args.rpm if by_rpm else args.speed)
+    auto = args.natural_frequency.strip().lower() == "auto"
     try:
-        step = float(args.step)
-        design = autopilot_study.Design(step=step,
-                                        natural_frequency=float(args.natural_frequency),
-                                        damping=float(args.damping))
+        step, damping = float(args.step), float(args.damping)
+        omega = 0.5 if auto else float(args.natural_frequency)
     except ValueError:
-        raise ValueError("--step, --natural-frequency and --damping take numbers.") from None
-    design.check()
+        raise ValueError("--step, --natural-frequency (or auto) and --damping take "
+                         "numbers.") from None
+    autopilot_study.Design.scaled(omega, step=step, damping=damping).check()
     vessel = get_vessel(args.vessel)
     check_operating_point(vessel, args.vessel, [] if by_rpm else values,
-                           values if by_rpm else [])
+                          values if by_rpm else [])
     model, report = read_result(args.model)
     check_out(args.out)
+    basis = ""
+    if auto:  # from the model's yaw time constant at the mean operating point of the runs
+        u0, n0 = autopilot_study.operating_point(
+            vessel, **{"rpm" if by_rpm else "speed": sum(values) / len(values)})
+        omega, basis = autopilot_study.natural_frequency_for(model, vessel, speed=u0, n=n0)
+    design = autopilot_study.Design.scaled(omega, step=step, damping=damping, basis=basis)
 
     bar = tqdm(total=2 + 2 * int(args.tune), desc="autopilot", unit="stage", leave=False,
                file=sys.stderr, disable=args.quiet)
@@ -87,6 +97,12 @@ def run(args) -> int:
               for row in evaluation.rows if not row["success"]]
     failure = (f"The closed loop blew up (not finite) for {'; '.join(failed)}: those runs "
                "have no metrics and say nothing about the autopilot." if failed else "")
+    pinned = [f"{row['controller']} at {row['rpm']:.4g} rpm, {row['speed']:.3g} m/s"
+              for row in evaluation.rows if row["code"] == "rudder_saturated"]
+    saturation = (f"The rudder sat at its limit for more than half the window in "
+                  f"{'; '.join(pinned)} (code rudder_saturated): the comparison there says "
+                  "little about the controllers; try a lower --natural-frequency."
+                  if pinned else "")
     with staged_folder(args.out) as stage:  # the whole set appears, or none of it
         (stage / "figures").mkdir()
         figures = []
@@ -116,14 +132,17 @@ def run(args) -> int:
             evaluation, title=f"Heading autopilot: {report['model']} on {args.vessel}",
             model_text=f"Model: {report['model']} ({type(model).__name__}) from "
             f"`{args.model}`: {parameters}.", figures=figures)
-        if failure:  # first, under the title
-            title, _, rest = page.partition("\n")
-            page = f"{title}\n\n**{failure}**\n{rest}"
+        for sentence in (saturation, failure):  # first, under the title
+            if sentence:
+                title, _, rest = page.partition("\n")
+                page = f"{title}\n\n**{sentence}**\n{rest}"
         (stage / "report.md").write_text(page)
     print(autopilot_study.gains_table(evaluation.gains()))
     print(autopilot_study.runs_table(evaluation.rows))
     print(f"wrote {args.out}/autopilot.json, {args.out}/report.md, {args.out}/figures/ "
           f"({len(figures)} figures)")
+    if saturation:
+        print(f"jaxship: warning: {saturation}", file=sys.stderr)
     if failure:
         print(f"jaxship: {failure}", file=sys.stderr)
         return 3

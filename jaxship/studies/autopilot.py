@@ -39,6 +39,12 @@ from jaxship.studies import thesis
 
 
 DEG = math.pi / 180.0
+# the thesis design's proportions (Table 5.1 with omega_n = 0.5 rad/s): reference model
+# at 0.4 omega_n, the heading step at 50 / omega_n (100 s), the run twice as long; and
+# its omega_n times the yaw time constant of its Nomoto model (2.6 s at 350 rpm: 1.3)
+REFERENCE_RATIO = 0.4
+STEP_TIME_RATIO = 50.0
+BANDWIDTH_TIMES_T = 1.25
 RPMS = (300.0, 400.0)  # thesis sec. 5.4: simulated at 300 and 400 rpm
 FAMILIES = ("turning", "zigzag", "thesis")
 MODELS = ("nomoto", "ross")
@@ -76,7 +82,13 @@ class Design:
     - `sample_interval` [s]: sampling of the residual eq. 3.19 and the RMS error over
       `step_time` to `duration`;
     - `tune_dt` [s], `tune_steps`, `rudder_weight`: `tune_autopilot`'s output
-      interval, step limit and rudder weight (`--tune`).
+      interval, step limit and rudder weight (`--tune`);
+    - `basis`: how the numbers were chosen, in one sentence (`scaled`).
+
+    `Design.scaled(omega_n)` keeps the thesis' proportions for any ship: the reference at
+    0.4 omega_n, the step at 50 / omega_n (two digits) and the run twice as long (Table 5.1's 0.2
+    rad/s, 100 s and 200 s for 0.5 rad/s); `natural_frequency_for` derives omega_n from
+    the model's own yaw time constant.
     """
 
     natural_frequency: float = 0.5
@@ -93,6 +105,17 @@ class Design:
     tune_dt: float = 1.0
     tune_steps: int = 20
     rudder_weight: float = 0.1
+    basis: str = "the thesis' numbers (Table 5.1) and omega_n = 0.5 rad/s"
+
+    @classmethod
+    def scaled(cls, natural_frequency: float, *, basis: str = "", **kwargs) -> "Design":
+        """The thesis' proportions about `natural_frequency` [rad/s] (class text)."""
+        w = float(natural_frequency)
+        step_time = float(f"{STEP_TIME_RATIO / w:.2g}")  # two digits: 100 s, 840 s
+        return cls(natural_frequency=w, reference_frequency=REFERENCE_RATIO * w,
+                   step_time=step_time, duration=2 * step_time,
+                   basis=basis or f"omega_n = {w:.4g} rad/s as given, the reference and "
+                   "timing in the thesis' proportions", **kwargs)
 
     @property
     def window(self) -> tuple[float, float]:
@@ -193,6 +216,26 @@ def operating_point(plant, *, rpm=None, speed=None) -> tuple[float, float]:
     return float(state.u), float(state.n)
 
 
+def natural_frequency_for(model, plant, *, speed: float, n: float) -> tuple[float, str]:
+    """`(omega_n, basis)`: the controller's natural frequency [rad/s] from the model's
+    yaw time constant $T = m/|d|$ (`jaxship.yaw_inertia` about the straight run at
+    `speed`, `n`), $\\omega_n = 1.25/T$ as the thesis design, at most half the rudder
+    servo's bandwidth $0.5/T_s$ of the vessel `plant` (which the controller does not
+    model), with the sentence saying so."""
+    m, d = (float(x) for x in js.yaw_inertia(model, speed=speed, n=n))
+    if not (m > 0 and d != 0 and math.isfinite(m / d)):
+        raise ValueError(f"the {type(model).__name__} model has no yaw time constant at "
+                         f"{speed:.3g} m/s (m = {m:.3g}, d = {d:.3g}); give "
+                         "--natural-frequency.")
+    T = abs(m / d)
+    servo = float(plant.rudder.time_constant)
+    w = min(BANDWIDTH_TIMES_T / T, 0.5 / servo)
+    limited = "half the servo bandwidth" if w < BANDWIDTH_TIMES_T / T else "1.25 / T"
+    return w, (f"omega_n = {w:.4g} rad/s from the model's yaw time constant T = {T:.4g} s at "
+               f"{speed:.3g} m/s ({limited}; at most 0.5 / T_servo = {0.5 / servo:.3g} "
+               "rad/s), the reference and timing in the thesis' proportions")
+
+
 def design_controllers(model, plant, design: Design = Design(), *, speed: float,
                        n: float) -> dict:
     """{"pid+ff": ..., "pid": ...}: `HeadingAutopilot`s for `model` (a steering model
@@ -219,13 +262,27 @@ def _finite(x):
     return x if math.isfinite(x) else None
 
 
-def run_rows(name: str, run, design: Design, rpm, speed) -> list[dict]:
-    """The rows (`RUN_KEYS` and `success`) of the closed-loop `run` of controller `name`
-    at the operating points `rpm`, `speed`."""
+# a run whose rudder sits at its limit for more than this share of the window says
+# little about the controller (its code is "rudder_saturated")
+SATURATED_SHARE = 0.5
+
+
+def run_rows(name: str, run, design: Design, rpm, speed, max_angle: float) -> list[dict]:
+    """The rows (`RUN_KEYS`, `success`, `time_saturated_s` and the run's `code`:
+    "successful", "blew_up" or "rudder_saturated", the rudder command within 1 % of its
+    limit `max_angle` [rad] for more than half the window) of the closed-loop `run` of
+    controller `name` at the operating points `rpm`, `speed`."""
     metrics = js.closed_loop_metrics(run, design.sample_interval, window=design.window)
     m = metrics.to_dict_deg()
+    t = np.asarray(run.t)
+    inside = (t >= design.window[0]) & (t <= design.window[1])
+    at_limit = np.abs(np.asarray(run.delta_c)[0]) >= 0.99 * max_angle  # the command
     rows = []
     for j in range(len(rpm)):
+        ok = bool(np.asarray(run.success)[0, j])
+        saturated = float(np.mean(at_limit[j][inside])) if ok else math.nan
+        code = ("blew_up" if not ok else "rudder_saturated" if saturated > SATURATED_SHARE
+                else "successful")
         rows.append({
             "controller": name, "rpm": float(rpm[j]), "speed": float(speed[j]),
             "sum_abs_error_deg": _finite(m["residual_sum_deg"][0][j]),
@@ -235,7 +292,8 @@ def run_rows(name: str, run, design: Design, rpm, speed) -> list[dict]:
             "mean_abs_rudder_deg": _finite(m["mean_abs_rudder_deg"][0][j]),
             "rudder_travel_deg": _finite(m["rudder_travel_deg"][0][j]),
             "time_rate_limited_s": _finite(m["time_at_rate_limit_s"][0][j]),
-            "success": bool(np.asarray(run.success)[0, j]),
+            "time_saturated_s": _finite(saturated * (design.window[1] - design.window[0])),
+            "success": ok, "code": code,
         })
     return rows
 
@@ -289,7 +347,8 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
         say(f"closed loop: {name}")
         runs[name] = js.closed_loop(plant, autopilot, duration=design.duration, dt=design.dt,
                                     **run_kw)
-        rows += run_rows(name, runs[name], design, rpms, speeds_)
+        rows += run_rows(name, runs[name], design, rpms, speeds_,
+                         float(plant.rudder.max_angle))
     return Evaluation(model=model, plant=plant, design=design, design_speed=u0,
                       design_rpm=60.0 * n0, controllers=controllers, runs=runs, rpm=rpms,
                       speed=speeds_, rows=rows, tuning=tuning)
@@ -344,7 +403,7 @@ def evaluation_report(evaluation: Evaluation, *, title: str = "Heading autopilot
         f"Reference model (eq. 5.7): omega = {d.reference_frequency:g} rad/s, zeta = "
         f"{d.reference_damping:g}; heading step {d.step:g} deg at {d.step_time:g} s. Rudder "
         f"limits {limits['max_rudder_deg']:.0f} deg and {limits['max_rudder_rate_deg_s']:.0f} "
-        f"deg/s; the controller updates every {d.interval:g} s.\n")
+        f"deg/s; the controller updates every {d.interval:g} s. Chosen: {d.basis}.\n")
     text.append("## Gains\n\n" + gains_table(evaluation.gains()))
     text.append("## Closed-loop runs\n\n" + runs_table(evaluation.rows))
     text.append(METRICS_TEXT.format(dt=d.sample_interval, start=d.window[0],
