@@ -116,11 +116,10 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     values or non-uniform sampling; for `armax`, more than one training record.
     `FitDivergedError` (a `ValueError`) when the fit diverged from every start tried.
 
-    **Warns:** one `IdentifiabilityWarning` per flag of the estimates (e.g. no
-    excitation: the fit still returns, with infinite standard errors), and a
-    `ConvergenceWarning`, in a plain sentence, when the optimiser stopped without
-    converging (the step limit, divergence) or an estimate ended on a bound of its
-    parameter; those sentences are also the result's `warnings`, with the flags.
+    Nothing is warned or printed: the fit's result code (`result.fit.code`) says whether
+    it converged, and the result's `warnings` hold a plain sentence for a fit that did not
+    (the step limit, divergence, a blow-up) and every flag of the estimates (an estimate
+    on a bound, no excitation: the fit still returns, with infinite standard errors).
 
     Records without a measured psi (or r) are filled by `Experiment` (psi integrated
     from r, r differenced from psi); a note says so, and with the default `channels`
