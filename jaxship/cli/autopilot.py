@@ -13,6 +13,7 @@ from .._models._vessel.catalogue import get_vessel
 from ..identification import read_result
 from ..plotting import plot_autopilot
 from ..studies import autopilot as autopilot_study
+from ..studies.autopilot import cell
 from ._common import check_operating_point, check_out, numbers
 
 
@@ -128,7 +129,7 @@ def run(args) -> int:
         (stage / "autopilot.json").write_text(json.dumps(result, indent=2) + "\n")
         parameters = ", ".join(f"{k} = {float(v):.4g}"
                                for k, v in result["model"]["parameters"].items())
-        page = autopilot_study.evaluation_report(
+        page = evaluation_report(
             evaluation, title=f"Heading autopilot: {report['model']} on {args.vessel}",
             model_text=f"Model: {report['model']} ({type(model).__name__}) from "
             f"`{args.model}`: {parameters}.", figures=figures)
@@ -137,8 +138,8 @@ def run(args) -> int:
                 title, _, rest = page.partition("\n")
                 page = f"{title}\n\n**{sentence}**\n{rest}"
         (stage / "report.md").write_text(page)
-    print(autopilot_study.gains_table(evaluation.gains()))
-    print(autopilot_study.runs_table(evaluation.rows))
+    print(gains_table(evaluation.gains()))
+    print(runs_table(evaluation.rows))
     print(f"wrote {args.out}/autopilot.json, {args.out}/report.md, {args.out}/figures/ "
           f"({len(figures)} figures)")
     if saturation:
@@ -147,3 +148,56 @@ def run(args) -> int:
         print(f"jaxship: {failure}", file=sys.stderr)
         return 3
     return 0
+
+
+def gains_table(gains: dict) -> str:
+    """Markdown table of `Evaluation.gains()`."""
+    lines = ["| controller | K_p [-] | K_i [1/s] | K_d [s] | feed-forward |",
+             "|---|---|---|---|---|"]
+    for name, g in gains.items():
+        lines.append(f"| {name} | {g['kp']:.4g} | {g['ki']:.4g} | {g['kd']:.4g} | "
+                     f"{g['feedforward'] or 'none'} |")
+    return "\n".join(lines) + "\n"
+
+
+def runs_table(rows: list[dict]) -> str:
+    """Markdown table of run rows (`RUN_KEYS`)."""
+    lines = ["| controller | rpm | speed [m/s] | sum abs error [deg] | RMS error [deg] | "
+             "overshoot [deg] | settling [s] | mean abs rudder [deg] | rudder travel [deg] | "
+             "rate-limited [s] |", "|---" * 10 + "|"]
+    for r in rows:
+        settle = "never" if r["settling_time_s"] is None else f"{r['settling_time_s']:.1f}"
+        lines.append(f"| {r['controller']} | {r['rpm']:.0f} | {r['speed']:.3f} | "
+                     f"{cell(r['sum_abs_error_deg'])} | {cell(r['rms_error_deg'], 3)} | "
+                     f"{cell(r['max_overshoot_deg'])} | {settle} | "
+                     f"{cell(r['mean_abs_rudder_deg'])} | {cell(r['rudder_travel_deg'], 1)} | "
+                     f"{cell(r['time_rate_limited_s'], 1)} |")
+    return "\n".join(lines) + "\n"
+
+
+def evaluation_report(evaluation: autopilot_study.Evaluation, *, title: str = "Heading autopilot",
+                      model_text: str = "", figures=()) -> str:
+    """A markdown page: the design, the gains, the runs and the `figures` (paths
+    relative to the page)."""
+    d = evaluation.design
+    limits = evaluation.to_dict()["design"]
+    text = [f"# {title}\n"]
+    if model_text:
+        text.append(model_text + "\n")
+    text.append(
+        f"Pole placement (thesis eq. 5.3-5.5) with omega_n = {d.natural_frequency:g} rad/s, "
+        f"zeta = {d.damping:g}, K_d = 2 zeta omega_n m"
+        + (" - d" if d.subtract_damping else "") + f", K_i = omega_n K_p / 10, about the "
+        f"straight run at {evaluation.design_speed:.3f} m/s ({evaluation.design_rpm:.0f} rpm). "
+        f"Reference model (eq. 5.7): omega = {d.reference_frequency:g} rad/s, zeta = "
+        f"{d.reference_damping:g}; heading step {d.step:g} deg at {d.step_time:g} s. Rudder "
+        f"limits {limits['max_rudder_deg']:.0f} deg and {limits['max_rudder_rate_deg_s']:.0f} "
+        f"deg/s; the controller updates every {d.interval:g} s. Chosen: {d.basis}.\n")
+    text.append("## Gains\n\n" + gains_table(evaluation.gains()))
+    text.append("## Closed-loop runs\n\n" + runs_table(evaluation.rows))
+    text.append(autopilot_study.METRICS_TEXT.format(dt=d.sample_interval, start=d.window[0],
+                                    end=d.window[1]) + "\n")
+    if figures:
+        text.append("## Figures\n")
+        text += [f"![{f}]({f})\n" for f in figures]
+    return "\n".join(text)

@@ -16,17 +16,13 @@ $\\sum_k|\\psi_d(t_k) - \\psi(t_k)|$ in degrees, **sampled every 1 s over 100-20
 ordering and ratios, not by absolute size).
 
 **The controller's own natural frequency and damping** are not in the thesis (only
-the reference model's, Table 5.1). `Design` uses $\\omega_n$ = 0.5 rad/s and
-$\\zeta$ = 1.0: the loop must be faster than the reference it tracks (2.5 times its
-0.2 rad/s, so the error stays small while $\\psi_d$ moves), and slower than the
-rudder servo it does not model (time constant 1 s, i.e. 1 rad/s, and 15 deg/s), so
-that the 45 deg step does not drive the rudder into its rate limit; $\\zeta$ = 1
-as the reference model, so the loop does not overshoot the ordered heading. $K_d$ is
-Fossen's $2\\zeta\\omega_n m - d$ (exact pole placement), not the thesis' printed
-"simplified" $2\\zeta\\omega_n m$ (which damps more by $d/(2m\\omega_n)$). The gains
-are designed once, at the mean operating point of the runs (the straight run at 350
-rpm for 300 and 400 rpm), and kept for every run (no gain schedule); the
-feed-forward uses the measured $u$, $v$ and $n$ of each instant.
+the reference model's, Table 5.1). `Design` uses $\\omega_n$ = 0.5 rad/s, 2.5 times
+the reference's 0.2 rad/s (the error stays small while $\\psi_d$ moves) and half the
+bandwidth of the rudder servo it does not model (1 s), and $\\zeta$ = 1 as the
+reference (no overshoot). $K_d$ is Fossen's $2\\zeta\\omega_n m - d$ (exact pole
+placement), not the thesis' printed $2\\zeta\\omega_n m$ (which damps more by
+$d/(2m\\omega_n)$). The gains are designed once, at the mean operating point of the
+runs, and kept for every run; the feed-forward uses the measured $u$, $v$, $n$.
 """
 
 import dataclasses
@@ -257,6 +253,10 @@ def design_controllers(model, plant, design: Design = Design(), *, speed: float,
             "pid": js.design_autopilot(model, feedforward=False, **kw)}
 
 
+def cell(x, digits=2) -> str:  # a table cell: "-" for None
+    return "-" if x is None else f"{x:.{digits}f}"
+
+
 def _finite(x):
     x = float(x)
     return x if math.isfinite(x) else None
@@ -352,66 +352,6 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
     return Evaluation(model=model, plant=plant, design=design, design_speed=u0,
                       design_rpm=60.0 * n0, controllers=controllers, runs=runs, rpm=rpms,
                       speed=speeds_, rows=rows, tuning=tuning)
-
-
-# ----------------------------------------------------------------------------- report
-
-
-def _cell(x, digits=2):
-    return "-" if x is None else f"{x:.{digits}f}"
-
-
-def gains_table(gains: dict) -> str:
-    """Markdown table of `Evaluation.gains()`."""
-    lines = ["| controller | K_p [-] | K_i [1/s] | K_d [s] | feed-forward |",
-             "|---|---|---|---|---|"]
-    for name, g in gains.items():
-        lines.append(f"| {name} | {g['kp']:.4g} | {g['ki']:.4g} | {g['kd']:.4g} | "
-                     f"{g['feedforward'] or 'none'} |")
-    return "\n".join(lines) + "\n"
-
-
-def runs_table(rows: list[dict]) -> str:
-    """Markdown table of run rows (`RUN_KEYS`)."""
-    lines = ["| controller | rpm | speed [m/s] | sum abs error [deg] | RMS error [deg] | "
-             "overshoot [deg] | settling [s] | mean abs rudder [deg] | rudder travel [deg] | "
-             "rate-limited [s] |", "|---" * 10 + "|"]
-    for r in rows:
-        settle = "never" if r["settling_time_s"] is None else f"{r['settling_time_s']:.1f}"
-        lines.append(f"| {r['controller']} | {r['rpm']:.0f} | {r['speed']:.3f} | "
-                     f"{_cell(r['sum_abs_error_deg'])} | {_cell(r['rms_error_deg'], 3)} | "
-                     f"{_cell(r['max_overshoot_deg'])} | {settle} | "
-                     f"{_cell(r['mean_abs_rudder_deg'])} | {_cell(r['rudder_travel_deg'], 1)} | "
-                     f"{_cell(r['time_rate_limited_s'], 1)} |")
-    return "\n".join(lines) + "\n"
-
-
-def evaluation_report(evaluation: Evaluation, *, title: str = "Heading autopilot",
-                      model_text: str = "", figures=()) -> str:
-    """A markdown page: the design, the gains, the runs and the `figures` (paths
-    relative to the page)."""
-    d = evaluation.design
-    limits = evaluation.to_dict()["design"]
-    text = [f"# {title}\n"]
-    if model_text:
-        text.append(model_text + "\n")
-    text.append(
-        f"Pole placement (thesis eq. 5.3-5.5) with omega_n = {d.natural_frequency:g} rad/s, "
-        f"zeta = {d.damping:g}, K_d = 2 zeta omega_n m"
-        + (" - d" if d.subtract_damping else "") + f", K_i = omega_n K_p / 10, about the "
-        f"straight run at {evaluation.design_speed:.3f} m/s ({evaluation.design_rpm:.0f} rpm). "
-        f"Reference model (eq. 5.7): omega = {d.reference_frequency:g} rad/s, zeta = "
-        f"{d.reference_damping:g}; heading step {d.step:g} deg at {d.step_time:g} s. Rudder "
-        f"limits {limits['max_rudder_deg']:.0f} deg and {limits['max_rudder_rate_deg_s']:.0f} "
-        f"deg/s; the controller updates every {d.interval:g} s. Chosen: {d.basis}.\n")
-    text.append("## Gains\n\n" + gains_table(evaluation.gains()))
-    text.append("## Closed-loop runs\n\n" + runs_table(evaluation.rows))
-    text.append(METRICS_TEXT.format(dt=d.sample_interval, start=d.window[0],
-                                    end=d.window[1]) + "\n")
-    if figures:
-        text.append("## Figures\n")
-        text += [f"![{f}]({f})\n" for f in figures]
-    return "\n".join(text)
 
 
 # ----------------------------------------------------------------------------- chapter 5
@@ -575,16 +515,16 @@ def comparison_table(study: dict) -> str:
                 continue
             row = [r for r in study["table"] if r["model"] == name and r["family"] == family
                    and r["controller"] == "pid+ff"]
-            pairs = " | ".join(f"{_cell(a)} | {_cell(r['thesis'])}" for a, r in zip(ff, row))
+            pairs = " | ".join(f"{cell(a)} | {cell(r['thesis'])}" for a, r in zip(ff, row))
             fit = row[0]["fit_family"]
             lines.append(f"| {THESIS_TABLES.get((name, family), '-')} | "
                          f"{MODEL_NAMES.get(name, name)} | {FAMILY_NAMES[family]} (merged) | "
-                         f"{pairs} | {' | '.join(_cell(x) for x in pid)} | {_cell(fit)} |")
+                         f"{pairs} | {' | '.join(cell(x) for x in pid)} | {cell(fit)} |")
     ref = study["reference"]
     by = {c: [r["sum_abs_error_deg"] for r in ref if r["controller"] == c] for c in CONTROLLERS}
     lines.append("| - | the vessel itself | (true yaw equation) | "
-                 + " | ".join(f"{_cell(a)} | -" for a in by["pid+ff"]) + " | "
-                 + " | ".join(_cell(x) for x in by["pid"]) + " | - |")
+                 + " | ".join(f"{cell(a)} | -" for a in by["pid+ff"]) + " | "
+                 + " | ".join(cell(x) for x in by["pid"]) + " | - |")
     return "\n".join(lines) + "\n"
 
 
@@ -619,16 +559,16 @@ def comparison_text(study: dict) -> str:
         f = g["feedforward"]
         text.append(
             f"Goal 1, feed-forward from the best identified model ({f['best_model']}, "
-            f"chapter-4 fit {_cell(f['fit_family'])} %) beats feedback only at every speed: "
+            f"chapter-4 fit {cell(f['fit_family'])} %) beats feedback only at every speed: "
             f"{'met' if f['met'] else 'NOT met'} (pid+ff "
-            f"{', '.join(_cell(x) for x in f['pid+ff'])} against pid "
-            f"{', '.join(_cell(x) for x in f['pid'])} deg); feed-forward helps for "
+            f"{', '.join(cell(x) for x in f['pid+ff'])} against pid "
+            f"{', '.join(cell(x) for x in f['pid'])} deg); feed-forward helps for "
             f"{len(f['met_by'])} of {len({(r['model'], r['family']) for r in study['table']})}"
             f" models ({', '.join(f['met_by']) or 'none'}).")
     if "ross_vs_nomoto" in g:
         r = g["ross_vs_nomoto"]
-        parts = [f"{FAMILY_NAMES[k]}: Ross {', '.join(_cell(x) for x in v['ross'])} vs "
-                 f"Nomoto {', '.join(_cell(x) for x in v['nomoto'])}"
+        parts = [f"{FAMILY_NAMES[k]}: Ross {', '.join(cell(x) for x in v['ross'])} vs "
+                 f"Nomoto {', '.join(cell(x) for x in v['nomoto'])}"
                  for k, v in r["families"].items()]
         text.append(
             f"Goal 2, Ross beats Nomoto when fitted on informative data (zig-zags, thesis "
