@@ -252,9 +252,9 @@ def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), fre
       a measured rudder and uniform sampling; r and psi are measured or derived; a
       vessel's windows start from the measured u and v too.
     - `estimator`: the strategy (`AbstractEstimator`): `PredictionError` (horizon,
-      channels, weights, holds, solver; the default), `Innovations` (the Kalman
-      filter's innovations, maximum likelihood with the noise), `ARMAX`,
-      `DiscreteResponse` or `LinearRegression` (start values by least squares).
+      channels, weights, holds, solver, start values `LinearStart`; the default),
+      `Innovations` (the Kalman filter's innovations, maximum likelihood with the
+      noise), `ARMAX` or `DiscreteResponse`.
     - `free`: which parameters to estimate: `None` (the model's defaults: its `param`
       fields declared free, or a vessel's `free_by_default`), a sequence of field
       names, or `{name: Free(value, lower=, upper=, scale=) or None}`.
@@ -280,7 +280,7 @@ def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), fre
     """
     if not isinstance(estimator, AbstractEstimator):
         raise ValueError(f"`estimator` must be a jaxship estimator (PredictionError, "
-                         f"Innovations, ARMAX, DiscreteResponse, LinearRegression), got "
+                         f"Innovations, ARMAX, DiscreteResponse), got "
                          f"{type(estimator).__name__}.")
     out = _final_verdict(estimator.fit(model, dataset, free, progress), model, free)
     if throw and not out.success:
