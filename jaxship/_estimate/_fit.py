@@ -587,7 +587,7 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
     report = parameter_report(transform.names, values, covariance,
                               units=tuple(s.unit for s in specs), null_directions=null,
                               extra_flags=flags, robust_covariance=robust[:d, :d],
-                              undetermined_flags=flags[:1] if no_excitation else (),
+                              undetermined_flags=flags if no_excitation else (),
                               white=white, hac_lags=lags, robust_method=method)
     out = FitResult(
         model=fitted, parameters=report, metrics=metrics, predictions=predictions,
