@@ -2,7 +2,7 @@
 
 For every scenario (an effect at a size, two effects, the white null and the coloured
 null with a slowly varying yaw moment) it runs discovery on `--seeds` independent data
-sets (`jaxship.studies.discovery`: Nomoto 1 truth integrated finely, rate-limited
+sets (`jaxship/cli/_studies/discovery.py`: Nomoto 1 truth integrated finely, rate-limited
 rudder logged at 2 Hz, 4 training zig-zags, 2 held-out turning circles) and prints:
 
 - detection: the hidden effect (or each of two) named or in a named class, nothing
@@ -30,7 +30,7 @@ import jax
 import numpy as np
 
 import jaxship as js
-from jaxship.studies.discovery import outcome, run_case, vessel_records
+from jaxship.cli._studies.discovery import outcome, run_case, vessel_records
 
 
 DEG = np.pi / 180

@@ -181,7 +181,7 @@ from ._simulation._simulate_steering import (
 
 __version__ = importlib.metadata.version("jaxship")  # from pyproject.toml
 
-# study and application helpers, added for jaxship.studies and the notebooks
+# helpers of the application (jaxship.cli) and the notebooks
 from ._models._armax_model import ARMAXModel as ARMAXModel
 from ._models._steering.ross import (
     ROSS_FREE as ROSS_FREE,
@@ -196,12 +196,6 @@ from ._trials import (
     initial_state as initial_state,
     run_trial as run_trial,
     trial_indices as trial_indices,
-)
-
-# (the application layer, .identification, imports jaxship itself: keep it last)
-from .identification import (
-    IdentificationResult as IdentificationResult,
-    identify as identify,
 )
 
 

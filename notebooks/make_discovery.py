@@ -8,6 +8,8 @@ import nbformat as nbf
 
 HERE = pathlib.Path(__file__).parent
 SETUP = """import os
+import pathlib
+import sys
 import time
 
 import jax
@@ -15,8 +17,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import jaxship as js
-from jaxship.studies.discovery import hidden_effect_records, vessel_records
-from jaxship.studies.real_data import (
+from jaxship.cli._identification import identify
+from jaxship.cli._studies.discovery import hidden_effect_records, vessel_records
+sys.path.insert(0, str(pathlib.Path.cwd().parent))  # the project root: benchmarks.studies
+from benchmarks.studies.real_data import (  # noqa: E402
     esso_osaka_low_speed_discovery,
     esso_osaka_low_speed_steering,
     esso_osaka_low_speed_sway_yaw,
@@ -130,7 +134,7 @@ nb.cells = [
     nbf.v4.new_code_cell(
         "if HAVE['kvlcc2_simman2008_hsva'] and HAVE['kvlcc2_simman2008_marin']:\n"
         "    train, holdout = kvlcc2_discovery_split(data)\n"
-        "    start = js.identify(train, model='kvlcc2').fit.model\n"
+        "    start = identify(train, model='kvlcc2').fit.model\n"
         "    t0 = time.perf_counter()\n"
         "    kvlcc2 = js.discover(start, train, holdout)\n"
         "    print(f'{time.perf_counter() - t0:.0f} s')\n"

@@ -2,7 +2,7 @@
 
 The notebook identifies the Esso Osaka 3-DOF model and Nomoto models on the FRT-DS-ESSO
 random runs and validates them on held-out runs, then Nomoto models on the HSVA KVLCC2
-zig-zags; the pipeline is `jaxship.studies.real_data`. Every cell after the first skips when
+zig-zags; the pipeline is `benchmarks/studies/real_data.py`. Every cell after the first skips when
 the measured data are absent.
 """
 
@@ -42,7 +42,11 @@ import numpy as np
 import matplotlib.pyplot as plt
 from IPython.display import Markdown, display
 import jaxship as js
-from jaxship.studies.real_data import identify_esso_osaka, identify_kvlcc2_hsva
+import pathlib
+import sys
+
+sys.path.insert(0, str(pathlib.Path.cwd().parent))  # the project root: benchmarks.studies
+from benchmarks.studies.real_data import identify_esso_osaka, identify_kvlcc2_hsva
 
 data = js.shared_data_dir()
 HAVE_ESSO = data is not None and (data / "esso_osaka_frt").is_dir()
@@ -75,7 +79,7 @@ def plot_runs(report, label, channels, predictors):
     runs = first.experiment_names
     fig, axes = plt.subplots(len(channels), len(runs), figsize=(5 * len(runs), 2.2 * len(channels)),
                              squeeze=False, sharex="col")
-    from jaxship.studies.real_data import esso_osaka_split, hsva_split
+    from benchmarks.studies.real_data import esso_osaka_split, hsva_split
     for j, run in enumerate(runs):
         for i, c in enumerate(channels):
             ax = axes[i, j]
@@ -100,7 +104,7 @@ def add_measured(axes, runs, channels):
     axes[0, 0].legend(fontsize=7)
 
 if HAVE_ESSO:
-    from jaxship.studies.real_data import esso_osaka_split
+    from benchmarks.studies.real_data import esso_osaka_split
     _, test = esso_osaka_split()
     fig, axes = plot_runs(esso, "3-DOF esso_osaka", ("psi", "r", "u", "v"),
                           ("T_p = 20 s", "simulation"))
@@ -121,7 +125,7 @@ validated by simulating the starboard-first 10/10 and 20/10 and the 10/5 and 20/
     for m in kv.models:
         print(m.result.summary(), end="\\n\\n")
     display(Markdown(kv.table()))
-    from jaxship.studies.real_data import hsva_split
+    from benchmarks.studies.real_data import hsva_split
     _, kv_test = hsva_split()
     fig, axes = plot_runs(kv, "Nomoto2", ("psi", "r"), ("simulation",))
     add_measured(axes, kv_test, ("psi", "r"))

@@ -19,7 +19,7 @@ LAYERS = {
     "simulate": ["_simulation"],
     "estimate": ["_estimate"],
     "analysis": ["_analysis"],
-    "application": ["identification", "studies", "_trials", "cli", "plotting", "__init__"],
+    "application": ["_trials", "cli", "plotting", "__init__"],
 }
 RANK = {name: i for i, names in enumerate(LAYERS.values()) for name in names}
 # imported inside functions on purpose: optional dependencies, and the CLI's heavy imports
@@ -186,3 +186,16 @@ def test_each_command_is_one_module_that_main_only_registers():
     main = [name for name, _ in calls(PACKAGE / "cli" / "__init__.py")]
     assert "parser.add_argument" in main and not any(
         name.endswith(".add_argument") and name != "parser.add_argument" for name in main)
+
+
+def test_the_package_never_imports_the_studies_outside_it():
+    """Paper reproductions and real-data studies are the application, outside the
+    package (`benchmarks/studies/`); the command backends are `jaxship.cli`'s own, and the
+    public API exports no application workflow."""
+    import jaxship as js
+
+    found = [f"{m}:{line} imports {t}" for m, path in modules()
+             for t, line, _ in imports(m, path) if t.split(".")[0] == "benchmarks"]
+    assert not found, "\n".join(found)
+    assert not (PACKAGE / "studies").exists() and not (PACKAGE / "identification").exists()
+    assert not hasattr(js, "identify") and not hasattr(js, "IdentificationResult")

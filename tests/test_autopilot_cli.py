@@ -15,9 +15,9 @@ import pytest
 
 import jaxship as js
 from jaxship.cli import main
-from jaxship.identification import model_from_report, read_result
+from jaxship.cli._identification import model_from_report, read_result
+from jaxship.cli._studies import autopilot as study
 from jaxship.plotting import plot_autopilot
-from jaxship.studies import autopilot as study
 
 
 matplotlib.use("Agg")

@@ -12,7 +12,7 @@ import jaxship as js
 from jaxship._foundation._files import MANIFEST
 from jaxship._foundation._params import parameter_fields, resolve_free
 from jaxship.cli import main
-from jaxship.identification.workflow import FitDivergedError
+from jaxship.cli._identification.workflow import FitDivergedError
 
 
 def test_vessels_lists_every_preset_with_source(capsys):

@@ -18,7 +18,7 @@ from jaxship import (
     write_trial_csv,
 )
 from jaxship._simulation._data import CHANNELS
-from jaxship.identification import read_experiments
+from jaxship.cli._identification import read_experiments
 
 
 def synthetic_experiment(num=201, dt=0.1, t0=5.0):

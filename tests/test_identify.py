@@ -13,18 +13,22 @@ import pytest
 import jaxship as js
 from jaxship import (
     AuxInputs,
-    IdentificationResult,
     LinearSwayYaw,
     Nomoto1,
     Nomoto2,
     NonlinearNomoto,
     NorrbinCrossFlow,
     RossAutopilot,
-    identify,
     simulate_steering,
 )
 from jaxship.cli import main
-from jaxship.identification import MODELS, Progress, read_experiments
+from jaxship.cli._identification import (
+    MODELS,
+    IdentificationResult,
+    Progress,
+    identify,
+    read_experiments,
+)
 
 
 DEG = np.pi / 180

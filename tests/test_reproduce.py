@@ -7,8 +7,8 @@ import re
 import pytest
 
 from jaxship.cli import main
-from jaxship.studies import reproduce as rp, reproduce_report
-from jaxship.studies.thesis import THESIS_FIT
+from jaxship.cli._studies import reproduce as rp, reproduce_report
+from jaxship.cli._studies.thesis import THESIS_FIT
 
 
 def test_quick_trials_match_thesis_ranges_and_open_the_report(tmp_path):
@@ -109,7 +109,7 @@ def test_quick_reproduce_command_writes_the_report(tmp_path, capsys):
 
 def test_a_failed_reproduce_leaves_the_earlier_report(tmp_path, monkeypatch):
     # issue 13: reproduce writes into a temporary folder; nothing moves after an error
-    import jaxship.studies.reproduce as job
+    import jaxship.cli._studies.reproduce as job
 
     out = tmp_path / "out"
     out.mkdir()
@@ -129,7 +129,7 @@ def test_a_failed_reproduce_leaves_the_earlier_report(tmp_path, monkeypatch):
 def test_a_failed_fit_in_the_study_leaves_the_others(monkeypatch):
     # issue 13: in the batch of chapter-4 fits, one that fails is reported and the others
     # are returned; its autopilot is skipped
-    from jaxship.studies import autopilot, thesis
+    from jaxship.cli._studies import autopilot, thesis
 
     families = {"turning": ("turn:40",), "zigzag": ("zigzag:40/40",)}
     real = thesis.identify

@@ -11,6 +11,13 @@ import numpy as np
 import pytest
 
 import jaxship as js
+from benchmarks.studies.astrom import (
+    FREE,
+    TABLE3_START,
+    NoiseLevels,
+    simulate_disturbed,
+    zigzag_trial,
+)
 from jaxship import (
     AuxInputs,
     LinearSwayYaw,
@@ -22,7 +29,6 @@ from jaxship import (
 from jaxship._models._steering import WindowStart
 from jaxship._models._vessel._base import state_derivative
 from jaxship._models._vessel.sway_yaw import sea_stratus_linear, sea_stratus_nonlinear
-from jaxship.studies.astrom import FREE, TABLE3_START, NoiseLevels, simulate_disturbed, zigzag_trial
 
 
 DEG = np.pi / 180

@@ -13,9 +13,9 @@ import matplotlib
 matplotlib.use("Agg")  # the command writes files; it never opens a window
 
 from .._foundation._cache import enable_compilation_cache  # noqa: E402
-from ..identification.workflow import FitDivergedError  # noqa: E402
 from . import autopilot, discover, identify, reproduce, simulate, vessels  # noqa: E402
 from ._common import one_line  # noqa: E402
+from ._identification.workflow import FitDivergedError  # noqa: E402
 
 
 EXIT_STATUS = """exit status: 0 done; 2 bad input (arguments, records, an --out that cannot be

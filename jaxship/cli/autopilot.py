@@ -10,11 +10,11 @@ from tqdm.auto import tqdm
 
 from .._foundation._files import staged_folder
 from .._models._vessel.catalogue import get_vessel
-from ..identification import read_result
 from ..plotting import plot_autopilot
-from ..studies import autopilot as autopilot_study
-from ..studies.autopilot import cell
 from ._common import check_operating_point, check_out, numbers
+from ._identification import read_result
+from ._studies import autopilot as autopilot_study
+from ._studies.autopilot import cell
 
 
 def register(sub) -> None:

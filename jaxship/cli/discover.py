@@ -5,8 +5,8 @@ import sys
 
 from tqdm.auto import tqdm
 
-from ..identification.discovery import run_discovery
 from ._common import check_out
+from ._identification.discovery import run_discovery
 
 
 def register(sub) -> None:

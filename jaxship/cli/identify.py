@@ -7,9 +7,9 @@ import pathlib
 import sys
 
 from .._foundation._files import staged_folder
-from ..identification import MODELS, get_model_entry, identify, read_experiments
 from ..plotting import save_identification_figures
 from ._common import ProgressBar, check_out, note, one_line
+from ._identification import MODELS, get_model_entry, identify, read_experiments
 
 
 def register(sub) -> None:

@@ -2,8 +2,8 @@
 
 import pathlib
 
-from ..studies.reproduce import reproduce
 from ._common import check_out
+from ._studies.reproduce import reproduce
 
 
 def register(sub) -> None:

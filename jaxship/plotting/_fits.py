@@ -35,7 +35,7 @@ def plot_comparison(assessment, index: int = 0, *, title: str = "", reference=No
 
     **Arguments:**
 
-    - `assessment`: a `jaxship.identification.Assessment` (or anything with `data`
+    - `assessment`: a `Assessment` of the `identify` command (or anything with `data`
       (a `Dataset`), `rudder`, `predictions` {channel: (E, N)}, `mask` (E, N) and
       `metrics` {channel: `ValidationReport`}).
     - `index`: which record (experiment) of the assessment.
@@ -169,7 +169,7 @@ def _file_part(name: str) -> str:
 
 
 def save_identification_figures(result, folder, *, dpi: int = 100) -> list:
-    """Write the figures of a `jaxship.IdentificationResult` into `folder`
+    """Write the figures of a result of the `identify` command into `folder`
     and return their paths:
 
     - `fit_train_NN_NAME.png`, `fit_validation_NN_NAME.png`: measured vs simulated

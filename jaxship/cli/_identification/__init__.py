@@ -1,4 +1,4 @@
-"""The identification workflow behind `jaxship.identify` and `jaxship identify`: read
+"""The identification workflow behind the `identify` and `discover` commands: read
 and check records (`data`), the registry of identifiable models with their start values
 (`registry`, `starts`, `armax`), the output-error simulation of each model family
 (`simulation`), the assessment on training and held-out records (`assessment`), the

@@ -30,7 +30,6 @@ import numpy as np
 import optimistix as optx
 
 import jaxship as js
-from jaxship._estimate._linear import initial_estimate
 
 
 ESSO_TEST = ("random_06-Aug-2020_16_24_25_3", "turn_14-Oct-2020_15_06_53",
@@ -166,8 +165,9 @@ def _validate(model, test, estimator, horizons):
 def _nomoto_models(train, test, estimator, horizons):
     """Nomoto1 from the ARX start, then Nomoto2 from the fitted Nomoto1."""
     est = dataclasses.replace(estimator, channels=("psi", "r"), wind=False)
-    start1 = initial_estimate(js.Nomoto1(K=0.1, T=10.0), train)
-    fit1 = js.fit(start1, train, estimator=est)
+    # the ARX least-squares start, then prediction error from it
+    fit1 = js.fit(js.Nomoto1(K=0.1, T=10.0), train,
+                  estimator=dataclasses.replace(est, start=js.LinearStart()))
     K, T = float(fit1.model.K), float(fit1.model.T)
     start2 = js.Nomoto2(K=K, T1=T, T2=0.1 * T, T3=0.05 * T)
     fit2 = js.fit(start2, train, estimator=est)

@@ -9,7 +9,7 @@ import numpy as np
 
 import jaxship as js
 
-from .._models._armax_model import ARMAXModel, simulate_armax
+from ..._models._armax_model import ARMAXModel, simulate_armax
 
 
 def simulate_records(model, dataset: js.Dataset, rudder: str, channels=("psi", "r"),

@@ -16,8 +16,8 @@ import numpy as np
 
 import jaxship as js
 
-from .._foundation._params import parameter_fields
-from .._foundation._validate import _to_plain
+from ..._foundation._params import parameter_fields
+from ..._foundation._validate import _to_plain
 from .assessment import Assessment
 from .registry import model_key
 

@@ -8,8 +8,8 @@ import numpy as np
 
 import jaxship as js
 
-from .._estimate._armax import fit_armax
-from .._models._armax_model import ARMAX_ORDERS, ARMAXModel
+from ..._estimate._armax import fit_armax
+from ..._models._armax_model import ARMAX_ORDERS, ARMAXModel
 from .starts import StartContext
 
 

@@ -10,7 +10,7 @@ import numpy as np
 
 import jaxship as js
 
-from .._foundation._files import staged_folder
+from ..._foundation._files import staged_folder
 from .data import read_experiments
 from .registry import get_model_entry
 from .workflow import identify, logs_wind

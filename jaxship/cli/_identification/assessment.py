@@ -10,7 +10,7 @@ import numpy as np
 
 import jaxship as js
 
-from .._foundation._validate import _to_plain
+from ..._foundation._validate import _to_plain
 
 
 CHANNEL_UNITS = {"psi": "rad", "r": "rad/s", "u": "m/s", "v": "m/s"}
