@@ -111,10 +111,10 @@ def main():
             counts[result] = counts.get(result, 0) + 1
             times.append(seconds)
             if result == "correct" and len(hidden) == 1:
-                for p_name, p in report.effects[0]["parameters"].items():
+                for p_name, p in report.effects[0].parameters.items():
                     if p_name in truth:
-                        errors.append(abs(p["value"] - truth[p_name]) / abs(truth[p_name]))
-                        covered.append(abs(p["value"] - truth[p_name]) <= 1.96 * p["std"])
+                        errors.append(abs(p.value - truth[p_name]) / abs(truth[p_name]))
+                        covered.append(abs(p.value - truth[p_name]) <= 1.96 * p.std)
         n = args.seeds
         share = lambda key: 100.0 * counts.get(key, 0) / n
         row = (name, share("correct") if hidden else share("nothing"), share("wrong"),

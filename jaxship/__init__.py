@@ -25,7 +25,12 @@ from ._analysis._discover._catalogue import (
     Candidate as Candidate,
 )
 from ._analysis._discover._locate import locate_disagreement as locate_disagreement
-from ._analysis._discover._report import DiscoveryReport as DiscoveryReport
+from ._analysis._discover._report import (
+    CandidateOutcome as CandidateOutcome,
+    CandidateScore as CandidateScore,
+    DiscoveryReport as DiscoveryReport,
+    EffectParameter as EffectParameter,
+)
 from ._analysis._discover._workflow import discover as discover
 from ._analysis._indices import (
     format_table as format_table,

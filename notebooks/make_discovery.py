@@ -92,7 +92,7 @@ nb.cells = [
         "train, holdout = hidden_effect_records(truth, seed=3)\n"
         "report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout)\n"
         "for e in report.effects:\n"
-        "    print(e['id'], e['parameters'], 'cannot be told from', e['equivalent_to'])"),
+        "    print(e.id, e.parameters, 'cannot be told from', e.equivalent_to)"),
     nbf.v4.new_markdown_cell(
         "## Nothing missing, also under a slowly varying disturbance\n\n"
         "A yaw moment that is not in any log (an Ornstein-Uhlenbeck equivalent rudder angle, "
@@ -103,9 +103,9 @@ nb.cells = [
         "                                       disturbance_std=1.0 * DEG)\n"
         "report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout)\n"
         "print(report.verdict)\n"
-        "for k, s in sorted(report.scores.items(), key=lambda kv: -kv[1]['score_naive']):\n"
-        "    print(f\"{k:24s} naive {s['score_naive']:8.2f}   robust {s['score']:6.2f}   \"\n"
-        "          f\"threshold {s['threshold']:.2f}\")"),
+        "for k, s in sorted(report.scores.items(), key=lambda kv: -kv[1].score_naive):\n"
+        "    print(f\"{k:24s} naive {s.score_naive:8.2f}   robust {s.score:6.2f}   \"\n"
+        "          f\"threshold {s.threshold:.2f}\")"),
     nbf.v4.new_markdown_cell(
         "## A current, seen only in the track\n\n"
         "A current leaves the velocities through the water, the heading and the yaw rate "
@@ -119,8 +119,8 @@ nb.cells = [
         "report = js.discover(js.vessel('mariner'), train, holdout)\n"
         "print(f'{time.perf_counter() - t0:.0f} s', report.verdict)\n"
         "for e in report.effects:\n"
-        "    print(e['id'], {k: f\"{v['value']:.3f} +- {v['std']:.3f} {v['unit']}\"\n"
-        "                    for k, v in e['parameters'].items()})\n"
+        "    print(e.id, {k: f\"{v.value:.3f} +- {v.std:.3f} {v.unit}\"\n"
+        "                    for k, v in e.parameters.items()})\n"
         "for c in report.channels:\n"
         "    print(f\"held-out {c}: {report.holdout_fit_percent_before[c]:5.1f} -> \"\n"
         "          f\"{report.holdout_fit_percent_after[c]:5.1f} %\")"),
@@ -145,7 +145,7 @@ nb.cells = [
         "        print(f\"  {name} [{v['unit']}]: {v['mean']:.3g}; {v['starboard']:.3g}, \"\n"
         "              f\"{v['port']:.3g}\")\n"
         "    # the slow test tier runs this notebook: these checks fail it if the story changes\n"
-        "    assert [e['id'] for e in kvlcc2.effects] == ['rudder_offset',\n"
+        "    assert list(kvlcc2.named) == ['rudder_offset',\n"
         "                                                 'surge_turn_resistance']\n"
         "    assert kvlcc2.holdout_cost_after < kvlcc2.holdout_cost_before"),
     nbf.v4.new_code_cell(
@@ -195,19 +195,19 @@ nb.cells = [
         "    t0 = time.perf_counter()\n"
         "    esso = js.discover(start, train, holdout)\n"
         "    print(f'{time.perf_counter() - t0:.0f} s', esso.verdict)\n"
-        "    for k, v in sorted(esso.scores.items(), key=lambda kv: -kv[1]['score'])[:5]:\n"
-        "        print(f\"{k:24s} robust score {v['score']:6.1f}  threshold \"\n"
-        "              f\"{v['threshold']:.1f}\")\n"
+        "    for k, v in sorted(esso.scores.items(), key=lambda kv: -kv[1].score)[:5]:\n"
+        "        print(f\"{k:24s} robust score {v.score:6.1f}  threshold \"\n"
+        "              f\"{v.threshold:.1f}\")\n"
         "    for e in esso.effects:\n"
-        "        print('accepted', e['id'], 'jointly with', e.get('jointly_with'),\n"
-        "              {k: f\"{v['value']:.3g} +- {v['std']:.2g}\" for k, v in e['parameters'].items()})\n"
+        "        print('accepted', e.id, 'jointly with', e.jointly_with,\n"
+        "              {k: f\"{v.value:.3g} +- {v.std:.2g}\" for k, v in e.parameters.items()})\n"
         "    for r in esso.rejected:\n"
-        "        print(r['id'], '-', '; '.join(r['why']))\n"
+        "        print(r.id, '-', '; '.join(r.why))\n"
         "    for label, fits in (('before', esso.holdout_fit_percent_before),\n"
         "                        ('after', esso.holdout_fit_percent_after)):\n"
         "        print('held-out fit %', label, {c: round(v, 1) for c, v in fits.items()})\n"
         "    # the slow test tier runs this notebook: these checks fail it if the story changes\n"
-        "    assert [e['id'] for e in esso.effects] == ['propeller_race', 'wind']\n"
+        "    assert list(esso.named) == ['propeller_race', 'wind']\n"
         "    assert esso.holdout_cost_after < 0.6 * esso.holdout_cost_before"),
     nbf.v4.new_code_cell(
         "if HAVE['esso_osaka_frt']:\n"
@@ -241,11 +241,11 @@ nb.cells = [
         "    low = esso_osaka_low_speed_discovery(data)\n"
         "    print(low.verdict, '| held-out cost before', round(low.holdout_cost_before, 1))\n"
         "    for r in low.rejected:\n"
-        "        cost = '' if r.get('holdout_cost') is None else \\\n"
-        "            f\" (held-out cost {r['holdout_cost']:.1f})\"\n"
-        "        print(f\"{r['id']}{cost}:\", '; '.join(r['why']))\n"
-        "        for name, v in r.get('parameters', {}).items():\n"
-        "            print(f\"    {name} = {v['value']:.3g} +- {v['std']:.2g} {v['unit']}\")"),
+        "        cost = '' if r.holdout_cost is None else \\\n"
+        "            f\" (held-out cost {r.holdout_cost:.1f})\"\n"
+        "        print(f\"{r.id}{cost}:\", '; '.join(r.why))\n"
+        "        for name, v in r.parameters.items():\n"
+        "            print(f\"    {name} = {v.value:.3g} +- {v.std:.2g} {v.unit}\")"),
     nbf.v4.new_markdown_cell(
         "The same three terms fitted by hand (output error on r), then with the two speed "
         "exponents free too, and simulated over the held-out runs; held-out fit % against "

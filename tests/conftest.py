@@ -25,11 +25,25 @@ def pytest_sessionstart(session):
                                 "JAXSHIP_DATA or put shared/ beside the checkout).")
 
 
+MAX_MAPS = 30_000  # the kernel's default vm.max_map_count is 65,530
+
+
+def _memory_maps() -> int:
+    try:
+        with open("/proc/self/maps", "rb") as maps:
+            return sum(1 for _ in maps)
+    except OSError:  # not Linux: no such limit to watch
+        return 0
+
+
 @pytest.fixture(autouse=True, scope="module")
 def _release_compiled_code():
-    """Free the compiled executables of each test module when it ends. Every XLA CPU
-    executable holds memory mappings, and a whole test run would otherwise pass the
-    kernel's limit of 65,530 (vm.max_map_count) and crash in the compiler."""
+    """Free the compiled executables when a test module ends with the process holding
+    more than `MAX_MAPS` memory mappings. Every XLA CPU executable holds some, and a
+    whole test run would otherwise pass the kernel's limit (vm.max_map_count) and crash
+    in the compiler; clearing only then keeps the traced and compiled programs that the
+    next modules share (the same fits and simulations on the same shapes)."""
     yield
-    jax.clear_caches()
-    gc.collect()
+    if _memory_maps() > MAX_MAPS:
+        jax.clear_caches()
+        gc.collect()

@@ -40,9 +40,9 @@ def run(*effects, seed=0, disturbance=0.0):
 
 def test_nothing_missing_on_white_null_data():
     report = run(seed=1)
-    assert report.verdict == "nothing_missing" and report.effects == []
-    best = max(s["score"] for s in report.scores.values())
-    assert best < min(s["threshold"] for s in report.scores.values())
+    assert report.verdict == "nothing_missing" and report.effects == ()
+    best = max(s.score for s in report.scores.values())
+    assert best < min(s.threshold for s in report.scores.values())
     assert "nothing missing" in report.to_markdown()
 
 
@@ -57,8 +57,8 @@ def test_nothing_missing_with_a_slowly_varying_yaw_moment():
                                                  disturbance_std=std), [])
                        for std in (0.0, 1.0 * DEG))
     assert min(np.max(np.abs(a.psi - b.psi)) for a, b in zip(calm, disturbed)) > 3 * DEG
-    naive = max(s["score_naive"] for s in report.scores.values())
-    threshold = min(s["threshold"] for s in report.scores.values())
+    naive = max(s.score_naive for s in report.scores.values())
+    threshold = min(s.threshold for s in report.scores.values())
     assert naive > threshold  # what a test assuming white residuals would have said
 
 
@@ -83,7 +83,7 @@ def test_the_held_out_check_vetoes_but_does_not_choose():
     report = run(js.RudderOffset(delta0=0.3 * DEG), seed=1018, disturbance=1.0 * DEG)
     assert report.verdict == "nothing_missing", report.to_markdown()
     assert any("rudder_offset or yaw_moment_bias explains the training data better" in why
-               for r in report.rejected for why in r.get("why", ())), report.to_markdown()
+               for r in report.rejected for why in r.why), report.to_markdown()
 
 
 def test_a_refit_that_fails_numerically_rejects_that_candidate_not_the_run(monkeypatch):
@@ -102,10 +102,10 @@ def test_a_refit_that_fails_numerically_rejects_that_candidate_not_the_run(monke
 
     monkeypatch.setattr(_workflow, "fit", failing)
     report = run(js.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
-    failed = [r for r in report.rejected if r["id"] == "rudder_offset"]
-    assert failed and failed[0]["why"] == [
-        "the refit failed numerically (LinAlgError: SVD did not converge)"]
-    assert "rudder_offset" not in [e["id"] for e in report.effects]
+    failed = [r for r in report.rejected if r.id == "rudder_offset"]
+    assert failed and failed[0].why == (
+        "the refit failed numerically (LinAlgError: SVD did not converge)",)
+    assert "rudder_offset" not in report.named
     assert report.to_markdown() and json.dumps(report.to_dict())
 
 
@@ -215,10 +215,10 @@ def test_an_implausibly_large_constant_moment_is_not_named():
                           max_effects=1)[0]
         assert (report.verdict == "missing_effect") is named, report.to_markdown()
         record = (report.effects or report.rejected)[0]
-        assert record["rudder_equivalent_deg"] == pytest.approx(np.degrees(angle), rel=0.1)
+        assert record.rudder_equivalent_deg == pytest.approx(np.degrees(angle), rel=0.1)
         if not named:
             assert any("deg of rudder, beyond the plausible 5.7 deg" in why
-                       for why in record["why"]), record
+                       for why in record.why), record
 
 
 def test_a_rudder_offset_is_named_with_its_class_and_the_gap_shrinks():
@@ -226,10 +226,10 @@ def test_a_rudder_offset_is_named_with_its_class_and_the_gap_shrinks():
     assert report.verdict == "missing_effect" and len(report.effects) == 1
     assert report.names_or_classes()[0] == {"rudder_offset", "yaw_moment_bias"}
     effect = report.effects[0]
-    assert "two speeds" in effect["equivalent_to"][0]["separate"]
-    value = next(iter(effect["parameters"].values()))
-    expected = 0.5 * DEG if effect["id"] == "rudder_offset" else K * 0.5 * DEG
-    assert abs(value["value"] - expected) < 4 * value["std"]
+    assert "two speeds" in effect.equivalent_to[0].separate
+    value = next(iter(effect.parameters.values()))
+    expected = 0.5 * DEG if effect.id == "rudder_offset" else K * 0.5 * DEG
+    assert abs(value.value - expected) < 4 * value.std
     assert report.holdout_cost_after < report.holdout_cost_before
     # located: a heading residual of one sign whichever way the ship turns (a bias, not a
     # term odd in r), gone after the offset is added
@@ -242,8 +242,8 @@ def test_a_rudder_offset_is_named_with_its_class_and_the_gap_shrinks():
 def test_cubic_damping_is_named_and_closes_the_held_out_gap():
     report = run(js.YawCubicDamping(beta=300.0), seed=4)
     assert report.named == ("yaw_cubic_damping",)
-    p = report.effects[0]["parameters"]["yaw_cubic_damping.beta"]
-    assert abs(p["value"] - 300.0) < 4 * p["std"]
+    p = report.effects[0].parameters["yaw_cubic_damping.beta"]
+    assert abs(p.value - 300.0) < 4 * p.std
     assert report.holdout_cost_after < 0.5 * report.holdout_cost_before
     to_json = report.to_dict()
     assert to_json["verdict"] == "missing_effect" and to_json["effects"][0]["p_value"] < 1e-3
@@ -304,8 +304,8 @@ def test_a_vessel_effect_is_named_from_records_without_a_logged_drift():
     report = js.discover(js.vessel("mariner"), train, holdout)
     assert report.channels == ("psi", "r", "u", "x", "y")
     assert outcome(report, ("sway_force_bias",)) == "correct", report.to_markdown()
-    force = report.effects[0]["parameters"]["sway_force_bias.y0"]
-    assert abs(force["value"] - 3e4) < 4 * force["std"], force
+    force = report.effects[0].parameters["sway_force_bias.y0"]
+    assert abs(force.value - 3e4) < 4 * force.std, force
     assert report.holdout_cost_after < report.holdout_cost_before
 
 
@@ -321,8 +321,8 @@ def test_windage_is_named_on_a_vessel_in_a_logged_wind():
     report = js.discover(js.vessel("mariner"), train, holdout)
     assert outcome(report, ("wind",)) == "correct", report.to_markdown()
     for name, area in areas.items():
-        got = report.effects[0]["parameters"][name]
-        assert abs(got["value"] - area) < 4 * got["std"], (name, got)
+        got = report.effects[0].parameters[name]
+        assert abs(got.value - area) < 4 * got.std, (name, got)
     assert report.holdout_cost_after < report.holdout_cost_before
 
 
@@ -354,9 +354,9 @@ def test_every_effect_seen_across_rpm_or_speed_is_named(hidden, value, at, chann
     effect = hidden.split(".")[0]
     assert outcome(report, (effect,)) == "correct", report.to_markdown()
     assert report.holdout_cost_after < report.holdout_cost_before
-    if report.effects[0]["id"] == effect:  # named itself, not another of its class
-        got = report.effects[0]["parameters"][hidden]
-        assert abs(got["value"] - value) < 4 * got["std"], got
+    if report.effects[0].id == effect:  # named itself, not another of its class
+        got = report.effects[0].parameters[hidden]
+        assert abs(got.value - value) < 4 * got.std, got
 
 
 def test_the_discover_command(tmp_path, capsys):
@@ -460,8 +460,8 @@ def test_wind_is_named_on_a_steering_model_with_logged_wind():
     train, holdout = wind_records(truth, 0)
     report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout)
     assert outcome(report, ("wind",)) == "correct", report.to_markdown()
-    c2 = report.effects[0]["parameters"]["wind.c2"]
-    assert abs(c2["value"] - 3e-6) < 4 * c2["std"], c2
+    c2 = report.effects[0].parameters["wind.c2"]
+    assert abs(c2.value - 3e-6) < 4 * c2.std, c2
     assert report.holdout_cost_after < report.holdout_cost_before
 
 
@@ -473,8 +473,8 @@ def test_propeller_race_is_named_from_runs_at_two_rpm():
     train, holdout = race_records(K, 25.0, gain, 0)
     report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout)
     assert outcome(report, ("propeller_race",)) == "correct", report.to_markdown()
-    b = report.effects[0]["parameters"]["propeller_race.gain"]
-    assert abs(b["value"] - gain) < 4 * b["std"], b
+    b = report.effects[0].parameters["propeller_race.gain"]
+    assert abs(b.value - gain) < 4 * b.std, b
     assert report.holdout_cost_after < report.holdout_cost_before
 
 

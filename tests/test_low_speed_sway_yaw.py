@@ -206,7 +206,7 @@ def test_discover_from_it_names_a_hidden_offset_and_nothing_on_null_data(hidden)
     truth = TRUTH if hidden is None else js.augment(TRUTH, hidden)
     records = [noisy(low_speed_record(s), truth, s) for s in range(4)]
     report = js.discover(js.LowSpeedSwayYaw(), records[:3], records[3:])
-    offered = {c["id"] for c in report.rejected} | set(report.named)
+    offered = {c.id for c in report.rejected} | set(report.named)
     assert not offered & set(js.LowSpeedSwayYaw.built_in_effects)
     if hidden is None:
         assert report.verdict == "nothing_missing", report.to_markdown()

@@ -140,12 +140,12 @@ def test_discover_finds_the_esso_osaka_low_speed_terms_only_together():
     at its -0.1 rad bound (T 7 -> 59 s), so the verdict stays "nothing missing": on
     these eight zig-zags the three cannot be told apart one by one."""
     report = esso_osaka_low_speed_discovery()
-    joint = [r for r in report.rejected if "+" in r["id"]]
-    assert [set(r["id"].split("+")) for r in joint] == [
+    joint = [r for r in report.rejected if "+" in r.id]
+    assert [set(r.id.split("+")) for r in joint] == [
         {"propeller_race", "wind", "yaw_quadratic_damping"}]
-    assert joint[0]["holdout_cost"] < 0.5 * report.holdout_cost_before
+    assert joint[0].holdout_cost < 0.5 * report.holdout_cost_before
     assert report.verdict == "nothing_missing"
-    why = joint[0]["why"]
+    why = joint[0].why
     assert [w for w in why if "confidence interval" in w] == [
         f"the confidence interval of {k} includes zero"
         for k in ("propeller_race", "wind", "yaw_quadratic_damping")]

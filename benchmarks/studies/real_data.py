@@ -31,9 +31,11 @@ import optimistix as optx
 
 import jaxship as js
 
+from .published_splits import WAKITA_2022
 
-ESSO_TEST = ("random_06-Aug-2020_16_24_25_3", "turn_14-Oct-2020_15_06_53",
-             "zigzag_31-Jul-2020_13_42_53")
+
+# Wakita et al.'s test runs that are manoeuvres (their berthing runs used thrusters)
+ESSO_TEST = tuple(r for r in WAKITA_2022["Test"] if not r.startswith("berthing"))
 # the 3-DOF coefficients estimated on the Esso Osaka data (default set of the preset)
 ESSO_FREE = ("x_0f", "y_v", "y_r", "n_v", "n_r", "c_d", "c_ry", "c_rn", "epsilon", "gamma_n",
              "gamma_p")

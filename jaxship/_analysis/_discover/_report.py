@@ -1,28 +1,79 @@
-"""`DiscoveryReport`: what `jaxship.discover` found, as data (`to_dict`, the JSON of
-`jaxship discover`) and as a page (`to_markdown`)."""
+"""`DiscoveryReport`: what `jaxship.discover` found, as data (typed outcomes; `to_dict`,
+the JSON of `jaxship discover`) and as a page (`to_markdown`)."""
+
+import dataclasses
 
 import equinox as eqx
 import jax
 import numpy as np
 
 
+class CandidateScore(eqx.Module):
+    """A candidate's robust score test at the base fit: the `score` statistic, the
+    `score_naive` one (white residuals assumed), its degrees of freedom `dof`, the
+    Bonferroni `threshold` it must pass and the cost decrease it predicts."""
+
+    score: float
+    score_naive: float
+    dof: int
+    threshold: float
+    predicted_decrease: float
+
+
+class EffectParameter(eqx.Module):
+    """A fitted effect parameter: `value`, robust standard error `std`, `unit`."""
+
+    value: float
+    std: float
+    unit: str
+
+
+class Equivalent(eqx.Module):
+    """A candidate these data cannot tell apart from another (canonical correlation of
+    their sensitivities above the threshold), and the experiment that would separate
+    them (`separate`)."""
+
+    id: str
+    separate: str
+
+
+class CandidateOutcome(eqx.Module):
+    """What became of one candidate (or of a joint set, `id`s joined by "+") in an
+    iteration of `discover`: accepted where `why` is empty, else rejected for the
+    reasons in `why`. A candidate rejected by its score alone was never refitted and
+    has no refit fields (None, empty)."""
+
+    id: str
+    name: str
+    iteration: int
+    score: float
+    why: tuple[str, ...] = ()
+    parameters: dict[str, EffectParameter] = eqx.field(default_factory=dict)
+    score_naive: float | None = None
+    likelihood_ratio: float | None = None  # robust (divided by the score's inflation)
+    p_value: float | None = None
+    delta_bic: float | None = None
+    holdout_cost: float | None = None
+    # the rudder angle [deg] whose loads match the effect's (family units only); per
+    # member for a rejected joint set
+    rudder_equivalent_deg: float | dict | None = None
+    equivalent_to: tuple[Equivalent, ...] = ()
+    jointly_with: tuple[str, ...] = ()  # the others accepted with it by the joint step
+
+    @property
+    def accepted(self) -> bool:
+        return not self.why
+
+
 class DiscoveryReport(eqx.Module):
     """The outcome of `discover`.
 
     - `verdict`: `"missing_effect"` or `"nothing_missing"`;
-    - `effects`: the accepted effects in order, each a dict with `id`, `name`,
-      `parameters` (`{name: {value, std, unit}}`, robust standard errors), `score`
-      (robust score statistic), `score_naive`, `likelihood_ratio` (robust),
-      `p_value`, `delta_bic`, `equivalent_to` (`[{id, separate}]`: candidates these
-      data cannot tell apart from it, with the experiment that would),
-      `holdout_cost` and `rudder_equivalent_deg` (for effects whose parameters have
-      family units: the rudder angle whose loads match the effect's, the size its
-      plausible range bounds; None for others);
-    - `rejected`: candidates refitted or scored that did not pass, with `why` (a
-      joint step's set as one entry, its ids joined by "+");
-    - an effect accepted by the joint step (effects too weak alone that pass together)
-      also lists `jointly_with`, the others accepted with it;
-    - `scores`: every candidate's score test at the base fit;
+    - `effects`: the accepted effects in order (`CandidateOutcome`s with empty `why`);
+    - `rejected`: candidates refitted or scored that did not pass (`CandidateOutcome`s
+      with their reasons in `why`; a joint step's set as one entry, its ids joined by
+      "+");
+    - `scores`: every candidate's score test at the base fit (`{id: CandidateScore}`);
     - `model_before`, `model_after`: the fitted base and augmented models;
     - `train_cost_*`, `holdout_cost_*` (half the sum of squared normalised
       residuals), `holdout_fit_percent_*` per channel, `holdout_indices` per
@@ -35,9 +86,9 @@ class DiscoveryReport(eqx.Module):
     """
 
     verdict: str
-    effects: list
-    rejected: list
-    scores: dict
+    effects: tuple[CandidateOutcome, ...]
+    rejected: tuple[CandidateOutcome, ...]
+    scores: dict[str, CandidateScore]
     model_before: eqx.Module
     model_after: eqx.Module
     train_cost_before: float
@@ -54,11 +105,11 @@ class DiscoveryReport(eqx.Module):
     @property
     def named(self) -> tuple[str, ...]:
         """The ids of the accepted effects, in order."""
-        return tuple(e["id"] for e in self.effects)
+        return tuple(e.id for e in self.effects)
 
     def names_or_classes(self) -> list[set]:
         """Per accepted effect, the set of its id and the ids it cannot be told from."""
-        return [{e["id"], *(q["id"] for q in e["equivalent_to"])} for e in self.effects]
+        return [{e.id, *(q.id for q in e.equivalent_to)} for e in self.effects]
 
     def to_dict(self) -> dict:
         """The JSON of `jaxship discover` (plain Python numbers and strings)."""
@@ -77,32 +128,30 @@ class DiscoveryReport(eqx.Module):
             lines += ["| effect | parameter | value | std | unit | score | LR | p | dBIC | "
                       "cannot be told from |", "|---|---|---|---|---|---|---|---|---|---|"]
             for e in self.effects:
-                twins = "; ".join(f"{q['id']} ({q['separate']})" for q in e["equivalent_to"])
+                twins = "; ".join(f"{q.id} ({q.separate})" for q in e.equivalent_to)
                 twins = twins.replace("|", "\\|")  # r|r| inside a table cell
-                for name, p in e["parameters"].items():
-                    unit = p["unit"].replace("|", "or")
-                    lines.append(f"| {e['name']} | `{name}` | {p['value']:.4g} | "
-                                 f"{p['std']:.2g} | {unit} | {e['score']:.3g} | "
-                                 f"{e['likelihood_ratio']:.3g} | {e['p_value']:.2g} | "
-                                 f"{e['delta_bic']:.1f} | {twins or '-'} |")
+                for name, p in e.parameters.items():
+                    unit = p.unit.replace("|", "or")
+                    lines.append(f"| {e.name} | `{name}` | {p.value:.4g} | {p.std:.2g} | "
+                                 f"{unit} | {e.score:.3g} | {e.likelihood_ratio:.3g} | "
+                                 f"{e.p_value:.2g} | {e.delta_bic:.1f} | {twins or '-'} |")
         else:
-            best = max(self.scores.items(), key=lambda kv: kv[1]["score"], default=None)
+            best = max(self.scores.items(), key=lambda kv: kv[1].score, default=None)
             lines.append("**Verdict: nothing missing.** No candidate passed the calibrated "
                          f"tests (family-wise false-alarm rate {self.alpha:g}).")
             if best:
-                lines.append(f"The largest robust score was {best[1]['score']:.3g} "
-                             f"({best[0]}), against a threshold of {best[1]['threshold']:.3g}.")
+                lines.append(f"The largest robust score was {best[1].score:.3g} "
+                             f"({best[0]}), against a threshold of {best[1].threshold:.3g}.")
         lines += _where(self.disagreement["before"], self.disagreement["after"])
         lines += ["", "## Candidates at the base fit", "",
                   "| candidate | robust score | naive score | threshold |", "|---|---|---|---|"]
-        for k, s in sorted(self.scores.items(), key=lambda kv: -kv[1]["score"]):
-            lines.append(f"| {k} | {s['score']:.3g} | {s['score_naive']:.3g} | "
-                         f"{s['threshold']:.3g} |")
+        for k, s in sorted(self.scores.items(), key=lambda kv: -kv[1].score):
+            lines.append(f"| {k} | {s.score:.3g} | {s.score_naive:.3g} | {s.threshold:.3g} |")
         if self.rejected:
             lines += ["", "## Rejected", ""]
-            lines += [f"- iteration {r['iteration']}, {r['id']}: {'; '.join(r['why'])}"
-                      + (f" (held-out cost with it {r['holdout_cost']:.4g})"
-                         if r.get("holdout_cost") is not None else "")
+            lines += [f"- iteration {r.iteration}, {r.id}: {'; '.join(r.why)}"
+                      + (f" (held-out cost with it {r.holdout_cost:.4g})"
+                         if r.holdout_cost is not None else "")
                       for r in self.rejected]
         lines += ["", "## The gap", "",
                   f"Training cost {self.train_cost_before:.5g} -> {self.train_cost_after:.5g}."]
@@ -173,7 +222,10 @@ def _where(before: dict, after: dict) -> list[str]:
 
 
 def _plain(x):
-    """Python floats, lists and dicts for JSON."""
+    """Python floats, lists and dicts for JSON (a typed outcome as the dict of its
+    fields)."""
+    if isinstance(x, eqx.Module):
+        return {f.name: _plain(getattr(x, f.name)) for f in dataclasses.fields(x)}
     if isinstance(x, dict):
         return {str(k): _plain(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):

@@ -50,7 +50,13 @@ from ._forces import smoothed_vessel_states
 from ._holdout import cost_rise, holdout_check, holdout_indices
 from ._locate import locate_disagreement
 from ._plausible import rudder_equivalent
-from ._report import DiscoveryReport
+from ._report import (
+    CandidateOutcome,
+    CandidateScore,
+    DiscoveryReport,
+    EffectParameter,
+    Equivalent,
+)
 from ._score import (
     canonical_correlation,
     forward_path,
@@ -79,16 +85,13 @@ def _free_names(entry, effect) -> tuple[str, ...]:
     return tuple(f"{entry.id}.{k}" for k, info in fields.items() if info.free)
 
 
-def _parameters(result, names) -> dict:
-    """`{name: {"value", "std", "unit"}}` with the robust standard error."""
+def _parameters(result, names) -> dict[str, EffectParameter]:
+    """`{name: EffectParameter}` with the robust standard error."""
     index = {n: i for i, n in enumerate(result.names)}
     fields = parameter_fields(result.model)
-    out = {}
-    for n in names:
-        i = index[n]
-        std = float(result.parameters.std_robust[i])
-        out[n] = {"value": float(result.values[i]), "std": std, "unit": fields[n].unit}
-    return out
+    return {n: EffectParameter(float(result.values[index[n]]),
+                               float(result.parameters.std_robust[index[n]]), fields[n].unit)
+            for n in names}
 
 
 def _at_edge(result, names) -> tuple[str, ...]:
@@ -232,7 +235,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         sigma2 = 2 * sens.cost / max(sens.residuals.size - len(theta) - len(nuisance), 1)
         ranked = sorted(scores, key=lambda k: -scores[k].statistic)
         if first_scores is None:
-            first_scores = {k: _score_dict(scores[k], threshold) for k in ranked}
+            first_scores = {k: _candidate_score(scores[k], threshold) for k in ranked}
         classes = {k: [j for j in ranked if j != k and canonical_correlation(
             scores[k], scores[j]) > equivalence] for k in ranked}
         chosen = []
@@ -251,10 +254,9 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             try:
                 return attempt(keys, s, limit, p_value)
             except (np.linalg.LinAlgError, OverflowError, FloatingPointError) as error:
-                why = [f"the refit failed numerically ({type(error).__name__}: {error})"]
-                return [{"id": k, "name": entry[k][0].name, "iteration": iteration + 1,
-                         "score": s.statistic, "parameters": {}, "rudder_equivalent_deg": None,
-                         "why": why} for k in keys], None, None, False
+                why = (f"the refit failed numerically ({type(error).__name__}: {error})",)
+                return [CandidateOutcome(k, entry[k][0].name, iteration + 1, s.statistic, why)
+                        for k in keys], None, None, False
 
         def attempt(keys, s, limit, p_value):
             start = augment(base, *effects, *(entry[k][1] for k in keys))
@@ -276,7 +278,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             # an effect with several parameters (added mass in sway and yaw) needs one away from
             # zero; the likelihood ratio tests them jointly
             for k in keys:
-                if not any(abs(p["value"]) > z * p["std"] for p in params[k].values()):
+                if not any(abs(p.value) > z * p.std for p in params[k].values()):
                     why.append(f"the confidence interval of {k} includes zero")
             # the new parameters, and base ones the refit pushes onto a bound (the new
             # terms then distort the base model rather than add to it)
@@ -295,18 +297,17 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                 reason = heldout_rise(after, held, before, estimator.horizon or BLOCK)
                 if reason:
                     why.append(reason)
-            shared = {"score": s.statistic, "score_naive": s.naive, "likelihood_ratio": lr,
-                      "p_value": float(stats.chi2.sf(lr, s.dof)) if p_value is None else p_value,
-                      "delta_bic": _delta_bic(cost, trial.cost, sens.residuals.size, s.dof),
-                      "holdout_cost": after["cost"] if holdout else None}
-            records = [{"id": k, "name": entry[k][0].name, "iteration": iteration + 1,
-                        "parameters": params[k], **shared,
-                        "rudder_equivalent_deg": (float(np.degrees(sizes[k][0])) if sizes[k]
-                                                  else None),
-                        "equivalent_to": [{"id": j, "separate": entry[j][0].separate}
-                                          for j in classes[k]]}
-                       | ({"jointly_with": [j for j in keys if j != k]} if len(keys) > 1 else {})
-                       | ({"why": why} if why else {}) for k in keys]
+            shared = dict(
+                iteration=iteration + 1, score=s.statistic, why=tuple(why),
+                score_naive=s.naive, likelihood_ratio=lr,
+                p_value=float(stats.chi2.sf(lr, s.dof)) if p_value is None else p_value,
+                delta_bic=_delta_bic(cost, trial.cost, sens.residuals.size, s.dof),
+                holdout_cost=after["cost"] if holdout else None)
+            records = [CandidateOutcome(
+                id=k, name=entry[k][0].name, parameters=params[k], **shared,
+                rudder_equivalent_deg=float(np.degrees(sizes[k][0])) if sizes[k] else None,
+                equivalent_to=tuple(Equivalent(j, entry[j][0].separate) for j in classes[k]),
+                jointly_with=tuple(j for j in keys if j != k)) for k in keys]
             return records, trial, after, others == 0 and len(why) == 1
 
         passed, vetoed = [], []  # vetoed: (id, cost) of refits failing only the held-out check
@@ -317,14 +318,14 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                        if s.statistic <= threshold(s.dof) else
                        "its score points out of the plausible range (a negative lag, rate "
                        "or area)")
-                rejected.append({"id": k, "name": entry[k][0].name, "score": s.statistic,
-                                 "iteration": iteration + 1, "why": [why]})
+                rejected.append(CandidateOutcome(k, entry[k][0].name, iteration + 1,
+                                                 s.statistic, (why,)))
                 continue
             say(f"iteration {iteration + 1}: refitting with {k}")
             records, trial, after, veto = judge((k,), s, threshold(s.dof))
             if veto:
                 vetoed.append((k, trial.cost))
-            if records[0].get("why"):
+            if records[0].why:
                 rejected.extend(records)
             else:
                 passed.append((records, trial, after))
@@ -338,32 +339,33 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             # offset and a yaw-moment bias on a Nomoto model), so which one was refitted
             # hangs on rounding
             rivals = " or ".join(sorted([rival[0], *classes[rival[0]]]))
+            why = (f"{rivals} explains the training data better but fails on the held-out "
+                   "runs",)
             for records, _, _ in passed:
-                rejected.extend(r | {"why": [f"{rivals} explains the training data better "
-                                             "but fails on the held-out runs"]} for r in records)
+                rejected.extend(dataclasses.replace(r, why=why) for r in records)
             passed = []
         size = min(top, max_effects - len(accepted))
         joint = (_joint_set(sens, theta + nuisance, scores, names, classes, scored, size,
                             level) if not (passed or contested) and size > 1 else None)
         if joint:
             union, s, limit, null = joint
-            group = {"id": "+".join(union), "iteration": iteration + 1, "name": "jointly: "
-                     + ", ".join(entry[k][0].name for k in union)}
+            group = dict(id="+".join(union), iteration=iteration + 1,
+                         name="jointly: " + ", ".join(entry[k][0].name for k in union))
             if s.statistic <= limit:
-                rejected.append({**group, "score": s.statistic,
-                                 "why": [f"joint score {s.statistic:.3g} below the threshold "
-                                         f"{limit:.3g} (simulated with the search)"]})
+                rejected.append(CandidateOutcome(
+                    **group, score=s.statistic, why=(f"joint score {s.statistic:.3g} below the "
+                                                     f"threshold {limit:.3g} (simulated with "
+                                                     "the search)",)))
             else:
                 say(f"iteration {iteration + 1}: refitting with {' + '.join(union)}")
                 records, trial, after, _ = judge(union, s, limit,
                                               p_value=float(np.mean(null >= s.statistic)))
-                if records[0].get("why"):  # one entry for the set
-                    shared = {key: value for key, value in records[0].items()
-                              if key not in ("equivalent_to", "jointly_with")}
-                    rejected.append(shared | group | {"parameters": {
-                        n: p for r in records for n, p in r["parameters"].items()},
-                        "rudder_equivalent_deg": {r["id"]: r["rudder_equivalent_deg"]
-                                                  for r in records}})
+                if records[0].why:  # one entry for the set
+                    rejected.append(dataclasses.replace(
+                        records[0], **group, equivalent_to=(), jointly_with=(),
+                        parameters={n: p for r in records for n, p in r.parameters.items()},
+                        rudder_equivalent_deg={r.id: r.rudder_equivalent_deg
+                                               for r in records}))
                 else:
                     passed.append((records, trial, after))
         if not passed:
@@ -372,16 +374,16 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         # robust ratios gate, but their per-candidate inflation must not rank)
         records, trial, held = min(passed, key=lambda row: row[1].cost)
         accepted.extend(records)
-        say(f"accepted {' + '.join(r['id'] for r in records)}")
-        current, theta, cost = trial, theta + sum((names[r["id"]] for r in records), ()), trial.cost
+        say(f"accepted {' + '.join(r.id for r in records)}")
+        current, theta, cost = trial, theta + sum((names[r.id] for r in records), ()), trial.cost
     after = check(current.model) if holdout else None
     say("locating the disagreement before and after")
     disagreement = {label: locate_disagreement(r.model, train, channels,
                                                wind=loss(r.model).wind)
                     for label, r in (("before", base_fit), ("after", current))}
     return DiscoveryReport(
-        verdict="missing_effect" if accepted else "nothing_missing", effects=accepted,
-        rejected=rejected, scores=first_scores or {}, model_before=base_fit.model,
+        verdict="missing_effect" if accepted else "nothing_missing", effects=tuple(accepted),
+        rejected=tuple(rejected), scores=first_scores or {}, model_before=base_fit.model,
         model_after=current.model, train_cost_before=base_fit.cost,
         train_cost_after=current.cost,
         holdout_cost_before=before["cost"] if holdout else None,
@@ -437,6 +439,5 @@ def _delta_bic(cost0, cost1, n, dof) -> float:
     return float(n * math.log(max(cost1, 1e-300) / max(cost0, 1e-300)) + dof * math.log(n))
 
 
-def _score_dict(s, threshold) -> dict:
-    return {"score": s.statistic, "score_naive": s.naive, "dof": s.dof,
-            "threshold": threshold(s.dof), "predicted_decrease": s.predicted_decrease}
+def _candidate_score(s, threshold) -> CandidateScore:
+    return CandidateScore(s.statistic, s.naive, s.dof, threshold(s.dof), s.predicted_decrease)
