@@ -166,6 +166,7 @@ from ._models._vessel.ross import RossVessel as RossVessel
 from ._models._vessel.sway_yaw import SwayYawVessel as SwayYawVessel
 from ._simulation._batch import simulate_batch as simulate_batch, stack as stack
 from ._simulation._data import Dataset as Dataset, Experiment as Experiment
+from ._simulation._froude import froude_scale as froude_scale
 from ._simulation._measured import (
     read_esso_osaka as read_esso_osaka,
     read_hsva_kvlcc2 as read_hsva_kvlcc2,

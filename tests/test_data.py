@@ -705,3 +705,15 @@ def test_a_folder_reads_quoted_headers_and_refuses_utf16(tmp_path):
     with pytest.raises(ValueError, match=r"wide\.csv: the file is UTF-16 text; save it as "
                                          r"UTF-8"):
         read_experiments([tmp_path])
+
+
+def test_a_held_out_record_named_as_a_training_one_is_told_apart(tmp_path):
+    """The trust audit: `discover` showed a training and a held-out `trial.csv` as the same
+    "trial". A name another role's records already use gets the record's folder."""
+    for folder in ("train", "test"):
+        (tmp_path / folder).mkdir()
+        (tmp_path / folder / "trial.csv").write_text(GOOD)
+    train = read_experiments([tmp_path / "train" / "trial.csv"])
+    held = read_experiments([tmp_path / "test" / "trial.csv"], role="held-out",
+                            taken=[e.name for e in train])
+    assert [e.name for e in train] == ["trial"] and [e.name for e in held] == ["test/trial"]

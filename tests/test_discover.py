@@ -7,6 +7,7 @@ step per 0.5 s sample), with a rate-limited rudder logged at the sample rate, as
 log would be. Training: 10/10 and 20/20 zig-zags to both sides; held out: +-20 deg
 turning circles (another manoeuvre type)."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -556,3 +557,23 @@ def test_the_missing_loads_count_the_logged_wind_where_asked():
     calm = np.abs(np.mean(residual_loads(windy, data)["N"][0]))
     replayed = np.abs(np.mean(residual_loads(windy, data, wind=True)["N"][0]))
     assert calm > 1e5 and replayed < 0.02 * calm, (calm, replayed)
+
+
+def test_a_report_says_first_when_the_base_model_does_not_describe_the_records():
+    """The trust audit: `discover` "found" an effect while the held-out fit stayed at
+    -2158 %. Where a held-out channel is predicted worse than its mean, the report's
+    first sentence says so, with the fits before and after."""
+    model = js.Nomoto1(K=0.05, T=20.0)
+    report = js.DiscoveryReport(
+        verdict="missing_effect", effects=(js.CandidateOutcome("rudder_offset", "offset", 1,
+                                                               30.0),),
+        rejected=(), scores={}, model_before=model, model_after=model, train_cost_before=2.0,
+        train_cost_after=1.0, holdout_cost_before=9.0, holdout_cost_after=8.0,
+        holdout_fit_percent_before={"psi": -2158.0, "r": 12.0},
+        holdout_fit_percent_after={"psi": -1900.0, "r": 15.0}, holdout_indices={},
+        alpha=0.01, channels=("psi", "r"), disagreement={})
+    first = report._base_does_not_describe()
+    assert first[0].startswith("**The base model does not describe these records:**")
+    assert "psi -2158 % (-1900 % after)" in first[0] and " r " not in first[0]
+    fine = dataclasses.replace(report, holdout_fit_percent_before={"psi": 5.0, "r": 12.0})
+    assert fine._base_does_not_describe() == []

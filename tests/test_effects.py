@@ -445,3 +445,19 @@ def test_a_vessel_only_effect_on_a_steering_model_is_an_error(effect):
     with pytest.raises(ValueError, match="augment a vessel instead"):
         js.augment(js.Nomoto1(K=K, T=T), effect)
     assert js.augment(js.vessel("mariner"), effect).effects == (effect,)
+
+
+def test_a_family_unit_is_read_on_the_model_it_acts_on():
+    """`YawMomentBias.n0` is N m on a vessel, rad/s on a Nomoto model (T r' + r = K delta
+    + f) and rad/s^2 on a model written as r' = ... (the Ross model)."""
+    from jaxship._models._effects import family_unit
+
+    unit = js.YawMomentBias.__dataclass_fields__["n0"].metadata
+    n0 = "N m | rad/s | rad/s^2"
+    assert n0 in str(unit)
+    assert family_unit(n0, js.vessel("mariner")) == "N m"
+    assert family_unit(n0, js.Nomoto1(K=0.1, T=10.0)) == "rad/s"
+    assert family_unit(n0, js.Nomoto2(K=0.1, T1=10.0, T2=1.0, T3=2.0)) == "rad/s"
+    assert family_unit(n0, js.RossAutopilot()) == "rad/s^2"
+    assert family_unit("s | -", js.Nomoto1(K=0.1, T=10.0)) == "-"
+    assert family_unit("rad", js.vessel("mariner")) == "rad"

@@ -256,7 +256,7 @@ def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), fre
       `Innovations` (the Kalman filter's innovations, maximum likelihood with the
       noise), `ARMAX` or `DiscreteResponse`.
     - `free`: which parameters to estimate: `None` (the model's defaults: its `param`
-      fields declared free, or a vessel's `free_by_default`), a sequence of field
+      fields declared free), a sequence of field
       names, or `{name: Free(value, lower=, upper=, scale=) or None}`.
     - `progress`: a callable receiving a `Progress` report per optimiser step (the
       library never prints).

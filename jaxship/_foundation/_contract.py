@@ -5,7 +5,7 @@ A model is replayed against a measured record: every prediction window starts fr
 state built from the record (`replay_state`) and runs the model's field with the
 record's inputs replayed (`replay_field`); `channel_index` and `measure` say where an
 output sits in the state and what its sensor reports. Its parameters are its `param`
-fields, or, for a vessel's coefficient table, its scalar fields with `free_by_default`
+fields, with their units and whether `fit` estimates them by default
 (`jaxship._foundation._params.parameter_fields`), addressed by name (`lookup`); a
 model with effects (`AbstractComposite`) adds each effect's as `"<effect id>.<field>"`.
 """
@@ -30,10 +30,6 @@ class AbstractModel(eqx.Module):
     wind_loads: eqx.AbstractClassVar[bool]
     has_servo: eqx.AbstractClassVar[bool]
     built_in_effects: ClassVar[tuple[str, ...]] = ()
-    # a coefficient table (vessels): its scalar fields are its parameters, these free
-    # by default, with the units of `units`
-    free_by_default: ClassVar[tuple[str, ...]] = ()
-    units: ClassVar[dict[str, str]] = {}
 
     @abc.abstractmethod
     def channel_index(self, channel: str) -> int:

@@ -83,28 +83,15 @@ class Free:
 
 def parameter_fields(model) -> dict[str, ParameterInfo]:
     """The estimable fields of `model` with their metadata, in field order: the fields
-    declared with `param`, or, for a vessel (whose coefficient tables are plain
-    floats), every scalar float field, free when named in its `free_by_default`, with
-    its unit from the class's `units` mapping if it has one; for a model with effects,
-    the base's and each effect's as `"<effect id>.<field>"` (the model contract,
+    declared with `param` (vessels, steering models and effects alike); for a model with
+    effects, the base's and each effect's as `"<effect id>.<field>"` (the model contract,
     `_contract.AbstractModel`)."""
     if isinstance(model, AbstractComposite):  # the base's and "<id>.<field>"
         out = dict(parameter_fields(model.base))
         for effect in model.effects:
             out.update({f"{effect.id}.{k}": v for k, v in parameter_fields(effect).items()})
         return out
-    fields = {f.name: f.metadata[_KEY] for f in dataclasses.fields(model) if _KEY in f.metadata}
-    if fields or not isinstance(model, AbstractModel):
-        return fields
-    default, units = model.free_by_default, model.units
-    out = {}
-    for f in dataclasses.fields(model):
-        value = getattr(model, f.name, None)
-        if isinstance(value, bool) or not (isinstance(value, (int, float, np.number)) or (
-                isinstance(value, (np.ndarray, jax.Array)) and np.ndim(value) == 0)):
-            continue
-        out[f.name] = ParameterInfo(free=f.name in default, unit=units.get(f.name, ""))
-    return out
+    return {f.name: f.metadata[_KEY] for f in dataclasses.fields(model) if _KEY in f.metadata}
 
 
 def default_free(model) -> tuple[str, ...]:
@@ -159,7 +146,7 @@ def resolve_free(model, free=None) -> tuple[ParameterSpec, ...]:
     """The free parameters of `model` for `fit(..., free=free)`.
 
     `free` is `None` (the fields declared `param(free=True)`, or a vessel's
-    `free_by_default`), a sequence of field names, or a dict `{name: Free(...) or
+    `param(free=True)`), a sequence of field names, or a dict `{name: Free(...) or
     None}` (None: the field's defaults). A scale of 0 (an unbounded parameter that
     starts at zero, with no scale given) means "from the Jacobian": `fit` sets it.
     Raises `ValueError` for unknown names, start values outside the bounds and

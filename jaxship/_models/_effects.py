@@ -57,6 +57,20 @@ from ._vessel._base import AbstractVessel
 SHORTEST_TIME_CONSTANT = 0.05
 
 
+
+def family_unit(unit: str, model) -> str:
+    """The unit that a family unit (`"N m | rad/s | rad/s^2"`: vessel | steering model,
+    the steering one split by the model's `yaw_term_unit` where it has two) takes on
+    `model` (a vessel or a steering model, without its effects); other units as given."""
+    parts = [p.strip() for p in unit.split("|")]
+    if len(parts) == 1:
+        return unit
+    if not isinstance(model, AbstractSteeringModel):
+        return parts[0]
+    if len(parts) == 2:
+        return parts[1]
+    return parts[1] if model.yaw_term_unit == "rad/s" else parts[2]
+
 class AbstractEffect(eqx.Module):
     """Base of all effects; `id` is the catalogue name (`"rudder_offset"`, ...)."""
 
@@ -389,10 +403,6 @@ class AugmentedVessel(_Augmented, AbstractVessel):
         for effect in self.effects:
             areas = effect.wind_areas(*areas)
         return areas
-
-    @property
-    def free_by_default(self):
-        return self.base.free_by_default
 
     def mass_matrix(self):
         matrix = self.base.mass_matrix()

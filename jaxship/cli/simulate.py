@@ -7,6 +7,7 @@ import pathlib
 
 from .._foundation._files import staged_folder
 from .._models._vessel.catalogue import get_vessel
+from .._simulation._froude import froude_scale
 from .._trials import TrialSpec, simulate_to_folder
 from ._common import check_operating_point, check_out, positive
 
@@ -24,12 +25,16 @@ def register(sub) -> None:
     sim.add_argument("--rpm", type=float, help="propeller rate [rpm]")
     sim.add_argument("--duration", type=float, help="duration [s]")
     sim.add_argument("--dt", type=float, help="sample interval [s]")
+    sim.add_argument("--length", type=float, metavar="L", help="Froude-scale the preset to "
+                     "this length between perpendiculars [m] (e.g. 320 for the KVLCC2 ship)")
     sim.set_defaults(run=run)
 
 
 def run(args) -> int:
     # every check before the simulation; the files appear in --out only when all are written
     vessel = get_vessel(args.vessel)
+    if positive("--length", args.length):
+        vessel = froude_scale(vessel, args.length / float(vessel.length))
     spec = TrialSpec.parse(args.manoeuvre)
     speed, rpm = positive("--speed", args.speed), positive("--rpm", args.rpm)
     duration, dt = positive("--duration", args.duration), positive("--dt", args.dt)

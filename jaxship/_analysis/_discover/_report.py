@@ -121,7 +121,7 @@ class DiscoveryReport(eqx.Module):
 
     def to_markdown(self) -> str:
         """The story in a page: verdict, effects, rejected candidates, the gap."""
-        lines = ["# Discovery report", ""]
+        lines = ["# Discovery report", ""] + self._base_does_not_describe()
         if self.effects:
             lines += [f"**Verdict: missing effect(s): {', '.join(self.named)}** (family-wise "
                       f"false-alarm rate {self.alpha:g}).", ""]
@@ -171,6 +171,23 @@ class DiscoveryReport(eqx.Module):
             lines += [f"| {r} | {k} | {fmt(v['measured'])} | {fmt(v['before'])} | "
                       f"{fmt(v['after'])} |" for r, k, v in rows]
         return "\n".join(lines) + "\n"
+
+
+    def _base_does_not_describe(self) -> list[str]:
+        """The first sentence where the base model predicts a held-out channel worse than
+        its mean (fit below 0 %): any effect named is then relative to a model that
+        does not describe the records."""
+        before = self.holdout_fit_percent_before or {}
+        poor = [c for c in self.channels if before.get(c, 0.0) < 0.0]
+        if not poor:
+            return []
+        after = self.holdout_fit_percent_after
+        fits = ", ".join(f"{c} {before[c]:.0f} %" + (f" ({after[c]:.0f} % after)" if
+                                                    self.effects else "") for c in poor)
+        return [f"**The base model does not describe these records:** its held-out fit is "
+                f"below 0 % (worse than each record's mean) on {fits}. What follows is "
+                "relative to a model that is wrong beyond any one effect; fix the model (or "
+                "its start values) before reading the effects as the missing physics.", ""]
 
 
 def _where(before: dict, after: dict) -> list[str]:

@@ -44,7 +44,7 @@ from ..._estimate._sensitivity import sensitivities
 from ..._estimate._windows import as_dataset
 from ..._foundation._contract import AbstractComposite
 from ..._foundation._params import default_free, parameter_fields, rebuild
-from ..._models._effects import augment
+from ..._models._effects import augment, family_unit
 from ._catalogue import DISCOVERY_CATALOGUE, applicable
 from ._forces import smoothed_vessel_states
 from ._holdout import cost_rise, holdout_check, holdout_indices
@@ -86,12 +86,14 @@ def _free_names(entry, effect) -> tuple[str, ...]:
 
 
 def _parameters(result, names) -> dict[str, EffectParameter]:
-    """`{name: EffectParameter}` with the robust standard error."""
+    """`{name: EffectParameter}` with the robust standard error, in the unit the
+    parameter has on this base model."""
     index = {n: i for i, n in enumerate(result.names)}
     fields = parameter_fields(result.model)
+    base = _split(result.model)[0]
     return {n: EffectParameter(float(result.values[index[n]]),
-                               float(result.parameters.std_robust[index[n]]), fields[n].unit)
-            for n in names}
+                               float(result.parameters.std_robust[index[n]]),
+                               family_unit(fields[n].unit, base)) for n in names}
 
 
 def _at_edge(result, names) -> tuple[str, ...]:

@@ -88,6 +88,9 @@ class AbstractSteeringModel(AbstractModel):
     start_channels: ClassVar[tuple[str, ...]] = ()
     wind_loads: ClassVar[bool] = False
     has_servo: ClassVar[bool] = False
+    # the unit of a term f an effect adds to the yaw equation (`yaw_term`): [rad/s^2]
+    # for models written as r' = ... + f; Nomoto models (T r' + r = K delta + f) say rad/s
+    yaw_term_unit: ClassVar[str] = "rad/s^2"
 
     @abc.abstractmethod
     def rhs(self, state: Array, delta: ArrayLike, aux: AuxInputs) -> Array:

@@ -26,6 +26,7 @@ class Nomoto1(AbstractSteeringModel):
     delta0: float = param(0.0, free=False, scale=0.01, unit="rad")  # delta_0 [rad], offset
 
     state_names = ("r",)
+    yaw_term_unit = "rad/s"  # T r' + r = K delta + f
 
     def rhs(self, state: Array, delta: ArrayLike, aux: AuxInputs) -> Array:
         del aux
@@ -79,6 +80,7 @@ class Nomoto2(AbstractSteeringModel):
     delta0: float = param(0.0, free=False, scale=0.01, unit="rad")  # delta_0 [rad], offset
 
     state_names = ("r", "r_aux")
+    yaw_term_unit = "rad/s"  # T r' + r = K delta + f
 
     def rhs(self, state: Array, delta: ArrayLike, aux: AuxInputs) -> Array:
         del aux
@@ -132,6 +134,7 @@ class NonlinearNomoto(AbstractSteeringModel):
     n0: float = param(0.0, free=False, scale=1e-3, unit="rad/s")  # n_0 [rad/s]
 
     state_names = ("r",)
+    yaw_term_unit = "rad/s"  # T r' + r = K delta + f
 
     def characteristic(self, r: ArrayLike) -> Array:
         """Norrbin's $H_N(r)$ [rad/s]."""

@@ -43,8 +43,7 @@ class AbstractVessel(AbstractModel):
     lateral_wind_area: eqx.AbstractVar[float]  # A_L [m^2]
 
     # the model contract (`AbstractModel`): fitted outputs by default, channels every
-    # window starts from, wind loads, a rudder servo; its coefficient table's scalar
-    # fields are its parameters, `free_by_default` those `jaxship.fit` estimates
+    # window starts from, wind loads, a rudder servo; its coefficients are `param` fields
     default_channels: ClassVar[tuple[str, ...]] = ("psi", "r", "u", "v")
     start_channels: ClassVar[tuple[str, ...]] = ("u", "v")
     wind_loads: ClassVar[bool] = True

@@ -12,12 +12,12 @@ from the upstream code's structure; parameter values are those of the upstream f
 (copies in `shared/data/esso_osaka_frt/reference/`), hard-coded below.
 """
 
-from typing import ClassVar
 
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
+from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
 from ._base import AbstractVessel
 from .mmg import GRAVITY, SPEED_FLOOR, SWITCH_WIDTH, safe_atan2, safe_sqrt, side_value, smooth_abs
@@ -91,79 +91,63 @@ class LowSpeedMMGVessel(AbstractVessel):
     is left out too (wind loads come from `Environment`; the projected areas are given).
     """
 
-    # fitted by default: the hull's linear derivatives and cross-flow drag, the resistance
-    # ahead, and the rudder's inflow and flow-straightening factors
-    free_by_default = ("x_0f", "y_v", "y_r", "n_v", "n_r", "c_d", "c_ry", "c_rn", "epsilon",
-                       "gamma_n", "gamma_p")
-    # units of the coefficients, for parameter tables (`parameter_fields`); "-": primed
-    # (non-dimensional) as in the source
-    units: ClassVar[dict[str, str]] = {
-        "length": "m", "nominal_speed": "m/s", "nominal_n": "rev/s", "frontal_wind_area": "m^2",
-        "lateral_wind_area": "m^2", "draft": "m", "propeller_diameter": "m",
-        "rudder_area": "m^2", "rho": "kg/m^3",
-        **dict.fromkeys((
-            "mass_nd", "x_g", "m_x", "m_y", "i_zz_j_zz", "x_0f", "x_0a", "x_vr", "y_v", "y_r",
-            "n_v", "n_r", "c_d", "c_ry", "c_rn", "pitch_ratio", "t_p", "w_p0", "tau_p", "c_p",
-            "x_p", "k_0", "k_1", "k_2", "c_3", "c_6", "c_7", "c_10", "j_syn", "j_syn0",
-            "rudder_aspect_ratio", "x_r", "t_r", "a_h", "x_h", "l_r", "k_x", "k_x_reverse",
-            "epsilon", "c_pr", "gamma_n", "gamma_p"), "-"),
-    }
-
-    length: float  # L_pp [m]
+    length: float = param(free=False, unit="m")  # L_pp
     rudder: RudderServo
     shaft: Shaft
-    nominal_speed: float  # U_0 [m/s]
-    nominal_n: float  # n [rev/s] giving U_0 in straight run
-    frontal_wind_area: float  # A_T [m^2], transverse projected area
-    lateral_wind_area: float  # A_L [m^2], lateral projected area
-    draft: float  # d [m]
-    mass_nd: float  # m' = m / (rho L^2 d / 2) [-]
-    x_g: float  # x_G' = x_G / L [-], forward of midship
-    m_x: float  # m_x' [-], / (rho L^2 d / 2)
-    m_y: float  # m_y' [-]
-    i_zz_j_zz: float  # (I_zG + J_z)' [-], / (rho L^4 d / 2)
-    x_0f: float  # X_0F' [-], resistance coefficient ahead
-    x_0a: float  # X_0A' [-], resistance coefficient astern
-    x_vr: float  # X_vr' [-]
-    y_v: float  # Y_v' [-]
-    y_r: float  # Y_r' [-]
-    n_v: float  # N_v' [-]
-    n_r: float  # N_r' [-]
-    c_d: float  # C_D [-], cross-flow drag coefficient
-    c_ry: float  # C_rY [-], yaw-rate factor in the sway cross-flow integral
-    c_rn: float  # C_rN [-], yaw-rate factor in the yaw cross-flow integral
-    propeller_diameter: float  # D [m]
-    pitch_ratio: float  # P/D [-]
-    t_p: float  # t_P [-]
-    w_p0: float  # w_P0 [-]
-    tau_p: float  # tau_P [-], wake change with |v' + x_P' r'|
-    c_p: float  # C_P' [-], wake change with (v' + x_P' r')^2
-    x_p: float  # x_P' [-]
-    k_0: float  # k_0 [-]
-    k_1: float  # k_1 [-]
-    k_2: float  # k_2 [-]
+    nominal_speed: float = param(free=False, unit="m/s")  # U_0
+    nominal_n: float = param(free=False, unit="rev/s")  # n giving U_0 in straight run
+    frontal_wind_area: float = param(free=False, unit="m^2")  # A_T, transverse projected area
+    lateral_wind_area: float = param(free=False, unit="m^2")  # A_L, lateral projected area
+    draft: float = param(free=False, unit="m")  # d
+    mass_nd: float = param(free=False, unit="-")  # m' = m / (rho L^2 d / 2)
+    x_g: float = param(free=False, unit="-")  # x_G' = x_G / L, forward of midship
+    m_x: float = param(free=False, unit="-")  # m_x', / (rho L^2 d / 2)
+    m_y: float = param(free=False, unit="-")  # m_y'
+    i_zz_j_zz: float = param(free=False, unit="-")  # (I_zG + J_z)', / (rho L^4 d / 2)
+    x_0f: float = param(free=True, unit="-")  # X_0F', resistance coefficient ahead
+    x_0a: float = param(free=False, unit="-")  # X_0A', resistance coefficient astern
+    x_vr: float = param(free=False, unit="-")  # X_vr'
+    y_v: float = param(free=True, unit="-")  # Y_v'
+    y_r: float = param(free=True, unit="-")  # Y_r'
+    n_v: float = param(free=True, unit="-")  # N_v'
+    n_r: float = param(free=True, unit="-")  # N_r'
+    c_d: float = param(free=True, unit="-")  # C_D, cross-flow drag coefficient
+    # C_rY, yaw-rate factor in the sway cross-flow integral
+    c_ry: float = param(free=True, unit="-")
+    c_rn: float = param(free=True, unit="-")  # C_rN, yaw-rate factor in the yaw cross-flow integral
+    propeller_diameter: float = param(free=False, unit="m")  # D
+    pitch_ratio: float = param(free=False, unit="-")  # P/D
+    t_p: float = param(free=False, unit="-")  # t_P
+    w_p0: float = param(free=False, unit="-")  # w_P0
+    tau_p: float = param(free=False, unit="-")  # tau_P, wake change with |v' + x_P' r'|
+    c_p: float = param(free=False, unit="-")  # C_P', wake change with (v' + x_P' r')^2
+    x_p: float = param(free=False, unit="-")  # x_P'
+    k_0: float = param(free=False, unit="-")  # k_0
+    k_1: float = param(free=False, unit="-")  # k_1
+    k_2: float = param(free=False, unit="-")  # k_2
     a_coeffs: tuple  # A_1..A_8 [-], propeller side force (astern quadrants)
     b_coeffs: tuple  # B_1..B_8 [-], propeller yaw moment (astern quadrants)
-    c_3: float  # C_3 [-], X_P/(rho n^2 D^4) for n < 0, J_s < C_10
-    c_6: float  # C_6 [-], for n < 0, J_s >= C_10: C_6 + C_7 J_s
-    c_7: float  # C_7 [-]
-    c_10: float  # C_10 [-], switch advance ratio
-    j_syn: float  # J_syn [-], side-force switch advance ratio (upstream constant)
-    j_syn0: float  # J_syn0 [-], (upstream constant)
-    rudder_area: float  # A_R [m^2]
-    rudder_aspect_ratio: float  # Lambda [-]
-    x_r: float  # x_R' [-], rudder position
-    t_r: float  # t_R [-]
-    a_h: float  # a_H [-]
-    x_h: float  # x_H' [-]
-    l_r: float  # l_R' [-]
-    k_x: float  # k_x [-], kappa = k_x / epsilon
-    k_x_reverse: float  # k_x for reversed propeller [-], Kitagawa
-    epsilon: float  # epsilon [-]
-    c_pr: float  # c_PR [-], Kitagawa's u_R term in u^2
-    gamma_n: float  # gamma_N [-], flow straightening for v + x_R r < 0
-    gamma_p: float  # gamma_P [-], for v + x_R r >= 0
-    rho: float = 998.0  # fresh water [kg/m^3]
+    c_3: float = param(free=False, unit="-")  # C_3, X_P/(rho n^2 D^4) for n < 0, J_s < C_10
+    c_6: float = param(free=False, unit="-")  # C_6, for n < 0, J_s >= C_10: C_6 + C_7 J_s
+    c_7: float = param(free=False, unit="-")  # C_7
+    c_10: float = param(free=False, unit="-")  # C_10, switch advance ratio
+    # J_syn, side-force switch advance ratio (upstream constant)
+    j_syn: float = param(free=False, unit="-")
+    j_syn0: float = param(free=False, unit="-")  # J_syn0, (upstream constant)
+    rudder_area: float = param(free=False, unit="m^2")  # A_R
+    rudder_aspect_ratio: float = param(free=False, unit="-")  # Lambda
+    x_r: float = param(free=False, unit="-")  # x_R', rudder position
+    t_r: float = param(free=False, unit="-")  # t_R
+    a_h: float = param(free=False, unit="-")  # a_H
+    x_h: float = param(free=False, unit="-")  # x_H'
+    l_r: float = param(free=False, unit="-")  # l_R'
+    k_x: float = param(free=False, unit="-")  # k_x, kappa = k_x / epsilon
+    k_x_reverse: float = param(free=False, unit="-")  # k_x for reversed propeller, Kitagawa
+    epsilon: float = param(free=True, unit="-")  # epsilon
+    c_pr: float = param(free=False, unit="-")  # c_PR, Kitagawa's u_R term in u^2
+    gamma_n: float = param(free=True, unit="-")  # gamma_N, flow straightening for v + x_R r < 0
+    gamma_p: float = param(free=True, unit="-")  # gamma_P, for v + x_R r >= 0
+    rho: float = param(998.0, free=False, unit="kg/m^3")  # fresh water
 
     def _scales(self):
         L, d = self.length, self.draft

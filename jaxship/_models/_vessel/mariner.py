@@ -10,6 +10,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
+from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
 from ._base import AbstractVessel
 
@@ -42,76 +43,77 @@ class Mariner(AbstractVessel):
     differs (MSS `mariner.m` takes $u_i$ with $\\delta_c = -u_i$; here $\\delta = u_i$).
     """
 
-    free_by_default = ("x_u", "y_v", "y_r", "n_v", "n_r", "y_d", "n_d")  # fitted by default
-
-    length: float = 160.93  # L_pp [m], MSS mariner.m
+    length: float = param(160.93, free=False, unit="m")  # L_pp, MSS mariner.m
     rudder: RudderServo = RudderServo(
         max_angle=float(np.deg2rad(40.0)),  # delta_max 40 deg, MSS mariner.m (2003 revision)
         max_rate=float(np.deg2rad(5.0)),  # delta_dot_max 5 deg/s, MSS mariner.m
         time_constant=1.0,  # T_delta [s], MSS mariner.m (delta_dot = delta_c - delta)
     )
     shaft: Shaft = Shaft()  # no propeller in the model; n is carried but ignored
-    nominal_speed: float = 7.7175  # U_0 [m/s] (15 kn), MSS mariner.m default
-    nominal_n: float = 0.0  # no propeller
-    frontal_wind_area: float = 0.0  # A_F [m^2], no windage in the source
-    lateral_wind_area: float = 0.0  # A_L [m^2]
-    rho: float = 1025.0  # water density [kg/m^3] used to dimensionalise the prime system
+    # U_0 (15 kn), MSS mariner.m default
+    nominal_speed: float = param(7.7175, free=False, unit="m/s")
+    nominal_n: float = param(0.0, free=False, unit="rev/s")  # no propeller
+    frontal_wind_area: float = param(0.0, free=False, unit="m^2")  # A_F, no windage in the source
+    lateral_wind_area: float = param(0.0, free=False, unit="m^2")  # A_L
+    # water density used to dimensionalise the prime system
+    rho: float = param(1025.0, free=False, unit="kg/m^3")
 
     # rigid body (prime system: mass / (rho L^3 / 2), inertia / (rho L^5 / 2), length / L)
-    m: float = 798e-5  # m' [-], MSS mariner.m (Chislett & Strom-Tejsen 1965)
-    iz: float = 39.2e-5  # I'_z [-], MSS mariner.m
-    xg: float = -0.023  # x'_G [-], MSS mariner.m
+    # m', MSS mariner.m (Chislett & Strom-Tejsen 1965)
+    m: float = param(798e-5, free=False, unit="-")
+    iz: float = param(39.2e-5, free=False, unit="-")  # I'_z, MSS mariner.m
+    xg: float = param(-0.023, free=False, unit="-")  # x'_G, MSS mariner.m
 
     # surge, X' coefficients [-], MSS mariner.m
-    x_udot: float = -42e-5  # X'_udot
-    x_u: float = -184e-5  # X'_u
-    x_uu: float = -110e-5  # X'_uu
-    x_uuu: float = -215e-5  # X'_uuu
-    x_vv: float = -899e-5  # X'_vv
-    x_rr: float = 18e-5  # X'_rr
-    x_dd: float = -95e-5  # X'_deltadelta
-    x_udd: float = -190e-5  # X'_udeltadelta
-    x_rv: float = 798e-5  # X'_rv (= m', the Coriolis term)
-    x_vd: float = 93e-5  # X'_vdelta
-    x_uvd: float = 93e-5  # X'_uvdelta
+    x_udot: float = param(-42e-5, free=False, unit="-")  # X'_udot
+    x_u: float = param(-184e-5, free=True, unit="-")  # X'_u
+    x_uu: float = param(-110e-5, free=False, unit="-")  # X'_uu
+    x_uuu: float = param(-215e-5, free=False, unit="-")  # X'_uuu
+    x_vv: float = param(-899e-5, free=False, unit="-")  # X'_vv
+    x_rr: float = param(18e-5, free=False, unit="-")  # X'_rr
+    x_dd: float = param(-95e-5, free=False, unit="-")  # X'_deltadelta
+    x_udd: float = param(-190e-5, free=False, unit="-")  # X'_udeltadelta
+    x_rv: float = param(798e-5, free=False, unit="-")  # X'_rv (= m', the Coriolis term)
+    x_vd: float = param(93e-5, free=False, unit="-")  # X'_vdelta
+    x_uvd: float = param(93e-5, free=False, unit="-")  # X'_uvdelta
 
     # sway, Y' coefficients [-], MSS mariner.m
-    y_vdot: float = -748e-5  # Y'_vdot
-    y_rdot: float = -9.354e-5  # Y'_rdot
-    y_v: float = -1160e-5  # Y'_v
-    y_r: float = -499e-5  # Y'_r (includes -m')
-    y_vvv: float = -8078e-5  # Y'_vvv
-    y_vvr: float = 15356e-5  # Y'_vvr
-    y_vu: float = -1160e-5  # Y'_vu
-    y_ru: float = -499e-5  # Y'_ru
-    y_d: float = 278e-5  # Y'_delta
-    y_ddd: float = -90e-5  # Y'_deltadeltadelta
-    y_ud: float = 556e-5  # Y'_udelta
-    y_uud: float = 278e-5  # Y'_uudelta
-    y_vdd: float = -4e-5  # Y'_vdeltadelta
-    y_vvd: float = 1190e-5  # Y'_vvdelta
-    y_0: float = -4e-5  # Y'_0
-    y_0u: float = -8e-5  # Y'_0u
-    y_0uu: float = -4e-5  # Y'_0uu
+    y_vdot: float = param(-748e-5, free=False, unit="-")  # Y'_vdot
+    y_rdot: float = param(-9.354e-5, free=False, unit="-")  # Y'_rdot
+    y_v: float = param(-1160e-5, free=True, unit="-")  # Y'_v
+    y_r: float = param(-499e-5, free=True, unit="-")  # Y'_r (includes -m')
+    y_vvv: float = param(-8078e-5, free=False, unit="-")  # Y'_vvv
+    y_vvr: float = param(15356e-5, free=False, unit="-")  # Y'_vvr
+    y_vu: float = param(-1160e-5, free=False, unit="-")  # Y'_vu
+    y_ru: float = param(-499e-5, free=False, unit="-")  # Y'_ru
+    y_d: float = param(278e-5, free=True, unit="-")  # Y'_delta
+    y_ddd: float = param(-90e-5, free=False, unit="-")  # Y'_deltadeltadelta
+    y_ud: float = param(556e-5, free=False, unit="-")  # Y'_udelta
+    y_uud: float = param(278e-5, free=False, unit="-")  # Y'_uudelta
+    y_vdd: float = param(-4e-5, free=False, unit="-")  # Y'_vdeltadelta
+    y_vvd: float = param(1190e-5, free=False, unit="-")  # Y'_vvdelta
+    y_0: float = param(-4e-5, free=False, unit="-")  # Y'_0
+    y_0u: float = param(-8e-5, free=False, unit="-")  # Y'_0u
+    y_0uu: float = param(-4e-5, free=False, unit="-")  # Y'_0uu
 
     # yaw, N' coefficients [-], MSS mariner.m
-    n_vdot: float = 4.646e-5  # N'_vdot
-    n_rdot: float = -43.8e-5  # N'_rdot
-    n_v: float = -264e-5  # N'_v
-    n_r: float = -166e-5  # N'_r (includes -m' x'_G)
-    n_vvv: float = 1636e-5  # N'_vvv
-    n_vvr: float = -5483e-5  # N'_vvr
-    n_vu: float = -264e-5  # N'_vu
-    n_ru: float = -166e-5  # N'_ru
-    n_d: float = -139e-5  # N'_delta
-    n_ddd: float = 45e-5  # N'_deltadeltadelta
-    n_ud: float = -278e-5  # N'_udelta
-    n_uud: float = -139e-5  # N'_uudelta
-    n_vdd: float = 13e-5  # N'_vdeltadelta
-    n_vvd: float = -489e-5  # N'_vvdelta
-    n_0: float = 3e-5  # N'_0
-    n_0u: float = 6e-5  # N'_0u
-    n_0uu: float = 3e-5  # N'_0uu
+    n_vdot: float = param(4.646e-5, free=False, unit="-")  # N'_vdot
+    n_rdot: float = param(-43.8e-5, free=False, unit="-")  # N'_rdot
+    n_v: float = param(-264e-5, free=True, unit="-")  # N'_v
+    n_r: float = param(-166e-5, free=True, unit="-")  # N'_r (includes -m' x'_G)
+    n_vvv: float = param(1636e-5, free=False, unit="-")  # N'_vvv
+    n_vvr: float = param(-5483e-5, free=False, unit="-")  # N'_vvr
+    n_vu: float = param(-264e-5, free=False, unit="-")  # N'_vu
+    n_ru: float = param(-166e-5, free=False, unit="-")  # N'_ru
+    n_d: float = param(-139e-5, free=True, unit="-")  # N'_delta
+    n_ddd: float = param(45e-5, free=False, unit="-")  # N'_deltadeltadelta
+    n_ud: float = param(-278e-5, free=False, unit="-")  # N'_udelta
+    n_uud: float = param(-139e-5, free=False, unit="-")  # N'_uudelta
+    n_vdd: float = param(13e-5, free=False, unit="-")  # N'_vdeltadelta
+    n_vvd: float = param(-489e-5, free=False, unit="-")  # N'_vvdelta
+    n_0: float = param(3e-5, free=False, unit="-")  # N'_0
+    n_0u: float = param(6e-5, free=False, unit="-")  # N'_0u
+    n_0uu: float = param(3e-5, free=False, unit="-")  # N'_0uu
 
     def mass_matrix(self) -> Array:
         L = self.length

@@ -7,12 +7,12 @@ project notes `reference/vessel-models.md` sec. 2.2 (cross-checked there against
 `ShipMMG/shipmmg` and other public implementations).
 """
 
-from typing import ClassVar
 
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
+from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
 from ._base import AbstractVessel
 
@@ -88,77 +88,61 @@ class MMGVessel(AbstractVessel):
     resistance $-R_0'U^2$ keeps its sign astern).
     """
 
-    # fitted by default: linear and cubic hull derivatives, resistance, rudder inflow factor
-    free_by_default = ("r_0", "y_v", "y_r", "n_v", "n_r", "y_vvv", "n_rrr", "epsilon")
-    # units of the coefficients, for parameter tables (`parameter_fields`); "-": primed
-    # (non-dimensional) as in the paper
-    units: ClassVar[dict[str, str]] = {
-        "length": "m", "nominal_speed": "m/s", "nominal_n": "rev/s", "frontal_wind_area": "m^2",
-        "lateral_wind_area": "m^2", "draft": "m", "volume": "m^3", "x_g": "m",
-        "radius_of_gyration": "m", "propeller_diameter": "m", "rudder_area": "m^2",
-        "rudder_span": "m", "rho": "kg/m^3",
-        **dict.fromkeys((
-            "m_x", "m_y", "j_z", "r_0", "x_vv", "x_vr", "x_rr", "x_vvvv", "y_v", "y_r", "y_vvv",
-            "y_vvr", "y_vrr", "y_rrr", "n_v", "n_r", "n_vvv", "n_vvr", "n_vrr", "n_rrr", "t_p",
-            "w_p0", "k_0", "k_1", "k_2", "x_p", "c_1", "c_2_plus", "c_2_minus", "t_r", "a_h",
-            "x_h", "x_r", "f_alpha", "epsilon", "kappa", "l_r", "gamma_r_plus",
-            "gamma_r_minus"), "-"),
-    }
-
-    length: float  # L_pp [m]
+    length: float = param(free=False, unit="m")  # L_pp
     rudder: RudderServo
     shaft: Shaft
-    nominal_speed: float  # U_0 [m/s]
-    nominal_n: float  # self-propulsion n_P at U_0 [rev/s]
-    frontal_wind_area: float  # A_F [m^2]
-    lateral_wind_area: float  # A_L [m^2]
-    draft: float  # d [m]
-    volume: float  # displacement volume nabla [m^3]; m = rho nabla
-    x_g: float  # x_G [m], centre of gravity forward of midship
-    radius_of_gyration: float  # k_zz [m]; I_zG = m k_zz^2
-    m_x: float  # m_x' [-], added mass in surge / (rho L^2 d / 2)
-    m_y: float  # m_y' [-], added mass in sway / (rho L^2 d / 2)
-    j_z: float  # J_z' [-], added yaw inertia / (rho L^4 d / 2)
-    r_0: float  # R_0' [-], straight-run resistance coefficient
-    x_vv: float  # X_vv' [-]
-    x_vr: float  # X_vr' [-]
-    x_rr: float  # X_rr' [-]
-    x_vvvv: float  # X_vvvv' [-]
-    y_v: float  # Y_v' [-]
-    y_r: float  # Y_r' [-]
-    y_vvv: float  # Y_vvv' [-]
-    y_vvr: float  # Y_vvr' [-]
-    y_vrr: float  # Y_vrr' [-]
-    y_rrr: float  # Y_rrr' [-]
-    n_v: float  # N_v' [-]
-    n_r: float  # N_r' [-]
-    n_vvv: float  # N_vvv' [-]
-    n_vvr: float  # N_vvr' [-]
-    n_vrr: float  # N_vrr' [-]
-    n_rrr: float  # N_rrr' [-]
-    propeller_diameter: float  # D_P [m]
-    t_p: float  # t_P [-], thrust deduction
-    w_p0: float  # w_P0 [-], wake fraction in straight motion
-    k_0: float  # k_0 [-], K_T = k_0 + k_1 J + k_2 J^2
-    k_1: float  # k_1 [-]
-    k_2: float  # k_2 [-]
-    x_p: float  # x_P' [-], effective propeller position in beta_P
-    c_1: float  # C_1 [-], wake change with beta_P
-    c_2_plus: float  # C_2 [-] for beta_P > 0
-    c_2_minus: float  # C_2 [-] for beta_P < 0
-    rudder_area: float  # A_R [m^2]
-    rudder_span: float  # H_R [m]
-    t_r: float  # t_R [-], steering resistance deduction
-    a_h: float  # a_H [-], rudder force increase factor
-    x_h: float  # x_H' [-], acting point of the hull force induced by steering
-    x_r: float  # x_R' [-], rudder position
-    f_alpha: float  # f_alpha [-], rudder lift gradient
-    epsilon: float  # epsilon [-], (1 - w_R)/(1 - w_P)
-    kappa: float  # kappa [-], propeller-race factor in u_R
-    l_r: float  # l_R' [-], effective rudder position in beta_R
-    gamma_r_plus: float  # gamma_R [-] for beta_R > 0 (flow straightening)
-    gamma_r_minus: float  # gamma_R [-] for beta_R < 0
-    rho: float = 1025.0  # water density [kg/m^3]
+    nominal_speed: float = param(free=False, unit="m/s")  # U_0
+    nominal_n: float = param(free=False, unit="rev/s")  # self-propulsion n_P at U_0
+    frontal_wind_area: float = param(free=False, unit="m^2")  # A_F
+    lateral_wind_area: float = param(free=False, unit="m^2")  # A_L
+    draft: float = param(free=False, unit="m")  # d
+    volume: float = param(free=False, unit="m^3")  # displacement volume nabla; m = rho nabla
+    x_g: float = param(free=False, unit="m")  # x_G, centre of gravity forward of midship
+    radius_of_gyration: float = param(free=False, unit="m")  # k_zz; I_zG = m k_zz^2
+    m_x: float = param(free=False, unit="-")  # m_x', added mass in surge / (rho L^2 d / 2)
+    m_y: float = param(free=False, unit="-")  # m_y', added mass in sway / (rho L^2 d / 2)
+    j_z: float = param(free=False, unit="-")  # J_z', added yaw inertia / (rho L^4 d / 2)
+    r_0: float = param(free=True, unit="-")  # R_0', straight-run resistance coefficient
+    x_vv: float = param(free=False, unit="-")  # X_vv'
+    x_vr: float = param(free=False, unit="-")  # X_vr'
+    x_rr: float = param(free=False, unit="-")  # X_rr'
+    x_vvvv: float = param(free=False, unit="-")  # X_vvvv'
+    y_v: float = param(free=True, unit="-")  # Y_v'
+    y_r: float = param(free=True, unit="-")  # Y_r'
+    y_vvv: float = param(free=True, unit="-")  # Y_vvv'
+    y_vvr: float = param(free=False, unit="-")  # Y_vvr'
+    y_vrr: float = param(free=False, unit="-")  # Y_vrr'
+    y_rrr: float = param(free=False, unit="-")  # Y_rrr'
+    n_v: float = param(free=True, unit="-")  # N_v'
+    n_r: float = param(free=True, unit="-")  # N_r'
+    n_vvv: float = param(free=False, unit="-")  # N_vvv'
+    n_vvr: float = param(free=False, unit="-")  # N_vvr'
+    n_vrr: float = param(free=False, unit="-")  # N_vrr'
+    n_rrr: float = param(free=True, unit="-")  # N_rrr'
+    propeller_diameter: float = param(free=False, unit="m")  # D_P
+    t_p: float = param(free=False, unit="-")  # t_P, thrust deduction
+    w_p0: float = param(free=False, unit="-")  # w_P0, wake fraction in straight motion
+    k_0: float = param(free=False, unit="-")  # k_0, K_T = k_0 + k_1 J + k_2 J^2
+    k_1: float = param(free=False, unit="-")  # k_1
+    k_2: float = param(free=False, unit="-")  # k_2
+    x_p: float = param(free=False, unit="-")  # x_P', effective propeller position in beta_P
+    c_1: float = param(free=False, unit="-")  # C_1, wake change with beta_P
+    c_2_plus: float = param(free=False, unit="-")  # C_2 for beta_P > 0
+    c_2_minus: float = param(free=False, unit="-")  # C_2 for beta_P < 0
+    rudder_area: float = param(free=False, unit="m^2")  # A_R
+    rudder_span: float = param(free=False, unit="m")  # H_R
+    t_r: float = param(free=False, unit="-")  # t_R, steering resistance deduction
+    a_h: float = param(free=False, unit="-")  # a_H, rudder force increase factor
+    # x_H', acting point of the hull force induced by steering
+    x_h: float = param(free=False, unit="-")
+    x_r: float = param(free=False, unit="-")  # x_R', rudder position
+    f_alpha: float = param(free=False, unit="-")  # f_alpha, rudder lift gradient
+    epsilon: float = param(free=True, unit="-")  # epsilon, (1 - w_R)/(1 - w_P)
+    kappa: float = param(free=False, unit="-")  # kappa, propeller-race factor in u_R
+    l_r: float = param(free=False, unit="-")  # l_R', effective rudder position in beta_R
+    gamma_r_plus: float = param(free=False, unit="-")  # gamma_R for beta_R > 0 (flow straightening)
+    gamma_r_minus: float = param(free=False, unit="-")  # gamma_R for beta_R < 0
+    rho: float = param(1025.0, free=False, unit="kg/m^3")  # water density
 
     def mass(self) -> Array:
         """Displacement mass $m = \\rho\\nabla$ [kg]."""

@@ -4,6 +4,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
+from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
 from ._base import AbstractVessel
 
@@ -20,21 +21,23 @@ class NomotoVessel(AbstractVessel):
     with the speed of the simulated state.
     """
 
-    free_by_default = ("gain", "time_constant")  # fitted by default
-
-    length: float  # L [m]
+    length: float = param(free=False, unit="m")  # L
     rudder: RudderServo
-    nominal_speed: float  # U [m/s], the constant surge speed the constants belong to
-    gain: float  # K [1/s], steady r/delta; positive: positive delta turns to starboard
-    time_constant: float  # T [s] (negative for a course-unstable linear model)
-    n1: float = 1.0  # n_1 [-], +1 course-stable, -1 unstable (Norrbin 1963)
-    n3: float = 0.0  # n_3 [s^2/rad^2]
-    n2: float = 0.0  # n_2 [s/rad]
-    n0: float = 0.0  # n_0 [rad/s], bias
+    # U, the constant surge speed the constants belong to
+    nominal_speed: float = param(free=False, unit="m/s")
+    # K, steady r/delta; positive: positive delta turns to starboard
+    gain: float = param(free=True, unit="1/s")
+    # T (negative for a course-unstable linear model)
+    time_constant: float = param(free=True, unit="s")
+    # n_1, +1 course-stable, -1 unstable (Norrbin 1963)
+    n1: float = param(1.0, free=False, unit="-")
+    n3: float = param(0.0, free=False, unit="s^2/rad^2")  # n_3
+    n2: float = param(0.0, free=False, unit="s/rad")  # n_2
+    n0: float = param(0.0, free=False, unit="rad/s")  # n_0, bias
     shaft: Shaft = Shaft()  # no propeller
-    nominal_n: float = 0.0
-    frontal_wind_area: float = 0.0  # A_F [m^2], no windage
-    lateral_wind_area: float = 0.0  # A_L [m^2]
+    nominal_n: float = param(0.0, free=False, unit="rev/s")
+    frontal_wind_area: float = param(0.0, free=False, unit="m^2")  # A_F, no windage
+    lateral_wind_area: float = param(0.0, free=False, unit="m^2")  # A_L
 
     def mass_matrix(self) -> Array:
         return jnp.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, self.time_constant]])

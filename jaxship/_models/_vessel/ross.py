@@ -13,6 +13,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
+from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
 from ._base import AbstractVessel
 
@@ -56,83 +57,81 @@ class RossVessel(AbstractVessel):
     model is port/starboard symmetric (no constant terms).
     """
 
-    # fitted by default (`jaxship.fit`, `jaxship identify`): linear and cross-flow hull
-    # damping in sway and yaw, the surge resistance and induced drag, and the rudder area
-    # (lift slope and area enter only as a product, so only one is free)
-    free_by_default = ("x_uu", "x_vv", "y_uv", "y_ur", "y_absv_v", "y_absr_v", "n_uv", "n_ur",
-                       "n_absv_r", "n_absr_r", "rudder_area")
-
-    length: float  # L_pp [m], thesis Table 4.1
+    length: float = param(free=False, unit="m")  # L_pp, thesis Table 4.1
     rudder: RudderServo
     shaft: Shaft
-    nominal_speed: float  # U_0 [m/s], straight run at nominal_n
-    nominal_n: float  # n_0 [rev/s], 500 rpm (thesis sec. 4.1)
-    frontal_wind_area: float  # A_F [m^2]
-    lateral_wind_area: float  # A_L [m^2]
-    rho: float  # water density [kg/m^3]
+    nominal_speed: float = param(free=False, unit="m/s")  # U_0, straight run at nominal_n
+    nominal_n: float = param(free=False, unit="rev/s")  # n_0, 500 rpm (thesis sec. 4.1)
+    frontal_wind_area: float = param(free=False, unit="m^2")  # A_F
+    lateral_wind_area: float = param(free=False, unit="m^2")  # A_L
+    rho: float = param(free=False, unit="kg/m^3")  # water density
 
     # rigid body and added mass (midship origin)
-    mass: float  # m [kg], rho * displacement
-    xg: float  # x_G [m]
-    iz: float  # I_z about midship [kg m^2]
-    x_udot: float  # X_udot [kg]
-    y_vdot: float  # Y_vdot [kg]
-    y_rdot: float  # Y_rdot = N_vdot [kg m] (symmetrised, thesis eq. 2.15)
-    n_rdot: float  # N_rdot [kg m^2]
+    mass: float = param(free=False, unit="kg")  # m, rho * displacement
+    xg: float = param(free=False, unit="m")  # x_G
+    iz: float = param(free=False, unit="kg m^2")  # I_z about midship
+    x_udot: float = param(free=False, unit="kg")  # X_udot
+    y_vdot: float = param(free=False, unit="kg")  # Y_vdot
+    y_rdot: float = param(free=False, unit="kg m")  # Y_rdot = N_vdot (symmetrised, thesis eq. 2.15)
+    n_rdot: float = param(free=False, unit="kg m^2")  # N_rdot
 
     # surge damping
-    x_uu: float  # X_|u|u [kg/m]
-    x_uuu: float  # X_uuu [kg s/m^2]
-    x_vv: float  # X_vv [kg/m]
-    u_sigma: float  # u_sigma [m/s], width of the smooth sign of the X_vv term
+    x_uu: float = param(free=True, unit="kg/m")  # X_|u|u
+    x_uuu: float = param(free=False, unit="kg s/m^2")  # X_uuu
+    x_vv: float = param(free=True, unit="kg/m")  # X_vv
+    # u_sigma, width of the smooth sign of the X_vv term
+    u_sigma: float = param(free=False, unit="m/s")
 
     # sway damping
-    y_uv: float  # Y_uv [kg/m]
-    y_ur: float  # Y_ur [kg]
-    y_uuv: float  # Y_uuv [kg s/m^2]
-    y_uur: float  # Y_uur [kg s/m]
-    y_vvv: float  # Y_vvv [kg s/m^2]
-    y_rrr: float  # Y_rrr [kg s m]
-    y_vvr: float  # Y_vvr [kg s/m]
-    y_rrv: float  # Y_rrv [kg s]
-    y_absv_v: float  # Y_|v|v [kg/m]
-    y_absr_v: float  # Y_|r|v [kg]
-    y_absv_r: float  # Y_|v|r [kg]
-    y_absr_r: float  # Y_|r|r [kg m]
+    y_uv: float = param(free=True, unit="kg/m")  # Y_uv
+    y_ur: float = param(free=True, unit="kg")  # Y_ur
+    y_uuv: float = param(free=False, unit="kg s/m^2")  # Y_uuv
+    y_uur: float = param(free=False, unit="kg s/m")  # Y_uur
+    y_vvv: float = param(free=False, unit="kg s/m^2")  # Y_vvv
+    y_rrr: float = param(free=False, unit="kg s m")  # Y_rrr
+    y_vvr: float = param(free=False, unit="kg s/m")  # Y_vvr
+    y_rrv: float = param(free=False, unit="kg s")  # Y_rrv
+    y_absv_v: float = param(free=True, unit="kg/m")  # Y_|v|v
+    y_absr_v: float = param(free=True, unit="kg")  # Y_|r|v
+    y_absv_r: float = param(free=False, unit="kg")  # Y_|v|r
+    y_absr_r: float = param(free=False, unit="kg m")  # Y_|r|r
 
     # yaw damping
-    n_uv: float  # N_uv [kg]
-    n_ur: float  # N_ur [kg m]
-    n_uuv: float  # N_uuv [kg s/m]
-    n_uur: float  # N_uur [kg s]
-    n_vvv: float  # N_vvv [kg s/m]
-    n_rrr: float  # N_rrr [kg s m^2]
-    n_vvr: float  # N_vvr [kg s]
-    n_rrv: float  # N_rrv [kg s m]
-    n_absv_v: float  # N_|v|v [kg]
-    n_absr_v: float  # N_|r|v [kg m]
-    n_absv_r: float  # N_|v|r [kg m]
-    n_absr_r: float  # N_|r|r [kg m^2]
+    n_uv: float = param(free=True, unit="kg")  # N_uv
+    n_ur: float = param(free=True, unit="kg m")  # N_ur
+    n_uuv: float = param(free=False, unit="kg s/m")  # N_uuv
+    n_uur: float = param(free=False, unit="kg s")  # N_uur
+    n_vvv: float = param(free=False, unit="kg s/m")  # N_vvv
+    n_rrr: float = param(free=False, unit="kg s m^2")  # N_rrr
+    n_vvr: float = param(free=False, unit="kg s")  # N_vvr
+    n_rrv: float = param(free=False, unit="kg s m")  # N_rrv
+    n_absv_v: float = param(free=False, unit="kg")  # N_|v|v
+    n_absr_v: float = param(free=False, unit="kg m")  # N_|r|v
+    n_absv_r: float = param(free=True, unit="kg m")  # N_|v|r
+    n_absr_r: float = param(free=True, unit="kg m^2")  # N_|r|r
 
     # propellers
-    n_propellers: float  # number of identical propellers [-]
-    prop_diameter: float  # D [m]
-    kt0: float  # k_0 [-], K_T(J) = k_0 + k_1 J + k_2 J^2
-    kt1: float  # k_1 [-]
-    kt2: float  # k_2 [-], <= 0 so that a stopped propeller only drags
-    wake: float  # w [-], Taylor wake fraction
-    thrust_deduction: float  # t [-]
+    n_propellers: float = param(free=False, unit="-")  # number of identical propellers
+    prop_diameter: float = param(free=False, unit="m")  # D
+    kt0: float = param(free=False, unit="-")  # k_0, K_T(J) = k_0 + k_1 J + k_2 J^2
+    kt1: float = param(free=False, unit="-")  # k_1
+    kt2: float = param(free=False, unit="-")  # k_2, <= 0 so that a stopped propeller only drags
+    wake: float = param(free=False, unit="-")  # w, Taylor wake fraction
+    thrust_deduction: float = param(free=False, unit="-")  # t
 
     # rudders
-    rudder_area: float  # A_R [m^2], total of all rudders
-    lift_slope: float  # f_alpha [1/rad], Fujii: 6.13 Lambda / (Lambda + 2.25)
-    normal_force_90: float  # C_N,90 [-], post-stall normal force coefficient at 90 deg
-    stall_angle: float  # alpha_s [rad], effective angle of attack at mid-stall (s = 1/2)
-    stall_width: float  # Delta alpha [rad], width of the stall transition
-    x_rudder: float  # x_R [m]
-    flow_straightening: float  # gamma_R [-]
-    race_kappa: float  # kappa [-], MMG propeller-race factor
-    race_epsilon: float  # epsilon [-], (1 - w_R) / (1 - w_P)
+    rudder_area: float = param(free=True, unit="m^2")  # A_R, total of all rudders
+    # f_alpha, Fujii: 6.13 Lambda / (Lambda + 2.25)
+    lift_slope: float = param(free=False, unit="1/rad")
+    # C_N,90, post-stall normal force coefficient at 90 deg
+    normal_force_90: float = param(free=False, unit="-")
+    # alpha_s, effective angle of attack at mid-stall (s = 1/2)
+    stall_angle: float = param(free=False, unit="rad")
+    stall_width: float = param(free=False, unit="rad")  # Delta alpha, width of the stall transition
+    x_rudder: float = param(free=False, unit="m")  # x_R
+    flow_straightening: float = param(free=False, unit="-")  # gamma_R
+    race_kappa: float = param(free=False, unit="-")  # kappa, MMG propeller-race factor
+    race_epsilon: float = param(free=False, unit="-")  # epsilon, (1 - w_R) / (1 - w_P)
 
     def mass_matrix(self) -> Array:
         m, xg = self.mass, self.xg

@@ -12,6 +12,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
+from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
 from ._base import AbstractVessel
 
@@ -62,28 +63,29 @@ class SwayYawVessel(AbstractVessel):
     starboard): they are minus the published $Y'_\\delta > 0$, $N'_\\delta < 0$.
     """
 
-    free_by_default = ("y_v", "y_r", "n_v", "n_r", "y_delta", "n_delta")  # fitted by default
-
-    length: float  # L [m]
-    draught: float  # T [m], constant along the hull (cross-flow drag only)
+    length: float = param(free=False, unit="m")  # L
+    # T, constant along the hull (cross-flow drag only)
+    draught: float = param(free=False, unit="m")
     rudder: RudderServo
-    nominal_speed: float  # V [m/s], approach speed
-    m22: float  # m' - Y'_vdot [-]
-    m23: float  # m'x'_G - Y'_rdot [-]
-    m32: float  # m'x'_G - N'_vdot [-]
-    m33: float  # I'_z - N'_rdot [-]
-    y_v: float  # Y'_v [-]
-    y_r: float  # Y'_r - m' [-]
-    n_v: float  # N'_v [-]
-    n_r: float  # N'_r - m'x'_G [-]
-    y_delta: float  # Y'_delta [-], jaxship sign (< 0 for a stern rudder)
-    n_delta: float  # N'_delta [-], jaxship sign (> 0: positive delta turns to starboard)
-    cross_flow: float = 0.0  # C [-], effective cross-flow drag coefficient (Norrbin 1976)
+    nominal_speed: float = param(free=False, unit="m/s")  # V, approach speed
+    m22: float = param(free=False, unit="-")  # m' - Y'_vdot
+    m23: float = param(free=False, unit="-")  # m'x'_G - Y'_rdot
+    m32: float = param(free=False, unit="-")  # m'x'_G - N'_vdot
+    m33: float = param(free=False, unit="-")  # I'_z - N'_rdot
+    y_v: float = param(free=True, unit="-")  # Y'_v
+    y_r: float = param(free=True, unit="-")  # Y'_r - m'
+    n_v: float = param(free=True, unit="-")  # N'_v
+    n_r: float = param(free=True, unit="-")  # N'_r - m'x'_G
+    y_delta: float = param(free=True, unit="-")  # Y'_delta, jaxship sign (< 0 for a stern rudder)
+    # N'_delta, jaxship sign (> 0: positive delta turns to starboard)
+    n_delta: float = param(free=True, unit="-")
+    # C, effective cross-flow drag coefficient (Norrbin 1976)
+    cross_flow: float = param(0.0, free=False, unit="-")
     shaft: Shaft = Shaft()  # no propeller: surge speed is frozen
-    nominal_n: float = 0.0
-    frontal_wind_area: float = 0.0  # A_F [m^2]
-    lateral_wind_area: float = 0.0  # A_L [m^2]
-    rho: float = 1025.0  # water density [kg/m^3]
+    nominal_n: float = param(0.0, free=False, unit="rev/s")
+    frontal_wind_area: float = param(0.0, free=False, unit="m^2")  # A_F
+    lateral_wind_area: float = param(0.0, free=False, unit="m^2")  # A_L
+    rho: float = param(1025.0, free=False, unit="kg/m^3")  # water density
 
     def mass_matrix(self) -> Array:
         L = self.length

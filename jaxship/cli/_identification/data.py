@@ -70,7 +70,8 @@ def _renamed(e: js.Experiment, name: str) -> js.Experiment:
     return js.Experiment(e.t, name=name, metadata=e.metadata, extra=e.extra, **measured)
 
 
-def read_experiments(paths, *, role: str = "training", note=None) -> list[js.Experiment]:
+def read_experiments(paths, *, role: str = "training", note=None, taken=()
+                     ) -> list[js.Experiment]:
     """Read measurement files and folders into experiments.
 
     A file is read with `read_measured` (trial CSV, Esso Osaka CSV, HSVA and MARIN
@@ -78,8 +79,8 @@ def read_experiments(paths, *, role: str = "training", note=None) -> list[js.Exp
     `.csv`, `.dat` or `.txt` suffix whose format `read_measured` recognises
     (others, such as a propeller open-water table, are skipped and named in one
     sentence to `note`, a callable, so that a fit never uses fewer records than the
-    user meant without saying so), in name order. Experiments with equal names get
-    their folder as a prefix.
+    user meant without saying so), in name order. Experiments with equal names, or with
+    a name in `taken` (those of another role's records), get their folder as a prefix.
 
     **Raises:** `ValueError` naming the file: missing, unreadable or malformed
     (the readers' messages name the column and row), or a folder with no records.
@@ -107,13 +108,13 @@ def read_experiments(paths, *, role: str = "training", note=None) -> list[js.Exp
             experiments.append(js.read_measured(path))
     if not experiments:
         raise ValueError(f"no {role} files given.")
-    names = [e.name for e in experiments]
+    names = [e.name for e in experiments] + list(taken)
     out = []
     for e in experiments:
         if names.count(e.name) > 1:
             e = _renamed(e, f"{Path(source(e)).parent.name}/{e.name}")
         out.append(e)
-    names = [e.name for e in out]
+    names = [e.name for e in out] + list(taken)
     for i, e in enumerate(out):  # still equal (same folder name): number them
         if names.count(e.name) > 1:
             out[i] = _renamed(e, f"{e.name}#{i}")

@@ -28,8 +28,9 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
     if not 0 < alpha < 1:
         raise ValueError(f"--alpha must be between 0 and 1, got {alpha}.")
     train = read_experiments(train_paths, role="training", note=say)
-    holdout = read_experiments(holdout_paths, role="held-out", note=say) if holdout_paths \
-        else None
+    # a held-out record named as a training one (two `trial.csv`) is told apart by its folder
+    holdout = read_experiments(holdout_paths, role="held-out", note=say,
+                               taken=[e.name for e in train]) if holdout_paths else None
     say(f"start values: identify {model} on {len(train)} training records")
     start = identify(train, model=model).fit.model
     report = js.discover(start, train, holdout, max_effects=max_effects, alpha=alpha,
