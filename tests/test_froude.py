@@ -5,9 +5,9 @@ import json
 import jax
 import numpy as np
 import pytest
+from helpers import tree_allclose
 
 import jaxship as js
-from helpers import tree_allclose
 from jaxship._simulation._froude import froude_exponent
 
 
