@@ -62,7 +62,11 @@ from ._estimate._likelihood import Innovations as Innovations
 from ._estimate._linear import LinearStart as LinearStart
 from ._estimate._lm import RESULTS as RESULTS, LevenbergMarquardt as LevenbergMarquardt
 from ._estimate._predict import predict as predict
-from ._estimate._result import FitError as FitError, FitResult as FitResult
+from ._estimate._result import (
+    FitError as FitError,
+    FitResult as FitResult,
+    Prediction as Prediction,
+)
 from ._foundation._cache import (
     compilation_cache_dir as compilation_cache_dir,
     enable_compilation_cache as enable_compilation_cache,

@@ -199,3 +199,36 @@ def test_the_package_never_imports_the_studies_outside_it():
     assert not found, "\n".join(found)
     assert not (PACKAGE / "studies").exists() and not (PACKAGE / "identification").exists()
     assert not hasattr(js, "identify") and not hasattr(js, "IdentificationResult")
+
+
+def test_every_public_estimator_is_accepted_by_fit_and_predict():
+    """One door per verb: each estimator of the public API fits through `jaxship.fit`,
+    and `jaxship.predict` of its `FitResult` with that estimator gives back the
+    predictions and fit % the fit reported."""
+    import jax
+    import numpy as np
+
+    import jaxship as js
+
+    jax.config.update("jax_enable_x64", True)
+    estimators = {v for v in vars(js).values() if isinstance(v, type)
+                  and issubclass(v, js.AbstractEstimator) and v is not js.AbstractEstimator}
+    assert estimators == {js.PredictionError, js.Innovations, js.ARMAX, js.DiscreteResponse}
+    t = np.arange(0.0, 240.0, 1.0)
+    delta = np.deg2rad(10.0) * np.sign(np.sin(2 * np.pi * t / 120.0))
+    truth = js.simulate_steering(js.Nomoto1(K=0.06, T=25.0), delta, 1.0, substeps=4)
+    noise = np.random.default_rng(0).standard_normal((2, t.size))
+    record = js.Experiment(t, delta, psi=np.asarray(truth.psi) + 0.01 * noise[0],
+                           r=np.asarray(truth.r) + 0.001 * noise[1])
+    start = js.Nomoto1(K=0.05, T=20.0)
+    for estimator, model in ((js.PredictionError(), start), (js.Innovations(), start),
+                             (js.DiscreteResponse(), start),
+                             (js.ARMAX(), js.ARMAXModel(dt=1.0))):
+        result = js.fit(model, [record], estimator=estimator)
+        assert result.success, (estimator, result.message)
+        again = js.predict(result, [record], estimator=estimator)
+        for channel, metrics in result.metrics.items():
+            assert again.metrics[channel].fit_percent == pytest.approx(
+                metrics.fit_percent, abs=1e-6), (estimator, channel)
+    with pytest.raises(ValueError, match="needs every noise variance; missing rudder"):
+        js.predict(start, [record], estimator=js.Innovations())

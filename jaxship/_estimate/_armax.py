@@ -31,7 +31,7 @@ from .._foundation._validate import validate
 from .._models._armax_model import ARMAX_NAMES, ARMAX_ORDERS, ARMAXModel
 from ._discrete import continuous_parameters
 from ._fit import AbstractEstimator, excitation_flags
-from ._result import FitResult
+from ._result import FitResult, Prediction
 from ._windows import as_dataset, check_data
 
 
@@ -278,3 +278,28 @@ class ARMAX(AbstractEstimator):
             window_samples=(1,), horizon=dt, experiment_names=tuple(ds.names),
             criterion="one-step prediction error (ARMAX)",
             noise={"innovations": float(res.noise_variance)}, noise_std={"innovations": math.nan})
+
+    def predict(self, model, dataset) -> Prediction:
+        """One-step-ahead predictions of r by `model`'s polynomials,
+        $\\hat y(t|t-1) = y(t) - \\varepsilon(t)$ (eq. 7, zero initial conditions), on
+        each record (its sample interval must be the model's `dt`)."""
+        if not isinstance(model, ARMAXModel):
+            raise ValueError(f"the ARMAX estimator predicts with an ARMAXModel, got "
+                             f"{type(model).__name__}.")
+        ds = as_dataset(dataset)
+        check_data(ds, self.rudder, ("r",))
+        A, B, C = model.polynomials()
+        first = max(A.size - 1, int(model.nk) + B.size - 1, C.size - 1, 1)
+        line, mask = np.zeros(ds.r.shape), np.zeros(ds.r.shape, bool)
+        for i, n in enumerate(int(k) for k in ds.lengths):
+            dt = float(np.asarray(ds.dt)[i])
+            if not math.isclose(dt, float(model.dt), rel_tol=1e-6):
+                raise ValueError(f"record {ds.names[i]!r} is sampled every {dt:g} s, the "
+                                 f"ARMAX model every {float(model.dt):g} s.")
+            y = np.asarray(ds.r, dtype=np.float64)[i, :n]
+            u = np.asarray(getattr(ds, self.rudder), dtype=np.float64)[i, :n]
+            line[i, :n] = y - _residuals(y, u, A, B, C, int(model.nk))
+            mask[i, first:n] = True
+        return Prediction.validated(ds, {"r": line}, mask, rudder=self.rudder,
+                                    max_lag=self.max_lag, horizon=float(model.dt),
+                                    window_samples=(1,) * ds.num_experiments)

@@ -29,8 +29,8 @@ from ._discrete import (
     fit_discrete_response,
     regressors,
 )
-from ._fit import AbstractEstimator
-from ._result import FitResult
+from ._fit import AbstractEstimator, PredictionError
+from ._result import FitResult, Prediction
 from ._windows import as_dataset, check_data
 
 
@@ -113,6 +113,17 @@ class DiscreteResponse(AbstractEstimator):
             cost=0.5 * float(np.sum(((r - line) * mask) ** 2)), weights={"r": 1.0},
             window_samples=(1,), horizon=res.dt, experiment_names=tuple(ds.names),
             criterion=f"equation error ({self.method}, Lu & Zhao {structure})")
+
+    def predict(self, model, dataset) -> Prediction:
+        """One-step-ahead predictions of r by the continuous `model` over each sample
+        interval from the measured state, the rudder held (`PredictionError(horizon=0,
+        hold="zoh")`): for the linear first-order structure the discrete model's own
+        zero-order-hold prediction; for the others the continuous model the estimate
+        was converted to, integrated rather than differenced."""
+        structure_of(model)  # one of Lu & Zhao's structures
+        one_step = PredictionError(horizon=0.0, channels=("r",), rudder=self.rudder,
+                                   hold="zoh", max_lag=self.max_lag)
+        return one_step.predict(model, dataset)
 
 
 def _experiment(ds, i, rudder) -> Experiment:

@@ -44,7 +44,7 @@ from ._lm import (
     solve_least_squares,
     value_and_jacfwd,
 )
-from ._result import FitError, FitResult
+from ._result import FitError, FitResult, Prediction
 from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_data, to_timeline
 
 
@@ -63,6 +63,11 @@ class AbstractEstimator(eqx.Module):
     @abc.abstractmethod
     def fit(self, model, dataset, free, progress) -> "FitResult":
         """Estimate the free parameters of `model` from `dataset` (see `jaxship.fit`)."""
+
+    @abc.abstractmethod
+    def predict(self, model, dataset) -> "Prediction":
+        """The estimator's predictions of `dataset`'s outputs by `model`, validated
+        (see `jaxship.predict`)."""
 
 
 class PredictionError(AbstractEstimator):
@@ -139,6 +144,23 @@ class PredictionError(AbstractEstimator):
     def fit(self, model, dataset, free=None, progress=None) -> "FitResult":
         return _fit_prediction_error(self, model, dataset, free, progress)
 
+    def predict(self, model, dataset) -> "Prediction":
+        """The windows of `fit` (a free simulation of each record for `horizon=None`),
+        integrated with the step that follows the model's fastest mode, as in `fit`."""
+        ds, windows, layout = _prepare(model, dataset, self)
+        model = as_arrays(model)
+        needed = min(_stable_substeps(model, windows, refuse=False), MAX_SUBSTEPS)
+        if needed > windows.substeps:
+            windows = dataclasses.replace(windows, substeps=needed)
+        pred = np.asarray(_predict_jit(model, windows), dtype=np.float64)
+        shape = (ds.num_experiments, ds.num_samples)
+        predictions = {}
+        for c, name in enumerate(windows.channels):
+            predictions[name], hit = to_timeline(pred[c], layout, shape)
+        return Prediction.validated(ds, predictions, hit, rudder=self.rudder,
+                                    max_lag=self.max_lag, horizon=self.horizon,
+                                    window_samples=layout["lengths"])
+
 
 def _predict(model, w: Windows, offsets=None):
     """Model outputs at the window samples, shape (C, E, W, L). `offsets` (E, W, 2):
@@ -164,6 +186,9 @@ def _predict(model, w: Windows, offsets=None):
 
     out = sharded_vmap(one, w.start, w.records, w.dt, offsets, batch_dims=2)
     return jnp.moveaxis(out, -1, 0)
+
+
+_predict_jit = eqx.filter_jit(lambda model, w: _predict(model, w))
 
 
 def _residuals(model, w: Windows, offsets=None):

@@ -25,6 +25,7 @@ from ._kalman import (
     _variance,
 )
 from ._lm import LevenbergMarquardt, solve_least_squares
+from ._result import Prediction
 from ._windows import channel_weights
 
 
@@ -335,3 +336,26 @@ class Innovations(AbstractEstimator):
                       noise_start=self.noise_start, rudder=self.rudder,
                       substeps=self.substeps, max_steps=self.max_steps, solver=self.solver,
                       hold=self.hold)
+
+    def predict(self, model, dataset) -> Prediction:
+        """The filter's one-step-ahead predictions with the noise variances `noise`
+        (every entry given, e.g. `Innovations(noise=fit.noise)`; `jaxship.predict` of a
+        `FitResult` takes them from it)."""
+        ds, channels = _check_inputs(model, dataset, self.channels, self.rudder,
+                                     self.substeps, vessels=False)
+        layout, z = _noise_layout(model, ds, channels, self.process, self.noise, None, "ml")
+        missing = [n for n, estimated in zip(layout.names, layout.estimated) if estimated]
+        if missing:
+            raise ValueError(f"the innovations predictor needs every noise variance; "
+                             f"missing {', '.join(missing)} (pass `Innovations(noise="
+                             "fit.noise)` or predict from the FitResult).")
+        rec = _records(ds, channels, self.rudder, self.substeps, self.hold)
+        _, pred = _innovations(jnp.zeros(0), as_arrays(model), Transform.from_specs(()),
+                               layout, rec)
+        predicted = np.asarray(ds.mask).copy()
+        predicted[:, 0] = False  # sample 0 is the prior, never predicted
+        pred = np.asarray(pred, dtype=np.float64)
+        predictions = {c: np.where(predicted, pred[..., i], 0.0) for i, c in enumerate(channels)}
+        return Prediction.validated(ds, predictions, predicted, rudder=self.rudder,
+                                    max_lag=25, horizon=float(np.min(ds.dt)),
+                                    window_samples=(1,) * ds.num_experiments)

@@ -1,75 +1,37 @@
-"""`predict`: a model's prediction-error outputs on (new) data, for validation.
+"""`predict`: a model's outputs on (new) data as an estimator predicts them, validated.
 
-The same windows as `fit` with the same `PredictionError` (horizon, channels,
-replayed rudder, wind): `horizon=None` is a free simulation of each experiment from
-its first sample (output error); a finite horizon restarts from the measured state
-every `horizon` seconds (k-step-ahead prediction). Works for steering models and
-vessels alike.
+Each estimator brings its own predictor (`AbstractEstimator.predict`): `PredictionError`
+the windows of `fit` (`horizon=None`: a free simulation of each record from its first
+sample; a finite horizon restarts from the measured state every `horizon` seconds),
+`Innovations` the Kalman filter's one-step-ahead predictions at given noise variances,
+`ARMAX` and `DiscreteResponse` one-step-ahead predictions of the yaw rate. Works for
+steering models and vessels alike, and for the result of any `fit`.
 """
 
 import dataclasses
 
-import equinox as eqx
-import numpy as np
-
-from .._foundation._params import as_arrays
-from .._foundation._validate import ValidationReport, validate
-from ._fit import MAX_SUBSTEPS, PredictionError, _predict, _prepare, _stable_substeps
-from ._windows import to_timeline
+from ._fit import AbstractEstimator, PredictionError
+from ._likelihood import Innovations
+from ._result import FitResult, Prediction
 
 
-_predict_jit = eqx.filter_jit(lambda model, w: _predict(model, w))
+def predict(model, dataset, *, estimator: AbstractEstimator = PredictionError()
+            ) -> Prediction:
+    """Predict the measured outputs of `dataset` with `model` (a steering model, a
+    vessel, or a `FitResult`, whose model is used) as `estimator` does, and validate
+    them (see `Prediction`). An `Innovations` estimator without given noise variances
+    takes those a `FitResult` estimated.
 
-
-@dataclasses.dataclass(frozen=True)
-class Prediction:
-    """Result of `predict`: `predictions` `{channel: (E, N)}` at the dataset's samples,
-    `predicted` (E, N) mask of predicted samples, `metrics` `{channel:
-    ValidationReport}` (fit %, loss, whiteness...), the estimator's `horizon` [s],
-    `window_samples` per experiment and the `experiment_names`."""
-
-    predictions: dict
-    predicted: np.ndarray
-    metrics: dict[str, ValidationReport]
-    horizon: float | None
-    window_samples: tuple[int, ...]
-    experiment_names: tuple[str, ...]
-
-    def fit_percent(self) -> dict[str, float]:
-        """`{channel: fit %}` pooled over the experiments."""
-        return {c: m.fit_percent for c, m in self.metrics.items()}
-
-    def fit_per_experiment(self) -> dict[str, dict[str, float]]:
-        """`{experiment: {channel: fit %}}`."""
-        return {name: {c: float(m.fit_per_experiment[i]) for c, m in self.metrics.items()}
-                for i, name in enumerate(self.experiment_names)}
-
-
-def predict(model, dataset, *, estimator: PredictionError = PredictionError()) -> Prediction:
-    """Predict the measured outputs of `dataset` with `model` (a steering model or a
-    vessel) as `fit` does with `estimator`, and validate them (see `Prediction`); the
-    integration step follows the model's fastest mode, as in `fit`.
-
-    Raises `ValueError` for bad data as `fit` does.
+    Raises `ValueError` for bad data as `fit` does, and for an estimator that cannot
+    predict without what it lacks (the noise variances of `Innovations`).
     """
-    if not isinstance(estimator, PredictionError):
-        raise ValueError(f"`estimator` must be a PredictionError, got "
+    if not isinstance(estimator, AbstractEstimator):
+        raise ValueError(f"`estimator` must be a jaxship estimator (PredictionError, "
+                         f"Innovations, ARMAX, DiscreteResponse), got "
                          f"{type(estimator).__name__}.")
-    ds, windows, layout = _prepare(model, dataset, estimator)
-    model = as_arrays(model)
-    needed = min(_stable_substeps(model, windows, refuse=False), MAX_SUBSTEPS)
-    if needed > windows.substeps:  # the step follows the model's fastest mode, as in `fit`
-        windows = dataclasses.replace(windows, substeps=needed)
-    channels = windows.channels
-    pred = _predict_jit(model, windows)
-    pred = np.asarray(pred, dtype=np.float64)
-    shape = (ds.num_experiments, ds.num_samples)
-    u = np.asarray(getattr(ds, estimator.rudder), dtype=np.float64)
-    predictions, metrics = {}, {}
-    for c, name in enumerate(channels):
-        timeline, hit = to_timeline(pred[c], layout, shape)
-        predictions[name] = timeline
-        metrics[name] = validate(np.asarray(getattr(ds, name), dtype=np.float64), timeline, hit,
-                                 u=u, max_lag=estimator.max_lag, channel=name)
-    return Prediction(predictions, hit, metrics, estimator.horizon, tuple(layout["lengths"]),
-                      tuple(ds.names))
+    if isinstance(model, FitResult):
+        if (isinstance(estimator, Innovations) and isinstance(estimator.noise, str)
+                and model.noise is not None):
+            estimator = dataclasses.replace(estimator, noise=dict(model.noise))
+        model = model.model
+    return estimator.predict(model, dataset)

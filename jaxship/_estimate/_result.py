@@ -1,5 +1,8 @@
-"""`FitResult`, the one result type of `jaxship.fit` whatever the estimator, and
-`FitError`, raised by `fit(..., throw=True)` when a fit did not converge."""
+"""`FitResult`, the one result type of `jaxship.fit` whatever the estimator, `Prediction`,
+that of `jaxship.predict`, and `FitError`, raised by `fit(..., throw=True)` when a fit did
+not converge."""
+
+import dataclasses
 
 import equinox as eqx
 import numpy as np
@@ -8,7 +11,7 @@ from scipy.special import ndtri
 from .._foundation._covariance import ParameterReport
 from .._foundation._frames import fit_to_dataframe
 from .._foundation._params import get_path, parameter_fields
-from .._foundation._validate import _to_plain
+from .._foundation._validate import ValidationReport, _to_plain, validate
 from ._lm import RESULTS, SolverOutcome
 
 
@@ -146,3 +149,39 @@ class FitResult(SolverOutcome):
 
 def _field_names(model):
     return tuple(parameter_fields(model))
+
+
+@dataclasses.dataclass(frozen=True)
+class Prediction:
+    """Result of `predict`: `predictions` `{channel: (E, N)}` at the dataset's samples,
+    `predicted` (E, N) mask of predicted samples, `metrics` `{channel:
+    ValidationReport}` (fit %, loss, whiteness...), the predictor's `horizon` [s] (None:
+    free simulation), `window_samples` per experiment and the `experiment_names`."""
+
+    predictions: dict
+    predicted: np.ndarray
+    metrics: dict[str, ValidationReport]
+    horizon: float | None
+    window_samples: tuple[int, ...]
+    experiment_names: tuple[str, ...]
+
+    def fit_percent(self) -> dict[str, float]:
+        """`{channel: fit %}` pooled over the experiments."""
+        return {c: m.fit_percent for c, m in self.metrics.items()}
+
+    def fit_per_experiment(self) -> dict[str, dict[str, float]]:
+        """`{experiment: {channel: fit %}}`."""
+        return {name: {c: float(m.fit_per_experiment[i]) for c, m in self.metrics.items()}
+                for i, name in enumerate(self.experiment_names)}
+
+    @classmethod
+    def validated(cls, ds, predictions: dict, predicted, *, rudder: str, max_lag: int,
+                  horizon, window_samples) -> "Prediction":
+        """The `Prediction` of `predictions` `{channel: (E, N)}` on the dataset `ds`,
+        each channel validated against its measurement (`validate`)."""
+        u = np.asarray(getattr(ds, rudder), dtype=np.float64)
+        metrics = {c: validate(np.asarray(getattr(ds, c), dtype=np.float64), line, predicted,
+                               u=u, max_lag=max_lag, channel=c)
+                   for c, line in predictions.items()}
+        return cls(predictions, predicted, metrics, horizon, tuple(window_samples),
+                   tuple(ds.names))

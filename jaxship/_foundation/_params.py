@@ -240,7 +240,7 @@ class Transform(eqx.Module):
                 out.append(hi - s * jax.nn.softplus(zi))
             else:
                 out.append(lo + (hi - lo) * jax.nn.sigmoid(zi))
-        return jnp.stack(out)
+        return jnp.stack(out) if out else jnp.zeros((0,), jnp.result_type(z, float))
 
     def to_unconstrained(self, p) -> np.ndarray:
         """Host-side inverse map (NumPy, float64)."""
