@@ -8,9 +8,9 @@ The continuous models (Lu & Zhao eqs. 1-4; $\\delta_r$ the rudder offset):
   $r_k = a_1r_{k-1} + a_2\\delta_{k-1} + b_0$.
 - `"nonlinear1"`: eq. (2) $\\dot r + \\alpha_1r + \\beta_1r^3 = \\alpha_2(\\delta + \\delta_r)$;
   eq. (8) $r_k = a_1r_{k-1} + a_2r_{k-1}^3 + a_3\\delta_{k-1} + b_0$.
-- `"linear2"`: eq. (3) $T_1T_2\\ddot r + (T_1 + T_2)\\dot r + r = K(\\delta + \\delta_r)
-  + KT_3\\dot\\delta$; eq. (9) $r_k = a_1r_{k-1} + a_2r_{k-2} + b_1\\delta_{k-1}
-  + b_2\\delta_{k-2} + c_0$.
+- `"linear2"`: eq. (3) $T_1T_2\\ddot r + (T_1 + T_2)\\dot r + r = K(\\delta + \\delta_r) +
+  KT_3\\dot\\delta$; eq. (9) $r_k = a_1r_{k-1} + a_2r_{k-2} + b_1\\delta_{k-1} +
+  b_2\\delta_{k-2} + c_0$.
 - `"nonlinear2"`: eq. (4), (3) with $\\alpha_1r + \\beta_1r^3$ for $r$; eq. (10), (9)
   $+\\,c_1r_{k-1}^3$.
 

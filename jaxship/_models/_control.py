@@ -89,7 +89,7 @@ class ReferenceModel(eqx.Module):
 
 
 class HeadingSteps(eqx.Module):
-    """The ordered heading: $\\psi_{ref}(t) = \\psi_0 + $ `headings[k]` from `times[k]`
+    """The ordered heading: $\\psi_{ref}(t) = \\psi_0 +$ `headings[k]` from `times[k]`
     on (the last step taken), $\\psi_0$ before the first step; relative to the initial
     heading $\\psi_0$. Default: thesis Table 5.1, a 45 deg step at 100 s."""
 

@@ -533,8 +533,8 @@ def augment(model, *effects):
 
 def nonlinear_nomoto2(K, T1, T2, T3, beta1=0.0, delta0=0.0) -> AugmentedSteering:
     """The second-order nonlinear response model of Lu & Zhao (2008, eq. 4; seed 002),
-    $T_1T_2\\ddot r + (T_1 + T_2)\\dot r + r + \\beta_1 r^3 = K(\\delta + \\delta_0)
-    + KT_3\\dot\\delta$ ($\\alpha_1 = 1$, as they fix it): `Nomoto2` with the effect
+    $T_1T_2\\ddot r + (T_1 + T_2)\\dot r + r + \\beta_1 r^3 = K(\\delta + \\delta_0) +
+    KT_3\\dot\\delta$ ($\\alpha_1 = 1$, as they fix it): `Nomoto2` with the effect
     `YawCubicDamping` (its parameter `"yaw_cubic_damping.beta"` is $\\beta_1$)."""
     return AugmentedSteering(Nomoto2(K=K, T1=T1, T2=T2, T3=T3, delta0=delta0),
                              (YawCubicDamping(beta=beta1),))

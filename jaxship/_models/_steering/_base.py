@@ -24,7 +24,7 @@ class AuxInputs(eqx.Module):
     model is evaluated: surge `u` and sway `v` velocity [m/s] at midship (through the
     water), the propeller rate `n` [rev/s] and, where wind is logged, the apparent
     wind `wind_u`, `wind_v` [m/s]: the ship's velocity through the air in body axes,
-    so that the wind comes from $\\gamma = $ atan2(`wind_v`, `wind_u`) off the bow,
+    so that the wind comes from $\\gamma =$ atan2(`wind_v`, `wind_u`) off the bow,
     positive from starboard (`jaxship.Wind`'s convention). Unused by the Nomoto models;
     effects use them (`jaxship.ApparentWind`)."""
 

@@ -64,8 +64,8 @@ class Nomoto2(AbstractSteeringModel):
 
     **Window starts.** Since $\\dot r_{aux} = K(\\delta + \\delta_0) - r$, the hidden
     state at a window start $t_s$ follows from the record without differentiating:
-    $r_{aux}(t_s) = r_{aux}(t_0) + K\\int_{t_0}^{t_s}(\\delta + \\delta_0)\\,dt
-    - (\\psi(t_s) - \\psi(t_0))$, with the measured heading, the exact integral of the
+    $r_{aux}(t_s) = r_{aux}(t_0) + K\\int_{t_0}^{t_s}(\\delta + \\delta_0)\\,dt -
+    (\\psi(t_s) - \\psi(t_0))$, with the measured heading, the exact integral of the
     held rudder, and $r_{aux}(t_0)$ of a steady state at the first sample of the
     experiment (a straight run or steady turn, as trials start; a record that
     starts mid-manoeuvre biases the fit: cut it with `Experiment.segment`). The

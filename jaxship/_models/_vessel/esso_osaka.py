@@ -51,8 +51,8 @@ class LowSpeedMMGVessel(AbstractVessel):
     change); u, v at midship. With $U = \\sqrt{u^2 + v^2}$, $\\hat\\beta = \\mathrm{atan2}(v, u)$,
     $v' = v/U$, $r' = rL/U$, all coefficients primed as in the source:
 
-    - hull: $X_H = \\tfrac12\\rho L d\\,[(X_{0F} + (X_{0A} - X_{0F})|\\hat\\beta|/\\pi)\\,uU
-      + X_{vr} v r L]$, $Y_H = \\tfrac12\\rho L d\\,[Y_v v|u| + Y_r rLu - C_D I_1(v, C_{rY}rL)]$,
+    - hull: $X_H = \\tfrac12\\rho L d\\,[(X_{0F} + (X_{0A} - X_{0F})|\\hat\\beta|/\\pi)\\,uU +
+      X_{vr} v r L]$, $Y_H = \\tfrac12\\rho L d\\,[Y_v v|u| + Y_r rLu - C_D I_1(v, C_{rY}rL)]$,
       $N_H = \\tfrac12\\rho L^2 d\\,[N_v vu + N_r rL|u| - C_D I_2(v, C_{rN}rL)]$ with the
       cross-flow integrals of `cross_flow_integrals`;
     - propeller: $w_P = w_{P0} - \\tau_P|v' + x_P'r'| - C_P'(v' + x_P'r')^2$,
@@ -67,12 +67,12 @@ class LowSpeedMMGVessel(AbstractVessel):
       $f_\\alpha = 6.13\\Lambda/(\\Lambda + 2.25)$,
       $\\alpha_R = \\delta - \\mathrm{atan2}(v_R, u_R)$,
       $v_R = -\\gamma_R(v + \\ell_R r)$ with $\\gamma_R = \\gamma_P$ if $v + x_R r \\ge 0$ else
-      $\\gamma_N$; $u_R = \\varepsilon\\sqrt{\\eta[u_P + \\kappa(\\sqrt{u_P^2 + 8K_Tn^2D^2/\\pi}
-      - u_P)]^2 + (1 - \\eta)u_P^2}$ if $n \\ge 0$ and $K_T > 0$ ($\\kappa = k_x/\\varepsilon$,
+      $\\gamma_N$; $u_R = \\varepsilon\\sqrt{\\eta[u_P + \\kappa(\\sqrt{u_P^2 + 8K_Tn^2D^2/\\pi} -
+      u_P)]^2 + (1 - \\eta)u_P^2}$ if $n \\ge 0$ and $K_T > 0$ ($\\kappa = k_x/\\varepsilon$,
       $\\eta = D/H_R$, $H_R = \\sqrt{A_R\\Lambda}$); otherwise $u_R = u$ astern and, ahead,
-      Kitagawa's $u_R = \\mathrm{sgn}(s)\\sqrt{|s|}$, $s = \\eta\\,\\mathrm{sgn}(a)a^2
-      + (1 - \\eta)(\\varepsilon u_P)^2 + c_{PR}u^2$, $a = \\varepsilon u_P
-      + \\mathrm{sgn}(n) D k_{x,rev}\\sqrt{8|n^2K_T|/\\pi}$; $X_R, Y_R, N_R$ as in the MMG
+      Kitagawa's $u_R = \\mathrm{sgn}(s)\\sqrt{|s|}$, $s = \\eta\\,\\mathrm{sgn}(a)a^2 +
+      (1 - \\eta)(\\varepsilon u_P)^2 + c_{PR}u^2$, $a = \\varepsilon u_P +
+      \\mathrm{sgn}(n) D k_{x,rev}\\sqrt{8|n^2K_T|/\\pi}$; $X_R, Y_R, N_R$ as in the MMG
       standard method with $t_R$, $a_H$, $x_H$, $x_R$.
 
     Mass matrix and Coriolis terms as in `MMGVessel` ($m$, $m_x$, $m_y$ from the primes,

@@ -24,14 +24,14 @@ class Mariner(AbstractVessel):
     `nominal_speed`), $v' = v/U$, $r' = rL/U$ and the source's rudder
     $\\delta_m = -\\delta$,
 
-    $X' = X_u u' + X_{uu} u'^2 + X_{uuu} u'^3 + X_{vv} v'^2 + X_{rr} r'^2
-    + X_{rv} r'v' + X_{\\delta\\delta}\\delta_m^2 + X_{u\\delta\\delta} u'\\delta_m^2
-    + X_{v\\delta} v'\\delta_m + X_{uv\\delta} u'v'\\delta_m$,
+    $X' = X_u u' + X_{uu} u'^2 + X_{uuu} u'^3 + X_{vv} v'^2 + X_{rr} r'^2 +
+    X_{rv} r'v' + X_{\\delta\\delta}\\delta_m^2 + X_{u\\delta\\delta} u'\\delta_m^2 +
+    X_{v\\delta} v'\\delta_m + X_{uv\\delta} u'v'\\delta_m$,
 
-    $Y' = Y_v v' + Y_r r' + Y_{vvv} v'^3 + Y_{vvr} v'^2 r' + Y_{vu} v'u' + Y_{ru} r'u'
-    + Y_\\delta\\delta_m + Y_{\\delta\\delta\\delta}\\delta_m^3 + Y_{u\\delta} u'\\delta_m
-    + Y_{uu\\delta} u'^2\\delta_m + Y_{v\\delta\\delta} v'\\delta_m^2
-    + Y_{vv\\delta} v'^2\\delta_m + Y_0 + Y_{0u} u' + Y_{0uu} u'^2$,
+    $Y' = Y_v v' + Y_r r' + Y_{vvv} v'^3 + Y_{vvr} v'^2 r' + Y_{vu} v'u' + Y_{ru} r'u' +
+    Y_\\delta\\delta_m + Y_{\\delta\\delta\\delta}\\delta_m^3 + Y_{u\\delta} u'\\delta_m +
+    Y_{uu\\delta} u'^2\\delta_m + Y_{v\\delta\\delta} v'\\delta_m^2 +
+    Y_{vv\\delta} v'^2\\delta_m + Y_0 + Y_{0u} u' + Y_{0uu} u'^2$,
 
     and $N'$ with the same terms; $X = \\tfrac12\\rho L^2U^2 X'$, $Y = \\tfrac12\\rho L^2U^2 Y'$,
     $N = \\tfrac12\\rho L^3U^2 N'$. The rigid-body Coriolis terms are part of the

@@ -56,17 +56,17 @@ class MMGVessel(AbstractVessel):
     starboard (the paper's convention, no sign change). With $U = \\sqrt{u^2+v^2}$,
     $v' = v/U$, $r' = rL/U$, $\\beta = \\mathrm{atan2}(-v, u)$:
 
-    - hull: $X_H = \\tfrac12\\rho L d U^2 (-R_0' + X_{vv}'v'^2 + X_{vr}'v'r' + X_{rr}'r'^2
-      + X_{vvvv}'v'^4)$, $Y_H = \\tfrac12\\rho L d U^2 (Y_v'v' + Y_r'r' + Y_{vvv}'v'^3
-      + Y_{vvr}'v'^2r' + Y_{vrr}'v'r'^2 + Y_{rrr}'r'^3)$, $N_H$ likewise with $L^2$;
+    - hull: $X_H = \\tfrac12\\rho L d U^2 (-R_0' + X_{vv}'v'^2 + X_{vr}'v'r' + X_{rr}'r'^2 +
+      X_{vvvv}'v'^4)$, $Y_H = \\tfrac12\\rho L d U^2 (Y_v'v' + Y_r'r' + Y_{vvv}'v'^3 +
+      Y_{vvr}'v'^2r' + Y_{vrr}'v'r'^2 + Y_{rrr}'r'^3)$, $N_H$ likewise with $L^2$;
     - propeller: $X_P = (1-t_P)\\rho n^2 D_P^4 K_T(J_P)$, $K_T = k_0 + k_1 J_P + k_2 J_P^2$,
       $J_P = u(1-w_P)/(nD_P)$, $1 - w_P = (1-w_{P0})[1 + (1 - e^{-C_1|\\beta_P|})(C_2 - 1)]$,
       $\\beta_P = \\beta - x_P' r'$, $C_2$ by the sign of $\\beta_P$;
     - rudder: $F_N = \\tfrac12\\rho A_R f_\\alpha U_R^2 \\sin\\alpha_R$,
       $\\alpha_R = \\delta - \\mathrm{atan}(v_R/u_R)$, $v_R = U\\gamma_R\\beta_R$,
       $\\beta_R = \\beta - \\ell_R' r'$, $\\gamma_R$ by the sign of $\\beta_R$,
-      $u_R = \\varepsilon u(1-w_P)\\sqrt{\\eta\\{1 + \\kappa[\\sqrt{1 + 8K_T/(\\pi J_P^2)}
-      - 1]\\}^2 + 1 - \\eta}$, $\\eta = D_P/H_R$; $X_R = -(1-t_R)F_N\\sin\\delta$,
+      $u_R = \\varepsilon u(1-w_P)\\sqrt{\\eta\\{1 + \\kappa[\\sqrt{1 + 8K_T/(\\pi J_P^2)} -
+      1]\\}^2 + 1 - \\eta}$, $\\eta = D_P/H_R$; $X_R = -(1-t_R)F_N\\sin\\delta$,
       $Y_R = -(1+a_H)F_N\\cos\\delta$, $N_R = -(x_R + a_H x_H)F_N\\cos\\delta$.
 
     The paper's equations at the centre of gravity become, at midship,

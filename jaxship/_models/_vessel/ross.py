@@ -24,22 +24,22 @@ G = 9.81  # gravity [m/s^2]
 class RossVessel(AbstractVessel):
     """3-DOF surge-sway-yaw model with Ross (2008) damping, propeller and stalling rudder.
 
-    With $\\nu = (u, v, r)$ at midship, $M\\dot\\nu = -C_{RB}(\\nu)\\nu - C_A(\\nu)\\nu
-    + \\tau_D(\\nu) + \\tau_P(u, n) + \\tau_R(\\nu, \\delta, n)$ (thesis eq. 2.13-2.20 in
+    With $\\nu = (u, v, r)$ at midship, $M\\dot\\nu = -C_{RB}(\\nu)\\nu - C_A(\\nu)\\nu +
+    \\tau_D(\\nu) + \\tau_P(u, n) + \\tau_R(\\nu, \\delta, n)$ (thesis eq. 2.13-2.20 in
     3 DOF). $M_A$ is the symmetrised added mass of thesis eq. 2.15 and $C_A$ the
     matching skew-symmetric added-mass Coriolis matrix (thesis eq. 2.18), so the
     Coriolis terms do no work. The damping $\\tau_D$ has Ross's terms:
 
     - surge: $X_{|u|u}|u|u + X_{uuu}u^3 + X_{vv}v^2\\sigma(u)$ with the smooth sign
       $\\sigma(u) = \\tanh(u/u_\\sigma)$ (the induced drag of the hull stays a drag astern);
-    - sway: $Y_{uv}|u|v + Y_{ur}|u|r + Y_{uuv}u^2v + Y_{uur}u^2r + Y_{vvv}v^3 + Y_{rrr}r^3
-      + Y_{vvr}v^2r + Y_{rrv}r^2v + Y_{|v|v}|v|v + Y_{|r|v}|r|v + Y_{|v|r}|v|r
-      + Y_{|r|r}|r|r$, and the same terms in yaw.
+    - sway: $Y_{uv}|u|v + Y_{ur}|u|r + Y_{uuv}u^2v + Y_{uur}u^2r + Y_{vvv}v^3 + Y_{rrr}r^3 +
+      Y_{vvr}v^2r + Y_{rrv}r^2v + Y_{|v|v}|v|v + Y_{|r|v}|r|v + Y_{|v|r}|v|r +
+      Y_{|r|r}|r|r$, and the same terms in yaw.
 
     Ross writes $u$ where we write $|u|$; the two agree ahead and $|u|$ keeps the
     lift terms dissipative astern. Propellers (`n_propellers` identical, thrust
-    deduction $t$, wake $w$): $T = \\rho D^4 (k_0 n|n| + k_1 |n| u_a/D
-    + k_2 u_a|u_a|/D^2)$, $u_a = (1 - w)u$, which is $\\rho D^4 n^2 K_T(J)$ with
+    deduction $t$, wake $w$): $T = \\rho D^4 (k_0 n|n| + k_1 |n| u_a/D +
+    k_2 u_a|u_a|/D^2)$, $u_a = (1 - w)u$, which is $\\rho D^4 n^2 K_T(J)$ with
     $K_T = k_0 + k_1 J + k_2 J^2$ ahead and pure drag at $n = 0$. Rudders (total
     area $A_R$ at $x_R$): normal force $F_N = \\tfrac12\\rho A_R U_R^2 C_N(\\alpha_R)$,
     $X = -F_N\\sin\\delta$, $Y = -F_N\\cos\\delta$, $N = x_R Y$, with the inflow

@@ -139,8 +139,8 @@ def _transfer_constants(M, A, b):
     """K, T1, T2, T3, Kv, T3v of $M\\dot x = Ax + b\\delta$, $x = (v, r)$ (eq. 4-5).
 
     With $s$ the Laplace variable, $\\det(sM - A) = \\det M\\,(s + 1/T_1)(s + 1/T_2)$, so
-    $T_1T_2 = \\det M/\\det A$ and $T_1 + T_2 = -(m_{11}a_{22} + m_{22}a_{11} - m_{12}a_{21}
-    - m_{21}a_{12})/\\det A$; the numerators give $K = (m_{11}b_2 - m_{21}b_1)/\\det M$,
+    $T_1T_2 = \\det M/\\det A$ and $T_1 + T_2 = -(m_{11}a_{22} + m_{22}a_{11} - m_{12}a_{21} -
+    m_{21}a_{12})/\\det A$; the numerators give $K = (m_{11}b_2 - m_{21}b_1)/\\det M$,
     $K/T_3 = (a_{21}b_1 - a_{11}b_2)/\\det M$, $K_v = (m_{22}b_1 - m_{12}b_2)/\\det M$,
     $K_v/T_{3v} = (a_{12}b_2 - a_{22}b_1)/\\det M$.
     """

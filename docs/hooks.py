@@ -1,0 +1,36 @@
+"""mkdocs hooks (mkdocs.yml `hooks:`), run by `mkdocs build`; nothing is written into the
+source tree.
+
+- The executed notebooks of `notebooks/` (outside `docs/`) become pages at
+  `notebooks/NAME/`: their files are added to the build as they are, and mkdocs-jupyter
+  renders them with the outputs CI stored (`execute: false`).
+- The home page (`docs/index.md`) takes the README below its first heading, its links
+  into `docs/` made relative to the site.
+"""
+
+import pathlib
+import re
+
+from mkdocs.plugins import event_priority
+from mkdocs.structure.files import File
+
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+README_MARKER = "<!-- README -->"
+
+
+@event_priority(100)  # before mkdocs-jupyter's on_files (priority 0) wraps the notebooks
+def on_files(files, config):
+    for path in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        files.append(File(f"notebooks/{path.name}", str(ROOT), config["site_dir"],
+                          config["use_directory_urls"]))
+    return files
+
+
+def on_page_markdown(markdown, page, config, files):
+    if page.file.src_uri != "index.md":
+        return markdown
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    body = readme.split("\n", 1)[1] if readme.startswith("# ") else readme
+    body = re.sub(r"\]\(docs/", "](", body)
+    return markdown.replace(README_MARKER, body)
