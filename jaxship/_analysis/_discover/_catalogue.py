@@ -1,8 +1,9 @@
 """The catalogue of candidate effects `jaxship.discover` scores: physically named
 effects of `jaxship.augment`, each zero (absent) in the base model.
 
-An entry says how to make the effect for a model (`make(model)`, None where it does
-not apply: e.g. a sway force on a steering model), which of its parameters a probe
+An entry names the effect class (its id names the candidate) and says how to make it
+for a model (the families it acts on, or `make(model, data)`; None where it does not
+apply: e.g. a sway force on a steering model), which of its parameters a probe
 value differentiates (effects switched off below a threshold, such as a lag, have no
 derivative at zero), and which experiment separates it from the effects it is often
 confused with. Adding an effect to discovery is adding one entry here.
@@ -45,22 +46,45 @@ from ._plausible import HARD_OVER
 
 @dataclasses.dataclass(frozen=True)
 class Candidate:
-    """One catalogue entry: `id` (the effect's), `name` (what a naval architect calls
-    it), `make(model, data)` the effect at zero for `model` and the training `data`
-    (a `Dataset`), or None where it does not apply or the data cannot show it;
-    `probes(model, data)` `{field: value}` for parameters scored by a secant to that
-    value (parameters bounded at zero, or switched off below a threshold, have no
-    useful derivative there); `separate`: the experiment that tells it apart from the
-    effects it resembles; `rudder_range`: for effects whose parameters have family
-    units (no bounds), the largest plausible rudder-equivalent angle [rad] of their
-    loads (`rudder_equivalent`)."""
+    """One catalogue entry: the `effect` class (or classes with one id: the wind on a
+    vessel and on a steering model), whose `id` names the candidate; `name` (what a
+    naval architect calls it); `families` the models it acts on (`"vessel"`,
+    `"steering"`); `make(model, data)` the effect at zero for `model` and the training
+    `data` (a `Dataset`), or None where it does not apply or the data cannot show it
+    (default: `effect()` on the `families`); `probes(model, data)` `{field: value}` for
+    parameters scored by a secant to that value (parameters bounded at zero, or switched
+    off below a threshold, have no useful derivative there); `separate`: the experiment
+    that tells it apart from the effects it resembles; `rudder_range`: for effects whose
+    parameters have family units (no bounds), the largest plausible rudder-equivalent
+    angle [rad] of their loads (`rudder_equivalent`)."""
 
-    id: str
+    effect: type | tuple[type, ...]
     name: str
-    make: Callable
+    families: tuple[str, ...] = ("vessel", "steering")
+    make: Callable | None = None
     probes: Callable = lambda model, data: {}
     separate: str = ""
     rudder_range: float | None = None
+
+    def __post_init__(self):
+        classes = self.effect if isinstance(self.effect, tuple) else (self.effect,)
+        if len({c.id for c in classes}) != 1:
+            raise ValueError(f"a candidate's effect classes must share one id, got "
+                             f"{', '.join(c.id for c in classes)}.")
+
+    @property
+    def id(self) -> str:
+        return (self.effect if isinstance(self.effect, type) else self.effect[0]).id
+
+    def build(self, model, data):
+        """The effect at zero for `model` on `data`, or None (see `make`)."""
+        if self.make is not None:
+            effect = self.make(model, data)
+        else:
+            effect = self.effect() if any(_is(model, f) for f in self.families) else None
+        if effect is not None and not isinstance(effect, self.effect):
+            raise TypeError(f"candidate {self.id!r} made a {type(effect).__name__}.")
+        return effect
 
 
 def _is(model, family):
@@ -70,11 +94,6 @@ def _is(model, family):
 
 def _measured(data, *channels) -> bool:
     return all(c in have for have in data.experiment_channels for c in channels)
-
-
-def _simple(cls, *families):
-    """`make` for an effect class acting on the given families of models."""
-    return lambda model, data: cls() if any(_is(model, f) for f in families) else None
 
 
 def _speed_dependent_rudder(model, data):
@@ -124,7 +143,7 @@ def _rate_probe(model, data):
     return {"inverse_rate": 2.0 / max(max(rates), 1e-6)}
 
 
-BOTH, VESSEL, STEERING = ("vessel", "steering"), ("vessel",), ("steering",)
+VESSEL = ("vessel",)  # `families` of the entries that act on vessels only
 SPEEDS = ("runs at two speeds or rpm: a rudder offset's moment scales with the rudder "
           "inflow speed squared, a constant moment does not, a propeller moment with rpm")
 STEADY_TURNS = ("steady turns over a wide range of yaw rate and rudder angle (turning "
@@ -138,55 +157,50 @@ RUDDER_STEPS = ("rudder steps of different sizes and fast reversals: a lag's or 
                 "timing is the same for every step, a rate limit's grows with the step")
 
 DISCOVERY_CATALOGUE = (
-    Candidate("rudder_offset", "rudder zero offset (indicator error or hull asymmetry)",
-              _simple(RudderOffset, *BOTH), separate=SPEEDS),
-    Candidate("yaw_moment_bias", "constant yaw moment (hull or appendage asymmetry)",
-              _simple(YawMomentBias, *BOTH), separate=SPEEDS, rudder_range=BIAS_RANGE),
-    Candidate("propeller_asymmetry", "propeller-induced yaw moment (single screw)",
-              _propeller_asymmetry, separate=SPEEDS, rudder_range=BIAS_RANGE),
-    Candidate("propeller_race", "rudder in the propeller race (inflow from rpm)",
-              _propeller_race,
+    Candidate(RudderOffset, "rudder zero offset (indicator error or hull asymmetry)",
+              separate=SPEEDS),
+    Candidate(YawMomentBias, "constant yaw moment (hull or appendage asymmetry)",
+              separate=SPEEDS, rudder_range=BIAS_RANGE),
+    Candidate(PropellerAsymmetry, "propeller-induced yaw moment (single screw)",
+              make=_propeller_asymmetry, separate=SPEEDS, rudder_range=BIAS_RANGE),
+    Candidate(PropellerRace, "rudder in the propeller race (inflow from rpm)",
+              make=_propeller_race,
               separate="runs at several rpm and at low or changing speed: the race's rudder "
                        "force grows with rpm squared, a rudder gain does not",
               rudder_range=HARD_OVER),
-    Candidate("sway_force_bias", "constant sway force", _simple(SwayForceBias, *VESSEL),
+    Candidate(SwayForceBias, "constant sway force", VESSEL,
               separate="measured sway velocity on straight legs", rudder_range=BIAS_RANGE),
-    Candidate("current", "uniform current", _simple(UniformCurrent, *VESSEL),
+    Candidate(UniformCurrent, "uniform current", VESSEL,
               separate="GNSS tracks on several headings: a current drifts each the same "
                        "earth-fixed way, a compass bias sets it off to one side of the heading"),
-    Candidate("wind", "wind loads (windage the model lacks)", _wind, probes=_wind_probes,
-              separate="runs at several headings to the wind", rudder_range=HARD_OVER),
-    Candidate("crossflow_drag", "cross-flow drag of the hull", _simple(CrossflowDrag, *VESSEL),
+    Candidate((Windage, ApparentWind), "wind loads (windage the model lacks)", make=_wind,
+              probes=_wind_probes, separate="runs at several headings to the wind",
+              rudder_range=HARD_OVER),
+    Candidate(CrossflowDrag, "cross-flow drag of the hull", VESSEL,
               probes=lambda model, data: {"coefficient": 0.02}, separate=STEADY_TURNS),
-    Candidate("yaw_quadratic_damping", "quadratic yaw damping r|r|",
-              _simple(YawQuadraticDamping, *BOTH), separate=STEADY_TURNS,
+    Candidate(YawQuadraticDamping, "quadratic yaw damping r|r|", separate=STEADY_TURNS,
               rudder_range=HARD_OVER),
-    Candidate("yaw_cubic_damping", "cubic yaw damping r^3 (Norrbin)",
-              _simple(YawCubicDamping, *BOTH), separate=STEADY_TURNS,
+    Candidate(YawCubicDamping, "cubic yaw damping r^3 (Norrbin)", separate=STEADY_TURNS,
               rudder_range=HARD_OVER),
-    Candidate("speed_dependent_rudder", "rudder force changing with inflow speed",
-              _speed_dependent_rudder,
+    Candidate(SpeedDependentRudder, "rudder force changing with inflow speed",
+              make=_speed_dependent_rudder,
               separate="turning circles (speed loss) or runs at several speeds"),
-    Candidate("speed_dependent_damping", "yaw damping scaling with speed (Nomoto's T = T'L/U)",
-              _speed_dependent_damping,
+    Candidate(SpeedDependentDamping, "yaw damping scaling with speed (Nomoto's T = T'L/U)",
+              make=_speed_dependent_damping,
               separate="turning circles (speed loss) or runs at several speeds"),
-    Candidate("rudder_stall", "rudder lift saturation (stall)", _simple(RudderStall, *BOTH),
-              separate=STEADY_TURNS),
-    Candidate("rudder_rate_limit", "rudder rate limit (slow steering gear)",
-              _simple(RudderRateLimit, *BOTH), probes=_rate_probe, separate=RUDDER_STEPS),
-    Candidate("rudder_delay", "rudder or time-stamp delay", _simple(RudderDelay, *BOTH),
+    Candidate(RudderStall, "rudder lift saturation (stall)", separate=STEADY_TURNS),
+    Candidate(RudderRateLimit, "rudder rate limit (slow steering gear)", probes=_rate_probe,
+              separate=RUDDER_STEPS),
+    Candidate(RudderDelay, "rudder or time-stamp delay",
               probes=lambda model, data: {"delay": 0.5}, separate=RUDDER_STEPS),
-    Candidate("rudder_lag", "rudder (steering gear) lag", _simple(RudderLag, *BOTH),
+    Candidate(RudderLag, "rudder (steering gear) lag",
               probes=lambda model, data: {"time_constant": 0.5}, separate=RUDDER_STEPS),
-    Candidate("surge_turn_resistance", "added surge resistance in turns",
-              _simple(SurgeTurnResistance, *VESSEL),
+    Candidate(SurgeTurnResistance, "added surge resistance in turns", VESSEL,
               separate="measured surge speed through turns"),
-    Candidate("added_mass_error", "added mass (inertia) error",
-              _simple(AddedMassError, *VESSEL), separate=RUDDER_STEPS),
-    Candidate("yaw_rate_sensor_bias", "yaw-rate gyro bias", _simple(YawRateSensorBias, *BOTH),
+    Candidate(AddedMassError, "added mass (inertia) error", VESSEL, separate=RUDDER_STEPS),
+    Candidate(YawRateSensorBias, "yaw-rate gyro bias",
               separate="the heading record: psi integrates the true r, not the reading"),
-    Candidate("heading_sensor_bias", "heading (compass) bias",
-              _simple(HeadingSensorBias, *BOTH),
+    Candidate(HeadingSensorBias, "heading (compass) bias",
               separate="an external heading reference (GNSS course on straight legs on "
                        "several headings: a current's drift angle changes with heading)"),
 )
@@ -200,7 +214,7 @@ def applicable(model, data, catalogue=DISCOVERY_CATALOGUE, exclude=()) -> list:
     for entry in catalogue:
         if entry.id in exclude:
             continue
-        effect = entry.make(model, data)
+        effect = entry.build(model, data)
         if effect is not None:
             out.append((entry, effect, entry.probes(model, data)))
     return out
