@@ -5,7 +5,8 @@ source tree.
   `notebooks/NAME/`: their files are added to the build as they are, and mkdocs-jupyter
   renders them with the outputs CI stored (`execute: false`).
 - The home page (`docs/index.md`) takes the README below its first heading, its links
-  into `docs/` made relative to the site.
+  into `docs/` made relative to the site, the notebooks' link to the first notebook's page
+  and the benchmarks' README named as a file of the project.
 """
 
 import pathlib
@@ -33,4 +34,7 @@ def on_page_markdown(markdown, page, config, files):
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     body = readme.split("\n", 1)[1] if readme.startswith("# ") else readme
     body = re.sub(r"\]\(docs/", "](", body)
+    # the notebooks are pages of the site; the benchmarks' README is a file of the project
+    body = body.replace("](notebooks/)", "](notebooks/quick_start.ipynb)")
+    body = re.sub(r"\[([^\]]+)\]\(benchmarks/README\.md\)", r"`benchmarks/README.md`", body)
     return markdown.replace(README_MARKER, body)
