@@ -2,7 +2,7 @@
 effects of `jaxship.augment`, each zero (absent) in the base model.
 
 An entry names the effect class (its id names the candidate) and says how to make it
-for a model (the families it acts on, or `make(model, data)`; None where it does not
+for a model (the kinds of model it acts on, or `make(model, data)`; None where it does not
 apply: e.g. a sway force on a steering model), which of its parameters a probe
 value differentiates (effects switched off below a threshold, such as a lag, have no
 derivative at zero), and which experiment separates it from the effects it is often
@@ -48,19 +48,19 @@ from ._plausible import HARD_OVER
 class Candidate:
     """One catalogue entry: the `effect` class (or classes with one id: the wind on a
     vessel and on a steering model), whose `id` names the candidate; `name` (what a
-    naval architect calls it); `families` the models it acts on (`"vessel"`,
-    `"steering"`); `make(model, data)` the effect at zero for `model` and the training
-    `data` (a `Dataset`), or None where it does not apply or the data cannot show it
-    (default: `effect()` on the `families`); `probes(model, data)` `{field: value}` for
-    parameters scored by a secant to that value (parameters bounded at zero, or switched
-    off below a threshold, have no useful derivative there); `separate`: the experiment
+    naval architect calls it); `acts_on` the model classes it acts on (vessels and
+    steering models by default); `make(model, data)` the effect at zero for `model` and
+    the training `data` (a `Dataset`), or None where it does not apply or the data cannot
+    show it (default: `effect()` on the models of `acts_on`); `probes(model, data)`
+    `{field: value}` for parameters scored by a secant to that value (parameters bounded
+    at zero, or switched off below a threshold, have no useful derivative there); `separate`: the experiment
     that tells it apart from the effects it resembles; `rudder_range`: for effects whose
     parameters have family units (no bounds), the largest plausible rudder-equivalent
     angle [rad] of their loads (`rudder_equivalent`)."""
 
     effect: type | tuple[type, ...]
     name: str
-    families: tuple[str, ...] = ("vessel", "steering")
+    acts_on: tuple[type, ...] = (AbstractVessel, AbstractSteeringModel)
     make: Callable | None = None
     probes: Callable = lambda model, data: {}
     separate: str = ""
@@ -81,15 +81,10 @@ class Candidate:
         if self.make is not None:
             effect = self.make(model, data)
         else:
-            effect = self.effect() if any(_is(model, f) for f in self.families) else None
+            effect = self.effect() if isinstance(model, self.acts_on) else None
         if effect is not None and not isinstance(effect, self.effect):
             raise TypeError(f"candidate {self.id!r} made a {type(effect).__name__}.")
         return effect
-
-
-def _is(model, family):
-    return isinstance(model, {"vessel": AbstractVessel,
-                              "steering": AbstractSteeringModel}[family])
 
 
 def _measured(data, *channels) -> bool:
@@ -97,7 +92,7 @@ def _measured(data, *channels) -> bool:
 
 
 def _speed_dependent_rudder(model, data):
-    if _is(model, "vessel"):
+    if isinstance(model, AbstractVessel):
         return SpeedDependentRudder()
     if _measured(data, "u"):  # a steering model sees the measured u
         return SpeedDependentRudder(nominal_speed=float(np.mean(data.u[data.mask])))
@@ -105,18 +100,21 @@ def _speed_dependent_rudder(model, data):
 
 
 def _speed_dependent_damping(model, data):
-    if _is(model, "steering") and _measured(data, "u"):  # a vessel's damping scales already
+    # a vessel's damping scales with speed already
+    if isinstance(model, AbstractSteeringModel) and _measured(data, "u"):
         return SpeedDependentDamping(nominal_speed=float(np.mean(data.u[data.mask])))
     return None
 
 
 def _propeller_asymmetry(model, data):
-    return PropellerAsymmetry() if _is(model, "vessel") or _measured(data, "n") else None
+    applies = isinstance(model, AbstractVessel) or _measured(data, "n")
+    return PropellerAsymmetry() if applies else None
 
 
 def _propeller_race(model, data):
     """Steering models only (a vessel's rudder model carries the race), where n is logged."""
-    return PropellerRace() if _is(model, "steering") and _measured(data, "n") else None
+    applies = isinstance(model, AbstractSteeringModel) and _measured(data, "n")
+    return PropellerRace() if applies else None
 
 
 def _wind(model, data):
@@ -124,13 +122,13 @@ def _wind(model, data):
     needs u and v to make the apparent wind), where the wind is logged."""
     if not _measured(data, "wind_speed", "wind_dir"):
         return None
-    if _is(model, "vessel"):
+    if isinstance(model, AbstractVessel):
         return Windage()
     return ApparentWind() if _measured(data, "u", "v") else None
 
 
 def _wind_probes(model, data):
-    if _is(model, "vessel"):
+    if isinstance(model, AbstractVessel):
         return {"lateral_area": 0.05 * float(model.length) ** 2,
                 "frontal_area": 0.01 * float(model.length) ** 2}
     return {}
@@ -143,7 +141,7 @@ def _rate_probe(model, data):
     return {"inverse_rate": 2.0 / max(max(rates), 1e-6)}
 
 
-VESSEL = ("vessel",)  # `families` of the entries that act on vessels only
+VESSEL = (AbstractVessel,)  # `acts_on` of the entries that act on vessels only
 SPEEDS = ("runs at two speeds or rpm: a rudder offset's moment scales with the rudder "
           "inflow speed squared, a constant moment does not, a propeller moment with rpm")
 STEADY_TURNS = ("steady turns over a wide range of yaw rate and rudder angle (turning "
