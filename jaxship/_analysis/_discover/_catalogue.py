@@ -53,10 +53,11 @@ class Candidate:
     the training `data` (a `Dataset`), or None where it does not apply or the data cannot
     show it (default: `effect()` on the models of `acts_on`); `probes(model, data)`
     `{field: value}` for parameters scored by a secant to that value (parameters bounded
-    at zero, or switched off below a threshold, have no useful derivative there); `separate`: the experiment
-    that tells it apart from the effects it resembles; `rudder_range`: for effects whose
-    parameters have family units (no bounds), the largest plausible rudder-equivalent
-    angle [rad] of their loads (`rudder_equivalent`)."""
+    at zero, or switched off below a threshold, have no useful derivative there);
+    `separate`: the experiment that tells it apart from the effects it resembles;
+    `rudder_range`: for effects whose parameters have family units (no bounds), the
+    largest plausible rudder-equivalent angle [rad] of their loads
+    (`rudder_equivalent`)."""
 
     effect: type | tuple[type, ...]
     name: str
