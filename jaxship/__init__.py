@@ -48,6 +48,8 @@ from ._estimate._armax import ARMAX as ARMAX
 from ._estimate._discrete_estimator import DiscreteResponse as DiscreteResponse
 from ._estimate._fit import (
     AbstractEstimator as AbstractEstimator,
+    EstimatedStarts as EstimatedStarts,
+    MeasuredStates as MeasuredStates,
     PredictionError as PredictionError,
     fit as fit,
 )

@@ -428,7 +428,7 @@ def test_fit_recovers_the_wind_a_steering_model_feels_from_logged_wind():
     train, _ = wind_records(truth, 0)
     start = js.augment(js.Nomoto1(K=0.05, T=20.0), js.ApparentWind())
     res = js.fit(start, train, estimator=js.PredictionError(horizon=60.0, wind=True,
-                                                            initial="estimate"))
+                                                            initial=js.EstimatedStarts()))
     got = dict(zip(res.names, zip(res.values, res.parameters.std_robust)))
     for name, value in (("wind.c2", 3e-6), ("wind.c1", 0.0)):
         assert abs(got[name][0] - value) < 3 * got[name][1], (name, got[name])

@@ -151,7 +151,7 @@ def test_interval_coverage_under_measurement_noise_without_retracing():
     truth = Nomoto1(K=0.06, T=25.0)
     delta = zigzag_like(600, 5)
     tr = simulate_steering(truth, delta, DT, hold="foh")
-    estimator = PredictionError(horizon=None, initial="estimate")
+    estimator = PredictionError(horizon=None, initial=js.EstimatedStarts())
     covered, sizes = [], []
     for seed in range(40):
         rng = np.random.default_rng(1000 + seed)
@@ -221,9 +221,11 @@ def test_other_bad_inputs():
         t = np.asarray(data.t).copy()
         t[10:] += 0.1
         fit(Nomoto1(K=0.05, T=20.0), js.Experiment(t, data.delta, psi=data.psi, r=data.r))
-    with pytest.raises(ValueError, match="initial='estimate'"):
-        fit(Nomoto1(K=0.05, T=20.0), data, estimator=PredictionError(horizon=0.0,
-                                                                     initial="estimate"))
+    with pytest.raises(ValueError, match=r"initial=EstimatedStarts\(\)` needs windows"):
+        fit(Nomoto1(K=0.05, T=20.0), data,
+            estimator=PredictionError(horizon=0.0, initial=js.EstimatedStarts()))
+    with pytest.raises(ValueError, match="`initial` must be MeasuredStates"):
+        fit(Nomoto1(K=0.05, T=20.0), data, estimator=PredictionError(initial="estimate"))
     with pytest.raises(ValueError, match="unknown output channel"):
         fit(Nomoto1(K=0.05, T=20.0), data, estimator=PredictionError(channels=("v",)))
     with pytest.raises(ValueError, match="steering model"):

@@ -85,7 +85,7 @@ def test_nomoto2_with_noise_inside_its_reported_intervals():
                           r=e.r + 0.01 * DEG * rng.standard_normal(e.num_samples))
             for e in logged_zigzags(truth, 5 * DEG, 0.5)]
     res = js.fit(js.Nomoto2(K=0.05, T1=20.0, T2=2.0, T3=3.0), data,
-                 estimator=js.PredictionError(horizon=None, initial="estimate"))
+                 estimator=js.PredictionError(horizon=None, initial=js.EstimatedStarts()))
     std = res.std if res.parameters.residuals_white else np.fmax(res.std,
                                                                  res.parameters.std_robust)
     error = np.abs(res.values - [0.06, 25.0, 3.0, 5.0])

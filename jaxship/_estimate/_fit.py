@@ -70,6 +70,19 @@ class AbstractEstimator(eqx.Module):
         (see `jaxship.predict`)."""
 
 
+class MeasuredStates(eqx.Module):
+    """`PredictionError(initial=MeasuredStates())` (the default): every window starts from
+    the measured r and psi (and a vessel's u and v) as they are."""
+
+
+class EstimatedStarts(eqx.Module):
+    """`PredictionError(initial=EstimatedStarts())`: corrections of the start r and psi of
+    every window join the estimated parameters (nuisance parameters, reported in no table
+    but counted in the FPE), which removes the errors-in-variables bias of a noisy start
+    sample: output error on noisy data (MATLAB's `InitialState='estimate'`). Costs two
+    parameters per window."""
+
+
 class PredictionError(AbstractEstimator):
     """Prediction-error estimator: the loss and the optimiser of `fit`.
 
@@ -108,12 +121,9 @@ class PredictionError(AbstractEstimator):
       equation-error least-squares estimates of the free parameters of `Nomoto1`,
       `NonlinearNomoto` and `RossAutopilot`); None (default): the model's values.
     - `max_lag`: largest lag of the residual correlation tests [samples].
-    - `initial`: `"measured"` (default) starts each window from the measured r and
-      psi as they are; `"estimate"` adds corrections of the start r and psi of every
-      window to the estimated parameters (nuisance parameters, reported in no table
-      but counted in the FPE), which removes the errors-in-variables bias of a noisy
-      start sample: use it for output error on noisy data (MATLAB's
-      `InitialState='estimate'`). Costs two parameters per window. A list of
+    - `initial`: where each window starts: `MeasuredStates()` (default), the measured r
+      and psi as they are; `EstimatedStarts()`, with corrections of the start r and psi
+      of every window estimated too (for output error on noisy data). A list of
       `SmoothedStates` (one per experiment, from `jaxship.smooth_states`) starts
       the windows from the EKF + RTS smoothed r and psi instead (and a vessel's u and
       v: so a vessel can be fitted to records without a logged v); the targets stay
@@ -137,7 +147,7 @@ class PredictionError(AbstractEstimator):
     max_steps: int = 256
     start: LinearStart | None = None
     max_lag: int = 25
-    initial: str | list = "measured"
+    initial: MeasuredStates | EstimatedStarts | list = MeasuredStates()
     wind: bool = False
     hold: str | dict | None = None
 
@@ -359,11 +369,11 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
         model = estimator.start(model, dataset, free, estimator.rudder)
     ds, windows, layout = _prepare(model, dataset, estimator)
     specs = resolve_free(model, free)
-    estimate_starts = estimator.initial == "estimate"
+    estimate_starts = isinstance(estimator.initial, EstimatedStarts)
     if estimate_starts and min(layout["lengths"]) < 2:
-        raise ValueError("`initial='estimate'` needs windows of at least 2 samples (with one "
-                         "sample the estimated start explains every residual); use a longer "
-                         "`horizon` or initial='measured'.")
+        raise ValueError("`initial=EstimatedStarts()` needs windows of at least 2 samples (with "
+                         "one sample the estimated start explains every residual); use a "
+                         "longer `horizon` or MeasuredStates().")
     base = as_arrays(model)
     needed = _stable_substeps(base, windows)
     if needed > windows.substeps:  # the step follows the start model's fastest mode
@@ -422,7 +432,7 @@ def _prepare(model, dataset, estimator):
                          f"effect (jaxship.ApparentWind); {type(model).__name__} has no wind "
                          "loads.")
     servo = estimator.rudder == "delta_c"
-    smoothed = not isinstance(estimator.initial, str)
+    smoothed = isinstance(estimator.initial, (list, tuple))
     starts = _smoothed_starts(ds, estimator.initial) if smoothed else None
     needed = [c for c in model.start_channels if starts is None or c not in starts]
     needed += ["delta"] if servo and model.has_servo else []
@@ -438,9 +448,9 @@ def _prepare(model, dataset, estimator):
                 "a steering model instead).")
     if int(estimator.substeps) < 1:
         raise ValueError(f"`substeps` must be a positive integer, got {estimator.substeps}.")
-    if not smoothed and estimator.initial not in ("measured", "estimate"):
-        raise ValueError(f"`initial` must be 'measured', 'estimate' or a list of smoothed "
-                         f"states, got {estimator.initial!r}.")
+    if not (smoothed or isinstance(estimator.initial, (MeasuredStates, EstimatedStarts))):
+        raise ValueError(f"`initial` must be MeasuredStates(), EstimatedStarts() or a list of "
+                         f"SmoothedStates, got {estimator.initial!r}.")
     windows, layout = build_windows(ds, horizon=estimator.horizon, channels=channels,
                                     weights=estimator.weights, rudder=estimator.rudder,
                                     substeps=int(estimator.substeps), starts=starts,

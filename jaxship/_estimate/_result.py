@@ -61,7 +61,7 @@ class FitResult(SolverOutcome):
     criterion: str = "prediction error"
     noise: dict | None = None  # innovations estimators: {name: variance} at the optimum
     noise_std: dict | None = None  # their standard errors (0 where held, NaN: not computed)
-    # `initial="estimate"`: the estimated corrections of the window starts' (r, psi),
+    # `initial=EstimatedStarts()`: the estimated corrections of the window starts' (r, psi),
     # shape (E, W, 2) as the windows of the fit
     start_offsets: np.ndarray | None = None
 

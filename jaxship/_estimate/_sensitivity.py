@@ -72,7 +72,7 @@ def sensitivities(model, dataset, estimator, names, probes=None,
     their Jacobian with respect to the parameters `names` at the model's values.
     `probes`: `{name: value}` for parameters differentiated by a secant to `value`.
     `start_offsets` (E, W, 2): the window-start corrections of a fit with
-    `initial="estimate"` (`FitResult.start_offsets`); they are differentiated too, as
+    `initial=EstimatedStarts()` (`FitResult.start_offsets`); they are differentiated too, as
     the parameters `"start[k]"` (appended to `names`)."""
     probes = dict(probes or {})
     ds, windows, layout = _prepare(model, dataset, estimator)

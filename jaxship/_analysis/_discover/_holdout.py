@@ -4,7 +4,7 @@ manoeuvre indices of each record, measured and predicted."""
 
 import numpy as np
 
-from ..._estimate._fit import PredictionError
+from ..._estimate._fit import MeasuredStates, PredictionError
 from ..._estimate._predict import predict
 from ..._estimate._windows import as_dataset
 from .._indices import turning_indices, zigzag_indices
@@ -12,7 +12,7 @@ from .._indices._series import _peak
 
 
 def holdout_check(model, holdout, channels, wind: bool = False, window=None,
-                  initial="measured") -> dict:
+                  initial=MeasuredStates()) -> dict:
     """Output-error predictions of `holdout` by `model` (with the logged wind replayed
     if `wind`): `cost` (half the sum of squared residuals, each channel divided by the
     standard deviation of its measured record, so models compare on one scale),

@@ -5,7 +5,7 @@ Ljung 1999, sec. 16.6, residual analysis; Astrom & Kallstrom 1979, sec. 5)."""
 
 import numpy as np
 
-from ..._estimate._fit import PredictionError
+from ..._estimate._fit import MeasuredStates, PredictionError
 from ..._estimate._predict import predict
 from ..._estimate._windows import as_dataset
 from ..._models._vessel._base import AbstractVessel
@@ -93,7 +93,7 @@ def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 6
         "v" in h for h in ds.experiment_channels) else None)
     out = predict(model, ds, estimator=PredictionError(
         horizon=None, channels=channels, wind=wind,
-        initial="measured" if smoothed is None else smoothed))
+        initial=MeasuredStates() if smoothed is None else smoothed))
     fit = out.fit_per_experiment()
     res, sig, reg = {c: [] for c in channels}, {}, {}
     records, windows = {}, {}

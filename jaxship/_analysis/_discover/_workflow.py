@@ -38,7 +38,7 @@ import math
 import numpy as np
 from scipy import stats
 
-from ..._estimate._fit import PredictionError, fit
+from ..._estimate._fit import EstimatedStarts, MeasuredStates, PredictionError, fit
 from ..._estimate._lm import RESULTS
 from ..._estimate._sensitivity import sensitivities
 from ..._estimate._windows import as_dataset
@@ -144,7 +144,8 @@ _JUDGED_BY_GATES = (RESULTS.successful, RESULTS.at_bound, RESULTS.poorly_determi
 
 
 def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
-             estimator: PredictionError = PredictionError(horizon=60.0, initial="estimate"),
+             estimator: PredictionError = PredictionError(horizon=60.0,
+                                                          initial=EstimatedStarts()),
              free=None,
              max_effects: int = 3, alpha: float = 0.01, top: int = 3,
              equivalence: float = 0.98, progress=None) -> DiscoveryReport:
@@ -191,8 +192,8 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         # (GNSS) its track too: a current shows
         channels = tuple(c for c in model.default_channels + ("x", "y") if everywhere(c))
         estimator = dataclasses.replace(estimator, channels=channels)
-    held_start = "measured"
-    if vessel and not everywhere("v") and isinstance(estimator.initial, str):
+    held_start = MeasuredStates()
+    if vessel and not everywhere("v") and not isinstance(estimator.initial, (list, tuple)):
         # a vessel's windows start from its states smoothed from psi, r, u and the track
         smoothed = [smoothed_vessel_states(model, d) for d in (data, held) if d is not None]
         if any(s is None for s in smoothed):

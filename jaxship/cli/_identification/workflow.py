@@ -170,7 +170,9 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     solver = js.LevenbergMarquardt(rtol=1e-9, atol=1e-9)
     estimator = js.PredictionError(horizon=horizon, channels=channels, rudder=rudder,
                                 substeps=int(substeps), solver=solver,
-                                max_steps=int(max_steps), initial=initial)
+                                max_steps=int(max_steps),
+                                initial={"estimate": js.EstimatedStarts(),
+                                         "measured": js.MeasuredStates()}[initial])
 
     def run_fit(start_model, *, free=None, stage="fitting", custom=None):
         relay = lambda event: report(dataclasses.replace(event, message=stage))
