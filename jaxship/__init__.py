@@ -45,7 +45,11 @@ from ._analysis._indices import (
     zigzag_indices as zigzag_indices,
 )
 from ._estimate._armax import ARMAX as ARMAX
-from ._estimate._discrete_estimator import DiscreteResponse as DiscreteResponse
+from ._estimate._discrete_estimator import (
+    DiscreteResponse as DiscreteResponse,
+    LeastSquaresRegression as LeastSquaresRegression,
+    SupportVectorRegression as SupportVectorRegression,
+)
 from ._estimate._fit import (
     AbstractEstimator as AbstractEstimator,
     EstimatedStarts as EstimatedStarts,
@@ -60,7 +64,11 @@ from ._estimate._kalman import (
     rts_smoother as rts_smoother,
     smooth_states as smooth_states,
 )
-from ._estimate._likelihood import Innovations as Innovations
+from ._estimate._likelihood import (
+    Innovations as Innovations,
+    InnovationsLeastSquares as InnovationsLeastSquares,
+    MaximumLikelihood as MaximumLikelihood,
+)
 from ._estimate._linear import LinearStart as LinearStart
 from ._estimate._lm import RESULTS as RESULTS, LevenbergMarquardt as LevenbergMarquardt
 from ._estimate._predict import predict as predict

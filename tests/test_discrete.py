@@ -95,6 +95,12 @@ def test_svr_recovers_noise_free(structure):
     # an iterative QP solver (liblinear, tol 1e-8): agreement to its tolerance
     for k in COEFFICIENTS[structure]:
         assert svr.coefficients[k] == pytest.approx(ls.coefficients[k], rel=1e-5, abs=1e-12)
+    # the same through the one door, with the method as a strategy object
+    door = js.fit(STEERING[structure](), e,
+                  estimator=js.DiscreteResponse(method=js.SupportVectorRegression()))
+    assert door.criterion.startswith("equation error (svr")
+    least_squares = js.fit(STEERING[structure](), e, estimator=js.DiscreteResponse())
+    assert door.values == pytest.approx(least_squares.values, rel=1e-4, abs=1e-9)
 
 
 def test_bad_inputs():

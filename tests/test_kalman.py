@@ -243,7 +243,7 @@ def test_fit_with_the_innovations_estimator_is_fit_ml():
     exp, _, _ = noisy_record(TRUTH, 400, 11)
     start = Nomoto1(K=0.05, T=20.0)
     direct = fit_ml(start, exp, criterion="pem")
-    res = js.fit(start, exp, estimator=js.Innovations(criterion="pem"))
+    res = js.fit(start, exp, estimator=js.Innovations(criterion=js.InnovationsLeastSquares()))
     assert isinstance(res, js.FitResult) and res.criterion == "pem"
     np.testing.assert_allclose(res.values, direct.values, rtol=1e-12)
     assert res.noise == direct.noise and set(res.metrics) == {"psi", "r"}

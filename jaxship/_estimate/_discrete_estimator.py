@@ -62,20 +62,32 @@ def structure_of(model) -> str:
                      f"{type(model).__name__}.")
 
 
+class LeastSquaresRegression(eqx.Module):
+    """`DiscreteResponse(method=LeastSquaresRegression())` (the default): the discrete
+    coefficients by linear least squares (`numpy.linalg.lstsq`)."""
+
+
+class SupportVectorRegression(eqx.Module):
+    """`DiscreteResponse(method=SupportVectorRegression(C, epsilon))`: the discrete
+    coefficients by epsilon-SVR with a linear kernel (scikit-learn `LinearSVR`; Lu & Zhao
+    2008), regulariser `C`, insensitivity `epsilon` [rad/s]."""
+
+    C: float = 1e10
+    epsilon: float = 0.0
+
+
 class DiscreteResponse(AbstractEstimator):
     """Equation-error fit of Lu & Zhao's discrete response models for `jaxship.fit`:
-    `method` `"ls"` (least squares) or `"svr"` (epsilon-SVR, scikit-learn, regulariser
-    `C`, insensitivity `epsilon` [rad/s]); `discretisation` `"zoh"` (linear models'
+    `method` `LeastSquaresRegression()` (default) or `SupportVectorRegression(C,
+    epsilon)`; `discretisation` `"zoh"` (linear models'
     default) or `"euler"`; `rudder` `"delta"` or `"delta_c"`. Equation-error
     estimates are biased by noise on r (errors in variables): use them as start values
     or quick looks, `PredictionError` for final estimates. `free` must be None: the
     structure fixes the parameters (with $n_1 = 1$ and $\\alpha_1 = 1$ frozen)."""
 
-    method: str = eqx.field(static=True, default="ls")
+    method: LeastSquaresRegression | SupportVectorRegression = LeastSquaresRegression()
     discretisation: str | None = eqx.field(static=True, default=None)
     rudder: str = eqx.field(static=True, default="delta")
-    C: float = 1e10
-    epsilon: float = 0.0
     max_lag: int = 25
 
     def fit(self, model, dataset, free=None, progress=None) -> FitResult:
@@ -86,14 +98,20 @@ class DiscreteResponse(AbstractEstimator):
         ds = as_dataset(dataset)
         check_data(ds, self.rudder, ("r",))
         records = [_experiment(ds, i, self.rudder) for i in range(ds.num_experiments)]
-        res = fit_discrete_response(structure, records, method=self.method,
-                                    discretisation=self.discretisation, rudder="delta",
-                                    C=self.C, epsilon=self.epsilon)
+        if isinstance(self.method, SupportVectorRegression):
+            options = dict(method="svr", C=self.method.C, epsilon=self.method.epsilon)
+        elif isinstance(self.method, LeastSquaresRegression):
+            options = dict(method="ls")
+        else:
+            raise ValueError(f"`method` must be LeastSquaresRegression() or "
+                             f"SupportVectorRegression(), got {self.method!r}.")
+        res = fit_discrete_response(structure, records, discretisation=self.discretisation,
+                                    rudder="delta", **options)
         fitted = res.to_steering()
         values = _PARAMETERS[structure](res.parameters)
         names = tuple(values)
         fields = parameter_fields(fitted)
-        covariance = _covariance(res, records) if self.method == "ls" else np.full(
+        covariance = _covariance(res, records) if options["method"] == "ls" else np.full(
             (len(names),) * 2, np.nan)
         report = parameter_report(names, np.array([values[k] for k in names]), covariance,
                                   units=tuple(fields[k].unit for k in names))
@@ -112,7 +130,7 @@ class DiscreteResponse(AbstractEstimator):
             else optx.RESULTS.nonlinear_max_steps_reached, num_steps=1,
             cost=0.5 * float(np.sum(((r - line) * mask) ** 2)), weights={"r": 1.0},
             window_samples=(1,), horizon=res.dt, experiment_names=tuple(ds.names),
-            criterion=f"equation error ({self.method}, Lu & Zhao {structure})")
+            criterion=f"equation error ({options['method']}, Lu & Zhao {structure})")
 
     def predict(self, model, dataset) -> Prediction:
         """One-step-ahead predictions of r by the continuous `model` over each sample

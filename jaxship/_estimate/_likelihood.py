@@ -312,14 +312,27 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
                    result, steps, criterion)
 
 
+class MaximumLikelihood(eqx.Module):
+    """`Innovations(criterion=MaximumLikelihood())` (the default): minimise the negative
+    log likelihood of the innovations over the model parameters and the log noise
+    variances (BFGS; standard errors from the inverse Hessian; Ljung 1999, sec. 7.4)."""
+
+
+class InnovationsLeastSquares(eqx.Module):
+    """`Innovations(criterion=InnovationsLeastSquares())`: the prediction-error method with
+    the innovations predictor, the weighted innovations minimised as least squares
+    (Levenberg-Marquardt; Ljung 1999, secs. 4.3, 7.2); the first channel's noise variance
+    is held, as the innovations do not fix the overall noise scale."""
+
+
 class Innovations(AbstractEstimator):
     """The innovations estimator of `jaxship.fit`: the extended Kalman filter's
     one-step-ahead prediction errors, minimised by maximum likelihood with the noise
-    variances (`criterion="ml"`) or as a prediction error (`"pem"`); the arguments
-    are those of `fit_ml`. The `FitResult` carries the noise (`noise`, `noise_std`)
-    and the filter's predictions."""
+    variances (`criterion=MaximumLikelihood()`) or as least squares
+    (`InnovationsLeastSquares()`); the other arguments are those of `fit_ml`. The
+    `FitResult` carries the noise (`noise`, `noise_std`) and the filter's predictions."""
 
-    criterion: str = "ml"
+    criterion: MaximumLikelihood | InnovationsLeastSquares = MaximumLikelihood()
     channels: tuple[str, ...] = KALMAN_CHANNELS
     process: str | tuple = "rudder"
     noise: str | dict = "estimate"
@@ -331,8 +344,12 @@ class Innovations(AbstractEstimator):
     hold: str | dict | None = None
 
     def fit(self, model, dataset, free=None, progress=None) -> FitResult:
+        if not isinstance(self.criterion, (MaximumLikelihood, InnovationsLeastSquares)):
+            raise ValueError(f"`criterion` must be MaximumLikelihood() or "
+                             f"InnovationsLeastSquares(), got {self.criterion!r}.")
+        criterion = "ml" if isinstance(self.criterion, MaximumLikelihood) else "pem"
         return fit_ml(model, dataset, free=free, channels=self.channels,
-                      criterion=self.criterion, process=self.process, noise=self.noise,
+                      criterion=criterion, process=self.process, noise=self.noise,
                       noise_start=self.noise_start, rudder=self.rudder,
                       substeps=self.substeps, max_steps=self.max_steps, solver=self.solver,
                       hold=self.hold)
