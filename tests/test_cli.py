@@ -431,3 +431,58 @@ def test_mmg_coefficients_have_units(preset):
     assert fields["rho"].unit == "kg/m^3"
     assert {spec.unit for spec in resolve_free(js.vessel(preset))} == {"-"}
     assert all(not info.unit for info in parameter_fields(js.vessel("mariner")).values())
+
+
+@pytest.mark.slow
+def test_ctrl_c_ends_the_command_with_130_at_once_every_time(tmp_path):
+    """The trust audit: Ctrl-C on `discover` segfaulted (exit 139) after printing
+    "interrupted.", and an interrupt raised inside a garbage-collection callback was
+    swallowed so the run went on to exit 0. Now a real SIGINT at any stage of the
+    command's work (from its first progress line on; before it, Python is still
+    importing the package) ends it with status 130 within `GRACE` seconds, with no
+    traceback, and a file of the user's in --out is left as it was."""
+    import signal
+    import subprocess
+    import sys
+    import threading
+    import time
+
+    from jaxship.cli import GRACE
+    from jaxship.cli._studies.discovery import hidden_effect_records
+
+    train, held = hidden_effect_records(js.Nomoto1(K=0.06, T=25.0), 0)
+    paths = []
+    for i, record in enumerate(train + held):
+        paths.append(tmp_path / f"r{i}.csv")
+        js.write_trial_csv(paths[-1], record)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "mine.txt").write_text("the user's\n")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    command = [sys.executable, "-m", "jaxship.cli", "discover", *map(str, paths[:-1]),
+               "--holdout", str(paths[-1]), "--model", "nomoto1", "--out", str(out)]
+    for delay in (0.0, 3.0, 8.0):  # start values, scoring, refits
+        process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                   text=True, env=env)
+        lines, started = [], threading.Event()
+
+        def read(stream=process.stderr, lines=lines, started=started):
+            for line in stream:
+                lines.append(line)
+                started.set()
+
+        reader = threading.Thread(target=read, daemon=True)
+        reader.start()
+        assert started.wait(120), "no progress line"
+        time.sleep(delay)
+        sent = time.monotonic()
+        process.send_signal(signal.SIGINT)
+        process.wait(timeout=60)
+        took = time.monotonic() - sent
+        reader.join(10)
+        process.stderr.close()
+        err = "".join(lines)
+        assert process.returncode == 130, (delay, process.returncode, err[-2000:])
+        assert took < GRACE + 3.0, (delay, took)
+        assert "Traceback" not in err and err.rstrip().endswith("jaxship: interrupted."), err
+        assert (out / "mine.txt").read_text() == "the user's\n"

@@ -4,7 +4,11 @@ function (`run`); `main` registers them and turns errors into exit statuses."""
 
 import argparse
 import importlib.metadata
+import os
+import signal
 import sys
+import threading
+import time
 
 import jax
 import matplotlib
@@ -26,6 +30,8 @@ interrupted. JAXSHIP_CACHE_DIR: where compiled programs are kept for later runs 
 ~/.cache/jaxship/jax; "off" disables)."""
 
 COMMANDS = (vessels, simulate, reproduce, identify, autopilot, discover)
+GRACE = 5.0  # [s] after Ctrl-C, the longest the process takes to end
+_INTERRUPTED = threading.Event()
 
 
 def main(argv=None) -> int:
@@ -55,3 +61,37 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("jaxship: interrupted.", file=sys.stderr)
         return 130
+
+
+def run() -> None:
+    """The console entry point: `main`, then exit with its status. After Ctrl-C the
+    process ends with status 130 without the interpreter's teardown, which crashed
+    (SIGSEGV) while XLA's threads were still running; and since an interrupt raised
+    inside a garbage-collection callback is swallowed, a watchdog ends the process
+    `GRACE` seconds after the signal whatever the main thread is doing. Results are
+    committed whole or not at all (`staged_folder`), so ending there loses nothing."""
+    signal.signal(signal.SIGINT, _interrupt)
+    status = main()
+    if _INTERRUPTED.is_set():
+        _end(130)
+    sys.exit(status)
+
+
+def _interrupt(signum, frame):
+    if _INTERRUPTED.is_set():
+        return  # a second Ctrl-C: the watchdog is already on its way
+    _INTERRUPTED.set()
+    threading.Thread(target=_watchdog, daemon=True).start()
+    raise KeyboardInterrupt
+
+
+def _watchdog():
+    time.sleep(GRACE)
+    print("jaxship: interrupted.", file=sys.stderr)
+    _end(130)
+
+
+def _end(status: int):
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(status)

@@ -1,4 +1,4 @@
-from . import main
+from . import run
 
 
-raise SystemExit(main())
+run()
