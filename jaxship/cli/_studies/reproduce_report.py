@@ -406,9 +406,10 @@ def _closed_loop_sentence(model, family, rows, fit, median, vessel_pid):
                  f"vessel's own yaw equation {' / '.join(f'{x:.1f}' for x in vessel_pid)}): "
                  f"the model ({fits}) is far from the vessel's yaw dynamics. ")
     elif spoilt:
+        factors = " and ".join(f"{a / b:.2g}" for a, b in zip(ff, fb) if a > 2 * b)
         text += (f"At {' and '.join(spoilt)} rpm the feed-forward through this model's "
-                 f"inverse makes the loop more than twice as bad as feedback alone (pid "
-                 f"{' / '.join(f'{x:.1f}' for x in fb)}): the model ({fits}) misstates "
+                 f"inverse makes the loop's residual {factors} times that of feedback alone "
+                 f"(pid {' / '.join(f'{x:.1f}' for x in fb)}): the model ({fits}) misstates "
                  f"the vessel's yaw response there, so its inverse orders the wrong rudder. ")
     else:
         side = ["better" if x < 0.4 * median else "worse" if x > 2.5 * median else ""
