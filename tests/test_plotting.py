@@ -316,3 +316,23 @@ def test_parameter_correlation_heat_map():
     ax = fig.axes[0]
     assert [t.get_text() for t in ax.texts][:3] == ["+1.00", "+0.90", "n/a"]
     assert len(fig.axes) == 2  # the heat map and its colour bar
+
+
+def test_the_trial_figure_gives_the_rudder_its_own_axis_and_keeps_thesis_ranges_off_the_data():
+    """`reproduce`'s trial figures: the heading ran to 1600 deg on the axis of a +-40 deg
+    rudder, which drew the rudder flat; the thesis figures' axis ranges were hatched over
+    the data and read as tolerance bands. Now the rudder has its own axis, and a range is
+    a bar beside the axes."""
+    from jaxship.plotting._report import plot_trial_vs_thesis
+
+    _, traj = js.run_trial(js.vessel("thesis"), "turn:40", rpm=500.0, duration=60.0)
+    fig = plot_trial_vs_thesis(traj, bands={"yaw_rate": [(0.0, 6.0, "axis 0-6 deg/s")]})
+    labels = {ax.get_ylabel() for ax in fig.axes}
+    assert {"heading [deg]", "rudder [deg]", "yaw rate [deg/s]"} <= labels
+    rudder = next(ax for ax in fig.axes if ax.get_ylabel() == "rudder [deg]")
+    assert rudder.get_ylim()[1] < 60.0  # scaled to the rudder, not to the heading
+    rate = next(ax for ax in fig.axes if ax.get_ylabel() == "yaw rate [deg/s]")
+    assert not rate.patches  # no shaded span over the data
+    bar = next(line for line in rate.lines if line.get_label() == "axis 0-6 deg/s")
+    assert not bar.get_clip_on() and min(bar.get_xdata()) > 1.0  # outside the axes
+    plt.close(fig)

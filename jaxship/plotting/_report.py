@@ -7,11 +7,13 @@ import numpy as np
 
 
 def _thesis_marks(ax, bands=(), lines=()):
-    """Shade the `bands` [(low, high, label)] and draw the `lines` [(value, label)]: what
-    a thesis figure states (its axis range or a reported value), not a thesis curve."""
+    """Mark the `bands` [(low, high, label)] as a bar outside the right edge of the
+    axes, and draw the `lines` [(value, label)]: what a thesis figure states (its axis
+    range, which is no tolerance and so is kept off the data, or a reported value), not
+    a thesis curve."""
     for low, high, label in bands:
-        ax.axhspan(low, high, facecolor="none", edgecolor="tab:orange", hatch="//", lw=0.0,
-                   alpha=0.6, label=label)
+        ax.plot([1.01, 1.01], [low, high], color="tab:orange", lw=4, solid_capstyle="butt",
+                transform=ax.get_yaxis_transform(), clip_on=False, label=label)
     for value, label in lines:
         ax.axhline(value, color="tab:orange", ls="--", lw=1.2, label=label)
 
@@ -25,7 +27,7 @@ def plot_trial_vs_thesis(traj, *, bands=None, lines=None, track_note="", title="
 
     - `traj`: a `Trajectory` (`t`, `state.x/y/psi/delta/r`, `speed`).
     - `bands`: `{panel: [(low, high, label)]}`, panels `"heading"` [deg], `"yaw_rate"`
-      [deg/s] and `"speed"` [m/s]: hatched ranges, e.g. the tick range of a thesis
+      [deg/s] and `"speed"` [m/s]: ranges marked beside the axes, e.g. the tick range of a thesis
       figure's axis (the thesis prints no curve values).
     - `lines`: `{panel: [(value, label)]}`: dashed lines, e.g. a peak value the thesis
       text reports.
@@ -50,16 +52,24 @@ def plot_trial_vs_thesis(traj, *, bands=None, lines=None, track_note="", title="
         track.text(0.02, 0.02, track_note, transform=track.transAxes, fontsize="small",
                    va="bottom", wrap=True, bbox=dict(facecolor="white", alpha=0.8, lw=0.0))
     axes["heading"].plot(t, np.rad2deg(np.asarray(s.psi)), label=f"{label} heading")
-    axes["heading"].plot(t, np.rad2deg(np.asarray(s.delta)), "--", label=f"{label} rudder")
+    # the rudder (tens of degrees) on its own axis: beside a heading of 1000 deg it is flat
+    rudder = axes["heading"].twinx()
+    rudder.plot(t, np.rad2deg(np.asarray(s.delta)), "--", color="tab:red",
+                label=f"{label} rudder")
+    rudder.set_ylabel("rudder [deg]", color="tab:red")
     axes["yaw_rate"].plot(t, np.rad2deg(np.asarray(s.r)), label=label)
     axes["speed"].plot(t, np.asarray(traj.speed), label=label)
-    units = {"heading": "heading, rudder [deg]", "yaw_rate": "yaw rate [deg/s]",
+    units = {"heading": "heading [deg]", "yaw_rate": "yaw rate [deg/s]",
              "speed": "speed [m/s]"}
     for key, ax in axes.items():
         _thesis_marks(ax, bands.get(key, ()), lines.get(key, ()))
         ax.set(ylabel=units[key])
-        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
-                  fontsize="small")
+        handles, names = ax.get_legend_handles_labels()
+        if key == "heading":
+            more = rudder.get_legend_handles_labels()
+            handles, names = handles + more[0], names + more[1]
+        ax.legend(handles, names, loc="upper left", bbox_to_anchor=(1.13, 1.0),
+                  borderaxespad=0.0, fontsize="small")
         ax.grid(True, alpha=0.3)
     axes["speed"].set(xlabel="time [s]")
     track.grid(True, alpha=0.3)
@@ -109,8 +119,8 @@ def plot_heading_tracking(t, desired, runs, *, window=None, bands=None, title=""
     - `t` [s], `desired` [deg]: the reference model's heading.
     - `runs`: `[(label, heading [deg], rudder [deg])]`, one per autopilot.
     - `window`: (start, end) [s] of the time axis.
-    - `bands`: `{"heading" | "error" | "rudder": [(low, high, label)]}`: hatched
-      ranges, e.g. a thesis figure's axis range.
+    - `bands`: `{"heading" | "error" | "rudder": [(low, high, label)]}`: ranges marked
+      beside the axes, e.g. a thesis figure's axis range.
     - `title`: the figure title.
 
     **Returns:** the matplotlib `Figure`.

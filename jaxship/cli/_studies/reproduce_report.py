@@ -192,8 +192,9 @@ def trials_section(indices, out, design):
                                    label=f"jaxship, {rpm:g} rpm")
         fig.savefig(out / "figures" / f"{name}.png", dpi=100)
         plt.close(fig)
-        caption = ("hatched: the tick range of the thesis figure's axis, dashed: a value "
-                   "the thesis states; the thesis gives no curve values, so none is drawn"
+        caption = ("orange bar beside the axes: the tick range of the thesis figure's axis "
+                   "(where its curve was drawn, no tolerance), dashed: a value the thesis "
+                   "states; the thesis gives no curve values, so none is drawn"
                    if bands or marks else "no thesis figure to compare (appendix A is not "
                    "in the seed)")
         lines.append(f"![{title}](figures/{name}.png)\n\n*{title}: ours; {caption}.*\n")
@@ -376,8 +377,9 @@ def autopilot_section(study, identification, out, quick):
             lines.append(
                 f"![{model} autopilots](figures/{name}.png)\n\n*The {autopilot.MODEL_NAMES[model]}"
                 f" autopilots (pid+ff) at 300 rpm, as in thesis figs. {figs}, 100-200 s; "
-                f"hatched: the range of those figures' axes (heading 0-60 deg, error +-4 "
-                f"deg); the thesis' curves are not available, so none is drawn.*\n")
+                f"orange bars beside the axes: the range of those figures' axes (heading "
+                f"0-60 deg, error +-4 deg; no tolerance); the thesis' curves are not "
+                f"available, so none is drawn.*\n")
     return "\n".join(lines) + "\n"
 
 
