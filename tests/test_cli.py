@@ -490,3 +490,20 @@ def test_ctrl_c_ends_the_command_with_130_at_once_every_time(tmp_path):
         assert took < GRACE + 3.0, (delay, took)
         assert "Traceback" not in err and err.rstrip().endswith("jaxship: interrupted."), err
         assert (out / "mine.txt").read_text() == "the user's\n"
+
+
+def test_help_shows_defaults_and_which_options_are_required(capsys):
+    """`--help` of each command: the options that must be given say "(required)", the
+    others their default where they have one."""
+    seen = {}
+    for command in ("simulate", "identify", "autopilot", "discover"):
+        with pytest.raises(SystemExit) as stop:
+            main([command, "--help"])
+        assert stop.value.code == 0
+        seen[command] = " ".join(capsys.readouterr().out.split())
+    assert "--vessel VESSEL preset name (see `jaxship vessels`) (required)" in seen["simulate"]
+    assert "--out OUT output folder (required)" in seen["identify"]
+    assert "--max-steps MAX_STEPS optimiser step limit (default: 256)" in seen["identify"]
+    assert "most effects added (default: 3)" in seen["discover"]
+    assert "the controller's zeta (default: 1.0)" in seen["autopilot"]
+    assert "(default: None)" not in " ".join(seen.values())

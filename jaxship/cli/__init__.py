@@ -34,6 +34,23 @@ GRACE = 5.0  # [s] after Ctrl-C, the longest the process takes to end
 _INTERRUPTED = threading.Event()
 
 
+class HelpFormatter(argparse.HelpFormatter):
+    """`--help` of every command: each option's default (where it has one), and
+    "(required)" on those that must be given."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        default = action.default
+        if (action.option_strings and default not in (None, False, argparse.SUPPRESS)
+                and "%(default)" not in text):
+            shown = " ".join(map(str, default)) if isinstance(default, (list, tuple)) \
+                else default
+            text += f" (default: {shown})".replace("%", "%%")
+        if action.required and action.option_strings:
+            text += " (required)"
+        return text
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="jaxship", description=__doc__.split("\n")[0],
                                      epilog=EXIT_STATUS,
@@ -43,6 +60,8 @@ def main(argv=None) -> int:
     sub = parser.add_subparsers(dest="command", required=True)
     for command in COMMANDS:
         command.register(sub)
+    for command_parser in sub.choices.values():
+        command_parser.formatter_class = HelpFormatter
     args = parser.parse_args(argv)
     jax.config.update("jax_enable_x64", True)
     enable_compilation_cache()  # second runs skip compilation ($JAXSHIP_CACHE_DIR moves it)

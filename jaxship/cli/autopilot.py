@@ -32,16 +32,16 @@ def register(sub) -> None:
     auto.add_argument("--rpm", nargs="+", default=None, help="propeller rates of the runs")
     auto.add_argument("--speed", nargs="+", default=None, help="approach speeds [m/s]")
     auto.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
-    auto.add_argument("--step", default="45", help="heading step [deg] (default 45), at "
-                      "50 / omega_n s (100 s for 0.5 rad/s)")
+    auto.add_argument("--step", default="45", help="heading step [deg], at 50 / omega_n "
+                      "s (100 s for 0.5 rad/s)")
     auto.add_argument("--tune", action="store_true",
                       help="also tune the gains on the vessel at the given rpm/speeds")
     auto.add_argument("--natural-frequency", default="auto",
-                      help="the controller's omega_n [rad/s]; auto (default): 1.25 / T from "
+                      help="the controller's omega_n [rad/s]; auto: 1.25 / T from "
                       "the model's yaw time constant T, at most half the rudder servo's "
                       "bandwidth (0.5 rad/s on the thesis vessel); the reference model, step "
                       "time and window follow it in the thesis' proportions")
-    auto.add_argument("--damping", default="1.0", help="the controller's zeta (default 1.0)")
+    auto.add_argument("--damping", default="1.0", help="the controller's zeta")
     auto.add_argument("--quiet", action="store_true", help="no progress bar")
     auto.set_defaults(run=run)
 

@@ -23,9 +23,9 @@ def register(sub) -> None:
     disc.add_argument("--model", required=True, help="a registered model (see `jaxship "
                       "identify --help`)")
     disc.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
-    disc.add_argument("--max-effects", type=int, default=3, help="most effects added (3)")
+    disc.add_argument("--max-effects", type=int, default=3, help="most effects added")
     disc.add_argument("--alpha", type=float, default=0.01,
-                      help="family-wise false-alarm rate (0.01)")
+                      help="family-wise false-alarm rate")
     disc.add_argument("--quiet", action="store_true", help="no progress messages")
     disc.set_defaults(run=run)
 

@@ -28,7 +28,7 @@ def register(sub) -> None:
                        help="a registered model (listed below): a steering model, armax or a "
                        "vessel preset name")
     ident.add_argument("--horizon", default=None,
-                       help="prediction horizon [s]; 'none' (default): output error, "
+                       help="prediction horizon [s]; none: output error, "
                        "0: equation error")
     ident.add_argument("--validate", nargs="+", type=pathlib.Path, default=None,
                        metavar="TEST", help="held-out records to validate on")
@@ -39,8 +39,8 @@ def register(sub) -> None:
                        "vessel's track (default: psi,r; psi,r,u,v for vessel presets; r for "
                        "armax)")
     ident.add_argument("--initial", default="auto",
-                       help="window start states: measured, estimate or auto (default: "
-                       "estimate for output error, else measured)")
+                       help="window start states: measured, estimate or auto (estimate for "
+                       "output error, else measured)")
     ident.add_argument("--max-steps", type=int, default=256, help="optimiser step limit")
     ident.add_argument("--no-figures", action="store_true", help="write result.json only")
     ident.add_argument("--quiet", action="store_true", help="no progress bar")
