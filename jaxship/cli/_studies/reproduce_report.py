@@ -519,7 +519,8 @@ def discovery_figure(report, holdout, path):
         pick = lambda p: np.where(mask, np.rad2deg(np.asarray(p.predictions["r"])[i, :n]),
                                   np.nan)
         panels[e.name] = [("base model (Nomoto 1)", pick(before)),
-                          ("with " + (", ".join(report.named) or "nothing named"), pick(after))]
+                          ("with " + (", ".join(e.name for e in report.effects)
+                                      or "nothing named"), pick(after))]
         ts.append(np.asarray(e.t))
         ms.append(np.rad2deg(np.asarray(e.r)))
     fig = plot_model_outputs(ts, ms, panels, title="discovery: held-out turning circles")
