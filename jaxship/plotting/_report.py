@@ -40,8 +40,9 @@ def plot_trial_vs_thesis(traj, *, bands=None, lines=None, track_note="", title="
     bands, lines = bands or {}, lines or {}
     s = traj.state
     t = np.asarray(traj.t, dtype=np.float64)
-    fig = plt.figure(figsize=(11, 7), constrained_layout=True)
-    grid = fig.add_gridspec(3, 2, width_ratios=[1, 1.4])
+    # a track as wide as the time panels: the thesis manoeuvre's spans a kilometre
+    fig = plt.figure(figsize=(13, 7), constrained_layout=True)
+    grid = fig.add_gridspec(3, 2, width_ratios=[1.3, 1.4])
     track = fig.add_subplot(grid[:, 0])
     axes = {k: fig.add_subplot(grid[i, 1]) for i, k in enumerate(("heading", "yaw_rate",
                                                                    "speed"))}
@@ -93,7 +94,7 @@ def plot_model_outputs(t, measured, panels, *, ylabel="yaw rate [deg/s]", title=
     """
     names = list(panels)
     many = isinstance(t, (list, tuple))
-    fig, axes = plt.subplots(len(names), 1, figsize=(10, 3.0 * len(names)), squeeze=False,
+    fig, axes = plt.subplots(len(names), 1, figsize=(12, 3.0 * len(names)), squeeze=False,
                              sharex=not many, constrained_layout=True)
     for i, (ax, name) in enumerate(zip(axes[:, 0], names)):
         ti = np.asarray(t[i] if many else t, dtype=np.float64)
@@ -104,7 +105,9 @@ def plot_model_outputs(t, measured, panels, *, ylabel="yaw rate [deg/s]", title=
         ax.set(ylabel=ylabel, title=name)
         ax.title.set_fontsize("medium")
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="best", fontsize="small")
+        # beside the axes: inside, the legend covered the curves
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+                  fontsize="small")
     axes[-1, 0].set(xlabel="time [s]")
     fig.suptitle(title)
     return fig
@@ -131,12 +134,17 @@ def plot_heading_tracking(t, desired, runs, *, window=None, bands=None, title=""
     fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True, constrained_layout=True)
     heading, error, rudder = axes
     heading.plot(t, desired, "k--", lw=1.4, label="desired (reference model)")
-    for label, psi, delta in runs:
-        (line,) = heading.plot(t, np.asarray(psi, dtype=np.float64), lw=1.2, label=label)
+    # runs that agree lie on one another: each later one thinner and dashed, so that
+    # every run stays visible
+    styles = [dict(lw=2.6, ls="-"), dict(lw=1.6, ls="--"), dict(lw=1.2, ls="-."),
+              dict(lw=1.0, ls=":")]
+    for k, (label, psi, delta) in enumerate(runs):
+        style = styles[k % len(styles)]
+        (line,) = heading.plot(t, np.asarray(psi, dtype=np.float64), label=label, **style)
         error.plot(t, desired - np.asarray(psi, dtype=np.float64), color=line.get_color(),
-                   lw=1.2, label=label)
-        rudder.plot(t, np.asarray(delta, dtype=np.float64), color=line.get_color(), lw=1.2,
-                    label=label)
+                   label=label, **style)
+        rudder.plot(t, np.asarray(delta, dtype=np.float64), color=line.get_color(),
+                    label=label, **style)
     for key, ax in (("heading", heading), ("error", error), ("rudder", rudder)):
         _thesis_marks(ax, bands.get(key, ()))
         ax.grid(True, alpha=0.3)
