@@ -228,7 +228,7 @@ def test_smoothed_window_starts_remove_the_bias_of_noisy_starts():
                                 measurement_noise={"psi": R_PSI, "r": r_r})
     truth = np.array([0.06, 25.0])
     errors = {}
-    for label, initial in (("measured", "measured"), ("smoothed", smoothed)):
+    for label, initial in (("measured", js.MeasuredStates()), ("smoothed", smoothed)):
         res = js.fit(start, exp, estimator=js.PredictionError(horizon=10.0, initial=initial))
         errors[label] = np.abs(res.values - truth) / res.std
     assert np.all(errors["measured"] > 10), errors

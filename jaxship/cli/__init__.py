@@ -34,7 +34,7 @@ GRACE = 5.0  # [s] after Ctrl-C, the longest the process takes to end
 _INTERRUPTED = threading.Event()
 
 
-class HelpFormatter(argparse.HelpFormatter):
+class _ShowsDefaults:
     """`--help` of every command: each option's default (where it has one), and
     "(required)" on those that must be given."""
 
@@ -51,6 +51,14 @@ class HelpFormatter(argparse.HelpFormatter):
         return text
 
 
+class HelpFormatter(_ShowsDefaults, argparse.HelpFormatter):
+    pass
+
+
+class RawHelpFormatter(_ShowsDefaults, argparse.RawDescriptionHelpFormatter):
+    """For commands whose description or epilog is laid out by hand (a list)."""
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="jaxship", description=__doc__.split("\n")[0],
                                      epilog=EXIT_STATUS,
@@ -61,7 +69,8 @@ def main(argv=None) -> int:
     for command in COMMANDS:
         command.register(sub)
     for command_parser in sub.choices.values():
-        command_parser.formatter_class = HelpFormatter
+        raw = issubclass(command_parser.formatter_class, argparse.RawDescriptionHelpFormatter)
+        command_parser.formatter_class = RawHelpFormatter if raw else HelpFormatter
     args = parser.parse_args(argv)
     jax.config.update("jax_enable_x64", True)
     enable_compilation_cache()  # second runs skip compilation ($JAXSHIP_CACHE_DIR moves it)
