@@ -52,10 +52,12 @@ from ._estimate._discrete_estimator import (
 )
 from ._estimate._fit import (
     AbstractEstimator as AbstractEstimator,
-    EstimatedStarts as EstimatedStarts,
-    MeasuredStates as MeasuredStates,
     PredictionError as PredictionError,
     fit as fit,
+)
+from ._estimate._initial import (
+    EstimatedStarts as EstimatedStarts,
+    MeasuredStates as MeasuredStates,
 )
 from ._estimate._kalman import (
     KalmanOutput as KalmanOutput,

@@ -34,6 +34,7 @@ from .._foundation._progress import ProgressCallback, reporting_steps, step_hook
 from .._foundation._sharding import sharded_vmap
 from .._foundation._validate import validate
 from .._simulation._simulate import Simulator, integrate, replay_policy
+from ._initial import EstimatedStarts, MeasuredStates
 from ._kalman import SmoothedStates
 from ._linear import LinearStart
 from ._lm import (
@@ -45,6 +46,7 @@ from ._lm import (
     value_and_jacfwd,
 )
 from ._result import FitError, FitResult, Prediction
+from ._step import MAX_SUBSTEPS, stable_substeps
 from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_data, to_timeline
 
 
@@ -68,19 +70,6 @@ class AbstractEstimator(eqx.Module):
     def predict(self, model, dataset) -> "Prediction":
         """The estimator's predictions of `dataset`'s outputs by `model`, validated
         (see `jaxship.predict`)."""
-
-
-class MeasuredStates(eqx.Module):
-    """`PredictionError(initial=MeasuredStates())` (the default): every window starts from
-    the measured r and psi (and a vessel's u and v) as they are."""
-
-
-class EstimatedStarts(eqx.Module):
-    """`PredictionError(initial=EstimatedStarts())`: corrections of the start r and psi of
-    every window join the estimated parameters (nuisance parameters, reported in no table
-    but counted in the FPE), which removes the errors-in-variables bias of a noisy start
-    sample: output error on noisy data (MATLAB's `InitialState='estimate'`). Costs two
-    parameters per window."""
 
 
 class PredictionError(AbstractEstimator):
@@ -159,7 +148,7 @@ class PredictionError(AbstractEstimator):
         integrated with the step that follows the model's fastest mode, as in `fit`."""
         ds, windows, layout = _prepare(model, dataset, self)
         model = as_arrays(model)
-        needed = min(_stable_substeps(model, windows, refuse=False), MAX_SUBSTEPS)
+        needed = min(stable_substeps(model, windows, refuse=False), MAX_SUBSTEPS)
         if needed > windows.substeps:
             windows = dataclasses.replace(windows, substeps=needed)
         pred = np.asarray(_predict_jit(model, windows), dtype=np.float64)
@@ -375,7 +364,7 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
                          "one sample the estimated start explains every residual); use a "
                          "longer `horizon` or MeasuredStates().")
     base = as_arrays(model)
-    needed = _stable_substeps(base, windows)
+    needed = stable_substeps(base, windows)
     if needed > windows.substeps:  # the step follows the start model's fastest mode
         windows = dataclasses.replace(windows, substeps=needed)
     specs = _jacobian_scales(specs, base, windows)
@@ -396,7 +385,7 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
                                                         offset_scale, solver,
                                                         int(estimator.max_steps))
             fitted = rebuild(base, transform.names, p)
-            needed = _stable_substeps(fitted, windows, refuse=False)
+            needed = stable_substeps(fitted, windows, refuse=False)
             if needed <= windows.substeps or needed > MAX_SUBSTEPS:
                 break
             windows, z0 = dataclasses.replace(windows, substeps=needed), z
@@ -456,39 +445,6 @@ def _prepare(model, dataset, estimator):
                                     substeps=int(estimator.substeps), starts=starts,
                                     hold=estimator.hold, wind=bool(estimator.wind))
     return ds, windows, layout
-
-
-# the most substeps the start model may ask for: beyond, a time constant that short is
-# no steering dynamics the samples can show
-MAX_SUBSTEPS = 64
-
-
-def _stable_substeps(model, windows, refuse: bool = True) -> int:
-    """RK4 steps per sample interval that keep `model`'s fastest mode stable:
-    $\\lceil \\rho\\,dt / 2.5 \\rceil$, $\\rho$ the largest eigenvalue modulus of the
-    field's Jacobian at the first window start (`ValueError` beyond `MAX_SUBSTEPS`, with
-    `refuse`)."""
-    start = jax.tree.map(lambda a: a[0, 0], windows.start)  # the first window's start
-    inputs = {k: a[0, 0, 0] for k, a in windows.records.items()}
-    rho = float(_fastest_rate(model, start, inputs, windows.servo))
-    dt = float(np.max(np.asarray(windows.dt)))
-    needed = max(1, math.ceil(rho * dt / 2.5)) if math.isfinite(rho) else MAX_SUBSTEPS + 1
-    if needed > MAX_SUBSTEPS and refuse:
-        raise ValueError(f"the start {type(model).__name__} has a time constant of "
-                         f"{1 / rho:.3g} s, too short to simulate over samples {dt:g} s "
-                         f"apart (it needs {needed} steps per sample); start from values "
-                         "whose time constants the samples can resolve.")
-    return needed
-
-
-@eqx.filter_jit
-def _fastest_rate(model, start, inputs, servo: bool):
-    """The largest eigenvalue modulus [1/s] of the replay field's Jacobian at a window
-    `start` with the replayed `inputs` there (one compilation per model type)."""
-    y0 = model.replay_state(start, servo)
-    field = model.replay_field(servo)
-    jac = jax.jacfwd(lambda y: field(0.0, y, inputs))(y0)
-    return jnp.max(jnp.abs(jnp.linalg.eigvals(jac)))
 
 
 def _jacobian_scales(specs, model, windows):

@@ -38,7 +38,8 @@ import math
 import numpy as np
 from scipy import stats
 
-from ..._estimate._fit import EstimatedStarts, MeasuredStates, PredictionError, fit
+from ..._estimate._fit import PredictionError, fit
+from ..._estimate._initial import EstimatedStarts, MeasuredStates
 from ..._estimate._lm import RESULTS
 from ..._estimate._sensitivity import sensitivities
 from ..._estimate._windows import as_dataset
