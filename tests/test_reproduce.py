@@ -43,6 +43,8 @@ def test_quick_trials_match_thesis_ranges_and_open_the_report(tmp_path):
     assert "fig. 4.3" in row and "fig. 4.8" in row  # the thesis values where it states them
     _assert_figures_exist(tmp_path, report, at_least=4)
     assert "A.3x" not in report and "## Left out" in report
+    assert "not in the seed" not in report  # issue 31: what the thesis does not give
+    assert "for them the thesis gives no value here" in report
     run = json.loads((tmp_path / "run.json").read_text())
     assert run["quick"] and run["seconds"] > 0 and set(run["stages_seconds"]) == {"trials"}
 
@@ -146,7 +148,9 @@ def test_a_failed_fit_in_the_study_leaves_the_others(monkeypatch):
     assert rows["zigzag"]["success"] is False and "diverged" in rows["zigzag"]["error"]
     assert rows["zigzag"]["fit"] is None and study["models"]["merged/nomoto/zigzag"] is None
     assert rows["turning"]["success"] and rows["turning"]["fit"] is not None
-    assert study["parameters"]["merged/nomoto/turning"]["K"] > 0  # -67.6 %: as in fig. 4.20
+    K = study["parameters"]["merged/nomoto/turning"]["K"]  # -67.6 %: as in fig. 4.20
+    assert K["value"] > 0 and K["unit"] == "1/s"  # issue 31: value, std and unit
+    assert 0 < K["std"] < K["value"] and K["std_robust"] > 0
     closed = autopilot.autopilot_study(identification=study, models=("nomoto",),
                                        rpms=(300.0,))
     assert {r["family"] for r in closed["table"]} == {"turning"}

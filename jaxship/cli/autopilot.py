@@ -175,6 +175,38 @@ def runs_table(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def feedforward_text(rows: list[dict]) -> str:
+    """Whether the feed-forward helped, per operating point: pid+ff against pid (the same
+    gains), summed and RMS error with their differences; where it is worse, why in
+    words: with the vessel as its own model the feed-forward (eq. 5.2/5.6) leaves
+    almost no error, so a worse pid+ff means the model's inverse orders a rudder the
+    vessel does not need at these rudder angles."""
+    by = {(r["controller"], r["rpm"], r["speed"]): r for r in rows}
+    parts, worse = [], []
+    for (controller, rpm, speed), ff in by.items():
+        fb = by.get(("pid", rpm, speed))
+        if controller != "pid+ff" or fb is None or None in (
+                ff["sum_abs_error_deg"], fb["sum_abs_error_deg"]):
+            continue
+        a, b = ff["sum_abs_error_deg"], fb["sum_abs_error_deg"]
+        where = f"{rpm:.4g} rpm, {speed:.3g} m/s"
+        parts.append(f"at {where} pid+ff {a:.1f} against pid {b:.1f} deg (difference "
+                     f"{a - b:+.1f} deg; RMS {cell(ff['rms_error_deg'], 3)} against "
+                     f"{cell(fb['rms_error_deg'], 3)} deg)")
+        if a > b:
+            worse.append(f"{where} (mean |rudder| {cell(ff['mean_abs_rudder_deg'])} deg)")
+    if not parts:
+        return ""
+    text = "Feed-forward against feedback only: " + "; ".join(parts) + "."
+    if worse:
+        text += (" **The feed-forward makes the tracking worse** at " + "; ".join(worse)
+                 + ": the model's inverse orders a rudder that the vessel does not need "
+                 "at these rudder angles (its gain or time constant differs from the "
+                 "vessel's there, e.g. a model identified from larger rudder angles); the "
+                 "gains are the same, so only the feed-forward differs.")
+    return text
+
+
 def evaluation_report(evaluation: autopilot_study.Evaluation, *, title: str = "Heading autopilot",
                       model_text: str = "", figures=()) -> str:
     """A markdown page: the design, the gains, the runs and the `figures` (paths
@@ -195,6 +227,9 @@ def evaluation_report(evaluation: autopilot_study.Evaluation, *, title: str = "H
         f"deg/s; the controller updates every {d.interval:g} s. Chosen: {d.basis}.\n")
     text.append("## Gains\n\n" + gains_table(evaluation.gains()))
     text.append("## Closed-loop runs\n\n" + runs_table(evaluation.rows))
+    verdict = feedforward_text(evaluation.rows)
+    if verdict:
+        text.append(verdict + "\n")
     text.append(autopilot_study.METRICS_TEXT.format(dt=d.sample_interval, start=d.window[0],
                                     end=d.window[1]) + "\n")
     if figures:

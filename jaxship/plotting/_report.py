@@ -79,7 +79,7 @@ def plot_trial_vs_thesis(traj, *, bands=None, lines=None, track_note="", title="
 
 
 def plot_model_outputs(t, measured, panels, *, ylabel="yaw rate [deg/s]", title="",
-                       measured_label="measured"):
+                       measured_label="record"):
     """One measured signal against model outputs, one axes per group of models.
 
     **Arguments:**

@@ -22,13 +22,16 @@ bandwidth of the rudder servo it does not model (1 s), and $\\zeta$ = 1 as the
 reference (no overshoot). $K_d$ is Fossen's $2\\zeta\\omega_n m - d$ (exact pole
 placement), not the thesis' printed $2\\zeta\\omega_n m$ (which damps more by
 $d/(2m\\omega_n)$). The gains are designed once, at the mean operating point of the
-runs, and kept for every run; the feed-forward uses the measured $u$, $v$, $n$.
+runs, and kept for every run; the feed-forward uses the simulated vessel's $u$, $v$, $n$
+(noise-free, as an ideal sensor would give them).
 """
 
 import dataclasses
+import itertools
 import math
 
 import numpy as np
+import scipy.stats
 
 import jaxship as js
 
@@ -451,8 +454,41 @@ def _beats(a, b):
     return all(x is not None and y is not None and x < y for x, y in zip(a, b))
 
 
+# the thesis' ordering of its six autopilots counts as reproduced when our ordering's
+# Spearman rank correlation with it is positive at this one-sided significance level
+ORDERING_ALPHA = 0.05
+
+
+def spearman_exact(x, y) -> tuple[float, float]:
+    """(rho, p): Spearman's rank correlation of `x` and `y` (`scipy.stats.spearmanr`) and
+    its one-sided p-value $P(\\rho' \\ge \\rho)$ over all $n!$ orderings of `x` (exact;
+    the t approximation misstates it for the six autopilots). NaN for constant input."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if np.ptp(x) == 0 or np.ptp(y) == 0:
+        return math.nan, math.nan
+    rho = float(scipy.stats.spearmanr(x, y)[0])
+    if len(x) > 8:  # 9! orderings and more: the t approximation
+        return rho, float(scipy.stats.spearmanr(x, y, alternative="greater")[1])
+    ry = scipy.stats.rankdata(y)
+    every = [np.corrcoef(scipy.stats.rankdata(x[list(p)]), ry)[0, 1]
+             for p in itertools.permutations(range(len(x)))]
+    return rho, float(np.mean(np.asarray(every) >= rho - 1e-12))
+
+
+def _thesis_keys(study):
+    """(model, family) of the autopilots that have a thesis table and a pid+ff run."""
+    return [(m, f) for m in ("nomoto", "ross") for f in FAMILIES
+            if _residuals(study, m, f, "pid+ff") and m in THESIS_RESIDUALS
+            and None not in _residuals(study, m, f, "pid+ff")]
+
+
 def goals(study: dict) -> dict:
-    """The two goals of the study, with their numbers:
+    """The goals of the study, with their numbers:
+
+    - `thesis_ordering` (all six autopilots at the thesis' 300 and 400 rpm): our
+      ordering of the mean pid+ff residual against the thesis' Tables 5.2-5.7, Spearman
+      rank correlation with its one-sided p-value (`scipy.stats.spearmanr`); met when
+      positive at `ORDERING_ALPHA`;
 
     - `feedforward`: the reference feed-forward of the best identified model (highest
       chapter-4 pooled fit % among the merged fits) lowers the residual below that
@@ -475,6 +511,15 @@ def goals(study: dict) -> dict:
                              if _beats(_residuals(study, m, f, "pid+ff"),
                                        _residuals(study, m, f, "pid"))),
         }
+    keys = _thesis_keys(study)
+    if len(keys) == 6 and len(study["rpms"]) == 2 and list(study["rpms"]) == list(RPMS):
+        ours = [float(np.mean(_residuals(study, m, f, "pid+ff"))) for m, f in keys]
+        paper = [float(np.mean(THESIS_RESIDUALS[m][f])) for m, f in keys]
+        rho, p = spearman_exact(ours, paper)
+        out["thesis_ordering"] = {
+            "autopilots": [f"{m}/{f}" for m, f in keys], "ours": ours, "thesis": paper,
+            "spearman": float(rho), "p_value": float(p), "alpha": ORDERING_ALPHA,
+            "met": bool(rho > 0 and p < ORDERING_ALPHA)}  # False for NaN
     if {"nomoto", "ross"} <= {m for m, _ in present}:
         per = {}
         for family in FAMILIES:
@@ -491,13 +536,6 @@ def goals(study: dict) -> dict:
 def to_json(study: dict) -> dict:
     """The study without the `Evaluation` objects, for `json.dumps`."""
     return {k: v for k, v in study.items() if k != "evaluations"}
-
-
-def _ranks(values):
-    order = np.argsort(values)
-    ranks = np.empty(len(values))
-    ranks[order] = np.arange(len(values))
-    return ranks
 
 
 def comparison_table(study: dict) -> str:
@@ -530,16 +568,16 @@ def comparison_table(study: dict) -> str:
 
 
 def comparison_text(study: dict) -> str:
-    """Sentences on orderings and ratios, ours against the thesis', and the goals."""
-    keys = [(m, f) for m in ("nomoto", "ross") for f in FAMILIES
-            if _residuals(study, m, f, "pid+ff") and m in THESIS_RESIDUALS]
+    """Sentences on orderings and ratios, ours against the thesis' (Spearman rank
+    correlation), the best run of the table, and the goals, each with its numbers."""
+    keys = _thesis_keys(study)
+    g = study["goals"]
     text = []
-    if len(keys) == 6 and len(study["rpms"]) == 2:
-        ours = [float(np.mean(_residuals(study, m, f, "pid+ff"))) for m, f in keys]
-        paper = [float(np.mean(THESIS_RESIDUALS[m][f])) for m, f in keys]
-        name = lambda k: f"{MODEL_NAMES[k[0]]}/{k[1]}"
+    name = lambda k: f"{MODEL_NAMES[k[0]]}/{k[1]}"
+    if "thesis_ordering" in g:
+        o = g["thesis_ordering"]
+        ours, paper = o["ours"], o["thesis"]
         order = lambda v: ", ".join(name(keys[i]) for i in np.argsort(v))
-        rho = float(np.corrcoef(_ranks(ours), _ranks(paper))[0, 1])
         ratio_ours = [a / b for a, b in (_residuals(study, m, f, "pid+ff") for m, f in keys)
                       if a and b]
         ratio_paper = [THESIS_RESIDUALS[m][f][0] / THESIS_RESIDUALS[m][f][1] for m, f in keys]
@@ -548,22 +586,31 @@ def comparison_text(study: dict) -> str:
                  if a is not None]
         text.append(
             f"Ordered by the mean residual of the two speeds (best first), the thesis has "
-            f"{order(paper)}; we have {order(ours)} (Spearman rank correlation {rho:+.2f}). "
+            f"{order(paper)}; we have {order(ours)}. Reproducing the thesis' ordering: "
+            f"{'met' if o['met'] else 'NOT met'} (Spearman rank correlation "
+            f"{o['spearman']:+.2f}, one-sided p = {o['p_value']:.2g} with {len(keys)} "
+            f"autopilots; met when positive at p < {o['alpha']:g}). "
             f"The ratio of the 300 rpm to the 400 rpm residual is "
             f"{', '.join(f'{x:.2f}' for x in ratio_paper)} in the thesis and "
             f"{', '.join(f'{x:.2f}' for x in ratio_ours)} here (same order of rows). "
             f"Cell by cell ours are {np.median(cells):.2g} times the thesis' (median; range "
             f"{min(cells):.2g}-{max(cells):.2g}): the thesis states neither the unit nor the "
             f"sampling of its residual, so only orderings and ratios compare.")
-    g = study["goals"]
+    best = best_run_text(study)
+    if best:
+        text.append(best)
     if "feedforward" in g:
         f = g["feedforward"]
+        diffs = [None if a is None or b is None else a - b for a, b in zip(f["pid+ff"], f["pid"])]
         text.append(
-            f"Goal 1, feed-forward from the best identified model ({f['best_model']}, "
-            f"chapter-4 fit {cell(f['fit_family'])} %) beats feedback only at every speed: "
+            f"Goal 1 (ours; the thesis runs no autopilot without feed-forward), feed-forward "
+            f"from the best identified model ({f['best_model']}, chapter-4 fit "
+            f"{cell(f['fit_family'])} %) beats feedback only at every speed: "
             f"{'met' if f['met'] else 'NOT met'} (pid+ff "
             f"{', '.join(cell(x) for x in f['pid+ff'])} against pid "
-            f"{', '.join(cell(x) for x in f['pid'])} deg); feed-forward helps for "
+            f"{', '.join(cell(x) for x in f['pid'])} deg, differences "
+            f"{', '.join('-' if x is None else f'{x:+.2f}' for x in diffs)} deg at "
+            f"{', '.join(f'{r:.0f}' for r in study['rpms'])} rpm); feed-forward helps for "
             f"{len(f['met_by'])} of {len({(r['model'], r['family']) for r in study['table']})}"
             f" models ({', '.join(f['met_by']) or 'none'}).")
     if "ross_vs_nomoto" in g:
@@ -571,11 +618,61 @@ def comparison_text(study: dict) -> str:
         parts = [f"{FAMILY_NAMES[k]}: Ross {', '.join(cell(x) for x in v['ross'])} vs "
                  f"Nomoto {', '.join(cell(x) for x in v['nomoto'])}"
                  for k, v in r["families"].items()]
+        paper = []
+        for k in r["informative"]:
+            ross, nomoto = THESIS_RESIDUALS["ross"][k], THESIS_RESIDUALS["nomoto"][k]
+            paper.append(f"{FAMILY_NAMES[k]}: Ross {', '.join(f'{x:.1f}' for x in ross)} vs "
+                         f"Nomoto {', '.join(f'{x:.1f}' for x in nomoto)} (Ross "
+                         f"{'better' if _beats(ross, nomoto) else 'not better'} at both)")
         text.append(
             f"Goal 2, Ross beats Nomoto when fitted on informative data (zig-zags, thesis "
             f"manoeuvre): {'met' if r['met'] else 'NOT met'} ({'; '.join(parts)} deg; each "
-            f"model brings its own gains and feed-forward).")
+            f"model brings its own gains and feed-forward). The thesis' tables give "
+            f"{'; '.join(paper)}.")
     return "\n\n".join(text) + "\n"
+
+
+def best_run_text(study: dict) -> str:
+    """A sentence on the run of lowest residual in the table (any model, family,
+    controller and rpm), against the thesis' number for it where the thesis has one."""
+    rows = [r for r in study["table"] if r["sum_abs_error_deg"] is not None]
+    if not rows:
+        return ""
+    b = min(rows, key=lambda r: r["sum_abs_error_deg"])
+    controller = ("pid+ff (the thesis' controller)" if b["controller"] == "pid+ff"
+                  else "pid (feedback only)")
+    what = (f"{controller} with the {MODEL_NAMES.get(b['model'], b['model'])} model from "
+            f"the merged {FAMILY_NAMES[b['family']]} at {b['rpm']:.0f} rpm")
+    text = (f"The best run of the table is {what}: residual {b['sum_abs_error_deg']:.2f} deg "
+            f"(RMS {cell(b['rms_error_deg'])} deg)")
+    rpms = list(study["rpms"])
+    paper = THESIS_RESIDUALS.get(b["model"], {}).get(b["family"])
+    if paper is not None and rpms == list(RPMS):
+        thesis_value = paper[rpms.index(b["rpm"])]
+        table = THESIS_TABLES[(b["model"], b["family"])]
+        ff = _residuals(study, b["model"], b["family"], "pid+ff")[rpms.index(b["rpm"])]
+        if b["controller"] == "pid+ff":
+            text += (f"; the thesis' Table {table} gives {thesis_value:.2f} for it (ours "
+                     f"{b['sum_abs_error_deg'] / thesis_value:.2g} times that)")
+        else:
+            text += (f". The thesis has no feedback-only run; with feed-forward the same "
+                     f"model gives {cell(ff)} deg here (difference "
+                     + ("-" if ff is None else f"{ff - b['sum_abs_error_deg']:+.2f}")
+                     + f" deg) and {thesis_value:.2f} in the thesis' Table {table}")
+        best_paper = min(((m, f, i) for m, f in keys_of(THESIS_RESIDUALS) for i in range(2)),
+                         key=lambda k: THESIS_RESIDUALS[k[0]][k[1]][k[2]])
+        m, f, i = best_paper
+        ours = _residuals(study, m, f, "pid+ff")
+        text += (f". The thesis' best is {MODEL_NAMES[m]} from the {FAMILY_NAMES[f]} at "
+                 f"{RPMS[i]:.0f} rpm ({THESIS_RESIDUALS[m][f][i]:.2f}, Table "
+                 f"{THESIS_TABLES[(m, f)]}); ours there "
+                 + (f"{cell(ours[i])} deg" if len(ours) == 2 else "not run"))
+    return text + "."
+
+
+def keys_of(table: dict) -> list:
+    """(model, family) pairs of a {model: {family: ...}} table."""
+    return [(m, f) for m, families in table.items() for f in families]
 
 
 def report_section(study: dict, *, level: int = 2) -> str:

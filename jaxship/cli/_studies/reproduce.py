@@ -54,6 +54,7 @@ from .reproduce_report import (
     header,
     identification_section,
     left_out,
+    sign_flips,
     trials_section,
 )
 
@@ -252,6 +253,7 @@ def _identification_json(study):
     for row in data["table"]:
         key = (row["case"], row["model"], row["family"])
         row["thesis_figure"] = THESIS_FIGURE.get(key)
+    data["sign_flips"] = sign_flips(study["parameters"])
     return data
 
 

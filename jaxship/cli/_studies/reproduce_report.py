@@ -21,7 +21,7 @@ DISCOVERY_SEED = 4
 
 # ------------------------------------------------------------------ what the thesis states
 # The thesis prints no table of trial indices: sec. 4.1 shows figures whose axes bound
-# its curves (tick labels read from the seed's text), and states the vessel's extremes.
+# its curves (tick labels read from the thesis' text), and states the vessel's extremes.
 TRIAL_THESIS = {
     "turn40_500rpm": ("0 to 6 (fig. 4.3 ticks); axis to 8 (fig. 4.8)",
                       "1.2 to 1.6 (fig. 4.3 ticks)"),
@@ -46,7 +46,8 @@ FIGURES = [
       "speed": [(0.8, 1.8, "thesis fig. 4.7: tick range 0.8-1.8 m/s")]}, {},
      "thesis fig. 4.6: axes east -200 to 1000 m,\nnorth 200 to 1000 m (origin unknown)"),
     ("thesis", 200.0, "thesis_manoeuvre_200rpm",
-     "thesis manoeuvre, 200 rpm (thesis sec. A.3 is not in the seed: nothing to compare)",
+     "thesis manoeuvre, 200 rpm (the thesis shows it in sec. A.3, an appendix: no figure "
+     "to compare)",
      {}, {}, ""),
 ]
 # thesis figures of chapter 4 whose legends give the fit %: (case, model, family) -> fig.
@@ -62,12 +63,15 @@ MODEL_NAMES = {"nomoto": "Nomoto 1st order", "ross": "Ross autopilot",
                "ross_speed_rudder": "Ross + speed-dependent rudder"}
 FAMILY_NAMES = {"turning": "turning circles", "zigzag": "zig-zags",
                 "thesis": "thesis manoeuvre"}
+# the legend of a record that is our simulation with noise added, never "measured"
+RECORD_LABEL = "simulated record (with noise)"
 LARGE = 5.0  # fit % points: a difference from the thesis that gets its sentence
 
 _VESSEL = ("our vessel's coefficients are derived from empirical formulas "
            "(docs/thesis_vessel.md), not the thesis' unpublished ones")
 _RUDDER = ("the thesis' vessel has a \"highly nonlinear rudder effect on the yaw motion\" "
-           "(its fig. B.15, not in the seed), ours a smooth normal-force law in the "
+           "(its fig. B.15, in appendix B, which our text of the thesis lacks: it gives no "
+           "values of that law), ours a smooth normal-force law in the "
            "propeller race (docs/thesis_vessel.md secs. 10, 16)")
 # one sentence per large difference: (case, model, family) -> (ours higher, ours lower)
 EXPLAIN = {
@@ -75,8 +79,8 @@ EXPLAIN = {
         "The thesis says its Nomoto fit does not reach the steady yaw rate because the "
         "record is short (sec. 4.2.1); our vessel settles into the turn within seconds "
         "(fitted T well under 1 s) over a record of 40 ship lengths, so a first-order "
-        "model follows it; why the thesis' fit stopped short is not recoverable from the "
-        "seed.", None),
+        "model follows it; the thesis gives neither its record length nor its fitted T, "
+        "so why its fit stopped short is unexplained.", None),
     ("single", "nomoto", "zigzag"): (
         f"Partly unexplained: a first-order model follows our vessel's 40/40 zig-zag more "
         f"closely than the thesis' one; {_RUDDER}.", None),
@@ -98,7 +102,7 @@ EXPLAIN = {
     ("merged", "ross", "turning"): (
         "The thesis blames its 61 % on \"too short steady-state simulation data\" (sec. "
         "4.3.1); our turning records run 40 ship lengths and the Ross model's rudder term "
-        "u^2 delta, with the measured u, carries the speed change between the two rates.",
+        "u^2 delta, with the recorded u, carries the speed change between the two rates.",
         None),
     ("merged", "ross", "zigzag"): (
         f"The thesis attributes its merged Ross fits to \"the highly nonlinear force caused "
@@ -175,7 +179,9 @@ def trials_section(indices, out, design):
              "table of indices: its columns give the tick range of the axes of its figs. "
              "4.3-4.8 (its curves lie within them) and its text (sec. 4.1: top speed about "
              "3.5 kn = 1.8 m/s, yaw rates \"as much as 10\" deg/s at 45 deg). The other "
-             "trials are in its appendix A, which is not in the seed (\"-\").\n",
+             "trials are shown only in its appendix A, which our text of the thesis "
+             "(chapters 1-6, without the appendices) does not contain: "
+             "for them the thesis gives no value here (\"-\").\n",
              "| trial | " + " | ".join(c[1] for c in cols)
              + " | thesis: yaw-rate axis [deg/s] | thesis: speed axis [m/s] |",
              "|---" * (len(cols) + 3) + "|"]
@@ -195,8 +201,8 @@ def trials_section(indices, out, design):
         caption = ("orange bar beside the axes: the tick range of the thesis figure's axis "
                    "(where its curve was drawn, no tolerance), dashed: a value the thesis "
                    "states; the thesis gives no curve values, so none is drawn"
-                   if bands or marks else "no thesis figure to compare (appendix A is not "
-                   "in the seed)")
+                   if bands or marks else "the thesis gives no figure of this record in its "
+                   "chapters 1-6 (it is in appendix A, which our text of the thesis lacks)")
         lines.append(f"![{title}](figures/{name}.png)\n\n*{title}: ours; {caption}.*\n")
     return "\n".join(lines) + "\n"
 
@@ -296,6 +302,9 @@ def identification_section(study, experiments, out, quick):
                  "only the 40 deg / 500 rpm record)" + ("; a single-record model may diverge "
                  "on the other records of its family (\"diverges\").\n" if "single" in cases
                  else ".\n"))
+    lines.append("The estimates, with their standard errors and units, are in "
+                 "`identification.json` (\"parameters\"). " + sign_flip_text(
+                     sign_flips(study["parameters"])))
     for family in study_families(study):
         name = f"fits_{family}"
         _fit_figure(study, experiments, family, out / "figures" / f"{name}.png")
@@ -304,11 +313,68 @@ def identification_section(study, experiments, out, quick):
         where = " and ".join({"single": "from that record", "merged": "from the merged "
                               "records"}[c] for c in cases)
         lines.append(f"![yaw-rate fits, {FAMILY_NAMES[family]}](figures/{name}.png)\n\n"
-                     f"*Measured (noisy) and simulated yaw rate on the 40 deg / 500 rpm record "
+                     f"*Recorded yaw rate (our simulation with noise added: no measured "
+                     f"data) and the models' simulated yaw rate on the 40 deg / 500 rpm record "
                      f"of the {FAMILY_NAMES[family]}, models identified {where}, as in "
                      f"thesis figs. {figs}; each legend gives our fit % and the thesis "
                      f"figure's legend value (its curves are not available, so none is "
                      f"drawn).*\n")
+    return "\n".join(lines) + "\n"
+
+
+def sign_flips(parameters: dict) -> list[dict]:
+    """The coefficients whose estimated sign differs between the fits of one model
+    (`parameters`: `{"case/model/family": thesis.parameter_entries(...) or None}`):
+    one dict per coefficient, `{model, parameter, unit, estimates: [{fit, value, std}],
+    determined}`, `std` the quoted one (`thesis.quoted_std`). `determined`: a positive
+    and a negative estimate both lie more than 2 std from zero (their 95 % intervals
+    exclude zero on opposite sides), so the flip is not within the uncertainty."""
+    by = {}
+    for key, entries in parameters.items():
+        if not entries:
+            continue
+        model = key.split("/")[1]
+        for name, e in entries.items():
+            by.setdefault((model, name), []).append(
+                {"fit": key, "value": e["value"], "std": thesis.quoted_std(e),
+                 "unit": e.get("unit")})
+    out = []
+    for (model, name), estimates in by.items():
+        signs = {np.sign(e["value"]) for e in estimates if e["value"] != 0}
+        if signs != {-1.0, 1.0}:
+            continue
+        sure = lambda sign: any(np.sign(e["value"]) == sign and abs(e["value"]) > 2 * e["std"]
+                                for e in estimates)
+        out.append({"model": model, "parameter": name, "unit": estimates[0]["unit"],
+                    "estimates": [{k: e[k] for k in ("fit", "value", "std")} | {
+                        "std": None if not np.isfinite(e["std"]) else e["std"]}
+                        for e in estimates],
+                    "determined": bool(sure(1.0) and sure(-1.0))})
+    return out
+
+
+def _fit_name(key):
+    case, _, family = key.split("/")
+    return (f"{'merged' if case == 'merged' else 'single 40 deg / 500 rpm'} "
+            f"{FAMILY_NAMES[family]}")
+
+
+def sign_flip_text(flips: list[dict]) -> str:
+    """A paragraph on the coefficients whose sign differs between fits (`sign_flips`)."""
+    if not flips:
+        return ("No identified coefficient changes sign between the fits of the same "
+                "model.\n")
+    lines = [f"**Signs that differ between fits** ({len(flips)} coefficient(s); value +- "
+             "std, the robust std where computed; \"within the uncertainty\" when no "
+             "positive and negative estimate both lie 2 std from zero):\n"]
+    for f in flips:
+        unit = "" if f["unit"] in (None, "-") else f" {f['unit']}"
+        std = lambda e: "inf" if e["std"] is None else f"{e['std']:.2g}"
+        values = "; ".join(f"{e['value']:+.3g} +- {std(e)}{unit} ({_fit_name(e['fit'])})"
+                           for e in f["estimates"])
+        verdict = ("the sign is determined on both sides: the fits disagree" if f["determined"]
+                   else "within the uncertainty: the data do not fix the sign")
+        lines.append(f"- `{f['parameter']}` ({MODEL_NAMES[f['model']]}): {values}; {verdict}.")
     return "\n".join(lines) + "\n"
 
 
@@ -338,7 +404,8 @@ def _fit_figure(study, experiments, family, path):
         if curves:
             panels[f"identified from the {where}"] = curves
     fig = plot_model_outputs(np.asarray(e.t), np.rad2deg(np.asarray(e.r)), panels,
-                             title=f"{FAMILY_NAMES[family]}: yaw rate, 40 deg / 500 rpm record")
+                             title=f"{FAMILY_NAMES[family]}: yaw rate, 40 deg / 500 rpm record",
+                             measured_label=RECORD_LABEL)
     fig.savefig(path, dpi=100)
     plt.close(fig)
 
@@ -503,7 +570,8 @@ def discovery_section(data):
         + (f". Rejected: {len(data['rejected'])} candidate(s)." if data["rejected"] else ".")
         + " The full report is `discovery.json` (`DiscoveryReport.to_dict()`).\n")
     lines.append("![discovery, held-out turns](figures/discovery_holdout.png)\n\n*Held-out "
-                 "turning circles: measured yaw rate, the fitted base model and the model "
+                 "turning circles: the record's yaw rate (simulated, with noise), the fitted base "
+                 "model and the model "
                  "with the named effect(s), simulated from the first sample (output error).*\n")
     return "\n".join(lines) + "\n"
 
@@ -523,18 +591,20 @@ def discovery_figure(report, holdout, path):
                                       or "nothing named"), pick(after))]
         ts.append(np.asarray(e.t))
         ms.append(np.rad2deg(np.asarray(e.r)))
-    fig = plot_model_outputs(ts, ms, panels, title="discovery: held-out turning circles")
+    fig = plot_model_outputs(ts, ms, panels, title="discovery: held-out turning circles",
+                             measured_label=RECORD_LABEL)
     fig.savefig(path, dpi=100)
     plt.close(fig)
 
 
 def left_out(quick, identification, closed_loop, discover):
     items = [
-        "the thesis' curves: the seed is a text extraction without numeric curve data, so "
+        "the thesis' curves: our text of the thesis gives no numeric curve data, so "
         "figures show what the thesis states (axis ranges, legend fit %, reported values) "
         "beside ours",
         "the thesis' appendices (A: the other trials' figures, B: the other closed-loop "
-        "runs and the rudder law of fig. B.15), which are not in the seed",
+        "runs and the rudder law of fig. B.15): our text of the thesis (chapters 1-6, "
+        "without the appendices) gives none of their values",
         "the thesis' loss function and Akaike FPE values (sec. 4.2-4.3): their scaling "
         "(MATLAB `idnlgrey`) is not stated",
     ]

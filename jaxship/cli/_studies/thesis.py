@@ -15,7 +15,8 @@ response models are identified by prediction-error minimisation:
 from single experiments (the 40 deg trial of each family at 500 rpm, thesis sec. 4.2)
 and from the merged experiments of each family at both rates (sec. 4.3). The score
 is the thesis' fit % (eq. 3.23; MATLAB `compare`) of the yaw rate simulated from the
-first sample with the measured rudder, u, v and n replayed (output error), on the
+first sample with the recorded (simulated, noisy) rudder, u, v and n replayed (output
+error), on the
 40 deg / 500 rpm record of the family that the thesis' figures 4.8-4.30 show. The
 fit % pooled over all records of the family is reported too.
 
@@ -72,7 +73,7 @@ class Settings:
     after the prediction-error stage, the `noise` and its `seed`.
 
     The thesis vessel's yaw response is fast (a fitted Nomoto T of 0.1-0.3 s against
-    records of 100-1600 s), so the prediction of a 10 s window forgets its measured
+    records of 100-1600 s), so the prediction of a 10 s window forgets its recorded
     start within a second: the 10 s prediction error is, to well under a percent of
     fit, the output error that the fit % measures, at a fraction of its cost (the
     windows run in parallel). `output_error=True` adds the output-error stage."""
@@ -279,7 +280,8 @@ def identification_study(vessel=None, *, quick=False, settings: Settings = Setti
     the yaw rate on the family's 40 deg / 500 rpm record, pooled over all records of
     the family at both rates (None where the model diverges), and the thesis'
     number; a fit that fails has `success` False and its `error`, and the others go
-    on), the fitted `parameters` per `"case/model/family"` (None where it failed), the
+    on), the fitted `parameters` per `"case/model/family"` (`parameter_entries`:
+    value, std, std_robust and unit of each; None where it failed), the
     `noise`,
     the `settings` and the experiment `records`.
 
@@ -328,7 +330,7 @@ def identification_study(vessel=None, *, quick=False, settings: Settings = Setti
                     per_record={e.name: _finite(f) for e, f in zip(family_records, per)},
                     success=result.success,
                 ))
-                params[key] = {n: float(v) for n, v in zip(result.names, result.values)}
+                params[key] = parameter_entries(result)
                 models[key] = result.model
     return {"table": rows, "parameters": params, "models": models,
             "noise": dict(settings.noise),
@@ -338,6 +340,33 @@ def identification_study(vessel=None, *, quick=False, settings: Settings = Setti
 
 def _finite(x):
     return float(x) if np.isfinite(x) else None
+
+
+def _plain(x):  # JSON: None for NaN (not computed), "inf" for an undetermined estimate
+    x = float(x)
+    return x if np.isfinite(x) else (None if np.isnan(x) else "inf")
+
+
+def parameter_entries(result) -> dict:
+    """`{name: {value, std, std_robust, unit}}` of the free parameters of a `FitResult`:
+    the estimate, its white-noise standard error, the one that does not assume white
+    residuals (`ParameterReport.std_robust`, clustered by window or Newey-West; None
+    where not computed) and the parameter's unit."""
+    p = result.parameters
+    robust = getattr(p, "std_robust", None)
+    robust = np.full(len(p.names), np.nan) if robust is None else np.asarray(robust)
+    return {n: {"value": float(v), "std": _plain(s), "std_robust": _plain(r), "unit": u}
+            for n, v, s, r, u in zip(p.names, p.values, p.std, robust, p.units)}
+
+
+def quoted_std(entry) -> float:
+    """The standard error to quote for a `parameter_entries` entry: the robust one where
+    computed, else the white-noise one (inf where undetermined)."""
+    for key in ("std_robust", "std"):
+        s = entry.get(key)
+        if s is not None:
+            return math.inf if s == "inf" else float(s)
+    return math.nan
 
 
 def to_json(study: dict) -> dict:
