@@ -622,8 +622,8 @@ def comparison_text(study: dict) -> str:
         for k in r["informative"]:
             ross, nomoto = THESIS_RESIDUALS["ross"][k], THESIS_RESIDUALS["nomoto"][k]
             paper.append(f"{FAMILY_NAMES[k]}: Ross {', '.join(f'{x:.1f}' for x in ross)} vs "
-                         f"Nomoto {', '.join(f'{x:.1f}' for x in nomoto)} (Ross "
-                         f"{'better' if _beats(ross, nomoto) else 'not better'} at both)")
+                         f"Nomoto {', '.join(f'{x:.1f}' for x in nomoto)} (Ross better at "
+                         f"{sum(x < y for x, y in zip(ross, nomoto))} of {len(ross)} speeds)")
         text.append(
             f"Goal 2, Ross beats Nomoto when fitted on informative data (zig-zags, thesis "
             f"manoeuvre): {'met' if r['met'] else 'NOT met'} ({'; '.join(parts)} deg; each "
