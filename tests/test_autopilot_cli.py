@@ -130,6 +130,10 @@ def _bad_cases(tmp_path, identified):
         (model + ["--vessel", "thesis", "--speed", "1e6"] + out, "10 times the service speed"),
         (model + ["--vessel", "thesis", "--rpm", "1e9"] + out, "10 times the service propeller"),
         (model + ["--vessel", "thesis", "--rpm", "300", "--speed", "1.0"] + out, "one of them"),
+        # a vessel without a propeller holds only its nominal speed: 5 m/s on the Mariner
+        # ran back to 7.7 m/s before the step and was reported as 5 m/s
+        (model + ["--vessel", "mariner", "--speed", "5"] + out,
+         "Mariner has no straight run at u = 5 m/s"),
         (model + ["--vessel", "thesis"] + out, "one of them"),
         (model + ["--vessel", "thesis", "--rpm", "300", "--step", "0"] + out, "step"),
         (["--model", str(tmp_path / "missing.json"), "--vessel", "thesis", "--rpm", "300"] + out,
@@ -349,6 +353,7 @@ def test_a_rudder_on_its_limits_is_a_code_and_a_sentence(identified, tmp_path, c
     assert "warning: The rudder sat at its limit" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_the_mariner_at_the_defaults(tmp_path):
     """Issue 31 point 3 on the Mariner (Nomoto 1 from a 20/20 zig-zag: K = 0.033 1/s,
     T = 21 s) at the defaults: omega_n = 1.25 / T, the reference model slower than the

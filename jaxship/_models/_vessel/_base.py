@@ -205,6 +205,10 @@ def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> Ship
     Give `speed` [m/s] to solve for the self-propulsion rate `n`, or `n` [rev/s] to
     solve for the equilibrium speed; with neither, the vessel's nominal approach.
     Vessels without a propeller term keep `n` as given and `speed` as given.
+
+    Raises `ValueError` where no such state exists: the surge force left at the state
+    found exceeds $10^{-3}\\,m_{11} u^2/L$ (0.25 % off its nominal speed on the Mariner,
+    whose surge equation has no propeller and balances only at that speed).
     """
     if speed is None and n is None:
         speed, n = vessel.nominal_speed, vessel.nominal_n
@@ -214,7 +218,22 @@ def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> Ship
         speed = _newton(
             lambda uu: surge_force(vessel, uu, jnp.asarray(n, float)), vessel.nominal_speed
         )
+    residual = float(surge_force(vessel, jnp.asarray(speed, float), jnp.asarray(n, float)))
+    scale = float(vessel.mass_matrix()[0, 0]) * float(speed) ** 2 / float(vessel.length)
+    if not abs(residual) <= 1e-3 * scale:
+        raise ValueError(
+            f"{type(vessel).__name__} has no straight run at u = {float(speed):.4g} m/s, n = "
+            f"{float(n):.4g} rev/s: a surge force of {residual:.4g} N is left (its surge "
+            f"equation balances at {float(vessel.nominal_speed):.4g} m/s"
+            + (" only: it has no propeller term)." if not _has_propeller(vessel) else ")."))
     return straight_state(speed, n, psi)
+
+
+def _has_propeller(vessel) -> bool:
+    """Whether the surge force depends on the propeller rate at the nominal speed."""
+    u = jnp.asarray(vessel.nominal_speed, float)
+    return float(jax.grad(lambda nn: surge_force(vessel, u, nn))(
+        jnp.asarray(vessel.nominal_n, float) + 1.0)) != 0.0
 
 
 def _newton(f, x0, iterations=50):
