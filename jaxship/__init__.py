@@ -110,6 +110,11 @@ from ._models._control import (
 )
 from ._models._effects import (
     AbstractEffect as AbstractEffect,
+    AbstractLoadEffect as AbstractLoadEffect,
+    AbstractRudderEffect as AbstractRudderEffect,
+    AbstractSensorEffect as AbstractSensorEffect,
+    AbstractVesselPropertyEffect as AbstractVesselPropertyEffect,
+    AbstractYawTermEffect as AbstractYawTermEffect,
     AugmentedSteering as AugmentedSteering,
     AugmentedVessel as AugmentedVessel,
     HeadingSensorBias as HeadingSensorBias,

@@ -174,6 +174,53 @@ def test_every_model_implements_the_one_contract():
     assert all(issubclass(c, js.AbstractModel) for c in classes)
 
 
+PLACES = ("AbstractRudderEffect", "AbstractLoadEffect", "AbstractYawTermEffect",
+          "AbstractVesselPropertyEffect", "AbstractSensorEffect")
+
+
+def test_every_effect_acts_through_the_small_classes_of_its_places():
+    """The effect seam is split by where an effect acts: every public effect derives
+    from at least one place class, `AbstractEffect` itself carries no hook, and a new
+    effect implements one small abstract class: a yaw term written by a user (an
+    offset $f = c$ in Nomoto's equation) runs on a steering model, equals a rudder
+    offset of $c/K$, and one that leaves its abstract method out cannot be made."""
+    from typing import ClassVar
+
+    import numpy as np
+    import pytest
+
+    import jaxship as js
+
+    places = tuple(getattr(js, n) for n in PLACES)
+    effects = [v for v in vars(js).values() if isinstance(v, type)
+               and issubclass(v, js.AbstractEffect) and v is not js.AbstractEffect
+               and v not in places]
+    assert len(effects) >= 20
+    assert all(issubclass(e, places) for e in effects), [
+        e.__name__ for e in effects if not issubclass(e, places)]
+    hooks = {"rudder", "loads", "yaw_term", "mass", "environment", "wind_areas", "measure",
+             "unmeasure", "initial_state", "state_rate"}
+    assert not hooks & set(vars(js.AbstractEffect))
+
+    class ConstantTerm(js.AbstractYawTermEffect):
+        c: float = 0.0
+        id: ClassVar[str] = "constant_term"
+
+        def yaw_term(self, model, x, delta, aux):
+            return self.c
+
+    class Forgotten(js.AbstractYawTermEffect):
+        id: ClassVar[str] = "forgotten"
+
+    with pytest.raises(TypeError):
+        Forgotten()
+    K, c = 0.06, 1e-3
+    delta = np.deg2rad(10) * np.sign(np.sin(np.arange(200) / 20.0) + 1e-9)
+    psi = [js.simulate_steering(js.augment(js.Nomoto1(K=K, T=25.0), effect), delta, 0.5).psi
+           for effect in (ConstantTerm(c=c), js.RudderOffset(delta0=c / K))]
+    np.testing.assert_allclose(psi[0], psi[1], rtol=1e-12, atol=1e-12)
+
+
 def test_each_command_is_one_module_that_main_only_registers():
     """`jaxship/cli/<command>.py` owns its parser (`register`) and its `run`; the
     package's `main` registers them and maps errors to exit statuses."""

@@ -447,6 +447,14 @@ def test_a_vessel_only_effect_on_a_steering_model_is_an_error(effect):
     assert js.augment(js.vessel("mariner"), effect).effects == (effect,)
 
 
+def test_a_yaw_term_on_a_vessel_is_an_error():
+    """The steering models' apparent-wind term has no place on a vessel (whose wind acts
+    through its loads: `Windage`)."""
+    with pytest.raises(ValueError, match="ApparentWind acts on nothing a vessel has .*"
+                       "augment a steering model instead"):
+        js.augment(js.vessel("mariner"), js.ApparentWind())
+
+
 def test_a_family_unit_is_read_on_the_model_it_acts_on():
     """`YawMomentBias.n0` is N m on a vessel, rad/s on a Nomoto model (T r' + r = K delta
     + f) and rad/s^2 on a model written as r' = ... (the Ross model)."""

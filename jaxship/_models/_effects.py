@@ -8,26 +8,33 @@ range, free by default); with every parameter at zero it adds nothing, so the
 augmented model equals its base bit for bit. Its parameters are fitted like any
 other, by the name `"<effect id>.<field>"` (e.g. `"rudder_offset.delta0"`).
 
-An effect may act on one or more of these places, each a method with a neutral
-default:
+An effect says where it acts by the abstract classes it derives from, each one small
+(one or two methods to write):
 
-- the actuator path, `rudder(delta, z, aux)`: the rudder angle the hydrodynamics see,
-  with the effect's own states `z` (`state_names`, `initial_state`, `state_rate`: a
-  lag, a delay or a rate limit; they travel in the simulated state after the model's
-  own) and, on a steering model, its auxiliary inputs `aux` (`AuxInputs`: measured u,
-  v, n; None on a vessel, whose effects see u, v, r, n in `loads`);
-- the loads, `loads(t, vessel, u, v, r, delta, n)`: body-fixed (X, Y, N) [N, N, N m]
-  added to a vessel's (Fossen 2021, eq. 6.1: $M\\dot\\nu = \\tau + \\tau_{effect}$),
-  `delta` the rudder after the actuator path;
-- the yaw equation of a steering model, `yaw_term(model, x, delta, aux)`: a term $f$
-  added to its right-hand side where the rudder's moment enters (for Nomoto
-  $T\\dot r + r = K\\delta + f$ [rad/s]; for models written as $\\dot r = \\dots$,
-  [rad/s^2]), `delta` the logged rudder (before the actuator path); the model's
-  `forcing(x)` says how it moves the state;
-- a vessel's mass matrix, `mass(M)`, its environment (current and wind) in the
-  equations of motion, `environment(env)`, and its wind areas,
-  `wind_areas(frontal, lateral)` [m^2]: each returns the corrected value;
-- the measurement, `measure(channel, value)`: what a sensor reports.
+- `AbstractRudderEffect`, the actuator path, `rudder(delta, z, aux)`: the rudder angle
+  the hydrodynamics see, with the effect's own states `z` (`state_names`,
+  `initial_state`, `state_rate`: a lag, a delay or a rate limit; they travel in the
+  simulated state after the model's own) and, on a steering model, its auxiliary
+  inputs `aux` (`AuxInputs`: measured u, v, n; None on a vessel, whose effects see u,
+  v, r, n in `loads`);
+- `AbstractLoadEffect`, a vessel's loads, `loads(t, vessel, u, v, r, delta, n)`:
+  body-fixed (X, Y, N) [N, N, N m] added to a vessel's (Fossen 2021, eq. 6.1:
+  $M\\dot\\nu = \\tau + \\tau_{effect}$), `delta` the rudder after the actuator path;
+- `AbstractYawTermEffect`, the yaw equation of a steering model, `yaw_term(model, x,
+  delta, aux)`: a term $f$ added to its right-hand side where the rudder's moment
+  enters (for Nomoto $T\\dot r + r = K\\delta + f$ [rad/s]; for models written as
+  $\\dot r = \\dots$, [rad/s^2]), `delta` the logged rudder (before the actuator
+  path); the model's `forcing(x)` says how it moves the state;
+- `AbstractVesselPropertyEffect`, a vessel's mass matrix `mass(M)`, its environment
+  (current and wind) in the equations of motion `environment(env)`, or its wind areas
+  `wind_areas(frontal, lateral)` [m^2]: each returns the corrected value (override the
+  ones the effect changes);
+- `AbstractSensorEffect`, the measurement, `measure(channel, value)` and its inverse
+  `unmeasure`: what a sensor reports.
+
+An effect on vessels and steering models alike derives from both places (a yaw moment:
+`AbstractLoadEffect` and `AbstractYawTermEffect`); a steering model refuses an effect
+with no place it has (loads, mass), a vessel one with none of its own (a yaw term).
 
 A parameter acting on several families has one unit per family ("family units",
 e.g. `YawMomentBias.n0`: N m on a vessel, rad/s on a Nomoto model); such parameters
@@ -37,6 +44,7 @@ effects are in `_hydro_effects.py`. Adding an effect is writing one such Module;
 discovery scores them by name.
 """
 
+import abc
 from typing import ClassVar
 
 import equinox as eqx
@@ -72,11 +80,21 @@ def family_unit(unit: str, model) -> str:
     return parts[1] if model.yaw_term_unit == "rad/s" else parts[2]
 
 class AbstractEffect(eqx.Module):
-    """Base of all effects; `id` is the catalogue name (`"rudder_offset"`, ...)."""
+    """Base of all effects; `id` is the catalogue name (`"rudder_offset"`, ...). An
+    effect derives from the abstract classes of the places it acts on (below)."""
 
     id: eqx.AbstractClassVar[str]
     state_names: ClassVar[tuple[str, ...]] = ()  # the effect's own states, if any
     uses_wind: ClassVar[bool] = False  # reads the replayed wind (`AuxInputs.wind_u`, ...)
+
+
+class AbstractRudderEffect(AbstractEffect):
+    """Acts on the actuator path, with states of its own where it has `state_names`."""
+
+    @abc.abstractmethod
+    def rudder(self, delta: ArrayLike, z, aux=None) -> ArrayLike:
+        """The rudder angle [rad] the model sees for `delta`, with the effect's states
+        `z` and a steering model's `AuxInputs` `aux` (None on a vessel)."""
 
     def initial_state(self, delta) -> Array:
         """The effect's states in a steady state at rudder `delta` [rad]."""
@@ -86,18 +104,26 @@ class AbstractEffect(eqx.Module):
         """The time derivative of the effect's states `z` at the rudder `delta` it sees."""
         return jnp.zeros_like(z)
 
-    def rudder(self, delta: ArrayLike, z, aux=None) -> ArrayLike:
-        """The rudder angle [rad] the model sees for `delta`, with the effect's states
-        `z` and a steering model's `AuxInputs` `aux` (None on a vessel)."""
-        return delta
 
+class AbstractLoadEffect(AbstractEffect):
+    """Adds loads to a vessel's."""
+
+    @abc.abstractmethod
     def loads(self, t, vessel, u, v, r, delta, n) -> ArrayLike:
         """Loads (X, Y, N) [N, N, N m] added to `vessel`'s at the rudder `delta` it sees."""
-        return 0.0
 
+
+class AbstractYawTermEffect(AbstractEffect):
+    """Adds a term to a steering model's yaw equation."""
+
+    @abc.abstractmethod
     def yaw_term(self, model, x, delta, aux) -> ArrayLike:
         """The term added to steering `model`'s yaw equation at its state `x`."""
-        return 0.0
+
+
+class AbstractVesselPropertyEffect(AbstractEffect):
+    """Corrects a vessel's mass matrix, environment or wind areas (neutral by default:
+    override what the effect changes)."""
 
     def mass(self, matrix: Array) -> Array:
         """A vessel's mass matrix $M$ [kg, kg m, kg m^2] with the effect's correction."""
@@ -111,15 +137,34 @@ class AbstractEffect(eqx.Module):
         """A vessel's frontal and lateral projected wind areas [m^2]."""
         return frontal, lateral
 
-    def measure(self, channel: str, value: ArrayLike) -> ArrayLike:
-        return value
 
+class AbstractSensorEffect(AbstractEffect):
+    """Changes what a sensor reports."""
+
+    @abc.abstractmethod
+    def measure(self, channel: str, value: ArrayLike) -> ArrayLike:
+        """The reading of `channel` whose true value is `value`."""
+
+    @abc.abstractmethod
     def unmeasure(self, channel: str, value: ArrayLike) -> ArrayLike:
         """The true value behind a reading (the inverse of `measure`)."""
-        return value
 
 
-class RudderOffset(AbstractEffect):
+# the places each family has: an effect must act on at least one of them
+VESSEL_PLACES = (AbstractRudderEffect, AbstractLoadEffect, AbstractVesselPropertyEffect,
+                 AbstractSensorEffect)
+STEERING_PLACES = (AbstractRudderEffect, AbstractYawTermEffect, AbstractSensorEffect)
+PLACE_NAMES = {AbstractRudderEffect: "rudder", AbstractLoadEffect: "loads",
+               AbstractYawTermEffect: "yaw equation",
+               AbstractVesselPropertyEffect: "mass, environment and wind areas",
+               AbstractSensorEffect: "sensors"}
+
+
+def _of(effects, place):
+    return [e for e in effects if isinstance(e, place)]
+
+
+class RudderOffset(AbstractRudderEffect):
     """A rudder angle offset: the hydrodynamics see $\\delta + \\delta_0$ (a misaligned
     rudder indicator or a hull asymmetry; Lu & Zhao 2008, eq. 1)."""
 
@@ -130,7 +175,7 @@ class RudderOffset(AbstractEffect):
         return delta + self.delta0
 
 
-class YawMomentBias(AbstractEffect):
+class YawMomentBias(AbstractLoadEffect, AbstractYawTermEffect):
     """A constant yaw moment: $N_0$ [N m] on a vessel; on a steering model the term
     $N_0$ in its yaw equation (`yaw_term`: [rad/s] for Nomoto models, where it equals
     a rudder offset $N_0/K$; [rad/s^2] for models written as $\\dot r = \\dots$)."""
@@ -145,7 +190,7 @@ class YawMomentBias(AbstractEffect):
         return self.n0
 
 
-class YawCubicDamping(AbstractEffect):
+class YawCubicDamping(AbstractLoadEffect, AbstractYawTermEffect):
     """Cubic yaw damping, $\\beta > 0$ more damping in both families.
 
     - Steering models: $-\\beta r^3$ in the yaw equation. With `Nomoto2` it is the
@@ -178,7 +223,7 @@ def _lag_gate(time_constant):
     return active, jnp.where(active, time_constant, 1.0)
 
 
-class RudderLag(AbstractEffect):
+class RudderLag(AbstractRudderEffect):
     """A first-order lag between the recorded and the acting rudder (a steering gear
     slower than logged, or a rudder angle read upstream of the gear):
     $T_l\\dot\\delta' = \\delta - \\delta'$ (Fossen 2021, eq. 9.8). Off (the base model
@@ -199,7 +244,7 @@ class RudderLag(AbstractEffect):
         return jnp.where(_lag_gate(self.time_constant)[0], z[0], delta)
 
 
-class RudderDelay(AbstractEffect):
+class RudderDelay(AbstractRudderEffect):
     """A pure delay $\\tau_d$ of the rudder, $\\delta'(t) = \\delta(t - \\tau_d)$, by its
     first-order Pade approximant $e^{-s\\tau_d} \\approx (1 - s\\tau_d/2)/(1 + s\\tau_d/2)$
     (Franklin, Powell & Emami-Naeini 2015, sec. 5.6): $\\delta' = 2z - \\delta$,
@@ -220,7 +265,7 @@ class RudderDelay(AbstractEffect):
         return jnp.where(_lag_gate(self.delay / 2)[0], 2 * z[0] - delta, delta)
 
 
-class RudderRateLimit(AbstractEffect):
+class RudderRateLimit(AbstractRudderEffect):
     """A steering gear slower than the recorded (commanded) rudder: the acting rudder
     follows it with time constant `tracking` (0.1 s) at no more than
     $\\dot\\delta_{max} = 1/s$ [rad/s] (Fossen 2021, sec. 9.3). Parametrised by the
@@ -243,7 +288,7 @@ class RudderRateLimit(AbstractEffect):
         return jnp.where(self.inverse_rate > 0, z[0], delta)
 
 
-class SwayForceBias(AbstractEffect):
+class SwayForceBias(AbstractLoadEffect):
     """A constant body-fixed sway force $Y_0$ [N] (vessels only)."""
 
     y0: ArrayLike = param(0.0, unit="N")
@@ -253,7 +298,7 @@ class SwayForceBias(AbstractEffect):
         return jnp.stack([0.0 * u, self.y0 + 0.0 * u, 0.0 * u])
 
 
-class YawRateSensorBias(AbstractEffect):
+class YawRateSensorBias(AbstractSensorEffect):
     """The yaw-rate sensor reads $r + b_r$ [rad/s] (a gyro bias)."""
 
     bias: ArrayLike = param(0.0, lower=-0.02, upper=0.02, scale=1e-3, unit="rad/s")
@@ -266,7 +311,7 @@ class YawRateSensorBias(AbstractEffect):
         return value - self.bias if channel == "r" else value
 
 
-class HeadingSensorBias(AbstractEffect):
+class HeadingSensorBias(AbstractSensorEffect):
     """The compass reads $\\psi + b_\\psi$ [rad] (a misaligned heading reference)."""
 
     bias: ArrayLike = param(0.0, lower=-0.2, upper=0.2, scale=0.01, unit="rad")
@@ -279,7 +324,7 @@ class HeadingSensorBias(AbstractEffect):
         return value - self.bias if channel == "psi" else value
 
 
-class RecordedDisturbance(AbstractEffect):
+class RecordedDisturbance(AbstractLoadEffect):
     """A body-fixed sway force `sway_force[k]` [N] and yaw moment `yaw_moment[k]`
     [N m] held over $[t_0 + k\\,dt, t_0 + (k+1)\\,dt)$ (e.g. a wave moment from a
     disturbance model; Astrom & Kallstrom 1979, sec. 3). Not fitted: its arrays are
@@ -308,15 +353,15 @@ class _Augmented(AbstractComposite):
 
     def effect_initial(self, delta):
         """The effects' states in a steady state at the rudder `delta` [rad]."""
-        return jnp.concatenate([jnp.zeros((0,))] + [e.initial_state(delta)
-                                                    for e in self.effects])
+        return jnp.concatenate([jnp.zeros((0,))] + [
+            e.initial_state(delta) for e in _of(self.effects, AbstractRudderEffect)])
 
     def rudder_path(self, delta, z, aux=None):
         """The rudder angle the base model sees, after every effect's actuator path in
         order, and the time derivative of the effects' states `z`; `aux`: a steering
         model's auxiliary inputs (None for a vessel)."""
         rates, i = [jnp.zeros((0,))], 0
-        for effect in self.effects:
+        for effect in _of(self.effects, AbstractRudderEffect):
             k = len(effect.state_names)
             rates.append(effect.state_rate(z[i:i + k], delta))
             delta = effect.rudder(delta, z[i:i + k], aux)
@@ -324,7 +369,7 @@ class _Augmented(AbstractComposite):
         return delta, jnp.concatenate(rates)
 
     def measure(self, channel: str, value):
-        for effect in self.effects:
+        for effect in _of(self.effects, AbstractSensorEffect):
             value = effect.measure(channel, value)
         return value
 
@@ -338,17 +383,22 @@ class _Augmented(AbstractComposite):
 
 
 def _unmeasure(effects, channel, value):
-    for effect in reversed(effects):
+    for effect in reversed(_of(effects, AbstractSensorEffect)):
         value = effect.unmeasure(channel, value)
     return value
 
 
-def _check_effects(effects):
+def _check_effects(effects, places, family):
     ids = [e.id for e in effects]
     for e in effects:
         if not isinstance(e, AbstractEffect):
             raise ValueError(f"effects must be jaxship effects (AbstractEffect), got "
                              f"{type(e).__name__}.")
+        if not isinstance(e, places):  # it would be a null parameter
+            other = "steering model" if family == "vessel" else "vessel"
+            raise ValueError(f"{type(e).__name__} acts on nothing a {family} has (its "
+                             f"{', '.join(PLACE_NAMES[p] for p in places)}): augment a "
+                             f"{other} instead.")
     if len(set(ids)) != len(ids):
         raise ValueError(f"each effect may appear once, got {ids}.")
     return tuple(effects)
@@ -368,7 +418,8 @@ class AugmentedVessel(_Augmented, AbstractVessel):
     held: Array | None = None
 
     def __init__(self, base: AbstractVessel, effects=(), held=None):
-        self.base, self.effects, self.held = base, _check_effects(effects), held
+        self.base, self.effects, self.held = base, _check_effects(effects, VESSEL_PLACES,
+                                                                  "vessel"), held
 
     @property
     def length(self):
@@ -400,19 +451,19 @@ class AugmentedVessel(_Augmented, AbstractVessel):
 
     def _wind_areas(self):
         areas = (self.base.frontal_wind_area, self.base.lateral_wind_area)
-        for effect in self.effects:
+        for effect in _of(self.effects, AbstractVesselPropertyEffect):
             areas = effect.wind_areas(*areas)
         return areas
 
     def mass_matrix(self):
         matrix = self.base.mass_matrix()
-        for effect in self.effects:
+        for effect in _of(self.effects, AbstractVesselPropertyEffect):
             matrix = effect.mass(matrix)
         return matrix
 
     def environment(self, environment):
         environment = self.base.environment(environment)
-        for effect in self.effects:
+        for effect in _of(self.effects, AbstractVesselPropertyEffect):
             environment = effect.environment(environment)
         return environment
 
@@ -423,7 +474,7 @@ class AugmentedVessel(_Augmented, AbstractVessel):
         z = self.effect_initial(delta) if self.held is None else self.held
         seen = self.rudder_path(delta, z)[0]
         tau = self.base.loads(t, u, v, r, seen, n)
-        for effect in self.effects:
+        for effect in _of(self.effects, AbstractLoadEffect):
             tau = tau + effect.loads(t, self.base, u, v, r, seen, n)
         return tau
 
@@ -459,14 +510,8 @@ class AugmentedSteering(_Augmented, AbstractSteeringModel):
     effects: tuple[AbstractEffect, ...]
 
     def __init__(self, base: AbstractSteeringModel, effects=()):
-        for e in effects:  # an effect with vessel hooks only would be a null parameter
-            if isinstance(e, AbstractEffect) and not any(
-                    getattr(type(e), hook) is not getattr(AbstractEffect, hook)
-                    for hook in ("rudder", "yaw_term", "measure", "state_rate")):
-                raise ValueError(f"{type(e).__name__} acts on a vessel's loads, mass, "
-                                 "environment or wind areas only; a steering model has none "
-                                 "of these (augment a vessel instead).")
-        self.base, self.effects = base, _check_effects(effects)
+        self.base, self.effects = base, _check_effects(effects, STEERING_PLACES,
+                                                       "steering model")
 
     @property
     def wind_loads(self) -> bool:
@@ -495,7 +540,7 @@ class AugmentedSteering(_Augmented, AbstractSteeringModel):
         x, z = self._split(state)
         seen, z_dot = self.rudder_path(delta, z, aux)
         term = sum(jnp.asarray(e.yaw_term(self.base, x, delta, aux), float)
-                   for e in self.effects)
+                   for e in _of(self.effects, AbstractYawTermEffect))
         x_dot = self.base.rhs(x, seen, aux) + self.base.forcing(x) * term
         return jnp.concatenate([x_dot, z_dot])
 

@@ -15,7 +15,12 @@ import jax.numpy as jnp
 from jaxtyping import ArrayLike
 
 from .._foundation._params import param
-from ._effects import AbstractEffect
+from ._effects import (
+    AbstractLoadEffect,
+    AbstractRudderEffect,
+    AbstractVesselPropertyEffect,
+    AbstractYawTermEffect,
+)
 from ._environment import Current, Environment
 
 
@@ -34,7 +39,7 @@ def _yaw_only(u, moment):
     return jnp.stack(jnp.broadcast_arrays(0.0 * u, 0.0 * u, moment))
 
 
-class YawQuadraticDamping(AbstractEffect):
+class YawQuadraticDamping(AbstractLoadEffect, AbstractYawTermEffect):
     """Quadratic (modulus) yaw damping, $\\beta > 0$ more damping in both families
     (Norrbin 1970, $N_{r|r|}$; Blanke 1981, the second-order modulus model):
 
@@ -76,7 +81,7 @@ def _crossflow_integrals(v, r, length):
     return sway, yaw
 
 
-class CrossflowDrag(AbstractEffect):
+class CrossflowDrag(AbstractLoadEffect):
     """Cross-flow drag of the hull in sway and yaw by strip theory (the cross-flow
     drag principle: Hoerner 1965; Faltinsen 1990; Fossen 2021, ch. 6, as in MSS
     `crossFlowDrag.m`), with a constant sectional drag coefficient $C_D$ and draught
@@ -103,7 +108,7 @@ class CrossflowDrag(AbstractEffect):
         return jnp.stack(jnp.broadcast_arrays(0.0 * u, -q * sway, -q * yaw))
 
 
-class SpeedDependentRudder(AbstractEffect):
+class SpeedDependentRudder(AbstractRudderEffect, AbstractLoadEffect):
     """Rudder effectiveness that changes with the inflow speed squared, by the factor
     $1 + \\kappa(u^2/U_0^2 - 1)$ ($\\kappa$ [-]; $u$ the surge speed through the
     water, $U_0$ `nominal_speed`):
@@ -151,7 +156,7 @@ class SpeedDependentRudder(AbstractEffect):
         return self._gain(u, nominal) * share
 
 
-class SpeedDependentDamping(AbstractEffect):
+class SpeedDependentDamping(AbstractYawTermEffect):
     """Yaw damping that scales with the surge speed (steering models): $-\\kappa(u/U_0 -
     1)\\,r$ in the yaw equation, with u the measured `AuxInputs.u` and $U_0$
     `nominal_speed` (the speed the model's time constants belong to). Nomoto's
@@ -173,7 +178,7 @@ class SpeedDependentDamping(AbstractEffect):
         return -self.kappa * (aux.u / self.nominal_speed - 1.0) * model.output(x)
 
 
-class RudderStall(AbstractEffect):
+class RudderStall(AbstractRudderEffect):
     """Lift saturation of the rudder as a third-order term linear in its parameter:
     the hydrodynamics see $\\delta' = \\delta - c\\,\\delta^3$ [c in 1/rad^2] (the
     Abkowitz $N_{\\delta\\delta\\delta}/N_\\delta$ form; Molland & Turnock 2007 for lift
@@ -191,7 +196,7 @@ class RudderStall(AbstractEffect):
         return delta - self.c * delta**3
 
 
-class PropellerAsymmetry(AbstractEffect):
+class PropellerAsymmetry(AbstractLoadEffect, AbstractYawTermEffect):
     """The yaw moment of a single screw (propeller walk: the asymmetric wake and the
     transverse force of the blades), proportional to the thrust, $\\propto n|n|$, with
     $n$ the propeller rate [rev/s] (Bech 1968: the offset of the reverse-spiral
@@ -218,7 +223,7 @@ class PropellerAsymmetry(AbstractEffect):
         return self.moment * aux.n * jnp.abs(aux.n)
 
 
-class PropellerRace(AbstractEffect):
+class PropellerRace(AbstractYawTermEffect):
     """The rudder's share of the propeller race, for steering models at low speed:
     the rudder inflow is $u_R^2 \\approx u^2 + c\\,(nD)^2$ (the MMG rudder inflow of
     Yasukawa & Yoshimura 2015, eq. 23, for a heavily loaded propeller, $u_P \\ll nD$;
@@ -244,7 +249,7 @@ class PropellerRace(AbstractEffect):
         return self.gain * n**2 * delta
 
 
-class SurgeTurnResistance(AbstractEffect):
+class SurgeTurnResistance(AbstractLoadEffect):
     """Added surge resistance in turns (Norrbin 1970; Ross 2008; MMG $X'_{vr}$ of
     Yasukawa & Yoshimura 2015): $X \\mathrel{+}= X_{vr}\\,vr$ with
     $X_{vr} = X'_{vr}\\tfrac12\\rho L^3$ (prime system, speed-free), $X'_{vr}$ [-] the
@@ -264,7 +269,7 @@ class SurgeTurnResistance(AbstractEffect):
         return jnp.stack(jnp.broadcast_arrays(x, 0.0 * u, 0.0 * u))
 
 
-class AddedMassError(AbstractEffect):
+class AddedMassError(AbstractVesselPropertyEffect):
     """An error in the sway and yaw entries of the mass matrix $M = M_{RB} + M_A$
     (Fossen 2021, eq. 6.1): $M_{22} \\to M_{22}(1 + s_v)$, $M_{33} \\to M_{33}(1 + s_r)$
     [-], the couplings $M_{23}, M_{32}$ unchanged. Added mass from slender-body or
@@ -293,7 +298,7 @@ class _AddedCurrent(eqx.Module):
         return north + self.north, east + self.east
 
 
-class UniformCurrent(AbstractEffect):
+class UniformCurrent(AbstractVesselPropertyEffect):
     """A uniform, constant earth-fixed current $V_c = (V_N, V_E)$ [m/s] added to the
     environment's. jaxship's hydrodynamics use velocities through the water, so it
     leaves u, v, r and psi unchanged and drifts the track,
@@ -320,7 +325,7 @@ class UniformCurrent(AbstractEffect):
                            wind=environment.wind)
 
 
-class Windage(AbstractEffect):
+class Windage(AbstractVesselPropertyEffect):
     """Projected wind areas the base vessel lacks, frontal $A_F$ and lateral $A_L$
     [m^2], added to its `frontal_wind_area` and `lateral_wind_area`, so that the
     vessel's wind model (`jaxship.Wind`: Fossen 2021, eqs. 10.7-10.10, coefficients
@@ -344,7 +349,7 @@ class Windage(AbstractEffect):
         return frontal + self.frontal_area, lateral + self.lateral_area
 
 
-class ApparentWind(AbstractEffect):
+class ApparentWind(AbstractYawTermEffect):
     """Wind on a steering model, from the logged wind: the yaw term
     $f_w = V_{rw}^2(c_2\\sin 2\\gamma + c_1\\sin\\gamma)
     = 2c_2u_{rw}v_{rw} + c_1V_{rw}v_{rw}$ with $(u_{rw}, v_{rw})$ the apparent wind of
