@@ -194,11 +194,8 @@ from ._simulation._readers import (
     read_trial_csv as read_trial_csv,
     write_trial_csv as write_trial_csv,
 )
-from ._simulation._simulate import RK4 as RK4, Simulator as Simulator, simulate as simulate
-from ._simulation._simulate_steering import (
-    SteeringTrajectory as SteeringTrajectory,
-    simulate_steering as simulate_steering,
-)
+from ._simulation._integrate import RK4 as RK4, Simulator as Simulator
+from ._simulation._simulate import simulate as simulate
 
 
 __version__ = importlib.metadata.version("jaxship")  # from pyproject.toml
@@ -212,12 +209,6 @@ from ._models._steering.ross import (
 from ._simulation._batch import (
     batch_turning_indices as batch_turning_indices,
     straight_run_batch as straight_run_batch,
-)
-from ._simulation._simulate_steering import steer_manoeuvre as steer_manoeuvre
-from ._trials import (
-    initial_state as initial_state,
-    run_trial as run_trial,
-    trial_indices as trial_indices,
 )
 
 

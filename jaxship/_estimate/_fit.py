@@ -33,7 +33,7 @@ from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
 from .._foundation._progress import ProgressCallback, reporting_steps, step_hook
 from .._foundation._sharding import sharded_vmap
 from .._foundation._validate import validate
-from .._simulation._simulate import Simulator, integrate, replay_policy
+from .._simulation._integrate import Simulator, integrate, replay_policy
 from ._initial import EstimatedStarts, MeasuredStates
 from ._kalman import SmoothedStates
 from ._linear import LinearStart

@@ -63,7 +63,7 @@ from .._foundation._state import STATE_FIELDS
 from .._models._steering._base import AbstractSteeringModel, AuxInputs, WindowStart
 from .._models._vessel._base import AbstractVessel
 from .._simulation._data import Experiment
-from .._simulation._simulate import Held, Simulator, integrate
+from .._simulation._integrate import Held, Simulator, integrate
 from ._windows import as_dataset, check_data, resolve_holds
 
 

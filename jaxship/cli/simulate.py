@@ -8,7 +8,7 @@ import pathlib
 from .._foundation._files import staged_folder
 from .._models._vessel.catalogue import get_vessel
 from .._simulation._froude import froude_scale
-from .._trials import TrialSpec, simulate_to_folder
+from ._trials import TrialSpec, simulate_to_folder
 from ._common import check_operating_point, check_out, positive
 
 

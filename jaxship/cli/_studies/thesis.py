@@ -33,6 +33,7 @@ import numpy as np
 
 import jaxship as js
 from jaxship._estimate._linear import initial_estimate
+from jaxship.cli._trials import initial_state
 
 
 DEG = math.pi / 180.0
@@ -134,7 +135,7 @@ def simulate_design(vessel=None, *, families=None, settings: Settings = Settings
             for rpm in RPMS:
                 if progress is not None:
                     progress(record_name(spec, rpm))
-                x0 = js.initial_state(vessel, rpm=rpm)
+                x0 = initial_state(vessel, rpm=rpm)
                 manoeuvre = _manoeuvre(spec, vessel, x0, settings)
                 traj = js.simulate(vessel, manoeuvre, x0, simulator=simulator)
                 if not bool(traj.success):
