@@ -183,6 +183,7 @@ from ._models._vessel.sway_yaw import SwayYawVessel as SwayYawVessel
 from ._simulation._batch import simulate_batch as simulate_batch, stack as stack
 from ._simulation._data import Dataset as Dataset, Experiment as Experiment
 from ._simulation._froude import froude_scale as froude_scale
+from ._simulation._integrate import RK4 as RK4, Simulator as Simulator
 from ._simulation._measured import (
     read_esso_osaka as read_esso_osaka,
     read_hsva_kvlcc2 as read_hsva_kvlcc2,
@@ -194,7 +195,6 @@ from ._simulation._readers import (
     read_trial_csv as read_trial_csv,
     write_trial_csv as write_trial_csv,
 )
-from ._simulation._integrate import RK4 as RK4, Simulator as Simulator
 from ._simulation._simulate import simulate as simulate
 
 

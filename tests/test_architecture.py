@@ -216,10 +216,11 @@ def test_every_public_estimator_is_accepted_by_fit_and_predict():
     assert estimators == {js.PredictionError, js.Innovations, js.ARMAX, js.DiscreteResponse}
     t = np.arange(0.0, 240.0, 1.0)
     delta = np.deg2rad(10.0) * np.sign(np.sin(2 * np.pi * t / 120.0))
-    truth = js.simulate_steering(js.Nomoto1(K=0.06, T=25.0), delta, 1.0, substeps=4)
+    truth = js.simulate(js.Nomoto1(K=0.06, T=25.0), js.Replay(delta, dt=1.0, delta_hold="foh"),
+                        simulator=js.Simulator(max_step=float("inf"), substeps=4))
     noise = np.random.default_rng(0).standard_normal((2, t.size))
-    record = js.Experiment(t, delta, psi=np.asarray(truth.psi) + 0.01 * noise[0],
-                           r=np.asarray(truth.r) + 0.001 * noise[1])
+    record = js.Experiment(t, delta, psi=np.asarray(truth.state.psi) + 0.01 * noise[0],
+                           r=np.asarray(truth.state.r) + 0.001 * noise[1])
     start = js.Nomoto1(K=0.05, T=20.0)
     for estimator, model in ((js.PredictionError(), start), (js.Innovations(), start),
                              (js.DiscreteResponse(), start),

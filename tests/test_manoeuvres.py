@@ -9,7 +9,7 @@ from helpers import linear_test_vessel
 
 import jaxship as js
 from jaxship._analysis._indices import reverse_spiral_curve
-from jaxship._trials import linear_yaw, yaw_rate_gains
+from jaxship.cli._trials import linear_yaw, run_spec, trial_indices, yaw_rate_gains
 
 
 AT_SAMPLES = js.Simulator(max_step=math.inf)  # controllers act at the output samples
@@ -305,7 +305,7 @@ def test_reverse_spiral_trial_reaches_every_level_across_the_direct_range(name):
     # for the KVLCC2, against +-0.6 and +-3 in the direct spiral) and the last one was
     # dropped (7 of 8 reported)
     vessel = js.vessel(name)
-    manoeuvre, traj = js.run_trial(vessel, "reverse-spiral")
+    manoeuvre, traj = run_spec(vessel, "reverse-spiral")  # the CLI's trial spec
     assert isinstance(manoeuvre, js.ReverseSpiral)
     curve = js.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
     ordered = np.asarray(manoeuvre.rates)
@@ -317,7 +317,7 @@ def test_reverse_spiral_trial_reaches_every_level_across_the_direct_range(name):
     r_port_max, r_stbd_max = _direct_range(vessel, x0, tau, float(manoeuvre.dt))
     assert np.ptp(curve.r) >= 0.5 * (r_port_max - r_stbd_max)
     assert np.all(np.abs(np.asarray(traj.command.delta)) <= vessel.rudder.max_angle + 1e-12)
-    indices = js.trial_indices("reverse-spiral", manoeuvre, traj)
+    indices = trial_indices("reverse-spiral", manoeuvre, traj)
     assert len(indices["r_deg_s"]) == 12
     if name == "kvlcc2":  # course-unstable: the S-curve has a loop between its branches
         assert curve.loop.width > np.deg2rad(0.1) and curve.loop.height > np.deg2rad(0.5)
@@ -344,7 +344,7 @@ def test_crash_stop_trial_ends_when_the_ship_has_stopped():
     # issue 13: the KVLCC2 kept going full astern after it had stopped and spun at
     # -4 deg/s to a heading of -1534 deg
     vessel = js.vessel("kvlcc2")
-    manoeuvre, traj = js.run_trial(vessel, "stop")
+    manoeuvre, traj = run_spec(vessel, "stop")  # the CLI's trial spec
     ind = js.stopping_indices(traj)
     t = np.asarray(traj.t)
     assert t[-1] <= ind.execute_time + 1.1 * ind.time_to_stop + 3 * float(manoeuvre.dt)

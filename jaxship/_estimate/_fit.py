@@ -7,7 +7,7 @@ and sums the squared, weighted output errors of all windows of all experiments
 of one sample equation error. The optimiser is `optimistix.LevenbergMarquardt` in
 the scaled, unconstrained parameter space of `_params.Transform` (with MINPACK's
 cost-based stopping rule added, `_lm.py`), the Jacobian by forward-mode autodiff
-through the simulator's time loop (`_simulate.integrate`), computed once per evaluation
+through the simulator's time loop (`_integrate.integrate`), computed once per evaluation
 (`_lm.stored_jacobian`). Steering models and vessels alike (the shared model contract).
 """
 

@@ -11,6 +11,7 @@ controller that sees the model's heading and yaw rate.
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from .._foundation._params import as_arrays
 from .._foundation._state import Command, ShipState, Trajectory
@@ -61,6 +62,9 @@ def simulate_steering_model(model: AbstractSteeringModel, manoeuvre, x0: ShipSta
     x0 = jax.tree.map(lambda a: jnp.asarray(a, float), x0)
     steps = simulator.steps_per_sample(manoeuvre.dt)
     if isinstance(manoeuvre, Replay):
+        if np.ndim(manoeuvre.delta_record) != 1 or np.shape(manoeuvre.delta_record)[0] < 2:
+            raise ValueError("`delta_record` must be a 1-D array of at least 2 samples, got "
+                             f"shape {np.shape(manoeuvre.delta_record)}.")
         return _replay(as_arrays(model), as_arrays(manoeuvre), x0, aux, simulator, steps)
     if aux is not None:
         raise ValueError("`aux` is replayed beside a `Replay`'s rudder record; a closed-loop "
