@@ -137,7 +137,7 @@ def _state_derivative(
     four times per step) and, with `wind=False`, without the wind loads (the simulator
     passes it when the wind speed is a static zero, where the loads vanish identically);
     `t` [s] for loads that vary in time; `rudder_rate` [rad/s]: a manoeuvre's limit on
-    the rudder rate, $|\dot\delta| \le$ min(servo's, `rudder_rate`) (None: the
+    the rudder rate, $|\\dot\\delta| \\le$ min(servo's, `rudder_rate`) (None: the
     servo's own). The vessel's `environment` hook sees the environment first."""
     environment = vessel.environment(environment)
     tau = vessel.loads(t, state.u, state.v, state.r, state.delta, state.n)
