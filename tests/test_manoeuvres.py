@@ -362,3 +362,25 @@ def test_crash_stop_trial_ends_when_the_ship_has_stopped():
     assert np.max(np.abs(np.asarray(long.state.psi))) < 1.0 * DEG
     assert np.max(np.abs(u[stopped])) < 0.05 * float(vessel.nominal_speed)
 
+
+
+def test_a_zigzag_rudder_rate_slower_than_the_servo_shows_in_the_rudder():
+    """Issue 34: the rudder rate is an argument of the trial. A Mariner (servo limit
+    5 deg/s) through a 20/20 zig-zag whose steering gear moves 2 deg/s: the actual
+    rudder moves at 2 deg/s, the smaller of the two limits; without it, at the servo's
+    5 deg/s; and the ordered rudder is the zig-zag's either way."""
+    mariner = js.vessel("mariner")
+    x0 = js.straight_run(mariner)
+    servo = float(mariner.rudder.max_rate)
+    assert servo == pytest.approx(5 * DEG)
+    rates = {}
+    for gear in (None, 2 * DEG):
+        zigzag = js.ZigZag(20 * DEG, 20 * DEG, duration=200.0, dt=0.1, rudder_rate=gear)
+        traj = js.simulate(mariner, zigzag, x0)
+        assert bool(traj.success)
+        assert np.max(np.abs(np.asarray(traj.command.delta))) == pytest.approx(20 * DEG)
+        rates[gear] = np.max(np.abs(np.diff(np.asarray(traj.state.delta)))) / 0.1
+    assert rates[None] == pytest.approx(servo, rel=1e-6)
+    assert rates[2 * DEG] == pytest.approx(2 * DEG, rel=1e-6)
+    with pytest.raises(ValueError, match="rudder_rate"):
+        js.Turn(10 * DEG, duration=10.0, rudder_rate=0.0)
