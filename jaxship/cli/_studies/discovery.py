@@ -110,10 +110,10 @@ def wind_records(truth, seed, *, speed=7.0, wind=(15.0, 60.0 * DEG), noise=(0.1,
     def one(manoeuvre, heading, name):
         calm = js.simulate(truth, dataclasses.replace(manoeuvre, rudder_rate=2.3 * DEG),
                            simulator=FINE)
-        t, delta = np.asarray(calm.t), np.asarray(calm.delta)
+        t, delta = np.asarray(calm.t), np.asarray(calm.state.delta)
         logged = dict(u=np.full(t.size, speed), v=np.zeros(t.size),
                       wind_speed=np.full(t.size, wind[0]), wind_dir=np.full(t.size, wind[1]))
-        psi, r = np.asarray(calm.psi) + heading, np.asarray(calm.r)
+        psi, r = np.asarray(calm.state.psi) + heading, np.asarray(calm.state.r)
         for _ in range(8):
             out = js.predict(truth, js.Experiment(t, delta, psi=psi, r=r, **logged),
                              estimator=replay)
