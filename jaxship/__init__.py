@@ -188,6 +188,7 @@ from ._models._vessel.sway_yaw import SwayYawVessel as SwayYawVessel
 from ._simulation._batch import simulate_batch as simulate_batch, stack as stack
 from ._simulation._data import Dataset as Dataset, Experiment as Experiment
 from ._simulation._froude import froude_scale as froude_scale
+from ._simulation._integrate import RK4 as RK4, Simulator as Simulator
 from ._simulation._measured import (
     read_esso_osaka as read_esso_osaka,
     read_hsva_kvlcc2 as read_hsva_kvlcc2,
@@ -199,11 +200,7 @@ from ._simulation._readers import (
     read_trial_csv as read_trial_csv,
     write_trial_csv as write_trial_csv,
 )
-from ._simulation._simulate import RK4 as RK4, Simulator as Simulator, simulate as simulate
-from ._simulation._simulate_steering import (
-    SteeringTrajectory as SteeringTrajectory,
-    simulate_steering as simulate_steering,
-)
+from ._simulation._simulate import simulate as simulate
 
 
 __version__ = importlib.metadata.version("jaxship")  # from pyproject.toml
@@ -217,12 +214,6 @@ from ._models._steering.ross import (
 from ._simulation._batch import (
     batch_turning_indices as batch_turning_indices,
     straight_run_batch as straight_run_batch,
-)
-from ._simulation._simulate_steering import steer_manoeuvre as steer_manoeuvre
-from ._trials import (
-    initial_state as initial_state,
-    run_trial as run_trial,
-    trial_indices as trial_indices,
 )
 
 

@@ -35,10 +35,15 @@ L, U = float(ship.length), float(ship.nominal_speed)
 print(f"Mariner: L = {L:.1f} m, approach speed U = {U:.2f} m/s ({U / 0.5144:.1f} kn)")"""),
     new_markdown_cell("""## Turning circle, 35 deg to starboard
 
-`js.run_trial` builds the trial from its name (as `jaxship simulate --manoeuvre` does) and
-simulates it from the straight run at the approach speed; the turn runs until the ship has
-turned 540 deg (ITTC). `js.turning_indices` gives advance, transfer and tactical diameter."""),
-    new_code_cell("""manoeuvre, turn = js.run_trial(ship, "turn:35")
+A trial is a manoeuvre (`js.Turn`, `js.ZigZag`, ...): `js.simulate` runs it from the
+straight run at the approach speed, here for 60 ship lengths' time L/U (past the 540 deg of
+heading change ITTC asks for), with an output every second and two RK4 steps per sample, as
+`jaxship simulate --manoeuvre turn:35` does. `js.turning_indices` gives advance, transfer
+and tactical diameter."""),
+    new_code_cell("""tau = L / U  # the ship's time scale [s]
+x0 = js.straight_run(ship)  # the approach at the nominal speed
+fine = js.Simulator(substeps=2)
+turn = js.simulate(ship, js.Turn(np.deg2rad(35), duration=60 * tau, dt=1.0), x0, simulator=fine)
 turning = js.turning_indices(turn)
 tactical = turning.tactical_diameter
 print(f"advance {turning.advance:.0f} m = {turning.advance / L:.2f} L, "
@@ -49,7 +54,8 @@ fig = plot_trajectory(turn, length=L, indices=turning, title="Mariner, 35 deg tu
 
 The rudder goes to 20 deg and is reversed each time the heading has changed by 20 deg; the
 overshoots are how far the heading swings past that before it turns back."""),
-    new_code_cell("""manoeuvre, zigzag = js.run_trial(ship, "zigzag:20/20")
+    new_code_cell("""zigzag = js.simulate(ship, js.ZigZag(np.deg2rad(20), np.deg2rad(20), duration=35 * tau, dt=1.0),
+                     x0, simulator=fine)
 zz20 = js.zigzag_indices(zigzag, np.deg2rad(20))
 print("overshoots [deg]:", np.round(np.rad2deg(zz20.overshoots), 2))
 fig = plot_trajectory(zigzag, length=L, indices=zz20, title="Mariner, 20/20 zig-zag")"""),
@@ -57,7 +63,8 @@ fig = plot_trajectory(zigzag, length=L, indices=zz20, title="Mariner, 20/20 zig-
 
 MSC.137(76) limits the 35 deg turn (advance 4.5 L, tactical diameter 5 L) and the zig-zag
 overshoots (the 10/10 limits depend on L/V)."""),
-    new_code_cell("""manoeuvre, zigzag10 = js.run_trial(ship, "zigzag:10/10")
+    new_code_cell("""zigzag10 = js.simulate(ship, js.ZigZag(np.deg2rad(10), np.deg2rad(10), duration=35 * tau,
+                                        dt=1.0), x0, simulator=fine)
 zz10 = js.zigzag_indices(zigzag10, np.deg2rad(10))
 rows = js.imo_criteria(L, U, turning35=turning, zigzag10=zz10, zigzag20=zz20)
 display(Markdown(js.format_table(rows)))

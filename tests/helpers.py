@@ -1,5 +1,7 @@
 """Shared test helpers: tree comparison, finite differences and a small test vessel."""
 
+import math
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -67,3 +69,9 @@ def linear_test_vessel():
 
 
 __all__ = ["tree_allclose", "central_difference", "linear_test_vessel", "eqx"]
+
+
+def per_sample(substeps: int = 1) -> js.Simulator:
+    """`substeps` fixed RK4 steps per sample interval, whatever its length: the numerics
+    of a rudder record replayed sample by sample (`Simulator(max_step=inf)`)."""
+    return js.Simulator(max_step=math.inf, substeps=substeps)

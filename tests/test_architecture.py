@@ -263,10 +263,11 @@ def test_every_public_estimator_is_accepted_by_fit_and_predict():
     assert estimators == {js.PredictionError, js.Innovations, js.ARMAX, js.DiscreteResponse}
     t = np.arange(0.0, 240.0, 1.0)
     delta = np.deg2rad(10.0) * np.sign(np.sin(2 * np.pi * t / 120.0))
-    truth = js.simulate_steering(js.Nomoto1(K=0.06, T=25.0), delta, 1.0, substeps=4)
+    truth = js.simulate(js.Nomoto1(K=0.06, T=25.0), js.Replay(delta, dt=1.0, delta_hold="foh"),
+                        simulator=js.Simulator(max_step=float("inf"), substeps=4))
     noise = np.random.default_rng(0).standard_normal((2, t.size))
-    record = js.Experiment(t, delta, psi=np.asarray(truth.psi) + 0.01 * noise[0],
-                           r=np.asarray(truth.r) + 0.001 * noise[1])
+    record = js.Experiment(t, delta, psi=np.asarray(truth.state.psi) + 0.01 * noise[0],
+                           r=np.asarray(truth.state.r) + 0.001 * noise[1])
     start = js.Nomoto1(K=0.05, T=20.0)
     for estimator, model in ((js.PredictionError(), start), (js.Innovations(), start),
                              (js.DiscreteResponse(), start),
@@ -279,3 +280,45 @@ def test_every_public_estimator_is_accepted_by_fit_and_predict():
                 metrics.fit_percent, abs=1e-6), (estimator, channel)
     with pytest.raises(ValueError, match="needs every noise variance; missing rudder"):
         js.predict(start, [record], estimator=js.Innovations())
+
+
+def test_the_public_simulation_doors_are_simulate_and_simulate_batch():
+    """Two doors to simulate (issue 33): `simulate` and `simulate_batch`, for vessels and
+    steering models alike, and one result type, `Trajectory` (a trial spec is a
+    manoeuvre, a record replay is a manoeuvre)."""
+    import jaxship as js
+
+    doors = {name for name, obj in vars(js).items() if callable(obj) and not isinstance(obj, type)
+             and name.startswith(("simulate", "steer", "run_"))}
+    assert doors == {"simulate", "simulate_batch"}, doors
+    results = {name for name, obj in vars(js).items() if isinstance(obj, type)
+               and name.endswith("Trajectory")}
+    assert results == {"Trajectory"}, results
+
+
+def test_a_replay_of_a_closed_loop_run_reproduces_it():
+    """The two semantics of the one door agree: a Nomoto 2 model through a rate-limited
+    ZigZag (the manoeuvre sees the heading), then the same model through a `Replay` of
+    that run's actual rudder. With samples every `max_step` (0.1 s) the closed loop
+    takes one RK4 step per sample with the rudder held over it, which is what a
+    zero-order-hold replay of the recorded rudder at one step per sample integrates: the
+    headings and yaw rates agree to rounding."""
+    import jax
+    import numpy as np
+
+    import jaxship as js
+
+    jax.config.update("jax_enable_x64", True)
+    model = js.Nomoto2(K=0.06, T1=25.0, T2=3.0, T3=5.0)
+    deg = np.pi / 180
+    zigzag = js.ZigZag(10 * deg, 10 * deg, duration=200.0, dt=0.1, rudder_rate=2.0 * deg)
+    closed = js.simulate(model, zigzag)
+    delta = np.asarray(closed.state.delta)
+    assert np.ptp(delta) > 15 * deg  # the rudder was reversed
+    assert np.max(np.abs(np.diff(delta))) <= 2.0 * deg * 0.1 + 1e-12  # at the gear's rate
+    replay = js.simulate(model, js.Replay(delta, dt=0.1, delta_hold="zoh"))
+    np.testing.assert_allclose(replay.state.psi, closed.state.psi, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(replay.state.r, closed.state.r, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(replay.internal, closed.internal, rtol=0, atol=1e-9)
+    assert bool(replay.success) and bool(closed.success)
+    np.testing.assert_array_equal(replay.state.x, 0.0)  # a response model has no track

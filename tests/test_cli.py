@@ -7,6 +7,7 @@ import os
 
 import numpy as np
 import pytest
+from helpers import per_sample
 
 import jaxship as js
 from jaxship._foundation._files import MANIFEST
@@ -91,9 +92,10 @@ def _record(path, *, psi=True, seed=0, num=400, dt=0.5):
     """A trial CSV of Nomoto1(K=0.06, T=25) driven by random rudder steps."""
     rng = np.random.default_rng(seed)
     delta = np.repeat(np.where(rng.random(num // 20) < 0.5, -1.0, 1.0) * np.deg2rad(10), 20)
-    tr = js.simulate_steering(js.Nomoto1(K=0.06, T=25.0), delta, dt, psi0=0.1)
-    channels = {"psi": np.asarray(tr.psi)} if psi else {}
-    js.write_trial_csv(path, js.Experiment(np.asarray(tr.t), delta, r=np.asarray(tr.r),
+    tr = js.simulate(js.Nomoto1(K=0.06, T=25.0), js.Replay(delta, dt=dt, delta_hold="foh"),
+                     js.straight_state(0.0, psi=0.1), simulator=per_sample())
+    channels = {"psi": np.asarray(tr.state.psi)} if psi else {}
+    js.write_trial_csv(path, js.Experiment(np.asarray(tr.t), delta, r=np.asarray(tr.state.r),
                                            name=path.stem, **channels))
     return str(path)
 

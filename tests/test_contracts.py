@@ -9,6 +9,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from helpers import per_sample
 
 import jaxship as js
 from jaxship._foundation._params import default_free, get_path, rebuild
@@ -149,8 +150,9 @@ def test_vessel_contract(name):
 def steering_final(model, name):
     delta = np.deg2rad(10) * np.sign(np.sin(2 * np.pi * np.arange(120) / 60.0) + 1e-9)
     aux = js.AuxInputs(u=1.5, v=0.05, n=8.0)
-    return lambda p: js.simulate_steering(rebuild(model, (name,), (p,)), delta, 0.5,
-                                          aux=aux).psi[-1]
+    return lambda p: js.simulate(rebuild(model, (name,), (p,)),
+                                 js.Replay(delta, dt=0.5, delta_hold="foh"), aux=aux,
+                                 simulator=per_sample()).state.psi[-1]
 
 
 @pytest.mark.parametrize("name", sorted(STEERING))
@@ -217,13 +219,15 @@ def test_effect_contract(effect):
         delta = np.deg2rad(10) * np.sign(np.sin(2 * np.pi * np.arange(200) / 80.0) + 1e-9)
         measured = shown.get("aux", {})
         aux = js.AuxInputs(**measured)
-        base = js.simulate_steering(model, delta, 0.5, aux=aux)
+        base = js.simulate(model, js.Replay(delta, dt=0.5, delta_hold="foh"), aux=aux,
+                           simulator=per_sample())
         augmented = js.augment(model, zero)
-        same = js.simulate_steering(augmented, delta, 0.5, aux=aux)
-        np.testing.assert_array_equal(same.psi, base.psi)
-        np.testing.assert_array_equal(same.r, base.r)
-        data = js.Experiment(np.asarray(base.t), delta, psi=np.asarray(base.psi),
-                             r=np.asarray(base.r), **measured)
+        same = js.simulate(augmented, js.Replay(delta, dt=0.5, delta_hold="foh"), aux=aux,
+                           simulator=per_sample())
+        np.testing.assert_array_equal(same.state.psi, base.state.psi)
+        np.testing.assert_array_equal(same.state.r, base.state.r)
+        data = js.Experiment(np.asarray(base.t), delta, psi=np.asarray(base.state.psi),
+                             r=np.asarray(base.state.r), **measured)
 
         def cost(p):
             m = rebuild(augmented, (name,), (p,))

@@ -3,6 +3,7 @@
 import jax
 import numpy as np
 import pytest
+from helpers import per_sample
 
 import jaxship as js
 from jaxship import (
@@ -11,8 +12,7 @@ from jaxship import (
     excitation_order,
     fisher_information,
     prbs,
-    simulate_steering,
-    steer_manoeuvre,
+    simulate,
 )
 
 
@@ -25,9 +25,9 @@ def test_excitation_order_known_signals():
         u = sum(np.sin(w * t + i) for i, w in enumerate(freqs))
         assert excitation_order(u) == 2 * k
     # PRBS of period 31 samples (order 5 register, one bit per sample)
-    u = np.asarray(steer_manoeuvre(Nomoto1(K=0.1, T=10.0),
-                                   prbs(1.0, bit_time=1.0, duration=31 * 40.0, order=5,
-                                        dt=1.0)).delta)
+    u = np.asarray(simulate(Nomoto1(K=0.1, T=10.0),
+                            prbs(1.0, bit_time=1.0, duration=31 * 40.0, order=5,
+                                 dt=1.0)).state.delta)
     assert excitation_order(u[1:], max_order=60) == 31
     white = np.random.default_rng(0).standard_normal(n)
     assert excitation_order(white, max_order=50) == 50
@@ -54,8 +54,9 @@ def test_fisher_against_finite_differences(model, free):
     for name in free:
         v = float(getattr(model, name))
         h = 1e-6 * abs(v)
-        sim = lambda x: np.asarray(simulate_steering(
-            jax.tree_util.tree_map(lambda a: a, _with(model, name, x)), delta, dt).r)
+        sim = lambda x: np.asarray(js.simulate(
+            jax.tree_util.tree_map(lambda a: a, _with(model, name, x)),
+            js.Replay(delta, dt=dt, delta_hold="foh"), simulator=per_sample()).state.r)
         cols.append((sim(v + h) - sim(v - h)) / (2 * h))
     jac = np.stack(cols, axis=1)
     fd = jac.T @ jac / sigma**2

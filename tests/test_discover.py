@@ -157,10 +157,9 @@ def test_a_predicted_overshoot_is_measured_between_the_logged_rudder_reversals()
     """On the measured heading the overshoots are the IMO ones; a prediction that
     replays the logged rudder but turns too little never reaches the switch angle, and
     its overshoots come out negative (before, such a prediction had none)."""
-    out = js.steer_manoeuvre(js.Nomoto1(K=K, T=25.0), js.ZigZag(10 * DEG, 10 * DEG,
-                                                                duration=400.0, dt=0.5),
-                             rudder_rate=2.3 * DEG)
-    t, delta, psi = (np.asarray(a) for a in (out.t, out.delta, out.psi))
+    out = js.simulate(js.Nomoto1(K=K, T=25.0), js.ZigZag(10 * DEG, 10 * DEG, duration=400.0,
+                                                         dt=0.5, rudder_rate=2.3 * DEG))
+    t, delta, psi = (np.asarray(a) for a in (out.t, out.state.delta, out.state.psi))
     imo = js.zigzag_indices(heading_switch=10 * DEG, t=t, psi=psi, delta=delta).overshoots
     measured = record_indices(t, delta, psi)
     assert [measured["overshoot_1_deg"], measured["overshoot_2_deg"]] == pytest.approx(

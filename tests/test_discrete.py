@@ -2,9 +2,10 @@
 
 import numpy as np
 import pytest
+from helpers import per_sample
 
 import jaxship as js
-from jaxship import Experiment, Nomoto1, Nomoto2, simulate_steering
+from jaxship import Experiment, Nomoto1, Nomoto2
 from jaxship._estimate._discrete import (
     COEFFICIENTS,
     DiscreteResponseFit,
@@ -57,11 +58,12 @@ def test_euler_linear_roundtrip(structure):
 
 def test_zoh_matches_continuous_models():
     """ZOH coefficients reproduce the continuous Nomoto models they were sampled from
-    (reference: simulate_steering with fine RK4 substeps), and the fit recovers K, T."""
+    (reference: simulate with fine RK4 substeps), and the fit recovers K, T."""
     d = _rudder(1500)
     for structure, model in (("linear1", Nomoto1(K=0.1, T=20.0, delta0=0.01)),
                              ("linear2", Nomoto2(K=0.1, T1=25.0, T2=3.0, T3=5.0, delta0=0.01))):
-        r = np.asarray(simulate_steering(model, d, H, substeps=40, hold="zoh").r)
+        r = np.asarray(js.simulate(model, js.Replay(d, dt=H, delta_hold="zoh"),
+                                   simulator=per_sample(40)).state.r)
         e = Experiment(np.arange(d.size) * H, d, r=r)
         f = fit_discrete_response(structure, e)
         for k, v in CASES[structure].items():
@@ -72,7 +74,8 @@ def test_zoh_matches_continuous_models():
                              ("linear2", Nomoto2(K=0.1, T1=25.0, T2=3.0, T3=5.0))):
         params = {k: v for k, v in CASES[structure].items() if k != "delta_r"}
         c = discretise(structure, params, H)
-        r = np.asarray(simulate_steering(model, d, H, substeps=40, hold="zoh").r)
+        r = np.asarray(js.simulate(model, js.Replay(d, dt=H, delta_hold="zoh"),
+                                   simulator=per_sample(40)).state.r)
         sim = DiscreteResponseFit(structure, "ls", "zoh", H, c, {}, 0.0, 0).simulate(d)
         assert np.max(np.abs(sim - r)) < 1e-9 * np.max(np.abs(r))
 

@@ -7,6 +7,7 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from helpers import per_sample
 from scipy.integrate import quad
 
 import jaxship as js
@@ -29,13 +30,13 @@ def test_rudder_lag_gives_the_two_time_constant_step_response():
     assert model.state_names == ("r", "rudder_lag.delta_lagged")
     dt = 0.5
     delta = step()
-    out = js.simulate_steering(model, delta, dt, hold="zoh", substeps=5)
+    out = js.simulate(model, js.Replay(delta, dt=dt, delta_hold="zoh"), simulator=per_sample(5))
     t = np.asarray(out.t) - dt  # the step acts from the second sample
     expected = K * 10 * DEG * (1 - (T * np.exp(-t / T) - lag * np.exp(-t / lag)) / (T - lag))
     # RK4 at 0.1 s control steps: error of order (h / T_l)^4 = 4e-7 of the final rate
-    np.testing.assert_allclose(out.r[1:], expected[1:], rtol=0, atol=1e-6 * K * 10 * DEG)
+    np.testing.assert_allclose(out.state.r[1:], expected[1:], rtol=0, atol=1e-6 * K * 10 * DEG)
     # the lagged rudder is a state: it follows delta (1 - exp(-t / T_l))
-    np.testing.assert_allclose(out.state[1:, 1], 10 * DEG * (1 - np.exp(-t[1:] / lag)),
+    np.testing.assert_allclose(out.internal[1:, 1], 10 * DEG * (1 - np.exp(-t[1:] / lag)),
                                atol=1e-6 * 10 * DEG)
 
 
@@ -44,13 +45,14 @@ def test_rudder_delay_follows_the_delayed_response():
     0.5 % of the step's final yaw rate once the delay has passed."""
     delay, dt = 2.0, 0.25
     model = js.augment(js.Nomoto1(K=K, T=T), js.RudderDelay(delay=delay))
-    out = js.simulate_steering(model, step(1200), dt, hold="zoh", substeps=5)
+    out = js.simulate(model, js.Replay(step(1200), dt=dt, delta_hold="zoh"),
+                      simulator=per_sample(5))
     t = np.asarray(out.t) - dt
     exact = K * 10 * DEG * (1 - np.exp(-np.clip(t - delay, 0, None) / T))
     late = t > 2 * delay
-    assert np.max(np.abs(out.r[late] - exact[late])) < 5e-3 * K * 10 * DEG
+    assert np.max(np.abs(out.state.r[late] - exact[late])) < 5e-3 * K * 10 * DEG
     undelayed = K * 10 * DEG * (1 - np.exp(-np.clip(t, 0, None) / T))
-    assert np.max(np.abs(out.r[late] - undelayed[late])) > 0.05 * K * 10 * DEG
+    assert np.max(np.abs(out.state.r[late] - undelayed[late])) > 0.05 * K * 10 * DEG
 
 
 def test_rudder_rate_limit_ramps_the_acting_rudder():
@@ -58,8 +60,9 @@ def test_rudder_rate_limit_ramps_the_acting_rudder():
     about that length (here 5 per 0.5 s sample)."""
     rate = 2.3 * DEG
     model = js.augment(js.Nomoto1(K=K, T=T), js.RudderRateLimit(inverse_rate=1 / rate))
-    out = js.simulate_steering(model, step(200, 20 * DEG), 0.5, hold="zoh", substeps=5)
-    acting = np.asarray(out.state[:, 1])
+    out = js.simulate(model, js.Replay(step(200, 20 * DEG), dt=0.5, delta_hold="zoh"),
+                      simulator=per_sample(5))
+    acting = np.asarray(out.internal[:, 1])
     slope = np.diff(acting) / 0.5
     np.testing.assert_allclose(slope[2:15], rate, rtol=1e-9)  # ramping at the limit
     assert acting[-1] == pytest.approx(20 * DEG, abs=1e-9)  # then reaches the order
@@ -97,8 +100,10 @@ def test_fit_recovers_a_rudder_lag_on_a_steering_model():
     truth = js.augment(js.Nomoto1(K=K, T=T), js.RudderLag(time_constant=3.0))
     delta = 10 * DEG * np.sign(np.sin(2 * np.pi * np.arange(800) / 160.0) + 1e-9)
     delta[0] = 0.0  # from a straight run, as trials start
-    out = js.simulate_steering(truth, delta, 0.5, substeps=20)  # a finer truth
-    data = js.Experiment(np.asarray(out.t), delta, psi=np.asarray(out.psi), r=np.asarray(out.r))
+    out = js.simulate(truth, js.Replay(delta, dt=0.5, delta_hold="foh"),
+                      simulator=per_sample(20))  # a finer truth
+    data = js.Experiment(np.asarray(out.t), delta, psi=np.asarray(out.state.psi),
+                         r=np.asarray(out.state.r))
     start = js.augment(js.Nomoto1(K=0.05, T=20.0), js.RudderLag(time_constant=1.0))
     result = js.fit(start, data, estimator=js.PredictionError(horizon=None, substeps=5),
                     free=("K", "T", "rudder_lag.time_constant"))
@@ -113,8 +118,10 @@ def test_a_model_augmented_with_no_effects_fits_as_its_base():
     lookup once failed on the empty effects tuple)."""
     delta = 10 * DEG * np.sign(np.sin(2 * np.pi * np.arange(400) / 160.0) + 1e-9)
     delta[0] = 0.0
-    out = js.simulate_steering(js.Nomoto1(K=K, T=T), delta, 0.5)
-    data = js.Experiment(np.asarray(out.t), delta, psi=np.asarray(out.psi), r=np.asarray(out.r))
+    out = js.simulate(js.Nomoto1(K=K, T=T), js.Replay(delta, dt=0.5, delta_hold="foh"),
+                      simulator=per_sample())
+    data = js.Experiment(np.asarray(out.t), delta, psi=np.asarray(out.state.psi),
+                         r=np.asarray(out.state.r))
     estimator = js.PredictionError(horizon=None)
     start = js.Nomoto1(K=0.05, T=20.0)
     plain = js.fit(start, data, estimator=estimator)
@@ -143,12 +150,15 @@ def test_a_yaw_moment_on_nomoto_equals_a_rudder_offset():
     d0 = 0.01
     delta = 10 * DEG * np.sign(np.sin(2 * np.pi * np.arange(400) / 160.0) + 1e-9)
     for base in (js.Nomoto1(K=K, T=T), js.Nomoto2(K=K, T1=T, T2=3.0, T3=5.0)):
-        moment = js.simulate_steering(js.augment(base, js.YawMomentBias(n0=K * d0)), delta, 0.5)
-        offset = js.simulate_steering(js.augment(base, js.RudderOffset(delta0=d0)), delta, 0.5)
+        moment = js.simulate(js.augment(base, js.YawMomentBias(n0=K * d0)),
+                             js.Replay(delta, dt=0.5, delta_hold="foh"), simulator=per_sample())
+        offset = js.simulate(js.augment(base, js.RudderOffset(delta0=d0)),
+                             js.Replay(delta, dt=0.5, delta_hold="foh"), simulator=per_sample())
         if isinstance(base, js.Nomoto1):
-            np.testing.assert_allclose(moment.r, offset.r, rtol=1e-12, atol=1e-15)
+            np.testing.assert_allclose(moment.state.r, offset.state.r, rtol=1e-12, atol=1e-15)
         else:  # Nomoto 2: the offset also enters through K T3 (delta + delta0)
-            assert np.max(np.abs(moment.r - offset.r)) < 1e-2 * np.max(np.abs(offset.r))
+            assert (np.max(np.abs(moment.state.r - offset.state.r))
+                    < 1e-2 * np.max(np.abs(offset.state.r)))
 
 
 # -- hull, rudder, propeller and environment effects (`_hydro_effects.py`) --
@@ -187,8 +197,9 @@ def test_load_effects_add_their_closed_form_to_a_vessel(effect, expected):
 
 def steady_r(model, angle, aux=None, num=800, dt=1.0):
     """The yaw rate after `num` samples of a rudder step to `angle` from rest."""
-    out = js.simulate_steering(model, step(num, angle), dt, aux=aux, hold="zoh", substeps=2)
-    return float(out.r[-1])
+    out = js.simulate(model, js.Replay(step(num, angle), dt=dt, delta_hold="zoh"), aux=aux,
+                      simulator=per_sample(2))
+    return float(out.state.r[-1])
 
 
 def test_quadratic_damping_shifts_the_steady_turn_of_nomoto1():
@@ -243,13 +254,16 @@ def test_speed_dependent_rudder_is_the_base_at_the_nominal_speed():
     base = js.Nomoto1(K=K, T=T)
     delta = step(100)
     at_nominal = js.AuxInputs(u=U0)
-    np.testing.assert_array_equal(js.simulate_steering(model, delta, 1.0, aux=at_nominal).r,
-                                  js.simulate_steering(base, delta, 1.0, aux=at_nominal).r)
+    np.testing.assert_array_equal(js.simulate(model, js.Replay(delta, dt=1.0, delta_hold="foh"),
+                                              aux=at_nominal, simulator=per_sample()).state.r,
+                                  js.simulate(base, js.Replay(delta, dt=1.0, delta_hold="foh"),
+                                              aux=at_nominal, simulator=per_sample()).state.r)
     slow = js.AuxInputs(u=0.8 * U0)
     assert steady_r(model, 10 * DEG, slow) == pytest.approx(
         K * 10 * DEG * (1 + kappa * (0.64 - 1)), rel=1e-9)
     with pytest.raises(ValueError, match="nominal_speed"):
-        js.simulate_steering(js.augment(base, js.SpeedDependentRudder(kappa=kappa)), delta, 1.0)
+        js.simulate(js.augment(base, js.SpeedDependentRudder(kappa=kappa)),
+                    js.Replay(delta, dt=1.0, delta_hold="foh"), simulator=per_sample())
 
 
 def test_speed_dependent_damping_and_rudder_make_nomoto_speed_scaled():
@@ -260,17 +274,22 @@ def test_speed_dependent_damping_and_rudder_make_nomoto_speed_scaled():
                         js.SpeedDependentDamping(kappa=1.0, nominal_speed=U0))
     delta = step(200)
     aux = js.AuxInputs(u=s * U0)
-    np.testing.assert_allclose(js.simulate_steering(scaled, delta, 1.0, aux=aux).r,
-                               js.simulate_steering(js.Nomoto1(K=K * s, T=T / s), delta, 1.0).r,
+    np.testing.assert_allclose(js.simulate(scaled, js.Replay(delta, dt=1.0, delta_hold="foh"),
+                                           aux=aux, simulator=per_sample()).state.r,
+                               js.simulate(js.Nomoto1(K=K * s, T=T / s),
+                                           js.Replay(delta, dt=1.0, delta_hold="foh"),
+                                           simulator=per_sample()).state.r,
                                rtol=1e-9, atol=1e-12)
     base = js.Nomoto1(K=K, T=T)
     np.testing.assert_allclose(  # the base model at the nominal speed (to rounding)
-        js.simulate_steering(js.augment(base, js.SpeedDependentDamping(kappa=1.0,
-                                                                       nominal_speed=U0)),
-                             delta, 1.0, aux=js.AuxInputs(u=U0)).r,
-        js.simulate_steering(base, delta, 1.0, aux=js.AuxInputs(u=U0)).r, rtol=1e-14, atol=0)
+        js.simulate(js.augment(base, js.SpeedDependentDamping(kappa=1.0, nominal_speed=U0)),
+                    js.Replay(delta, dt=1.0, delta_hold="foh"), aux=js.AuxInputs(u=U0),
+                    simulator=per_sample()).state.r,
+        js.simulate(base, js.Replay(delta, dt=1.0, delta_hold="foh"), aux=js.AuxInputs(u=U0),
+                    simulator=per_sample()).state.r, rtol=1e-14, atol=0)
     with pytest.raises(ValueError, match="nominal_speed"):
-        js.simulate_steering(js.augment(base, js.SpeedDependentDamping(kappa=1.0)), delta, 1.0)
+        js.simulate(js.augment(base, js.SpeedDependentDamping(kappa=1.0)),
+                    js.Replay(delta, dt=1.0, delta_hold="foh"), simulator=per_sample())
 
 
 def test_rudder_stall_saturates_only_large_rudder_angles():
@@ -387,14 +406,20 @@ def test_apparent_wind_adds_its_yaw_term_to_a_steering_model():
                        wind_v=20.0 * np.sin(gamma))
     delta = np.deg2rad(10) * np.sign(np.sin(2 * np.pi * t / 80.0) + 1e-9)
     model = js.Nomoto1(K=K, T=T)
-    base = js.simulate_steering(model, delta, 0.5, aux=aux)
+    base = js.simulate(model, js.Replay(delta, dt=0.5, delta_hold="foh"), aux=aux,
+                       simulator=per_sample())
     zero = js.augment(model, js.ApparentWind())
-    np.testing.assert_array_equal(js.simulate_steering(zero, delta, 0.5, aux=aux).psi, base.psi)
+    np.testing.assert_array_equal(js.simulate(zero, js.Replay(delta, dt=0.5, delta_hold="foh"),
+                                              aux=aux,
+                                              simulator=per_sample()).state.psi, base.state.psi)
     windy = js.augment(model, js.ApparentWind(c2=3e-6, c1=-1e-6))
-    np.testing.assert_array_equal(js.simulate_steering(windy, delta, 0.5).psi,
-                                  js.simulate_steering(model, delta, 0.5).psi)  # calm
-    assert np.max(np.abs(js.simulate_steering(windy, delta, 0.5, aux=aux).psi
-                         - base.psi)) > 1 * DEG
+    np.testing.assert_array_equal(js.simulate(windy, js.Replay(delta, dt=0.5, delta_hold="foh"),
+                                              simulator=per_sample()).state.psi,
+                                  js.simulate(model, js.Replay(delta, dt=0.5, delta_hold="foh"),
+                                              simulator=per_sample()).state.psi)  # calm
+    assert np.max(np.abs(js.simulate(windy, js.Replay(delta, dt=0.5, delta_hold="foh"), aux=aux,
+                                     simulator=per_sample()).state.psi
+                         - base.state.psi)) > 1 * DEG
     one = js.AuxInputs(u=7.0, wind_u=20.0 * np.cos(0.7), wind_v=20.0 * np.sin(0.7))
     x = jnp.array([0.01])
     term = 400.0 * (3e-6 * np.sin(1.4) - 1e-6 * np.sin(0.7))

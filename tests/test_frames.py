@@ -5,6 +5,7 @@ import warnings
 
 import numpy as np
 import pytest
+from helpers import per_sample
 
 import jaxship as js
 from jaxship._foundation._frames import Z95, fit_to_dataframe, trajectory_to_dataframe
@@ -56,10 +57,11 @@ def test_batched_trajectory_is_refused():
 def test_fit_frame_has_one_row_per_free_parameter():
     model = js.Nomoto1(K=0.1, T=20.0)
     delta = np.deg2rad(10.0) * np.sign(np.sin(2 * np.pi * np.arange(400) / 120.0) + 1e-9)
-    sim = js.simulate_steering(model, delta, 0.5, hold="foh")  # a logged rudder angle
+    sim = js.simulate(model, js.Replay(delta, dt=0.5, delta_hold="foh"),
+                      simulator=per_sample())  # a logged rudder angle
     rng = np.random.default_rng(0)
-    data = js.Experiment(0.5 * np.arange(400), delta, psi=np.asarray(sim.psi),
-                         r=np.asarray(sim.r) + 1e-4 * rng.standard_normal(400))
+    data = js.Experiment(0.5 * np.arange(400), delta, psi=np.asarray(sim.state.psi),
+                         r=np.asarray(sim.state.r) + 1e-4 * rng.standard_normal(400))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         result = js.fit(js.Nomoto1(K=0.05, T=10.0), data,

@@ -9,6 +9,7 @@ import math
 import equinox as eqx
 import numpy as np
 import pytest
+from helpers import per_sample
 
 import jaxship as js
 from jaxship import (
@@ -19,7 +20,6 @@ from jaxship import (
     NonlinearNomoto,
     NorrbinCrossFlow,
     RossAutopilot,
-    simulate_steering,
 )
 from jaxship.cli import main
 from jaxship.cli._identification import (
@@ -54,10 +54,11 @@ def record(model, delta, *, name, noise=0.0, seed=0, command=None):
     measurement noise of `noise` deg on psi and `noise / 10` deg/s on r. `command`:
     an optional commanded rudder written as `delta_c`, which then drives the model held
     over each interval (as `identify --rudder delta_c` replays a command)."""
-    tr = simulate_steering(model, delta, DT, psi0=0.1, hold="foh" if command is None else "zoh")
+    tr = js.simulate(model, js.Replay(delta, dt=DT, delta_hold="foh" if command is None else "zoh"),
+                     js.straight_state(0.0, psi=0.1), simulator=per_sample())
     rng = np.random.default_rng(seed)
-    psi = np.asarray(tr.psi) + noise * DEG * rng.standard_normal(NUM)
-    r = np.asarray(tr.r) + 0.1 * noise * DEG * rng.standard_normal(NUM)
+    psi = np.asarray(tr.state.psi) + noise * DEG * rng.standard_normal(NUM)
+    r = np.asarray(tr.state.r) + 0.1 * noise * DEG * rng.standard_normal(NUM)
     extra = {} if command is None else {"delta_c": command}
     return js.Experiment(np.asarray(tr.t), delta, psi=psi, r=r, name=name, **extra)
 
@@ -321,10 +322,11 @@ def steering_csvs(folder, truth, dt, num, aux_of_t, seed=0):
     for k in range(2):
         t = dt * np.arange(num)
         delta, aux = steps(num, seed + k), aux_of_t(t)
-        tr = simulate_steering(truth, delta, dt, aux=aux, psi0=0.2)
-        v = np.asarray(tr.state[:, 1]) if "v" in truth.state_names else aux.v
-        e = js.Experiment(t, delta, psi=np.asarray(tr.psi), r=np.asarray(tr.r), u=aux.u, v=v,
-                          n=aux.n, name=("train", "test")[k])
+        tr = js.simulate(truth, js.Replay(delta, dt=dt, delta_hold="foh"),
+                         js.straight_state(0.0, psi=0.2), aux=aux, simulator=per_sample())
+        v = np.asarray(tr.internal[:, 1]) if "v" in truth.state_names else aux.v
+        e = js.Experiment(t, delta, psi=np.asarray(tr.state.psi), r=np.asarray(tr.state.r),
+                          u=aux.u, v=v, n=aux.n, name=("train", "test")[k])
         paths.append(write(folder / f"{e.name}.csv", e))
     return paths
 

@@ -27,6 +27,7 @@ from jaxship._analysis._indices import (
     ZigZagIndices,
     imo_overshoot_limits_deg,
 )
+from jaxship.cli._trials import run_spec, trial_indices
 
 
 DEG = np.pi / 180
@@ -411,8 +412,8 @@ def test_kvlcc2_direct_spiral_shows_its_loop():
     # the simulated trial (`jaxship simulate --manoeuvre spiral`): finer steps near
     # midships; the loop of this MMG model lies between about 0 and 0.5 deg of rudder
     vessel = js.vessel("kvlcc2")
-    manoeuvre, traj = js.run_trial(vessel, "spiral")
-    indices = js.trial_indices("spiral", manoeuvre, traj)
+    manoeuvre, traj = run_spec(vessel, "spiral")
+    indices = trial_indices("spiral", manoeuvre, traj)
     hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
     curve = spiral_curve(traj, hold=hold)
     assert curve.r.size == 29 and len(indices["r_deg_s"]) == 29  # every level

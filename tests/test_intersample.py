@@ -48,12 +48,12 @@ def logged_zigzags(truth, rate, dt_log, *, fine=0.01):
     out = []
     every = int(round(dt_log / fine))
     for angle in (10, -20):
-        man = js.ZigZag(angle * DEG, abs(angle) * DEG, duration=400.0, dt=fine)
-        tr = js.steer_manoeuvre(truth, man, rudder_rate=rate,
-                                simulator=js.Simulator(max_step=fine))
+        man = js.ZigZag(angle * DEG, abs(angle) * DEG, duration=400.0, dt=fine,
+                        rudder_rate=rate)
+        tr = js.simulate(truth, man, simulator=js.Simulator(max_step=fine))
         s = slice(None, None, every)
-        out.append(js.Experiment(np.asarray(tr.t)[s], np.asarray(tr.delta)[s],
-                                 psi=np.asarray(tr.psi)[s], r=np.asarray(tr.r)[s],
+        out.append(js.Experiment(np.asarray(tr.t)[s], np.asarray(tr.state.delta)[s],
+                                 psi=np.asarray(tr.state.psi)[s], r=np.asarray(tr.state.r)[s],
                                  name=f"zigzag {angle}"))
     return out
 

@@ -6,10 +6,11 @@ import math
 
 import numpy as np
 import pytest
+from helpers import per_sample
 from test_estimate import zigzag_like
 
 import jaxship as js
-from jaxship import Nomoto1, NonlinearNomoto, simulate_steering
+from jaxship import Nomoto1, NonlinearNomoto
 from jaxship._estimate import _likelihood
 from jaxship._estimate._likelihood import fit_ml
 
@@ -26,8 +27,9 @@ def noisy_record(model, num, seed, *, q=Q_RUDDER, r_psi=R_PSI, r_r=R_R, dt=DT):
     with white noise; returns (experiment, true psi, true r)."""
     rng = np.random.default_rng(seed)
     delta = zigzag_like(num, seed)
-    tr = simulate_steering(model, delta + math.sqrt(q) * rng.standard_normal(num), dt)
-    psi, r = np.asarray(tr.psi), np.asarray(tr.r)
+    noisy = delta + math.sqrt(q) * rng.standard_normal(num)  # process noise on the rudder
+    tr = js.simulate(model, js.Replay(noisy, dt=dt, delta_hold="foh"), simulator=per_sample())
+    psi, r = np.asarray(tr.state.psi), np.asarray(tr.state.r)
     exp = js.Experiment(np.asarray(tr.t), delta,
                         psi=psi + math.sqrt(r_psi) * rng.standard_normal(num),
                         r=r + math.sqrt(r_r) * rng.standard_normal(num), name=f"seed {seed}")

@@ -7,6 +7,7 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from helpers import per_sample
 
 import jaxship as js
 from jaxship._models._vessel.sway_yaw import _cross_flow_integrals
@@ -76,9 +77,10 @@ def low_speed_record(seed, truth=TRUTH, metadata=()):
     delta = np.array(delta[:num])
     u = 0.3 + 0.15 * np.sin(2 * np.pi * t / rng.uniform(80, 200) + seed)
     n = np.full(num, rng.choice([8.0, 10.0, 15.0]))
-    tr = js.simulate_steering(truth, delta, dt, aux=js.AuxInputs(u=u, n=n))
-    return js.Experiment(t, delta, psi=np.asarray(tr.psi), r=np.asarray(tr.r), u=u, n=n,
-                         v=np.asarray(tr.state[:, 1]), metadata=metadata)
+    tr = js.simulate(truth, js.Replay(delta, dt=dt, delta_hold="foh"), aux=js.AuxInputs(u=u, n=n),
+                     simulator=per_sample())
+    return js.Experiment(t, delta, psi=np.asarray(tr.state.psi), r=np.asarray(tr.state.r), u=u, n=n,
+                         v=np.asarray(tr.internal[:, 1]), metadata=metadata)
 
 
 def test_fit_recovers_the_hull_and_race_coefficients_from_its_own_records():
@@ -143,11 +145,12 @@ def windy_record(seed, name):
     for _ in range(40):
         aux = js.AuxInputs(u=u, n=n, wind_u=u - (air_n * np.cos(psi) + air_e * np.sin(psi)),
                            wind_v=v - (-air_n * np.sin(psi) + air_e * np.cos(psi)))
-        tr = js.simulate_steering(TRUTH, calm.delta, 0.5, aux=aux)
-        step = max(np.max(np.abs(tr.psi - psi)), np.max(np.abs(tr.state[:, 1] - v)))
-        psi, v = np.asarray(tr.psi), np.asarray(tr.state[:, 1])
+        tr = js.simulate(TRUTH, js.Replay(calm.delta, dt=0.5, delta_hold="foh"), aux=aux,
+                         simulator=per_sample())
+        step = max(np.max(np.abs(tr.state.psi - psi)), np.max(np.abs(tr.internal[:, 1] - v)))
+        psi, v = np.asarray(tr.state.psi), np.asarray(tr.internal[:, 1])
     assert step < 1e-13
-    return js.Experiment(t, calm.delta, psi=psi, r=np.asarray(tr.r), u=u, v=v, n=n,
+    return js.Experiment(t, calm.delta, psi=psi, r=np.asarray(tr.state.r), u=u, v=v, n=n,
                          wind_speed=speed, wind_dir=direction, name=name)
 
 
@@ -188,11 +191,11 @@ def with_noise(e, rng, name=None, v_noise=3e-3):
 
 def noisy(record, truth, seed):
     """`record`'s inputs driving `truth`, with measurement noise (`with_noise`)."""
-    tr = js.simulate_steering(truth, record.delta, 0.5, aux=js.AuxInputs(u=record.u,
-                                                                          n=record.n))
-    clean = js.Experiment(record.t, record.delta, psi=np.asarray(tr.psi),
-                          r=np.asarray(tr.r), u=record.u, n=record.n,
-                          v=np.asarray(tr.state[:, 1]))
+    tr = js.simulate(truth, js.Replay(record.delta, dt=0.5, delta_hold="foh"),
+                     aux=js.AuxInputs(u=record.u, n=record.n), simulator=per_sample())
+    clean = js.Experiment(record.t, record.delta, psi=np.asarray(tr.state.psi),
+                          r=np.asarray(tr.state.r), u=record.u, n=record.n,
+                          v=np.asarray(tr.internal[:, 1]))
     return with_noise(clean, np.random.default_rng(100 + seed), name=f"run{seed}")
 
 

@@ -9,7 +9,7 @@ from helpers import linear_test_vessel
 
 import jaxship as js
 from jaxship._analysis._indices import reverse_spiral_curve
-from jaxship._trials import linear_yaw, yaw_rate_gains
+from jaxship.cli._trials import linear_yaw, run_spec, trial_indices, yaw_rate_gains
 
 
 AT_SAMPLES = js.Simulator(max_step=math.inf)  # controllers act at the output samples
@@ -305,7 +305,7 @@ def test_reverse_spiral_trial_reaches_every_level_across_the_direct_range(name):
     # for the KVLCC2, against +-0.6 and +-3 in the direct spiral) and the last one was
     # dropped (7 of 8 reported)
     vessel = js.vessel(name)
-    manoeuvre, traj = js.run_trial(vessel, "reverse-spiral")
+    manoeuvre, traj = run_spec(vessel, "reverse-spiral")  # the CLI's trial spec
     assert isinstance(manoeuvre, js.ReverseSpiral)
     curve = js.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
     ordered = np.asarray(manoeuvre.rates)
@@ -317,7 +317,7 @@ def test_reverse_spiral_trial_reaches_every_level_across_the_direct_range(name):
     r_port_max, r_stbd_max = _direct_range(vessel, x0, tau, float(manoeuvre.dt))
     assert np.ptp(curve.r) >= 0.5 * (r_port_max - r_stbd_max)
     assert np.all(np.abs(np.asarray(traj.command.delta)) <= vessel.rudder.max_angle + 1e-12)
-    indices = js.trial_indices("reverse-spiral", manoeuvre, traj)
+    indices = trial_indices("reverse-spiral", manoeuvre, traj)
     assert len(indices["r_deg_s"]) == 12
     if name == "kvlcc2":  # course-unstable: the S-curve has a loop between its branches
         assert curve.loop.width > np.deg2rad(0.1) and curve.loop.height > np.deg2rad(0.5)
@@ -344,7 +344,7 @@ def test_crash_stop_trial_ends_when_the_ship_has_stopped():
     # issue 13: the KVLCC2 kept going full astern after it had stopped and spun at
     # -4 deg/s to a heading of -1534 deg
     vessel = js.vessel("kvlcc2")
-    manoeuvre, traj = js.run_trial(vessel, "stop")
+    manoeuvre, traj = run_spec(vessel, "stop")  # the CLI's trial spec
     ind = js.stopping_indices(traj)
     t = np.asarray(traj.t)
     assert t[-1] <= ind.execute_time + 1.1 * ind.time_to_stop + 3 * float(manoeuvre.dt)
@@ -362,3 +362,25 @@ def test_crash_stop_trial_ends_when_the_ship_has_stopped():
     assert np.max(np.abs(np.asarray(long.state.psi))) < 1.0 * DEG
     assert np.max(np.abs(u[stopped])) < 0.05 * float(vessel.nominal_speed)
 
+
+
+def test_a_zigzag_rudder_rate_slower_than_the_servo_shows_in_the_rudder():
+    """Issue 34: the rudder rate is an argument of the trial. A Mariner (servo limit
+    5 deg/s) through a 20/20 zig-zag whose steering gear moves 2 deg/s: the actual
+    rudder moves at 2 deg/s, the smaller of the two limits; without it, at the servo's
+    5 deg/s; and the ordered rudder is the zig-zag's either way."""
+    mariner = js.vessel("mariner")
+    x0 = js.straight_run(mariner)
+    servo = float(mariner.rudder.max_rate)
+    assert servo == pytest.approx(5 * DEG)
+    rates = {}
+    for gear in (None, 2 * DEG):
+        zigzag = js.ZigZag(20 * DEG, 20 * DEG, duration=200.0, dt=0.1, rudder_rate=gear)
+        traj = js.simulate(mariner, zigzag, x0)
+        assert bool(traj.success)
+        assert np.max(np.abs(np.asarray(traj.command.delta))) == pytest.approx(20 * DEG)
+        rates[gear] = np.max(np.abs(np.diff(np.asarray(traj.state.delta)))) / 0.1
+    assert rates[None] == pytest.approx(servo, rel=1e-6)
+    assert rates[2 * DEG] == pytest.approx(2 * DEG, rel=1e-6)
+    with pytest.raises(ValueError, match="rudder_rate"):
+        js.Turn(10 * DEG, duration=10.0, rudder_rate=0.0)

@@ -16,7 +16,7 @@ from matplotlib.patches import Polygon  # noqa: E402
 
 import jaxship as js  # noqa: E402
 from jaxship._analysis._indices import SpiralCurve, StoppingIndices  # noqa: E402
-from jaxship._trials import simulate_to_folder  # noqa: E402
+from jaxship.cli._trials import simulate_to_folder  # noqa: E402
 from jaxship.plotting import (  # noqa: E402
     plot_comparison,
     plot_imo_criteria,
@@ -325,7 +325,9 @@ def test_the_trial_figure_gives_the_rudder_its_own_axis_and_keeps_thesis_ranges_
     a bar beside the axes."""
     from jaxship.plotting._report import plot_trial_vs_thesis
 
-    _, traj = js.run_trial(js.vessel("thesis"), "turn:40", rpm=500.0, duration=60.0)
+    vessel = js.vessel("thesis")
+    traj = js.simulate(vessel, js.Turn(np.deg2rad(40.0), duration=60.0),
+                       js.straight_run(vessel, n=500.0 / 60))
     fig = plot_trial_vs_thesis(traj, bands={"yaw_rate": [(0.0, 6.0, "axis 0-6 deg/s")]})
     labels = {ax.get_ylabel() for ax in fig.axes}
     assert {"heading [deg]", "rudder [deg]", "yaw rate [deg/s]"} <= labels

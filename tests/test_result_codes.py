@@ -5,6 +5,7 @@ from the library on the way."""
 
 import numpy as np
 import pytest
+from helpers import per_sample
 
 import jaxship as js
 
@@ -16,10 +17,10 @@ def zigzag_record(dt, *, model=js.Nomoto1(K=0.06, T=25.0), duration=300.0, noise
     """A noise-free (or noisy) 10/10-like record of `model`, sampled every `dt` s."""
     t = np.arange(0.0, duration, dt)
     delta = np.where((t // 30.0) % 2 == 0, 10 * DEG, -10 * DEG)
-    out = js.simulate_steering(model, delta, dt, psi0=0.0, substeps=20, hold="foh")
+    out = js.simulate(model, js.Replay(delta, dt=dt, delta_hold="foh"), simulator=per_sample(20))
     rng = np.random.default_rng(0)
-    return js.Experiment(t, delta, psi=np.asarray(out.psi) + rng.normal(0, noise, t.size),
-                         r=np.asarray(out.r) + rng.normal(0, noise / 10, t.size))
+    return js.Experiment(t, delta, psi=np.asarray(out.state.psi) + rng.normal(0, noise, t.size),
+                         r=np.asarray(out.state.r) + rng.normal(0, noise / 10, t.size))
 
 
 def test_the_step_follows_the_start_models_fastest_mode():

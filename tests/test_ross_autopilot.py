@@ -8,7 +8,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from helpers import central_difference
+from helpers import central_difference, per_sample
 
 import jaxship as js
 from jaxship import (
@@ -19,7 +19,6 @@ from jaxship import (
     PredictionError,
     RossAutopilot,
     fit,
-    simulate_steering,
 )
 from jaxship._estimate._linear import initial_estimate
 from jaxship._foundation._params import parameter_fields
@@ -58,8 +57,10 @@ def record(model, num, seed, rpm, *, name="synthetic"):
     """Noise-free record of rudder steps held over each interval (a commanded,
     piecewise-constant rudder; fitted with `hold="zoh"`)."""
     delta, aux = synthetic_inputs(num, seed, rpm)
-    tr = simulate_steering(model, delta, DT, aux=aux, psi0=0.2, hold="zoh")
-    return js.Experiment(np.asarray(tr.t), delta, psi=np.asarray(tr.psi), r=np.asarray(tr.r),
+    tr = js.simulate(model, js.Replay(delta, dt=DT, delta_hold="zoh"),
+                     js.straight_state(0.0, psi=0.2), aux=aux, simulator=per_sample())
+    return js.Experiment(np.asarray(tr.t), delta, psi=np.asarray(tr.state.psi),
+                         r=np.asarray(tr.state.r),
                          u=aux.u, v=aux.v, n=aux.n, name=name)
 
 
@@ -143,8 +144,9 @@ def test_frozen_terms_enter_the_start_as_known():
 
 
 def _loss(model, delta, aux, target):
-    tr = simulate_steering(model, delta, DT, aux=aux, psi0=0.2)
-    return jnp.sum((tr.r - target) ** 2)
+    tr = js.simulate(model, js.Replay(delta, dt=DT, delta_hold="foh"),
+                     js.straight_state(0.0, psi=0.2), aux=aux, simulator=per_sample())
+    return jnp.sum((tr.state.r - target) ** 2)
 
 
 _jit_loss = eqx.filter_jit(_loss)
@@ -154,7 +156,9 @@ def test_gradient_matches_finite_differences():
     """Reverse- and forward-mode derivatives of the squared simulation error with
     respect to every coefficient equal central differences."""
     delta, aux = synthetic_inputs(150, 7, 500.0)
-    target = np.asarray(simulate_steering(TRUTH, delta, DT, aux=aux, psi0=0.2).r)
+    target = np.asarray(js.simulate(TRUTH, js.Replay(delta, dt=DT, delta_hold="foh"),
+                                    js.straight_state(0.0, psi=0.2), aux=aux,
+                                    simulator=per_sample()).state.r)
     model = eqx.tree_at(lambda m: (m.n_ur, m.n_delta), TRUTH, (-3.5, 2.2))
     model = jax.tree.map(lambda x: jnp.asarray(x, dtype=float), model)
     grads = eqx.filter_jit(jax.grad(_loss))(model, delta, aux, target)

@@ -12,6 +12,7 @@ from pathlib import Path
 import jax
 import numpy as np
 import pytest
+from helpers import per_sample
 
 import jaxship as js
 from jaxship._estimate import _fit
@@ -30,10 +31,10 @@ def results() -> dict:
     records = []
     for k, num in enumerate((170, 230, 310)):
         delta = np.where((np.arange(num) // 40) % 2 == 0, 10.0, -10.0) * DEG * (1 + 0.2 * k)
-        tr = js.simulate_steering(truth, delta, 0.5)
+        tr = js.simulate(truth, js.Replay(delta, dt=0.5, delta_hold="foh"), simulator=per_sample())
         records.append(js.Experiment(np.asarray(tr.t), delta,
-                                     psi=np.asarray(tr.psi) + 1e-3 * rng.standard_normal(num),
-                                     r=np.asarray(tr.r) + 1e-4 * rng.standard_normal(num),
+                                     psi=np.asarray(tr.state.psi) + 1e-3 * rng.standard_normal(num),
+                                     r=np.asarray(tr.state.r) + 1e-4 * rng.standard_normal(num),
                                      name=f"record {k}"))
     start = js.Nomoto1(K=0.04, T=15.0)
     with warnings.catch_warnings():

@@ -1,5 +1,6 @@
 """Response models (Nomoto 1/2, nonlinear Nomoto) and their RK4 simulation."""
 
+import dataclasses
 import math
 
 import equinox as eqx
@@ -7,9 +8,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from helpers import per_sample
 
 import jaxship as js
-from jaxship import AuxInputs, Nomoto1, Nomoto2, NonlinearNomoto, simulate_steering
+from jaxship import AuxInputs, Nomoto1, Nomoto2, NonlinearNomoto
 from jaxship._models._steering import WindowStart
 
 
@@ -24,13 +26,14 @@ def test_nomoto1_step_response_is_exact():
     """T r' + r = K (delta + delta0): r = K (delta + delta0)(1 - exp(-t/T)) and
     psi = K (delta + delta0)(t - T (1 - exp(-t/T))) (thesis eq. 3.17 with r(0) = 0)."""
     m = Nomoto1(K=0.06, T=25.0, delta0=0.5 * DEG)
-    tr = simulate_steering(m, step_input(), 0.5, psi0=0.3)
+    tr = js.simulate(m, js.Replay(step_input(), dt=0.5, delta_hold="foh"),
+                     js.straight_state(0.0, psi=0.3), simulator=per_sample())
     t = np.asarray(tr.t)
     gain = 0.06 * 10.5 * DEG
-    np.testing.assert_allclose(tr.r, gain * (1 - np.exp(-t / 25.0)), rtol=1e-8, atol=1e-14)
-    np.testing.assert_allclose(tr.psi, 0.3 + gain * (t - 25.0 * (1 - np.exp(-t / 25.0))),
+    np.testing.assert_allclose(tr.state.r, gain * (1 - np.exp(-t / 25.0)), rtol=1e-8, atol=1e-14)
+    np.testing.assert_allclose(tr.state.psi, 0.3 + gain * (t - 25.0 * (1 - np.exp(-t / 25.0))),
                                rtol=1e-8)
-    assert tr.r[-1] > 0  # positive rudder turns to starboard
+    assert tr.state.r[-1] > 0  # positive rudder turns to starboard
 
 
 def nomoto2_step(K, T1, T2, T3, t):
@@ -48,8 +51,9 @@ def test_nomoto2_step_response_and_rk4_order():
     exact = 10 * DEG * nomoto2_step(K, T1, T2, T3, t)
     errors = []
     for substeps in (1, 2, 4):
-        tr = simulate_steering(m, step_input(), 0.5, substeps=substeps)
-        errors.append(np.max(np.abs(np.asarray(tr.r) - exact)))
+        tr = js.simulate(m, js.Replay(step_input(), dt=0.5, delta_hold="foh"),
+                         simulator=per_sample(substeps))
+        errors.append(np.max(np.abs(np.asarray(tr.state.r) - exact)))
     assert errors[-1] < 1e-9 * np.max(exact)
     assert 12 < errors[0] / errors[1] < 20 and 12 < errors[1] / errors[2] < 20
     # the hidden state of a steady turn is (T1 + T2 - T3) r
@@ -60,22 +64,27 @@ def test_nomoto2_with_cancelling_zero_is_nomoto1():
     """T3 = T2 cancels the fast pole: Nomoto2(K, T1, T2, T2) = Nomoto1(K, T1)."""
     rng = np.random.default_rng(0)
     delta = np.repeat(rng.choice([-1, 1], 20) * 15 * DEG, 30)
-    a = simulate_steering(Nomoto2(K=0.05, T1=20.0, T2=2.0, T3=2.0), delta, 0.25, substeps=2)
-    b = simulate_steering(Nomoto1(K=0.05, T=20.0), delta, 0.25, substeps=2)
-    np.testing.assert_allclose(a.r, b.r, rtol=1e-8, atol=1e-12)
-    np.testing.assert_allclose(a.psi, b.psi, rtol=1e-8, atol=1e-10)
+    a = js.simulate(Nomoto2(K=0.05, T1=20.0, T2=2.0, T3=2.0),
+                    js.Replay(delta, dt=0.25, delta_hold="foh"), simulator=per_sample(2))
+    b = js.simulate(Nomoto1(K=0.05, T=20.0), js.Replay(delta, dt=0.25, delta_hold="foh"),
+                    simulator=per_sample(2))
+    np.testing.assert_allclose(a.state.r, b.state.r, rtol=1e-8, atol=1e-12)
+    np.testing.assert_allclose(a.state.psi, b.state.psi, rtol=1e-8, atol=1e-10)
 
 
 def test_nonlinear_nomoto_steady_turn_and_linear_limit():
     """In a steady turn H_N(r) = K delta; with n3 = n2 = n0 = 0, n1 = 1 it is Nomoto1."""
     m = NonlinearNomoto(K=0.06, T=20.0, n3=400.0, n2=5.0, n0=1e-4)
-    tr = simulate_steering(m, step_input(2001, 20 * DEG), 0.5)
-    r_end = float(tr.r[-1])
+    tr = js.simulate(m, js.Replay(step_input(2001, 20 * DEG), dt=0.5, delta_hold="foh"),
+                     simulator=per_sample())
+    r_end = float(tr.state.r[-1])
     assert abs(float(m.characteristic(r_end)) - 0.06 * 20 * DEG) < 1e-12
     assert r_end < 0.06 * 20 * DEG  # the cubic term reduces the steady rate
-    lin = simulate_steering(NonlinearNomoto(K=0.06, T=20.0), step_input(), 0.5)
-    ref = simulate_steering(Nomoto1(K=0.06, T=20.0), step_input(), 0.5)
-    np.testing.assert_allclose(lin.r, ref.r, rtol=1e-13, atol=1e-16)
+    lin = js.simulate(NonlinearNomoto(K=0.06, T=20.0),
+                      js.Replay(step_input(), dt=0.5, delta_hold="foh"), simulator=per_sample())
+    ref = js.simulate(Nomoto1(K=0.06, T=20.0), js.Replay(step_input(), dt=0.5, delta_hold="foh"),
+                      simulator=per_sample())
+    np.testing.assert_allclose(lin.state.r, ref.state.r, rtol=1e-13, atol=1e-16)
 
 
 def test_nomoto2_window_state_reconstructs_the_hidden_state():
@@ -85,15 +94,16 @@ def test_nomoto2_window_state_reconstructs_the_hidden_state():
     rng = np.random.default_rng(1)
     delta = np.repeat(rng.uniform(-20, 20, 25) * DEG, 16)
     dt, r_first = 0.5, 0.004
-    tr = simulate_steering(m, delta, dt, state0=m.initial_state(r_first), psi0=0.2,
-                           hold="zoh")
+    tr = js.simulate(m, js.Replay(delta, dt=dt, delta_hold="zoh"),
+                     dataclasses.replace(js.straight_state(0.0, psi=0.2), r=r_first),
+                     simulator=per_sample())
     integral = np.concatenate([[0.0], np.cumsum(delta[:-1]) * dt])
     k = np.arange(delta.shape[0])
-    start = WindowStart(r=tr.r, psi=tr.psi, delta=delta, r_first=r_first, psi_first=0.2,
+    start = WindowStart(r=tr.state.r, psi=tr.state.psi, delta=delta, r_first=r_first, psi_first=0.2,
                         delta_integral=integral, elapsed=k * dt, aux=AuxInputs())
     states = jax.vmap(m.window_state, in_axes=(WindowStart(0, 0, 0, None, None, 0, 0, None),))(
         start)
-    np.testing.assert_allclose(states, tr.state, rtol=1e-9, atol=1e-13)
+    np.testing.assert_allclose(states, tr.internal, rtol=1e-9, atol=1e-13)
 
 
 def test_forward_mode_derivatives_match_finite_differences():
@@ -102,7 +112,8 @@ def test_forward_mode_derivatives_match_finite_differences():
 
     def psi_end(params):
         K, T = params
-        return simulate_steering(Nomoto1(K=K, T=T), delta, 0.5).psi[-1]
+        return js.simulate(Nomoto1(K=K, T=T), js.Replay(delta, dt=0.5, delta_hold="foh"),
+                           simulator=per_sample()).state.psi[-1]
 
     p = jnp.array([0.06, 25.0])
     jac = jax.jacfwd(psi_end)(p)
@@ -114,31 +125,36 @@ def test_forward_mode_derivatives_match_finite_differences():
 
 
 def test_vmap_over_parameters_equals_loop_and_no_retrace():
-    from jaxship._simulation._simulate_steering import _simulate_steering
+    from jaxship._simulation._simulate_steering import _replay
 
     delta = np.repeat(np.array([10, -10, 20]) * DEG, 30)
     gains = jnp.array([0.03, 0.05, 0.08])
-    batched = jax.vmap(lambda K: simulate_steering(Nomoto1(K=K, T=15.0), delta, 0.5).r)(gains)
-    simulate_steering(Nomoto1(K=0.01, T=15.0), delta, 0.5)
-    size = _simulate_steering._cached._cache_size()
+    batched = jax.vmap(lambda K: js.simulate(Nomoto1(K=K, T=15.0),
+                                             js.Replay(delta, dt=0.5, delta_hold="foh"),
+                                             simulator=per_sample()).state.r)(gains)
+    js.simulate(Nomoto1(K=0.01, T=15.0), js.Replay(delta, dt=0.5, delta_hold="foh"),
+                simulator=per_sample())
+    size = _replay._cached._cache_size()
     for i, K in enumerate([0.03, 0.05, 0.08]):
-        single = simulate_steering(Nomoto1(K=K, T=15.0 + i), delta, 0.5)
+        single = js.simulate(Nomoto1(K=K, T=15.0 + i), js.Replay(delta, dt=0.5, delta_hold="foh"),
+                             simulator=per_sample())
         if i == 0:
-            np.testing.assert_allclose(batched[0], single.r, rtol=1e-14)
-    assert _simulate_steering._cached._cache_size() == size
-    counted = eqx.debug.assert_max_traces(_simulate_steering.__wrapped__, max_traces=1)
+            np.testing.assert_allclose(batched[0], single.state.r, rtol=1e-14)
+    assert _replay._cached._cache_size() == size
+    counted = eqx.debug.assert_max_traces(_replay.__wrapped__, max_traces=1)
     jitted = eqx.filter_jit(counted)
     for K in (0.02, 0.04):
         m = Nomoto1(K=jnp.asarray(K), T=jnp.asarray(10.0), delta0=jnp.asarray(0.0))
-        zero = jnp.zeros(delta.shape)
-        records = {"delta": jnp.asarray(delta), "u": zero, "v": zero, "n": zero}
-        jitted(m, records, jnp.asarray(0.5), None, jnp.asarray(0.0), jnp.asarray(0.0),
-               dict.fromkeys(records, "zoh"), js.Simulator(max_step=math.inf), 1)
+        replay = js.Replay(jnp.asarray(delta), dt=jnp.asarray(0.5), start=jnp.asarray(0.0),
+                           duration=jnp.asarray(0.5 * (delta.shape[0] - 1)))
+        x0 = js.straight_state(jnp.asarray(0.0))
+        jitted(m, replay, x0, None, js.Simulator(max_step=math.inf), 1)
 
 
 def test_simulate_rejects_bad_arguments():
     m = Nomoto1(K=0.05, T=10.0)
     with pytest.raises(ValueError, match="delta"):
-        simulate_steering(m, np.zeros((3, 3)), 0.5)
+        js.simulate(m, js.Replay(np.zeros((3, 3)), dt=0.5, delta_hold="foh"),
+                    simulator=per_sample())
     with pytest.raises(ValueError, match="substeps"):
-        simulate_steering(m, np.zeros(10), 0.5, substeps=0)
+        js.simulate(m, js.Replay(np.zeros(10), dt=0.5, delta_hold="foh"), simulator=per_sample(0))

@@ -9,6 +9,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from helpers import per_sample
 
 import jaxship as js
 from benchmarks.studies.astrom import (
@@ -24,7 +25,6 @@ from jaxship import (
     NorrbinCrossFlow,
     PredictionError,
     fit,
-    simulate_steering,
 )
 from jaxship._models._steering import WindowStart
 from jaxship._models._vessel._base import state_derivative
@@ -63,9 +63,10 @@ def own_record(model, delta, dt=1.0, seed=0):
     (7.2-8.8 m/s): the model must use the measured u as V at every sample."""
     t = dt * np.arange(delta.shape[0])
     u = 8.0 + 0.8 * np.sin(2 * np.pi * t / 700.0 + seed)
-    tr = simulate_steering(model, delta, dt, psi0=0.2, aux=AuxInputs(u=u))
-    return js.Experiment(t, delta, psi=np.asarray(tr.psi), r=np.asarray(tr.r), u=u,
-                         v=np.asarray(tr.state[:, 1]))
+    tr = js.simulate(model, js.Replay(delta, dt=dt, delta_hold="foh"),
+                     js.straight_state(0.0, psi=0.2), aux=AuxInputs(u=u), simulator=per_sample())
+    return js.Experiment(t, delta, psi=np.asarray(tr.state.psi), r=np.asarray(tr.state.r), u=u,
+                         v=np.asarray(tr.internal[:, 1]))
 
 
 # -- the steering model is the vessel's sway-yaw dynamics ----------------------------------
@@ -98,9 +99,9 @@ def test_matches_the_3dof_simulation_of_sea_stratus():
     tr = js.simulate(VESSEL, man, js.straight_run(VESSEL))
     d = np.asarray(tr.state.delta)
     for over, tol in ((1, 2e-6), (10, 2e-4)):
-        st = simulate_steering(TRUTH, d[::over], 0.1 * over,
-                               aux=AuxInputs(u=np.asarray(tr.state.u)[::over]))
-        for name, got in (("r", st.r), ("v", st.state[:, 1]), ("psi", st.psi)):
+        st = js.simulate(TRUTH, js.Replay(d[::over], dt=0.1 * over, delta_hold="foh"),
+                         aux=AuxInputs(u=np.asarray(tr.state.u)[::over]), simulator=per_sample())
+        for name, got in (("r", st.state.r), ("v", st.internal[:, 1]), ("psi", st.state.psi)):
             ref = np.asarray(getattr(tr.state, name))[::over]
             assert np.max(np.abs(got - ref)) <= tol * np.ptp(ref), (name, over)
     np.testing.assert_allclose(np.asarray(tr.state.u), 8.0, rtol=1e-12)
@@ -169,8 +170,9 @@ def test_gradients_match_finite_differences():
     def loss(values):
         model = eqx.tree_at(lambda m: tuple(getattr(m, k) for k in FREE), TRUTH,
                             tuple(values[i] for i in range(len(FREE))))
-        tr = simulate_steering(model, delta, 1.0, aux=aux)
-        return jnp.sum(tr.r**2) * 1e4 + jnp.sum(tr.state[:, 1] ** 2)
+        tr = js.simulate(model, js.Replay(delta, dt=1.0, delta_hold="foh"), aux=aux,
+                         simulator=per_sample())
+        return jnp.sum(tr.state.r**2) * 1e4 + jnp.sum(tr.internal[:, 1] ** 2)
 
     p = jnp.array([getattr(TRUTH, k) for k in FREE])
     grad = jax.grad(loss)(p)

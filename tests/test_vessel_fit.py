@@ -8,6 +8,7 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from helpers import per_sample
 
 import jaxship as js
 from jaxship._estimate import _fit
@@ -157,9 +158,10 @@ class SwayYawTest(AbstractSteeringModel):
 def test_v_channel_for_steering_models_with_a_v_state():
     truth = SwayYawTest(a11=-0.5, a12=-0.8, a21=-0.02, a22=-0.6, b1=0.15, b2=-0.05)
     delta = np.repeat(np.array([1, -1, 1, 1, -1, -1, 1, -1]) * 10 * DEG, 40)
-    tr = js.simulate_steering(truth, delta, 0.25, hold="foh")
-    v = np.asarray(tr.state[:, 1])
-    data = js.Experiment(np.asarray(tr.t), delta, psi=np.asarray(tr.psi), r=np.asarray(tr.r),
+    tr = js.simulate(truth, js.Replay(delta, dt=0.25, delta_hold="foh"), simulator=per_sample())
+    v = np.asarray(tr.internal[:, 1])
+    data = js.Experiment(np.asarray(tr.t), delta, psi=np.asarray(tr.state.psi),
+                         r=np.asarray(tr.state.r),
                          v=v)
     start = eqx.tree_at(lambda m: (m.a11, m.b1), truth, (-0.4, 0.12))
     res = fit(start, data, estimator=PredictionError(horizon=5.0, channels=("r", "v")),

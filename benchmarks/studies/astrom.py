@@ -131,12 +131,13 @@ class AstromRow:
 def _simulate_fit(model, exp: js.Experiment) -> dict:
     """Fit % of the fitted model simulated over the whole record (replayed rudder and
     speed) against the noisy measurements, psi, r and v."""
-    tr = js.simulate_steering(model, exp.delta, exp.dt,
-                              state0=jnp.array([exp.r[0], exp.v[0]]), psi0=exp.psi[0],
-                              aux=js.AuxInputs(u=exp.u, v=exp.v, n=exp.n), hold="foh")
-    return {"psi": js.fit_percent(exp.psi, np.asarray(tr.psi)),
-            "r": js.fit_percent(exp.r, np.asarray(tr.r)),
-            "v": js.fit_percent(exp.v, np.asarray(tr.state[:, 1]))}
+    x0 = dataclasses.replace(js.straight_state(0.0, psi=exp.psi[0]), r=exp.r[0])
+    tr = js.simulate(model, js.Replay(exp.delta, dt=exp.dt, delta_hold="foh"), x0,
+                     aux=js.AuxInputs(u=exp.u, v=exp.v, n=exp.n),
+                     simulator=js.Simulator(max_step=math.inf))
+    return {"psi": js.fit_percent(exp.psi, np.asarray(tr.state.psi)),
+            "r": js.fit_percent(exp.r, np.asarray(tr.state.r)),
+            "v": js.fit_percent(exp.v, np.asarray(tr.internal[:, 1]))}
 
 
 def astrom_kallstrom(*, noise: NoiseLevels = NoiseLevels(), seed: int = 0, dt: float = 1.0,

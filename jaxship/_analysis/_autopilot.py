@@ -21,7 +21,8 @@ from .._models._control import (
 from .._models._steering._base import AbstractSteeringModel
 from .._models._vessel._base import AbstractVessel, straight_run
 from .._simulation._batch import stack
-from .._simulation._simulate import Simulator, _as_arrays
+from .._simulation._integrate import Simulator
+from .._simulation._simulate import _as_arrays
 from ._closed_loop import YawDisturbance, _closed_loop, _setup, tracking_objective
 
 

@@ -15,14 +15,8 @@ from .._models._environment import Environment
 from .._models._steering._base import AbstractSteeringModel
 from .._models._vessel._base import AbstractVessel, straight_run
 from .._simulation._batch import stack, straight_run_batch
-from .._simulation._simulate import (
-    Held,
-    Simulator,
-    _as_arrays,
-    initial_vector,
-    integrate,
-    vessel_field,
-)
+from .._simulation._integrate import Held, Simulator, integrate
+from .._simulation._simulate import _as_arrays, initial_vector, vessel_field
 from .._simulation._simulate_steering import steering_field
 
 

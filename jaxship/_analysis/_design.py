@@ -15,6 +15,7 @@
 """
 
 import dataclasses
+import math
 
 import equinox as eqx
 import jax
@@ -22,9 +23,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._foundation._params import as_arrays, rebuild, resolve_free
-from .._models._manoeuvres import AbstractManoeuvre
+from .._models._manoeuvres import AbstractManoeuvre, Replay
 from .._models._steering._base import AbstractSteeringModel
-from .._simulation._simulate_steering import simulate_steering, steer_manoeuvre
+from .._simulation._integrate import Simulator
+from .._simulation._simulate import simulate
 
 
 def excitation_order(u, *, max_order: int | None = None, rtol: float | None = None) -> int:
@@ -112,21 +114,20 @@ class DesignReport:
 
 def fisher_information(model: AbstractSteeringModel, manoeuvre, noise_std, *,
                        dt: float | None = None, free=None, outputs=("r",),
-                       rudder_rate: float | None = None, substeps: int = 1) -> DesignReport:
+                       substeps: int = 1) -> DesignReport:
     """Fisher information and Cramer-Rao bounds of a planned experiment.
 
     **Arguments:**
 
     - `model`: a steering model with its nominal (expected) parameter values.
     - `manoeuvre`: an `AbstractManoeuvre` (closed-loop ones such as `ZigZag` are
-      run on the nominal model with `steer_manoeuvre`, then their rudder is replayed
-      open loop, as estimation does) or a 1-D array of rudder angles [rad] held over
-      each interval (then `dt` [s] is required).
+      run on the nominal model with `simulate`, at the manoeuvre's `rudder_rate`, then
+      their rudder is replayed open loop, as estimation does) or a 1-D array of
+      rudder angles [rad] at the samples (then `dt` [s] is required).
     - `noise_std`: the standard deviation of the white measurement noise on each
       output, a number or a dict `{output: std}` (SI: rad/s for r, rad for psi).
     - `free`: the parameters (as `fit`'s `free`; default the model's free fields).
     - `outputs`: measured channels, any of `"r"`, `"psi"`.
-    - `rudder_rate` [rad/s]: the steering gear's rate limit for manoeuvres.
     - `substeps`: RK4 steps per sample interval.
 
     The Jacobian is `jax.jacfwd` of the simulated outputs (from rest) with respect
@@ -150,8 +151,8 @@ def fisher_information(model: AbstractSteeringModel, manoeuvre, noise_std, *,
         if dt is not None and abs(float(dt) - float(manoeuvre.dt)) > 1e-12:
             raise ValueError("`dt` is set by the manoeuvre; leave it out.")
         dt = float(manoeuvre.dt)
-        delta = np.asarray(steer_manoeuvre(model, manoeuvre, rudder_rate=rudder_rate,
-                                           substeps=substeps).delta)
+        delta = np.asarray(simulate(model, manoeuvre,
+                                    simulator=Simulator(substeps=substeps)).state.delta)
     else:
         delta = np.asarray(manoeuvre, dtype=np.float64)
         if delta.ndim != 1 or delta.size < 2:
@@ -180,7 +181,10 @@ def fisher_information(model: AbstractSteeringModel, manoeuvre, noise_std, *,
 @eqx.filter_jit
 def _jacobian(model, names, values, delta, dt, outputs, substeps):
     def sim(theta):
-        traj = simulate_steering(rebuild(model, names, theta), delta, dt, substeps=substeps)
-        return tuple(getattr(traj, o) for o in outputs)
+        # the rudder interpolated between samples, one RK4 step per sample (`substeps`)
+        replay = Replay(delta, dt=dt, duration=dt * (delta.shape[0] - 1), delta_hold="foh")
+        per_sample = Simulator(max_step=math.inf, substeps=substeps)
+        traj = simulate(rebuild(model, names, theta), replay, simulator=per_sample)
+        return tuple(getattr(traj.state, o) for o in outputs)
 
     return jax.jacfwd(sim)(values)

@@ -321,7 +321,7 @@ class DiscreteResponseFit:
     def simulate(self, delta, r0: float = 0.0) -> np.ndarray:
         """Run the difference equation on the rudder `delta` [rad] (held from each
         sample), shape `(N,)`, from `r[0] = r0` with, before sample 0, the yaw rate
-        `r0` and zero rudder (from rest when `r0 = 0`, as `simulate_steering`)."""
+        `r0` and zero rudder (from rest when `r0 = 0`, as `simulate` starts a steering model)."""
         d = np.concatenate([[0.0], np.asarray(delta, dtype=np.float64)])
         c = self.coefficients
         r = np.full(d.shape, float(r0))

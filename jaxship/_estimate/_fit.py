@@ -7,7 +7,7 @@ and sums the squared, weighted output errors of all windows of all experiments
 of one sample equation error. The optimiser is `optimistix.LevenbergMarquardt` in
 the scaled, unconstrained parameter space of `_params.Transform` (with MINPACK's
 cost-based stopping rule added, `_lm.py`), the Jacobian by forward-mode autodiff
-through the simulator's time loop (`_simulate.integrate`), computed once per evaluation
+through the simulator's time loop (`_integrate.integrate`), computed once per evaluation
 (`_lm.stored_jacobian`). Steering models and vessels alike (the shared model contract).
 """
 
@@ -33,7 +33,7 @@ from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
 from .._foundation._progress import ProgressCallback, reporting_steps, step_hook
 from .._foundation._sharding import sharded_vmap
 from .._foundation._validate import validate
-from .._simulation._simulate import Simulator, integrate, replay_policy
+from .._simulation._integrate import Simulator, integrate, replay_policy
 from ._initial import EstimatedStarts, MeasuredStates
 from ._kalman import SmoothedStates
 from ._linear import LinearStart

@@ -10,7 +10,7 @@ heading), for a vessel $z = (u, v, r, x, y, \\psi, \\delta, n)$ and its effects'
 rudder and auxiliary inputs are replayed as `fit` replays them (the measured angle
 linear between $\\delta_k$ and $\\delta_{k+1}$, a command held) and the interval map
 $F$ is the simulator's time loop over the interval
-(`jaxship._simulation._simulate.integrate`, the same numerics as `simulate_steering` and `fit`):
+(`jaxship._simulation._integrate.integrate`, the same numerics as `simulate` and `fit`):
 
 $$z_{k+1} = F(z_k, \\delta_k + w_k) + v_k, \\qquad y_k = h(z_k) + e_k,$$
 
@@ -63,7 +63,7 @@ from .._foundation._state import STATE_FIELDS
 from .._models._steering._base import AbstractSteeringModel, AuxInputs, WindowStart
 from .._models._vessel._base import AbstractVessel
 from .._simulation._data import Experiment
-from .._simulation._simulate import Held, Simulator, integrate
+from .._simulation._integrate import Held, Simulator, integrate
 from ._windows import as_dataset, check_data, resolve_holds
 
 

@@ -81,12 +81,18 @@ def tree_axpy(a: ArrayLike, x, y):
 
 
 class Trajectory(eqx.Module):
-    """Result of `simulate`: states and commands at the sample times.
+    """Result of `simulate`: states and commands at the sample times, for a vessel or a
+    steering model alike.
 
     `state.*` and `command.*` have shape `(num_samples,)` (plus any batch axes in
     front). `valid` marks samples inside the manoeuvre's duration (padding beyond it
     is simulated but should be ignored); `success` is False when the solver failed or
-    a state became non-finite.
+    a state became non-finite. A steering model's trajectory has its heading, yaw
+    rate and actual rudder in `state`, the replayed auxiliary inputs in `state.u`,
+    `state.v`, `state.n` (zeros where none), no track (`state.x = state.y = 0`: a
+    response model has no position), the ordered rudder in `command.delta`, and the
+    model's own state vector in `internal`, shape `(num_samples, num_states)`
+    (`None` for a vessel).
     """
 
     t: Array
@@ -94,6 +100,7 @@ class Trajectory(eqx.Module):
     command: Command
     valid: Array
     success: Array
+    internal: Array | None = None
 
     def to_dataframe(self):
         """One row per valid sample (pandas, an optional dependency): t, the state, and

@@ -2,7 +2,7 @@
 
 `augment(model, *effects)` returns the model with the effects' terms added: an
 `AugmentedVessel` or an `AugmentedSteering`, which behave as their base model in
-`simulate`, `simulate_steering`, `fit` and `predict`. An effect is an equinox Module
+`simulate`, `simulate_batch`, `fit` and `predict`. An effect is an equinox Module
 whose fields are its parameters (declared with `jaxship.param`: unit, plausible
 range, free by default); with every parameter at zero it adds nothing, so the
 augmented model equals its base bit for bit. Its parameters are fitted like any

@@ -12,6 +12,7 @@ and propeller rates rev/s; degrees and rpm belong to the CLI and the file format
 import abc
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import ArrayLike
@@ -40,6 +41,12 @@ class AbstractManoeuvre(AbstractController):
             self.num_samples = int(round(float(self.duration) / float(self.dt))) + 1
         if self.num_samples < 2:
             raise ValueError(f"`duration` ({self.duration} s) must cover at least one `dt`.")
+
+    @property
+    def rudder_rate(self) -> ArrayLike | None:
+        """The manoeuvre's limit on the rudder rate [rad/s] (None: none beyond a
+        vessel's servo); `Turn`, `ZigZag` and `Schedule` take it as an argument."""
+        return None
 
 
 class Controlled(AbstractManoeuvre):
@@ -93,8 +100,18 @@ def _step(tau, execute):
     return jnp.where(tau >= execute, 1.0, 0.0)
 
 
+def _check_rate(rate):
+    """A rudder rate [rad/s] must be positive (or None); traced values are not checked."""
+    if rate is None or isinstance(rate, jax.core.Tracer):
+        return
+    if not np.all(np.asarray(rate, dtype=float) > 0):
+        raise ValueError(f"`rudder_rate` must be positive [rad/s] or None, got {rate}.")
+
+
 class Turn(AbstractTrial):
-    """Turning circle: rudder `angle` ordered at `execute` and held (ITTC 7.5-04-02-01 2.2.1)."""
+    """Turning circle: rudder `angle` ordered at `execute` and held (ITTC 7.5-04-02-01
+    2.2.1). `rudder_rate` [rad/s]: the steering gear's rate limit for the trial (a
+    vessel's servo rate too applies, the smaller wins; None: the servo's alone)."""
 
     angle: ArrayLike  # delta [rad]; positive turns to starboard
     duration: ArrayLike
@@ -103,6 +120,10 @@ class Turn(AbstractTrial):
     start: ArrayLike = 0.0
     n: ArrayLike | None = None
     num_samples: int | None = eqx.field(static=True, default=None)
+    rudder_rate: ArrayLike | None = None  # |d delta/dt| limit [rad/s]; None: none
+
+    def __check_init__(self):
+        _check_rate(self.rudder_rate)
 
     def init_memory(self, x0):
         return None
@@ -119,7 +140,9 @@ class ZigZag(AbstractTrial):
     `heading` on the side the rudder is turning the ship to: at the control step
     nearest to the crossing (`switch_at="nearest"`, within half a step, 0.05 s by
     default) or at the first control step after it (`"after"`, as MSS `zigzag.m` and
-    sampled-logic implementations do, late by up to one step).
+    sampled-logic implementations do, late by up to one step). `rudder_rate` [rad/s]:
+    the steering gear's rate limit for the trial (a vessel's servo rate too applies,
+    the smaller wins; None: the servo's alone).
     """
 
     angle: ArrayLike  # delta_0 [rad], sign gives the first side
@@ -131,10 +154,12 @@ class ZigZag(AbstractTrial):
     n: ArrayLike | None = None
     num_samples: int | None = eqx.field(static=True, default=None)
     switch_at: str = eqx.field(static=True, default="nearest")
+    rudder_rate: ArrayLike | None = None  # |d delta/dt| limit [rad/s]; None: none
 
     def __check_init__(self):
         if self.switch_at not in ("nearest", "after"):
             raise ValueError(f"`switch_at` must be 'nearest' or 'after', got {self.switch_at!r}.")
+        _check_rate(self.rudder_rate)
 
     def init_memory(self, x0):
         return jnp.sign(jnp.asarray(self.angle, dtype=float))
@@ -154,7 +179,8 @@ class Schedule(AbstractTrial):
 
     The building block of the direct spiral, pull-out, 3-2-1-1, PRBS and the thesis
     manoeuvre; before the first time the first angle holds, after the last the last.
-    Steps are written as two points at the same time.
+    Steps are written as two points at the same time. `rudder_rate` [rad/s]: the
+    steering gear's rate limit (as `Turn`'s; None: none beyond a vessel's servo).
     """
 
     times: ArrayLike  # [s] after start, non-decreasing
@@ -164,6 +190,10 @@ class Schedule(AbstractTrial):
     start: ArrayLike = 0.0
     n: ArrayLike | None = None
     num_samples: int | None = eqx.field(static=True, default=None)
+    rudder_rate: ArrayLike | None = None  # |d delta/dt| limit [rad/s]; None: none
+
+    def __check_init__(self):
+        _check_rate(self.rudder_rate)
 
     def init_memory(self, x0):
         return None
@@ -323,7 +353,7 @@ class ReverseSpiral(AbstractManoeuvre):
     $\\dot r = -a r + b\\delta$ its closed loop is $s^2 + (a + bK_d)s + bK_p$.
     `jaxship simulate` places those poles from the vessel's linearised yaw dynamics
     and sizes the rates from its steady turn at the direct spiral's largest rudder
-    angle (`jaxship._trials.reverse_spiral`).
+    angle (`jaxship.cli._trials.reverse_spiral`).
     """
 
     rates: ArrayLike  # r_ref levels [rad/s]
@@ -378,11 +408,13 @@ class Replay(AbstractTrial):
     commanded, piecewise-constant signal) or interpolated linearly (`"foh"`,
     first-order hold: right for a measured, continuous signal such as a logged rudder
     angle or shaft speed), as MATLAB's `InterSample`. Commands default to `"zoh"`.
+    `n_record=None` holds the initial propeller rate (and is what a steering model,
+    which takes no propeller order, needs); `dt` is keyword-only.
     """
 
     delta_record: ArrayLike
-    n_record: ArrayLike
-    dt: ArrayLike
+    n_record: ArrayLike | None = None
+    dt: ArrayLike = eqx.field(kw_only=True)
     start: ArrayLike = 0.0
     duration: ArrayLike | None = None
     n: None = None
@@ -392,7 +424,7 @@ class Replay(AbstractTrial):
 
     def __post_init__(self):
         length = np.shape(self.delta_record)[0]
-        if np.shape(self.n_record)[0] != length:
+        if self.n_record is not None and np.shape(self.n_record)[0] != length:
             raise ValueError("`delta_record` and `n_record` must have the same length.")
         for name in ("delta_hold", "n_hold"):
             if getattr(self, name) not in HOLDS:
@@ -412,6 +444,8 @@ class Replay(AbstractTrial):
     def command(self, t, state, memory, h):
         tau = t - self.start
         delta, delta_rate = interpolate(self.delta_record, self.dt, tau, self.delta_hold)
+        if self.n_record is None:  # the initial propeller rate held
+            return Command(delta, memory[0], delta_rate, None), memory
         n, n_rate = interpolate(self.n_record, self.dt, tau, self.n_hold)
         return Command(delta, n, delta_rate, n_rate), memory
 

@@ -1,6 +1,7 @@
 """The batching layer: many simulations in one compiled call, sharded over all devices.
 
-`simulate_batch` vmaps `simulate` over a leading batch axis of any of its inputs and
+`simulate_batch` vmaps `simulate` (a vessel's or a steering model's jitted body) over a
+leading batch axis of any of its inputs and
 splits that axis across the devices of a `jax.sharding.Mesh` with `jax.shard_map`
 (`_sharding`; one device: plain vmap). Multi-host runs use the same code after
 `jax.distributed.initialize()`; see `benchmarks/README.md`.
@@ -17,8 +18,12 @@ from jax.sharding import PartitionSpec as P
 from .._foundation._sharding import AXIS, batch_mesh, pad_batch
 from .._foundation._state import Trajectory, straight_state
 from .._models._environment import Environment
-from .._models._vessel._base import surge_force
-from ._simulate import Simulator, _as_arrays, _is_static_zero, _simulate
+from .._models._manoeuvres import Replay
+from .._models._steering._base import AbstractSteeringModel
+from .._models._vessel._base import straight_run, surge_force
+from ._integrate import Simulator
+from ._simulate import _as_arrays, _is_static_zero, _simulate
+from ._simulate_steering import _replay, _steer, at_rest
 
 
 def stack(modules: Sequence) -> eqx.Module:
@@ -51,9 +56,9 @@ def stack(modules: Sequence) -> eqx.Module:
 
 
 def simulate_batch(
-    vessel,
+    model,
     manoeuvre,
-    x0,
+    x0=None,
     *,
     environment: Environment = Environment(),
     simulator: Simulator = Simulator(),
@@ -66,10 +71,13 @@ def simulate_batch(
 
     **Arguments:**
 
-    - `vessel`, `manoeuvre`, `x0`, `environment`, `simulator`: as for `simulate`; the
-      batched ones carry a leading batch axis on their array leaves (build them with
-      `stack`, or with arrays in place of numbers, e.g. `straight_state(speeds)`).
-    - `in_axes`: which of `(vessel, manoeuvre, x0, environment)` are batched: `0` for
+    - `model`, `manoeuvre`, `x0`, `environment`, `simulator`: as for `simulate` (a
+      vessel or a steering model; `x0=None`: a vessel's `straight_run`, which needs an
+      unbatched vessel, or a steering model at rest); the batched ones carry a
+      leading batch axis on their array leaves (build them with `stack`, or with
+      arrays in place of numbers, e.g. `straight_state(speeds)`). A steering model
+      takes no `aux` here: its replays run in calm water with zero speeds.
+    - `in_axes`: which of `(model, manoeuvre, x0, environment)` are batched: `0` for
       a leading batch axis, `None` for shared by all runs, as in `jax.vmap`; each entry
       may also be a pytree prefix of its argument (e.g. a vessel with `0` on some
       fields and `None` on the rest). The default batches the manoeuvre and the initial
@@ -91,11 +99,18 @@ def simulate_batch(
     Values never trigger recompilation; the batch size, the shapes and the static
     structure (manoeuvre type, `num_samples`, `simulator`) do.
     """
-    wind = not _is_static_zero(getattr(getattr(environment, "wind", None), "speed", None))
-    args = _as_arrays((vessel, manoeuvre, x0, environment))
     if not (isinstance(in_axes, tuple) and len(in_axes) == 4):
-        raise ValueError("`in_axes` must be a 4-tuple for (vessel, manoeuvre, x0, environment).")
-    names = ("vessel", "manoeuvre", "x0", "environment")
+        raise ValueError("`in_axes` must be a 4-tuple for (model, manoeuvre, x0, environment).")
+    if x0 is None and isinstance(model, AbstractSteeringModel):
+        x0 = at_rest()
+    elif x0 is None:
+        if in_axes[0] is not None:
+            raise ValueError("a batch of vessels needs its initial states `x0` (e.g. "
+                             "`straight_run_batch`).")
+        x0 = straight_run(model)
+    wind = not _is_static_zero(getattr(getattr(environment, "wind", None), "speed", None))
+    args = _as_arrays((model, manoeuvre, x0, environment))
+    names = ("model", "manoeuvre", "x0", "environment")
     axes = tuple(_resolve_axes(a, arg, name) for a, arg, name in zip(in_axes, args, names))
     is_none = lambda x: x is None
     # a 0-d leaf cannot carry a batch axis: it is shared even inside a batched argument
@@ -141,10 +156,15 @@ def _resolve_axes(prefix, tree, name):
 def _batched(b_dyn, s_dyn, b_static, s_static, simulator, steps, output, wind, size, mesh,
              chunk_size):
     def one(b, s):
-        vessel, manoeuvre, x0, environment = eqx.combine(b, b_static, s, s_static)
-        traj = _simulate.__wrapped__(
-            vessel, manoeuvre, x0, environment, simulator, steps, wind=wind, per_field=True
-        )
+        model, manoeuvre, x0, environment = eqx.combine(b, b_static, s, s_static)
+        if isinstance(model, AbstractSteeringModel) and isinstance(manoeuvre, Replay):
+            traj = _replay.__wrapped__(model, manoeuvre, x0, None, simulator, steps)
+        elif isinstance(model, AbstractSteeringModel):
+            traj = _steer.__wrapped__(model, manoeuvre, x0, simulator, steps)
+        else:
+            traj = _simulate.__wrapped__(
+                model, manoeuvre, x0, environment, simulator, steps, wind=wind, per_field=True
+            )
         return traj if output is None else output(traj)
 
     def local(b, s):  # the runs of one device (all runs without a mesh)

@@ -1,22 +1,11 @@
-"""`Simulator` strategy, `integrate` and `simulate()`: the one place that integrates.
+"""`simulate()`: the one door to simulate a model through a manoeuvre.
 
-Every time loop of jaxship (vessel simulation, steering-model simulation, the
-prediction windows of a fit, the Kalman filter's prediction step) is `integrate`:
-a `jax.lax.scan` over output samples, each split into control steps of at most
-`Simulator.max_step` seconds. At the start of each control step a *policy* (a
-controller, a trial's logic or a replay of recorded inputs) returns the inputs for
-that step as a value and a slope (zero-order hold: slope 0; first-order hold:
-recorded signals interpolated linearly), and the vector field sees them at every
-stage time of the solver. The solver is any diffrax solver, stepped with its
-`init`/`step` methods inside the scan (diffrax's manual-stepping API; the fast path,
-default `RK4`), or `diffrax.diffeqsolve` with a step-size controller per control
-step for accuracy-critical work.
+A vessel (`AbstractVessel`) is integrated here (`vessel_field`, the jitted body
+`_simulate`); a steering model (`AbstractSteeringModel`) goes to `_simulate_steering`,
+which replays a `Replay`'s rudder record or runs any other manoeuvre's logic on the
+model's heading. Both return one `Trajectory`; both run `_integrate.integrate`.
 """
 
-import math
-from typing import ClassVar
-
-import diffrax as dfx
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -31,185 +20,73 @@ from .._foundation._state import (
     to_vector,
 )
 from .._models._environment import Environment
-from .._models._manoeuvres import interpolate
-from .._models._vessel._base import AbstractVessel, _state_derivative, inverse3
-
-
-class RK4(dfx.AbstractSolver):
-    """The classical fourth-order Runge-Kutta method (Kutta 1901) as a diffrax solver.
-
-    $k_1 = f(t, y)$, $k_2 = f(t + h/2, y + hk_1/2)$, $k_3 = f(t + h/2, y + hk_2/2)$,
-    $k_4 = f(t + h, y + hk_3)$, $y_1 = y + h(k_1 + 2k_2 + 2k_3 + k_4)/6$ (Hairer,
-    Norsett & Wanner 1993, sec. II.1). Fixed steps (no error estimate); written out
-    rather than through diffrax's general Runge-Kutta stage loop, whose per-step
-    overhead dominates on a six-state ship, so it is the fast path's default. Works in
-    `diffrax.diffeqsolve` with `ConstantStepSize` too.
-    """
-
-    term_structure: ClassVar = dfx.ODETerm
-    interpolation_cls: ClassVar = dfx.LocalLinearInterpolation
-
-    def order(self, terms):
-        return 4
-
-    def init(self, terms, t0, t1, y0, args):
-        return None
-
-    def step(self, terms, t0, t1, y0, args, solver_state, made_jump):
-        del solver_state, made_jump
-        h = t1 - t0
-        f = lambda t, y: terms.vf(t, y, args)
-        axpy = lambda a, x, y: jax.tree.map(lambda xi, yi: yi + a * xi, x, y)
-        k1 = f(t0, y0)
-        k2 = f(t0 + h / 2, axpy(h / 2, k1, y0))
-        k3 = f(t0 + h / 2, axpy(h / 2, k2, y0))
-        k4 = f(t1, axpy(h, k3, y0))
-        incr = jax.tree.map(lambda a, b, c, d: (a + 2 * b + 2 * c + d) / 6, k1, k2, k3, k4)
-        y1 = axpy(h, incr, y0)
-        return y1, None, dict(y0=y0, y1=y1), None, dfx.RESULTS.successful
-
-    def func(self, terms, t0, y0, args):
-        return terms.vf(t0, y0, args)
-
-
-class Simulator(eqx.Module):
-    """Numerics of every simulation and prediction.
-
-    - `solver`: a diffrax solver; default `jaxship.RK4()`.
-    - `max_step`: the longest control step [s]: each output sample interval `dt` is
-      split into `ceil(dt / max_step)` equal control steps (at least `substeps`), and
-      controllers (zig-zag switching, heading control) act at every control step, so trial
-      indices do not depend on the output interval. Replayed records are sampled at
-      their own interval; set `max_step=inf` to integrate one step per sample.
-    - `substeps`: the least number of steps per output sample.
-    - `stepsize_controller`: `None` (default): one fixed solver step per control step,
-      taken with the solver's `init`/`step` in a `lax.scan` (fast, forward- and
-      reverse-mode differentiable). A diffrax controller, e.g.
-      `diffrax.PIDController(rtol=1e-8, atol=1e-8)`, runs `diffeqsolve` over each
-      control step (use an adaptive solver such as `diffrax.Tsit5()`), with `adjoint`
-      (`diffrax.ForwardMode()` for forward-mode Jacobians) and `max_steps`.
-    """
-
-    solver: dfx.AbstractSolver = RK4()
-    max_step: float = eqx.field(static=True, default=0.1)
-    substeps: int = eqx.field(static=True, default=1)
-    stepsize_controller: dfx.AbstractStepSizeController | None = None
-    adjoint: dfx.AbstractAdjoint = dfx.RecursiveCheckpointAdjoint()
-    max_steps: int = eqx.field(static=True, default=4096)
-
-    def __check_init__(self):
-        if not self.max_step > 0:
-            raise ValueError(f"`max_step` must be positive [s], got {self.max_step}.")
-        if int(self.substeps) < 1:
-            raise ValueError(f"`substeps` must be a positive integer, got {self.substeps}.")
-
-    def steps_per_sample(self, dt) -> int:
-        """Control steps per output interval `dt` [s] (a number or an array of them).
-
-        **Raises:** `ValueError` when `dt` is traced (e.g. `jax.vmap` over manoeuvres),
-        so that it cannot be read, unless `max_step` is infinite (`substeps` steps per
-        interval): batch with `jaxship.simulate_batch`, which reads it first."""
-        if isinstance(dt, jax.core.Tracer):
-            if math.isinf(self.max_step):
-                return int(self.substeps)
-            raise ValueError(
-                "the sample interval `dt` is traced (a transformation such as jax.vmap over "
-                "manoeuvres), so the simulator cannot split it into control steps of at most "
-                f"`max_step` = {self.max_step} s: batch with jaxship.simulate_batch, or use "
-                "Simulator(max_step=math.inf, substeps=k) for k steps per sample.")
-        longest = float(np.max(np.asarray(dt, dtype=float)))
-        if not (longest > 0 and math.isfinite(longest)):
-            raise ValueError(f"the sample interval `dt` must be positive and finite, got {dt}.")
-        return max(int(self.substeps), math.ceil(longest / self.max_step - 1e-9))
-
-    def step(self, field, t, h, y, args):
-        """Advance `y` over `[t, t + h]` under `dy/dt = field(t, y, args)`; returns
-        `(y, success)`."""
-        term = dfx.ODETerm(field)
-        if self.stepsize_controller is None:
-            solver = self.solver
-            if getattr(solver, "scan_kind", "") is None:
-                # diffrax's Runge-Kutta stage loop in its scan form: differentiable in
-                # forward and reverse mode and under vmap, as the fast path must be
-                solver = eqx.tree_at(lambda s: s.scan_kind, solver, "bounded",
-                                     is_leaf=lambda x: x is None)
-            state = solver.init(term, t, t + h, y, args)
-            y, _, _, _, result = solver.step(term, t, t + h, y, args, state, made_jump=False)
-            return y, result == dfx.RESULTS.successful
-        sol = dfx.diffeqsolve(term, self.solver, t, t + h, h, y, args,
-                              stepsize_controller=self.stepsize_controller,
-                              adjoint=self.adjoint, max_steps=self.max_steps, throw=False)
-        return sol.ys[-1], sol.result == dfx.RESULTS.successful
-
-
-def integrate(field, y0, policy, policy_state, t0, dt, num, simulator: Simulator, steps: int,
-              observe=None, *, emit: str = "start"):
-    """The time loop: `num` output samples from `y0` at `t0` every `dt`.
-
-    - `field(t, y, (inputs, t_k))`: the vector field, with the inputs held from the
-      control step's start `t_k` (evaluate them at `t` with `inputs.at(t - t_k)`).
-    - `policy(t, y, policy_state, h) -> (inputs, policy_state)`: called at the start
-      of each of the `steps` control steps of length `h = dt / steps` per sample.
-    - `observe(y, inputs)`: what to record for each sample interval (default
-      `(y, inputs)`), with the inputs at the interval's start and the state at its
-      start (`emit="start"`: sample 0 is the initial state; the last interval is
-      integrated and dropped) or at its end (`emit="end"`: the `num` samples after
-      the initial state, as predictions need).
-
-    Returns `(outputs, ok)`: the recorded pytree with a leading axis `num`, and whether
-    every step succeeded and stayed finite.
-    """
-    h = dt / steps
-    observe = (lambda y, inputs: (y, inputs)) if observe is None else observe
-
-    def sample(carry, k):
-        t_sample = t0 + k * dt
-
-        def control_step(carry, j):
-            y, ps, ok = carry
-            t = t_sample + j * h
-            inputs, ps = policy(t, y, ps, h)
-            y, success = simulator.step(field, t, h, y, (inputs, t))
-            return (y, ps, ok & success), inputs
-
-        y = carry[0]
-        carry, inputs = jax.lax.scan(control_step, carry, jnp.arange(steps),
-                                     unroll=steps <= 4)
-        y = carry[0] if emit == "end" else y
-        return carry, observe(y, jax.tree.map(lambda a: a[0], inputs))
-
-    (_, _, ok), out = jax.lax.scan(sample, (y0, policy_state, jnp.array(True)),
-                                   jnp.arange(num))
-    finite = jnp.all(jnp.stack([jnp.all(jnp.isfinite(a)) for a in jax.tree.leaves(out)]))
-    return out, ok & finite
+from .._models._steering._base import AbstractSteeringModel, AuxInputs
+from .._models._vessel._base import (
+    AbstractVessel,
+    _state_derivative,
+    inverse3,
+    straight_run,
+)
+from ._integrate import Simulator, integrate
+from ._simulate_steering import simulate_steering_model
 
 
 def simulate(
-    vessel: AbstractVessel,
+    model: AbstractVessel | AbstractSteeringModel,
     manoeuvre,
-    x0: ShipState,
+    x0: ShipState | None = None,
     *,
     environment: Environment = Environment(),
     simulator: Simulator = Simulator(),
+    aux: AuxInputs | None = None,
 ) -> Trajectory:
-    """Simulate `vessel` through `manoeuvre` from the initial state `x0`.
+    """Simulate `model` through `manoeuvre` from the initial state `x0`.
 
     **Arguments:**
 
-    - `vessel`: any `AbstractVessel`.
-    - `manoeuvre`: an `AbstractManoeuvre`: its controller orders the rudder and
-      propeller at every control step; its `dt` is the output interval.
-    - `x0`: initial `ShipState` (e.g. from `straight_run(vessel)`).
-    - `environment`: current and wind; calm water by default.
+    - `model`: an `AbstractVessel` or an `AbstractSteeringModel`.
+    - `manoeuvre`: an `AbstractManoeuvre`: its controller orders the rudder (and
+      propeller) at every control step; its `dt` is the output interval. A trial
+      spec is a manoeuvre (`Turn`, `ZigZag`, ...), a record replay is a manoeuvre
+      (`Replay`).
+    - `x0`: initial `ShipState`. A vessel starts from it (default
+      `straight_run(model)`: the nominal straight run); a steering model takes its
+      heading `psi` and yaw rate `r` (the model's steady state `initial_state(r)`),
+      default at rest with $\\psi = 0$.
+    - `environment`: current and wind of a vessel; calm water by default.
     - `simulator`: the numerics; see `Simulator`.
+    - `aux`: steering models only: the measured `AuxInputs` (u, v, n, apparent
+      wind) replayed beside a `Replay`'s rudder, leaves of shape `(N,)` or scalars
+      (zeros, calm, by default), with the rudder's hold.
 
-    **Returns:** a `Trajectory` with `manoeuvre.num_samples` samples.
+    A steering model through a `Replay` replays the rudder record (`delta_hold`;
+    its `n_record` is not used: a response model takes a measured propeller rate
+    through `aux`); through any other manoeuvre the manoeuvre sees the model's
+    heading and yaw rate at every control step (zig-zag switching, heading control)
+    and orders the rudder, which moves towards the order by at most
+    `manoeuvre.rudder_rate * h` per control step of `h` seconds (no limit when
+    None) and is held over the step; its propeller order is not used.
+
+    **Returns:** a `Trajectory` with `manoeuvre.num_samples` samples. For a steering
+    model its `state` holds `psi`, `r` and the actual rudder `delta` from the
+    simulation, `u`, `v`, `n` the replayed auxiliary inputs (zeros where none) and
+    `x = y = 0` (a response model has no track); `command.delta` is the ordered
+    rudder and `internal` the model's own state vector, shape `(N, num_states)`.
 
     Parameter values are traced, never baked in: changing them does not recompile.
     """
+    if isinstance(model, AbstractSteeringModel):
+        return simulate_steering_model(model, manoeuvre, x0, aux=aux, simulator=simulator)
+    if not isinstance(model, AbstractVessel):
+        raise TypeError(f"`model` must be an AbstractVessel or an AbstractSteeringModel, got "
+                        f"{type(model).__name__}.")
+    if aux is not None:
+        raise ValueError("`aux` replays measured inputs of a steering model; a vessel "
+                         "simulates its own speeds.")
+    x0 = straight_run(model) if x0 is None else x0
     wind = not _is_static_zero(environment.wind.speed)
     steps = simulator.steps_per_sample(manoeuvre.dt)
-    return _simulate(*_as_arrays((vessel, manoeuvre, x0, environment)), simulator, steps,
+    return _simulate(*_as_arrays((model, manoeuvre, x0, environment)), simulator, steps,
                      wind=wind)
 
 
@@ -236,23 +113,26 @@ def initial_vector(vessel, x0: ShipState):
     return y0
 
 
-def vessel_field(vessel, environment, *, wind=True):
+def vessel_field(vessel, environment, *, wind=True, rudder_rate=None):
     """The vector field of `integrate` for a vessel driven by a `Command` policy: the
     flat state `(u, v, r, x, y, psi, delta, n)` (then any effect states) and the
-    command at time `t`."""
+    command at time `t`; `rudder_rate` [rad/s]: a manoeuvre's rudder-rate limit on
+    top of the vessel's servo (None: the servo's own)."""
     mass_inverse = inverse3(vessel.mass_matrix())  # once per run, outside the time loop
     size = len(STATE_FIELDS)
 
     def field(t, y, args):
         command, t_k = args
         return to_vector(_state_derivative(vessel, from_vector(y), command.at(t - t_k),
-                                          environment, mass_inverse, wind=wind, t=t))
+                                          environment, mass_inverse, wind=wind, t=t,
+                                          rudder_rate=rudder_rate))
 
     def field_with_effects(t, y, args):
         command, t_k = args
         z = y[size:]
         y_dot = _state_derivative(vessel.holding(z), from_vector(y), command.at(t - t_k),
-                                  environment, mass_inverse, wind=wind, t=t)
+                                  environment, mass_inverse, wind=wind, t=t,
+                                  rudder_rate=rudder_rate)
         return jnp.concatenate([to_vector(y_dot), vessel.rudder_path(y[6], z)[1]])
 
     return field_with_effects if vessel.effect_state_size else field
@@ -281,7 +161,8 @@ def _simulate(vessel, manoeuvre, x0, environment, simulator, steps, wind=True, p
             return tuple(y[i] for i in range(len(STATE_FIELDS))) + (delta, n)
         return jnp.concatenate([y[:len(STATE_FIELDS)], jnp.stack([delta, n])])
 
-    out, ok = integrate(vessel_field(vessel, environment, wind=wind), y0, policy,
+    field = vessel_field(vessel, environment, wind=wind, rudder_rate=manoeuvre.rudder_rate)
+    out, ok = integrate(field, y0, policy,
                         manoeuvre.init(x0), t0, dt, num, simulator, steps, observe)
     if not per_field:
         out = tuple(out[:, i] for i in range(len(STATE_FIELDS) + 2))
@@ -294,27 +175,3 @@ def _simulate(vessel, manoeuvre, x0, environment, simulator, steps, wind=True, p
         valid=t - t0 <= manoeuvre.duration + 1e-9 * dt,
         success=ok,
     )
-
-
-class Held(eqx.Module):
-    """Inputs over one control step: their `value` at its start and their `slope`
-    (two pytrees of one structure); `at(tau)` is $v + s\\tau$ leaf by leaf."""
-
-    value: object
-    slope: object
-
-    def at(self, tau):
-        return jax.tree.map(lambda v, s: v + s * tau, self.value, self.slope)
-
-
-def replay_policy(records: dict, dt, holds: dict):
-    """A policy of `integrate` replaying recorded signals: `records` maps a name to
-    its samples (the first at the start of the run, every `dt` seconds), `holds` maps
-    it to `"zoh"` or `"foh"` (see `jaxship.Replay`). Returns `Held` dictionaries."""
-
-    def policy(t, y, state, h):
-        pairs = {k: interpolate(a, dt, t, holds[k]) for k, a in records.items()}
-        return Held({k: p[0] for k, p in pairs.items()},
-                    {k: p[1] for k, p in pairs.items()}), state
-
-    return policy

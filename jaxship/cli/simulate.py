@@ -8,8 +8,8 @@ import pathlib
 from .._foundation._files import staged_folder
 from .._models._vessel.catalogue import get_vessel
 from .._simulation._froude import froude_scale
-from .._trials import TrialSpec, simulate_to_folder
 from ._common import check_operating_point, check_out, positive
+from ._trials import TrialSpec, simulate_to_folder
 
 
 # the most samples `simulate` integrates (10 million samples hold gigabytes)

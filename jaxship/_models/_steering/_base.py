@@ -5,8 +5,9 @@ is the integral of the yaw rate. Unlike a vessel (`jaxship.AbstractVessel`) it h
 sway or surge dynamics of its own: measured speeds, when a model needs them, come in
 as the auxiliary inputs `AuxInputs(u, v, n)` of the current sample.
 
-The models never integrate themselves: `jaxship.simulate_steering`,
-`jaxship.steer_manoeuvre` and `fit` run them through the simulator's one time loop.
+The models never integrate themselves: `jaxship.simulate` (a `Replay` of recorded
+inputs, or any other manoeuvre closed on the model's heading) and `fit` run them
+through the simulator's one time loop.
 """
 
 import abc
@@ -78,7 +79,7 @@ class AbstractSteeringModel(AbstractModel):
       first-order models; hidden states from measured signals as each model
       documents.
 
-    The model never integrates itself: `simulate_steering` and `fit` own the numerics.
+    The model never integrates itself: `simulate` and `fit` own the numerics.
     """
 
     state_names: eqx.AbstractClassVar[tuple[str, ...]]

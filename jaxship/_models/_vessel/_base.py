@@ -131,12 +131,14 @@ def _state_derivative(
     *,
     wind: bool = True,
     t=0.0,
+    rudder_rate=None,
 ) -> ShipState:
     """`state_derivative` with $M^{-1}$ given (the simulator inverts $M$ once per run, not
     four times per step) and, with `wind=False`, without the wind loads (the simulator
     passes it when the wind speed is a static zero, where the loads vanish identically);
-    `t` [s] for loads that vary in time. The vessel's `environment` hook sees the
-    environment first."""
+    `t` [s] for loads that vary in time; `rudder_rate` [rad/s]: a manoeuvre's limit on
+    the rudder rate, $|\\dot\\delta| \\le$ min(servo's, `rudder_rate`) (None: the
+    servo's own). The vessel's `environment` hook sees the environment first."""
     environment = vessel.environment(environment)
     tau = vessel.loads(t, state.u, state.v, state.r, state.delta, state.n)
     xdot, ydot = environment.ground_velocity(state.u, state.v, state.psi)
@@ -156,9 +158,15 @@ def _state_derivative(
         x=xdot,
         y=ydot,
         psi=state.r,
-        delta=vessel.rudder.rate(state.delta, command.delta),
+        delta=_rudder_rate(vessel.rudder.rate(state.delta, command.delta), rudder_rate),
         n=vessel.shaft.rate(state.n, command.n),
     )
+
+
+def _rudder_rate(rate, limit):
+    """The servo's rudder rate, clipped to a manoeuvre's `limit` [rad/s] where given:
+    the smaller of the two rate limits wins."""
+    return rate if limit is None else jnp.clip(rate, -limit, limit)
 
 
 def inverse3(m: Array) -> Array:

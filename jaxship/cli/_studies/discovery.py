@@ -11,6 +11,8 @@ equivalent rudder angle (20 s correlation time), the kind of disturbance waves a
 gusts cause, which colours the residuals without being physics to name.
 """
 
+import dataclasses
+import math
 import time
 
 import numpy as np
@@ -38,13 +40,14 @@ def disturbance(t, std, seed, correlation_time=20.0) -> np.ndarray:
 
 def record(truth, manoeuvre, name, rng, *, disturbance_std=0.0, noise=(0.1, 0.05)):
     """One noisy record of `truth` through `manoeuvre` (see the module text)."""
-    out = js.steer_manoeuvre(truth, manoeuvre, simulator=FINE, rudder_rate=2.3 * DEG)
-    t, delta = np.asarray(out.t), np.asarray(out.delta)
-    psi, r = np.asarray(out.psi), np.asarray(out.r)
+    out = js.simulate(truth, dataclasses.replace(manoeuvre, rudder_rate=2.3 * DEG), simulator=FINE)
+    t, delta = np.asarray(out.t), np.asarray(out.state.delta)
+    psi, r = np.asarray(out.state.psi), np.asarray(out.state.r)
     if disturbance_std:
         w = disturbance(t, disturbance_std, int(rng.integers(2**31)))
-        out = js.simulate_steering(truth, delta + w, float(t[1] - t[0]), substeps=25)
-        psi, r = np.asarray(out.psi), np.asarray(out.r)
+        out = js.simulate(truth, js.Replay(delta + w, dt=float(t[1] - t[0]), delta_hold="foh"),
+                          simulator=js.Simulator(max_step=math.inf, substeps=25))
+        psi, r = np.asarray(out.state.psi), np.asarray(out.state.r)
     psi, r = np.asarray(truth.measure("psi", psi)), np.asarray(truth.measure("r", r))  # sensors
     return js.Experiment(t, delta, psi=psi + rng.normal(0, noise[0] * DEG, t.size),
                          r=r + rng.normal(0, noise[1] * DEG, t.size), name=name)
@@ -66,7 +69,7 @@ def condition_records(at, seed, *, channel="n", values=(1.0, 2.0), held=None):
     held constant in each run: the propeller rate (`channel="n"`, [rev/s]) or the
     surge speed (`"u"`, [m/s]). `at(value)` is the truth at that value, exact where
     the effect is a gain, time constant or moment constant at a constant rate or
-    speed (`steer_manoeuvre` has no logged inputs). 10/10 and 20/20 zig-zags to
+    speed (a steering model's closed loop has no logged inputs). 10/10 and 20/20 zig-zags to
     starboard at each of `values` to train, +-20 deg turns at `held` (default their
     mean) held out, run as `record` does."""
     rng = np.random.default_rng(seed)
@@ -105,11 +108,12 @@ def wind_records(truth, seed, *, speed=7.0, wind=(15.0, 60.0 * DEG), noise=(0.1,
     replay = js.PredictionError(horizon=None, wind=True, substeps=10)
 
     def one(manoeuvre, heading, name):
-        calm = js.steer_manoeuvre(truth, manoeuvre, simulator=FINE, rudder_rate=2.3 * DEG)
-        t, delta = np.asarray(calm.t), np.asarray(calm.delta)
+        calm = js.simulate(truth, dataclasses.replace(manoeuvre, rudder_rate=2.3 * DEG),
+                           simulator=FINE)
+        t, delta = np.asarray(calm.t), np.asarray(calm.state.delta)
         logged = dict(u=np.full(t.size, speed), v=np.zeros(t.size),
                       wind_speed=np.full(t.size, wind[0]), wind_dir=np.full(t.size, wind[1]))
-        psi, r = np.asarray(calm.psi) + heading, np.asarray(calm.r)
+        psi, r = np.asarray(calm.state.psi) + heading, np.asarray(calm.state.r)
         for _ in range(8):
             out = js.predict(truth, js.Experiment(t, delta, psi=psi, r=r, **logged),
                              estimator=replay)

@@ -42,6 +42,7 @@ from tqdm.auto import tqdm
 
 import jaxship as js
 from jaxship._foundation._files import staged_folder
+from jaxship.cli._trials import trial_indices
 
 from . import autopilot, discovery, thesis
 from .reproduce_report import (
@@ -217,7 +218,7 @@ def _trials(vessel, families, out, progress):
     for family, spec, rpm, manoeuvre, traj in sorted(design.values(), key=lambda d: d[2]):
         name = _file_name(spec, rpm)
         js.write_trial_csv(out / "trials" / f"{name}.csv", traj)
-        indices[name] = _finite(js.trial_indices(spec, manoeuvre, traj))
+        indices[name] = _finite(trial_indices(spec, manoeuvre, traj))
     return design, indices
 
 

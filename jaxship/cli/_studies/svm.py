@@ -12,11 +12,15 @@ and a turning circle (sec. 3.2).
 thesis manoeuvre for Nomoto 1 and 2 models of a vessel (thesis sec. 3.3.2).
 """
 
+import dataclasses
+import math
+
 import equinox as eqx
 import numpy as np
 
 import jaxship as js
 from jaxship._estimate._discrete import fit_discrete_response
+from jaxship.cli._trials import initial_state
 
 
 DEG = np.pi / 180.0
@@ -91,7 +95,7 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
     `"generalisation"` {(structure, method): {trial: fit % of r}} and the records.
     """
     v = js.vessel(vessel) if isinstance(vessel, str) else vessel
-    x0 = js.initial_state(v, rpm=rpm)
+    x0 = initial_state(v, rpm=rpm)
     tau = float(v.length) / float(x0.u)
     duration = duration_lengths * tau
     rate = float(v.rudder.max_rate)
@@ -124,13 +128,15 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
         except ValueError:
             table1.append((f"{key[0]} ({key[1]})", np.nan, np.nan))
             continue
-        tr = js.steer_manoeuvre(model, trials["zigzag 20/20"], rudder_rate=rate, substeps=2)
-        o1, o2 = _overshoots(tr.t, tr.psi, tr.delta, 20 * DEG)
+        zigzag = dataclasses.replace(trials["zigzag 20/20"], rudder_rate=rate)
+        tr = js.simulate(model, zigzag, simulator=js.Simulator(substeps=2))
+        o1, o2 = _overshoots(tr.t, tr.state.psi, tr.state.delta, 20 * DEG)
         table1.append((f"{key[0]} ({key[1]})", o1, o2))
         general[key] = {}
         for name, rec in records.items():
-            sim = js.simulate_steering(model, rec.delta, rec.dt, substeps=2)
-            general[key][name] = js.fit_percent(rec.r, np.asarray(sim.r))
+            sim = js.simulate(model, js.Replay(rec.delta, dt=rec.dt, delta_hold="foh"),
+                              simulator=js.Simulator(max_step=math.inf, substeps=2))
+            general[key][name] = js.fit_percent(rec.r, np.asarray(sim.state.r))
     table1 = [(n, o1 / DEG, o2 / DEG) for n, o1, o2 in table1]
     table1_discrete = [(n, o1 / DEG, o2 / DEG) for n, o1, o2 in table1_discrete]
     consistency = {key: f.parameters for key, f in fits.items()}
@@ -155,7 +161,7 @@ def design_study(vessel="thesis", *, rpm=500.0, dt=0.5, noise_r=0.05 * DEG, dura
     **Returns** `{"nominal": {...}, "reports": {(model, manoeuvre): DesignReport}}`.
     """
     v = js.vessel(vessel) if isinstance(vessel, str) else vessel
-    x0 = js.initial_state(v, rpm=rpm)
+    x0 = initial_state(v, rpm=rpm)
     thesis = js.thesis_manoeuvre(dt=dt)
     duration = float(thesis.duration) if duration is None else float(duration)
     rate = float(v.rudder.max_rate)
@@ -178,7 +184,8 @@ def design_study(vessel="thesis", *, rpm=500.0, dt=0.5, noise_r=0.05 * DEG, dura
     for mname, model, free in (("Nomoto1", n1, ("K", "T")),
                                ("Nomoto2", n2, ("K", "T1", "T2", "T3"))):
         for name, m in manoeuvres.items():
-            reports[(mname, name)] = js.fisher_information(model, m, noise_r, free=free,
-                                                        rudder_rate=rate, substeps=2)
+            geared = dataclasses.replace(m, rudder_rate=rate)  # the vessel's gear rate
+            reports[(mname, name)] = js.fisher_information(model, geared, noise_r, free=free,
+                                                        substeps=2)
     return {"nominal": {"Nomoto1": n1, "Nomoto2": n2}, "reports": reports,
             "duration": duration}

@@ -34,6 +34,7 @@ import numpy as np
 
 import jaxship as js
 from jaxship._estimate._linear import initial_estimate
+from jaxship.cli._trials import initial_state
 
 
 DEG = math.pi / 180.0
@@ -135,7 +136,7 @@ def simulate_design(vessel=None, *, families=None, settings: Settings = Settings
             for rpm in RPMS:
                 if progress is not None:
                     progress(record_name(spec, rpm))
-                x0 = js.initial_state(vessel, rpm=rpm)
+                x0 = initial_state(vessel, rpm=rpm)
                 manoeuvre = _manoeuvre(spec, vessel, x0, settings)
                 traj = js.simulate(vessel, manoeuvre, x0, simulator=simulator)
                 if not bool(traj.success):
@@ -176,10 +177,11 @@ def thesis_experiments(vessel=None, *, families=None, settings: Settings = Setti
 def simulate_record(model, e: js.Experiment, substeps: int = 2) -> np.ndarray:
     """Yaw rate [rad/s] of `model` simulated over the record `e` from its first
     sample with its rudder, u, v and n replayed (no restarts: output error)."""
-    tr = js.simulate_steering(model, e.delta, e.dt, state0=model.initial_state(e.r[0]),
-                           psi0=e.psi[0], aux=js.AuxInputs(u=e.u, v=e.v, n=e.n),
-                           substeps=substeps)
-    return np.asarray(tr.r)
+    tr = js.simulate(model, js.Replay(e.delta, dt=e.dt, delta_hold="foh"),
+                     dataclasses.replace(js.straight_state(0.0, psi=e.psi[0]), r=e.r[0]),
+                     aux=js.AuxInputs(u=e.u, v=e.v, n=e.n),
+                     simulator=js.Simulator(max_step=math.inf, substeps=substeps))
+    return np.asarray(tr.state.r)
 
 
 def simulation_fit(model, records, substeps: int = 2) -> tuple[float, list[float]]:

@@ -1,6 +1,8 @@
 """Trial specifications such as `turn:35` or `zigzag:-10/10`, and running them.
 
-This is the edge of the library: specs are written in degrees, vessels by name.
+This is the application's (`jaxship simulate`), not the library's: specs are strings
+in degrees, vessels go by name. A library user builds the manoeuvre (`jaxship.Turn`,
+`jaxship.ZigZag`, ...) and calls `jaxship.simulate`.
 Durations default to multiples of the vessel's time scale L/U so that the same
 spec suits a 4 m model and a 160 m ship.
 """
@@ -14,14 +16,15 @@ import jax.numpy as jnp
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ._analysis import _indices as ix
-from ._foundation._state import straight_state
-from ._models import _manoeuvres as man
-from ._models._vessel._base import straight_run, surge_force
-from ._simulation._data import Experiment
-from ._simulation._readers import write_trial_csv
-from ._simulation._simulate import Simulator, simulate
-from .plotting import plot_imo_criteria, plot_spiral, plot_trajectory
+from .._analysis import _indices as ix
+from .._foundation._state import straight_state
+from .._models import _manoeuvres as man
+from .._models._vessel._base import straight_run, surge_force
+from .._simulation._data import Experiment
+from .._simulation._integrate import Simulator
+from .._simulation._readers import write_trial_csv
+from .._simulation._simulate import simulate
+from ..plotting import plot_imo_criteria, plot_spiral, plot_trajectory
 
 
 SPEC_HELP = (
@@ -272,7 +275,7 @@ def initial_state(vessel, *, speed=None, rpm=None):
     return straight_run(vessel, speed=speed, n=n)
 
 
-def run_trial(vessel, spec, *, speed=None, rpm=None, duration=None, dt=None, substeps=2):
+def run_spec(vessel, spec, *, speed=None, rpm=None, duration=None, dt=None, substeps=2):
     """Simulate the trial `spec` (a string or `TrialSpec`); returns `(manoeuvre, trajectory)`.
 
     A turning circle is extended until it has turned at least 540 degrees (ITTC).
@@ -397,7 +400,7 @@ def simulate_to_folder(
     rows under "imo_criteria" in `indices.json`) for a trial that an IMO criterion
     checks."""
     spec = TrialSpec.parse(spec) if isinstance(spec, str) else spec
-    manoeuvre, traj = run_trial(vessel, spec, speed=speed, rpm=rpm, duration=duration, dt=dt)
+    manoeuvre, traj = run_spec(vessel, spec, speed=speed, rpm=rpm, duration=duration, dt=dt)
     if not bool(traj.success):
         raise ValueError(
             f"the simulation of {spec!r} failed (non-finite state); try a smaller --dt."
