@@ -216,7 +216,8 @@ def test_every_effect_acts_through_the_small_classes_of_its_places():
         Forgotten()
     K, c = 0.06, 1e-3
     delta = np.deg2rad(10) * np.sign(np.sin(np.arange(200) / 20.0) + 1e-9)
-    psi = [js.simulate_steering(js.augment(js.Nomoto1(K=K, T=25.0), effect), delta, 0.5).psi
+    psi = [js.simulate(js.augment(js.Nomoto1(K=K, T=25.0), effect),
+                       js.Replay(delta, dt=0.5)).state.psi
            for effect in (ConstantTerm(c=c), js.RudderOffset(delta0=c / K))]
     np.testing.assert_allclose(psi[0], psi[1], rtol=1e-12, atol=1e-12)
 

@@ -303,3 +303,16 @@ def test_norrbin_steady_state():
     x1 = dataclasses.replace(js.straight_run(ship), r=jnp.asarray(1e-3))
     drift = js.simulate(ship, js.Turn(0.0, duration=2000.0, dt=1.0), x1).state.r[-1]
     np.testing.assert_allclose(drift, np.sqrt(1 / 4.0e5), rtol=1e-8)
+
+
+def test_a_steering_simulation_starts_from_the_sway_velocity_it_is_given():
+    """`simulate` takes psi, r and, on a model with a sway state, v from `x0` (a record's
+    first sample): the linear sway-yaw model with the rudder amidships starts at the
+    given drift and decays from it."""
+    model = js.LinearSwayYaw.from_vessel(js.vessel("sea_stratus_linear"))
+    x0 = dataclasses.replace(js.straight_state(0.0, psi=0.2), r=0.001, v=0.1)
+    tr = js.simulate(model, js.Replay(np.zeros(40), dt=0.5), x0,
+                     aux=js.AuxInputs(u=8.0))
+    v = np.asarray(tr.internal[:, model.state_names.index("v")])
+    assert v[0] == 0.1 and float(tr.state.r[0]) == 0.001 and float(tr.state.psi[0]) == 0.2
+    assert abs(v[-1]) < abs(v[0])

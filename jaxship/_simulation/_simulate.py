@@ -51,8 +51,8 @@ def simulate(
       (`Replay`).
     - `x0`: initial `ShipState`. A vessel starts from it (default
       `straight_run(model)`: the nominal straight run); a steering model takes its
-      heading `psi` and yaw rate `r` (the model's steady state `initial_state(r)`),
-      default at rest with $\\psi = 0$.
+      heading `psi` and yaw rate `r` (the model's steady state `initial_state(r)`)
+      and, where it has a sway state, `v`; default at rest with $\\psi = 0$.
     - `environment`: current and wind of a vessel; calm water by default.
     - `simulator`: the numerics; see `Simulator`.
     - `aux`: steering models only: the measured `AuxInputs` (u, v, n, apparent

@@ -12,6 +12,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+from jaxtyping import Array
 
 from .._foundation._params import as_arrays
 from .._foundation._state import Command, ShipState, Trajectory
@@ -52,6 +53,15 @@ def at_rest(dtype=float) -> ShipState:
     """The default start of a steering model: at rest, heading 0."""
     zero = jnp.zeros((), dtype)
     return ShipState(*(zero,) * 8)
+
+
+def start_state(model: AbstractSteeringModel, x0: ShipState) -> Array:
+    """The model state at `x0`: the steady turn at its yaw rate (`initial_state(r)`),
+    with its sway velocity `v` where the model has a sway state (sway-yaw models)."""
+    state = model.initial_state(x0.r)
+    if "v" in model.state_names:
+        state = state.at[model.state_names.index("v")].set(x0.v)
+    return state
 
 
 def simulate_steering_model(model: AbstractSteeringModel, manoeuvre, x0: ShipState | None,
@@ -113,7 +123,7 @@ def _replay(model, manoeuvre, x0, aux, simulator, steps):
     """The jitted body of a steering model's replay of a rudder record."""
     records, holds = replay_records(manoeuvre, aux)
     dt = jnp.asarray(manoeuvre.dt, float)
-    state0, psi0 = model.initial_state(x0.r), x0.psi
+    state0, psi0 = start_state(model, x0), x0.psi
     (psi, r, states), ok = _propagate(model, state0, psi0, records, dt, holds, simulator,
                                       steps)
     first = lambda a0, a: jnp.concatenate([jnp.asarray(a0)[None], a])
@@ -146,7 +156,7 @@ def _steer(model, manoeuvre, x0, simulator, steps):
         held["ordered"] = jnp.asarray(command.delta, float)  # recorded, not an input
         return Held(held, jax.tree.map(jnp.zeros_like, held)), (delta, memory)
 
-    state0 = model.initial_state(x0.r)
+    state0 = start_state(model, x0)
     y0 = jnp.concatenate([state0, jnp.reshape(psi0, (1,))])
     memory = manoeuvre.init(ship(y0, zero))
     observe = lambda y, held: (y[-1], model.output(y[:-1]), y[:-1], held.value["delta"],
