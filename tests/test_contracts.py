@@ -127,24 +127,28 @@ def vessel_final(vessel, name, manoeuvre=None):
     return lambda p: js.simulate(rebuild(vessel, (name,), (p,)), man, x0).state.psi[-1]
 
 
+def check_contract(f, p0, *, eps, rtol, atol):
+    """vmap equals a loop, the forward derivative equals a central difference of
+    relative step `eps`, and new values do not retrace: the loop and the difference run
+    through one jitted `f` that may be traced once (one compilation for all five
+    calls; the arguments are float64 arrays, never weakly typed Python floats)."""
+    jitted = jax.jit(eqx.debug.assert_max_traces(f, max_traces=1))
+    call = lambda p: jitted(jnp.asarray(p, float))
+    values = p0 * jnp.array([0.9, 1.0, 1.1])
+    np.testing.assert_allclose(jax.vmap(f)(values), jnp.stack([call(v) for v in values]),
+                               rtol=1e-10, atol=1e-12)
+    h = eps * abs(p0)
+    fd = (call(p0 + h) - call(p0 - h)) / (2 * h)
+    fwd = jax.jvp(f, (jnp.asarray(p0),), (jnp.asarray(1.0),))[1]
+    np.testing.assert_allclose(fwd, fd, rtol=rtol, atol=atol)
+
+
 @pytest.mark.parametrize("name", VESSELS)
 def test_vessel_contract(name):
     vessel = js.vessel(name)
     coefficient = default_free(vessel)[0]
     p0 = float(get_path(vessel, coefficient))
-    f = vessel_final(vessel, coefficient)
-    values = p0 * jnp.array([0.9, 1.0, 1.1])
-    batched = jax.vmap(f)(values)
-    looped = jnp.stack([f(v) for v in values])
-    np.testing.assert_allclose(batched, looped, rtol=1e-10, atol=1e-12)
-    eps = 1e-5 * abs(p0)
-    fd = (f(p0 + eps) - f(p0 - eps)) / (2 * eps)
-    fwd = jax.jvp(f, (jnp.asarray(p0),), (jnp.asarray(1.0),))[1]
-    np.testing.assert_allclose(fwd, fd, rtol=1e-4, atol=1e-9)
-    counted = eqx.debug.assert_max_traces(f, max_traces=1)
-    jitted = jax.jit(counted)
-    for v in values:
-        jitted(v)  # new values, one trace
+    check_contract(vessel_final(vessel, coefficient), p0, eps=1e-5, rtol=1e-4, atol=1e-9)
 
 
 def steering_final(model, name):
@@ -160,17 +164,7 @@ def test_steering_model_contract(name):
     model = STEERING[name]
     parameter = next(n for n in default_free(model) if float(get_path(model, n)) != 0.0)
     p0 = float(get_path(model, parameter))
-    f = steering_final(model, parameter)
-    values = p0 * jnp.array([0.9, 1.0, 1.1])
-    np.testing.assert_allclose(jax.vmap(f)(values), jnp.stack([f(v) for v in values]),
-                               rtol=1e-10, atol=1e-12)
-    eps = 1e-6 * abs(p0)
-    fd = (f(p0 + eps) - f(p0 - eps)) / (2 * eps)
-    fwd = jax.jvp(f, (jnp.asarray(p0),), (jnp.asarray(1.0),))[1]
-    np.testing.assert_allclose(fwd, fd, rtol=1e-5, atol=1e-10)
-    jitted = jax.jit(eqx.debug.assert_max_traces(f, max_traces=1))
-    for v in values:
-        jitted(v)
+    check_contract(steering_final(model, parameter), p0, eps=1e-6, rtol=1e-5, atol=1e-10)
 
 
 def _with_wind(data, environment):
