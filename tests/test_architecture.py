@@ -153,6 +153,16 @@ def test_no_hasattr_in_the_package():
     assert not found, "\n".join(found)
 
 
+
+def test_one_assembler_builds_the_fit_result():
+    """Every estimator's `fit` ends in one assembler (issue 33), `assemble_result`, which
+    validates each channel and builds the `FitResult`: the class is constructed in exactly
+    one place in the package (`dataclasses.replace` of a result does not count)."""
+    found = [f"{m}:{line}" for m, path in modules() for name, line in calls(path)
+             if name == "FitResult" or name.endswith(".FitResult")]
+    assert len(found) == 1, "\n".join(found) or "FitResult is never constructed"
+    assert found[0].startswith("jaxship._estimate._result:"), found
+
 def test_the_library_never_prints_or_warns():
     """Outcomes are result codes and progress goes to a callable the caller passes: no
     print, warnings.warn or jax.debug.print below the application layer."""

@@ -27,11 +27,10 @@ from scipy.signal import lfilter
 
 from .._foundation._covariance import parameter_report
 from .._foundation._params import parameter_fields
-from .._foundation._validate import validate
 from .._models._armax_model import ARMAX_NAMES, ARMAX_ORDERS, ARMAXModel
 from ._discrete import continuous_parameters
 from ._fit import AbstractEstimator, excitation_flags
-from ._result import FitResult, Prediction
+from ._result import FitResult, Prediction, assemble_result
 from ._windows import as_dataset, check_data
 
 
@@ -266,17 +265,13 @@ class ARMAX(AbstractEstimator):
         eps = res.residuals(y, u)
         line, mask = np.zeros((1, ds.num_samples)), np.zeros((1, ds.num_samples), bool)
         line[0, :n], mask[0, first:n] = y - eps, True
-        rudder = np.asarray(getattr(ds, self.rudder), dtype=np.float64)
-        metrics = {"r": validate(np.asarray(ds.r, dtype=np.float64), line, mask,
-                                 num_params=len(ARMAX_NAMES), u=rudder, max_lag=self.max_lag,
-                                 channel="r")}
-        return FitResult(
-            model=fitted, parameters=report, metrics=metrics, predictions={"r": line},
-            predicted=mask, result=optx.RESULTS.successful if res.converged
-            else optx.RESULTS.nonlinear_max_steps_reached, num_steps=int(res.iterations),
+        return assemble_result(
+            fitted, report, ds, {"r": line}, mask, rudder=self.rudder,
+            num_params=len(ARMAX_NAMES), max_lag=self.max_lag,
+            result=optx.RESULTS.successful if res.converged
+            else optx.RESULTS.nonlinear_max_steps_reached, num_steps=res.iterations,
             cost=0.5 * float(np.sum(eps[first:] ** 2)), weights={"r": 1.0},
-            window_samples=(1,), horizon=dt, experiment_names=tuple(ds.names),
-            criterion="one-step prediction error (ARMAX)",
+            window_samples=(1,), horizon=dt, criterion="one-step prediction error (ARMAX)",
             noise={"innovations": float(res.noise_variance)}, noise_std={"innovations": math.nan})
 
     def predict(self, model, dataset) -> Prediction:

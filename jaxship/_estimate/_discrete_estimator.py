@@ -18,7 +18,6 @@ import optimistix as optx
 
 from .._foundation._covariance import parameter_report
 from .._foundation._params import parameter_fields
-from .._foundation._validate import validate
 from .._models._effects import AugmentedSteering, YawCubicDamping
 from .._models._steering.nomoto import Nomoto1, Nomoto2, NonlinearNomoto
 from .._simulation._data import Experiment
@@ -30,7 +29,7 @@ from ._discrete import (
     regressors,
 )
 from ._fit import AbstractEstimator, PredictionError
-from ._result import FitResult, Prediction
+from ._result import FitResult, Prediction, assemble_result
 from ._windows import as_dataset, check_data
 
 
@@ -121,15 +120,12 @@ class DiscreteResponse(AbstractEstimator):
             line[i, order:e.t.size] = res.one_step(e.r, e.delta)
             mask[i, order:e.t.size] = True
         r = np.asarray(ds.r, dtype=np.float64)
-        metrics = {"r": validate(r, line, mask, num_params=len(names),
-                                 u=np.asarray(getattr(ds, self.rudder), dtype=np.float64),
-                                 max_lag=self.max_lag, channel="r")}
-        return FitResult(
-            model=fitted, parameters=report, metrics=metrics, predictions={"r": line},
-            predicted=mask, result=optx.RESULTS.successful if res.converged
+        return assemble_result(
+            fitted, report, ds, {"r": line}, mask, rudder=self.rudder, num_params=len(names),
+            max_lag=self.max_lag, result=optx.RESULTS.successful if res.converged
             else optx.RESULTS.nonlinear_max_steps_reached, num_steps=1,
             cost=0.5 * float(np.sum(((r - line) * mask) ** 2)), weights={"r": 1.0},
-            window_samples=(1,), horizon=res.dt, experiment_names=tuple(ds.names),
+            window_samples=(1,), horizon=res.dt,
             criterion=f"equation error ({options['method']}, Lu & Zhao {structure})")
 
     def predict(self, model, dataset) -> Prediction:

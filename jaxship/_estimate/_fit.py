@@ -32,7 +32,6 @@ from .._foundation._covariance import (
 from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
 from .._foundation._progress import ProgressCallback, reporting_steps, step_hook
 from .._foundation._sharding import sharded_vmap
-from .._foundation._validate import validate
 from .._simulation._integrate import Simulator, integrate, replay_policy
 from ._initial import EstimatedStarts, MeasuredStates
 from ._kalman import SmoothedStates
@@ -45,7 +44,7 @@ from ._lm import (
     solve_least_squares,
     value_and_jacfwd,
 )
-from ._result import FitError, FitResult, Prediction
+from ._result import FitError, FitResult, Prediction, assemble_result
 from ._step import MAX_SUBSTEPS, stable_substeps
 from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_data, to_timeline
 
@@ -540,51 +539,43 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
     groups = np.concatenate([np.full(int(mask.sum()), c) for c in range(len(channels))])
     result = _verdict(as_code(result), specs, values, rows, jrows[:, :d], pred, targets, mask)
     blown = result == RESULTS.simulation_blew_up  # nothing below means anything: NaN
-    quiet = (lambda: np.errstate(all="ignore")) if blown else contextlib.nullcontext
-    with quiet():
+    with np.errstate(all="ignore") if blown else contextlib.nullcontext():
         cost = 0.5 * float(np.sum(rows**2))
     nan = np.full((columns.shape[0],) * 2, np.nan)
     full, null = (nan, []) if blown else least_squares_covariance(jrows, rows, groups)
     covariance = full[:d, :d]
     null = [v[:d] / np.linalg.norm(v[:d]) for v in null if np.linalg.norm(v[:d]) > 1e-3]
     flags, no_excitation = excitation_flags(ds, estimator.rudder)
-    num_params = columns.shape[0]
 
     shape = (ds.num_experiments, ds.num_samples)
-    predictions, metrics = {}, {}
-    u = np.asarray(getattr(ds, estimator.rudder), dtype=np.float64)
+    predictions = {}
     for c, name in enumerate(channels):
-        timeline, hit = to_timeline(pred[c], layout, shape)
-        predictions[name] = timeline
-        measured = np.asarray(getattr(ds, name), dtype=np.float64)
-        with quiet():  # blown: on what stayed finite
-            metrics[name] = validate(measured, timeline, hit & np.isfinite(timeline),
-                                     num_params=num_params, u=u, max_lag=estimator.max_lag,
-                                     channel=name)
-    # standard errors that do not assume white residuals, reported and flagged when the
-    # residuals fail the whiteness test: clustered by prediction window when there are
-    # enough windows (they restart from measurements), else Newey-West HAC in time
-    white = all(m.white for m in metrics.values())
-    windows_used = int(mask.any(axis=-1).sum())
-    if blown:
-        robust, lags, method = nan, None, "none (the simulation blew up)"
-    elif windows_used >= MIN_CLUSTERS:
-        robust, _ = cluster_from_windows(jac[..., columns], resid, mask)
-        lags, method = None, f"clustered by prediction window, {windows_used} windows"
-    else:
-        robust, lags = hac_from_windows(jac[..., columns], resid, layout,
-                                        num_samples=shape[1], focus=np.arange(d))
-        method = f"Newey-West HAC, {lags} lags"
-    report = parameter_report(transform.names, values, covariance,
-                              units=tuple(s.unit for s in specs), null_directions=null,
-                              extra_flags=flags, robust_covariance=robust[:d, :d],
-                              undetermined_flags=flags if no_excitation else (),
-                              white=white, hac_lags=lags, robust_method=method)
-    out = FitResult(
-        model=fitted, parameters=report, metrics=metrics, predictions=predictions,
-        predicted=hit, result=result, num_steps=int(num_steps), cost=cost,
-        weights={c: float(w) for c, w in zip(channels, weights)},
-        window_samples=tuple(layout["lengths"]), horizon=estimator.horizon,
-        experiment_names=tuple(ds.names),
-    )
-    return out
+        predictions[name], hit = to_timeline(pred[c], layout, shape)
+
+    def report(metrics):
+        # standard errors that do not assume white residuals, reported and flagged when
+        # the residuals fail the whiteness test: clustered by prediction window when there
+        # are enough windows (they restart from measurements), else Newey-West HAC in time
+        white = all(m.white for m in metrics.values())
+        windows_used = int(mask.any(axis=-1).sum())
+        if blown:
+            robust, lags, method = nan, None, "none (the simulation blew up)"
+        elif windows_used >= MIN_CLUSTERS:
+            robust, _ = cluster_from_windows(jac[..., columns], resid, mask)
+            lags, method = None, f"clustered by prediction window, {windows_used} windows"
+        else:
+            robust, lags = hac_from_windows(jac[..., columns], resid, layout,
+                                            num_samples=shape[1], focus=np.arange(d))
+            method = f"Newey-West HAC, {lags} lags"
+        return parameter_report(transform.names, values, covariance,
+                                units=tuple(s.unit for s in specs), null_directions=null,
+                                extra_flags=flags, robust_covariance=robust[:d, :d],
+                                undetermined_flags=flags if no_excitation else (),
+                                white=white, hac_lags=lags, robust_method=method)
+
+    return assemble_result(
+        fitted, report, ds, predictions, hit, rudder=estimator.rudder,
+        num_params=columns.shape[0], max_lag=estimator.max_lag, result=result,
+        num_steps=num_steps, cost=cost, weights={c: float(w) for c, w in zip(channels, weights)},
+        window_samples=layout["lengths"], horizon=estimator.horizon, quiet=blown,
+        valid={c: hit & np.isfinite(line) for c, line in predictions.items()})  # blown: finite

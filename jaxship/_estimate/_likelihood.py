@@ -13,7 +13,6 @@ import optimistix as optx
 
 from .._foundation._covariance import least_squares_covariance, parameter_report
 from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
-from .._foundation._validate import validate
 from .._models._steering._base import AbstractSteeringModel
 from ._fit import AbstractEstimator, FitResult
 from ._kalman import (
@@ -25,7 +24,7 @@ from ._kalman import (
     _variance,
 )
 from ._lm import LevenbergMarquardt, solve_least_squares
-from ._result import Prediction
+from ._result import Prediction, assemble_result
 from ._windows import channel_weights
 
 
@@ -157,22 +156,15 @@ def _report(model, ds, channels, rudder, specs, transform, layout, rec, z, cov, 
     pred = np.asarray(pred, dtype=np.float64)
     predicted = np.asarray(ds.mask).copy()
     predicted[:, 0] = False  # sample 0 is the prior, never predicted
-    u = np.asarray(getattr(ds, rudder), dtype=np.float64)
-    predictions, metrics = {}, {}
-    for c, name in enumerate(channels):
-        predictions[name] = np.where(predicted, pred[..., c], 0.0)
-        metrics[name] = validate(np.asarray(getattr(ds, name), dtype=np.float64),
-                                 predictions[name], predicted, num_params=int(q.shape[0]),
-                                 u=u, max_lag=max_lag, channel=name)
-    return FitResult(
-        model=fitted, parameters=report, metrics=metrics, predictions=predictions,
-        predicted=predicted, result=result, num_steps=int(steps), cost=float(loss),
+    predictions = {name: np.where(predicted, pred[..., c], 0.0)
+                   for c, name in enumerate(channels)}
+    return assemble_result(
+        fitted, report, ds, predictions, predicted, rudder=rudder, num_params=int(q.shape[0]),
+        max_lag=max_lag, result=result, num_steps=steps, cost=loss,
         weights=dict(zip(channels, channel_weights(ds, channels, None).tolist())),
         window_samples=(1,) * ds.num_experiments, horizon=float(np.min(ds.dt)),
-        experiment_names=tuple(ds.names), criterion=criterion,
-        noise={n: float(v) for n, v in zip(layout.names, var)},
-        noise_std={n: float(v * s) for n, v, s in zip(layout.names, var, log_std)},
-    )
+        criterion=criterion, noise={n: float(v) for n, v in zip(layout.names, var)},
+        noise_std={n: float(v * s) for n, v, s in zip(layout.names, var, log_std)})
 
 
 def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):

@@ -2,6 +2,7 @@
 that of `jaxship.predict`, and `FitError`, raised by `fit(..., throw=True)` when a fit did
 not converge."""
 
+import contextlib
 import dataclasses
 
 import equinox as eqx
@@ -151,6 +152,49 @@ def _field_names(model):
     return tuple(parameter_fields(model))
 
 
+def assemble_result(model, parameters, ds, predictions: dict, predicted, *, rudder: str,
+                    num_params: int, max_lag: int, result, num_steps, cost, weights: dict,
+                    window_samples, horizon, criterion: str = "prediction error",
+                    noise: dict | None = None, noise_std: dict | None = None,
+                    valid: dict | None = None, quiet: bool = False) -> FitResult:
+    """The one place a `FitResult` is built (every estimator's `fit` ends here): each
+    channel of `predictions` `{channel: (E, N)}` validated against its measurement in the
+    dataset `ds` (`validate`, with `num_params`, the rudder channel `rudder` for the
+    residual-input correlation and `max_lag`), and the experiment names from `ds`.
+
+    - `parameters`: the `ParameterReport`, or a callable of the metrics `{channel:
+      ValidationReport}` returning it (a report whose robust standard errors depend on
+      the residuals' whiteness);
+    - `predicted`: the (E, N) mask of predicted samples, the validation mask of every
+      channel unless `valid` `{channel: mask}` says otherwise (e.g. only the finite
+      samples of a simulation that blew up); `quiet`: floating-point warnings silenced
+      in the validation (nothing of a blown-up fit means anything);
+    - the rest is stored as given (see `FitResult`)."""
+    with np.errstate(all="ignore") if quiet else contextlib.nullcontext():
+        metrics = _validate_channels(ds, predictions, predicted, valid, rudder=rudder,
+                                     num_params=num_params, max_lag=max_lag)
+    if callable(parameters):
+        parameters = parameters(metrics)
+    return FitResult(
+        model=model, parameters=parameters, metrics=metrics, predictions=predictions,
+        predicted=predicted, result=result, num_steps=int(num_steps), cost=float(cost),
+        weights=weights, window_samples=tuple(window_samples), horizon=horizon,
+        experiment_names=tuple(ds.names), criterion=criterion, noise=noise,
+        noise_std=noise_std,
+    )
+
+
+def _validate_channels(ds, predictions: dict, predicted, valid=None, *, rudder: str,
+                       num_params: int = 0, max_lag: int) -> dict[str, ValidationReport]:
+    """`{channel: ValidationReport}` of `predictions` against the measurements in `ds`,
+    each on its `valid` mask (default `predicted`)."""
+    u = np.asarray(getattr(ds, rudder), dtype=np.float64)
+    return {c: validate(np.asarray(getattr(ds, c), dtype=np.float64), line,
+                        predicted if valid is None else valid[c], num_params=num_params,
+                        u=u, max_lag=max_lag, channel=c)
+            for c, line in predictions.items()}
+
+
 @dataclasses.dataclass(frozen=True)
 class Prediction:
     """Result of `predict`: `predictions` `{channel: (E, N)}` at the dataset's samples,
@@ -179,9 +223,7 @@ class Prediction:
                   horizon, window_samples) -> "Prediction":
         """The `Prediction` of `predictions` `{channel: (E, N)}` on the dataset `ds`,
         each channel validated against its measurement (`validate`)."""
-        u = np.asarray(getattr(ds, rudder), dtype=np.float64)
-        metrics = {c: validate(np.asarray(getattr(ds, c), dtype=np.float64), line, predicted,
-                               u=u, max_lag=max_lag, channel=c)
-                   for c, line in predictions.items()}
+        metrics = _validate_channels(ds, predictions, predicted, rudder=rudder,
+                                     max_lag=max_lag)
         return cls(predictions, predicted, metrics, horizon, tuple(window_samples),
                    tuple(ds.names))
