@@ -17,6 +17,7 @@ not logged, so no model fed these logs can follow them.
 """
 
 import argparse
+import math
 import pathlib
 import sys
 import time
@@ -44,7 +45,8 @@ FREE_SETS = {"": ESSO_FREE, " + I_zz, k_x": ESSO_FREE + ("i_zz_j_zz", "k_x")}
 def identified(train_names, horizon, free):
     """The `free` coefficients of the preset fitted on `train_names` (2 Hz)."""
     train = [decimate(r, 5) for r in read_runs(train_names)]
-    estimator = js.PredictionError(horizon=horizon, wind=True, substeps=2, max_steps=100,
+    estimator = js.PredictionError(horizon=horizon, wind=True, max_steps=100,
+                                   simulator=js.Simulator(max_step=math.inf, substeps=2),
                                    solver=optx.LevenbergMarquardt(rtol=1e-6, atol=1e-6))
     return js.fit(js.vessel("esso_osaka"), train, estimator=estimator, free=free)
 

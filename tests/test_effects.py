@@ -105,7 +105,8 @@ def test_fit_recovers_a_rudder_lag_on_a_steering_model():
     data = js.Experiment(np.asarray(out.t), delta, psi=np.asarray(out.state.psi),
                          r=np.asarray(out.state.r))
     start = js.augment(js.Nomoto1(K=0.05, T=20.0), js.RudderLag(time_constant=1.0))
-    result = js.fit(start, data, estimator=js.PredictionError(horizon=None, substeps=5),
+    result = js.fit(start, data,
+                    estimator=js.PredictionError(horizon=None, simulator=per_sample(5)),
                     free=("K", "T", "rudder_lag.time_constant"))
     values = dict(zip(result.names, result.values))
     for name, value in (("K", K), ("T", T), ("rudder_lag.time_constant", 3.0)):

@@ -258,3 +258,23 @@ def test_result_serialises_and_summarises():
     assert set(out["train"]) == {"psi", "r"}
     assert out["train"]["r"]["fit_percent"] > 99.99
     assert "K" in res.summary() and math.isfinite(out["cost"])
+
+
+def test_the_user_chooses_the_numerics_of_a_fit():
+    """`PredictionError(simulator=...)` integrates the predictions with the simulator
+    given: `max_step` 0.25 s on 0.5 s samples is two steps per sample, the same fit as
+    `substeps=2` to rounding; diffrax's Euler method gives another fit (the solver is the
+    one asked for), and on data RK4 made with one step per sample RK4 fits exactly."""
+    import diffrax
+
+    data = record(Nomoto1(K=0.06, T=25.0), zigzag_like(300, 4))
+    fits = {name: fit(Nomoto1(K=0.05, T=20.0), data, estimator=PredictionError(
+        horizon=30.0, simulator=simulator)) for name, simulator in (
+            ("rk4", per_sample(1)), ("two", per_sample(2)),
+            ("max_step", js.Simulator(max_step=0.25)),
+            ("euler", js.Simulator(max_step=math.inf, solver=diffrax.Euler())))}
+    np.testing.assert_allclose(fits["max_step"].values, fits["two"].values, rtol=1e-12)
+    assert fits["rk4"].cost < 1e-12 < fits["euler"].cost
+    assert abs(fits["euler"].values[1] - fits["rk4"].values[1]) > 1e-3  # T moves
+    with pytest.raises(ValueError, match="`simulator` must be a jaxship.Simulator"):
+        fit(Nomoto1(K=0.05, T=20.0), data, estimator=PredictionError(simulator=2))

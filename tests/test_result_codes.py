@@ -38,7 +38,8 @@ def test_the_step_follows_the_start_models_fastest_mode():
     res = js.fit(js.Nomoto1(K=0.1, T=0.31), noise)
     assert res.success and abs(res.model.K) < 0.01, res.message
     assert res.cost < 1e3 and np.all(np.isfinite(res.predictions["psi"]))
-    asked = js.fit(js.Nomoto1(K=0.1, T=0.31), noise, estimator=js.PredictionError(substeps=2))
+    asked = js.fit(js.Nomoto1(K=0.1, T=0.31), noise,
+                   estimator=js.PredictionError(simulator=per_sample(2)))
     np.testing.assert_allclose(asked.values, res.values, rtol=1e-9)
     with pytest.raises(ValueError, match="time constant of 0.001 s, too short"):
         js.fit(js.Nomoto1(K=0.1, T=1e-3), noise)

@@ -24,6 +24,7 @@ keep the fits fast; the raw data are 10 Hz (Esso Osaka) and 20 Hz (HSVA).
 """
 
 import dataclasses
+import math
 from pathlib import Path
 
 import numpy as np
@@ -197,8 +198,8 @@ def identify_esso_osaka(root=None, *, factor: int = 5, horizon: float = 20.0,
     vessel = js.vessel("esso_osaka")
     # tolerances of 1e-6: relative cost changes below that are far inside the noise
     solver = optx.LevenbergMarquardt(rtol=tol, atol=tol)
-    est = js.PredictionError(horizon=horizon, wind=wind, substeps=substeps, max_steps=max_steps,
-                          solver=solver)
+    est = js.PredictionError(horizon=horizon, wind=wind, max_steps=max_steps, solver=solver,
+                             simulator=js.Simulator(max_step=math.inf, substeps=substeps))
     horizons = (horizon, None)
     baseline = _validate(vessel, test, est, horizons)
     res = js.fit(vessel, train, estimator=est, free=free)

@@ -96,10 +96,13 @@ class PredictionError(AbstractEstimator):
       dimensionless.
     - `rudder`: the replayed rudder channel, `"delta"` (measured angle) or
       `"delta_c"` (command).
-    - `substeps`: solver steps per sample interval, at least: a start model whose
-      fastest mode (the largest eigenvalue modulus $\\rho$ of its field's Jacobian at
-      the first window start) makes one RK4 step unstable gets more, so that
-      $\\rho\\,dt/\\text{substeps} \\le 2.5$ (RK4 is stable to 2.785 on the real axis).
+    - `simulator`: the numerics of the predictions (`jaxship.Simulator`): its solver
+      (classical RK4 by default, or any diffrax solver, adaptive with a step-size
+      controller) and its steps per sample interval (`substeps`, or `max_step` [s];
+      default one step per sample), at least: a start model whose fastest mode (the
+      largest eigenvalue modulus $\\rho$ of its field's Jacobian at the first window
+      start) makes one RK4 step unstable gets more, so that
+      $\\rho\\,dt/\\text{steps} \\le 2.5$ (RK4 is stable to 2.785 on the real axis).
     - `solver`: an `optimistix` least-squares solver; by default jaxship's
       `LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-10)`: optimistix's solver that
       also stops, like MINPACK, once an accepted step lowers the cost by at most
@@ -130,7 +133,7 @@ class PredictionError(AbstractEstimator):
     channels: tuple[str, ...] | None = None
     weights: dict | tuple | None = None
     rudder: str = "delta"
-    substeps: int = 1
+    simulator: Simulator = Simulator(max_step=math.inf)
     solver: optx.AbstractLeastSquaresSolver = LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-10)
     max_steps: int = 256
     start: LinearStart | None = None
@@ -167,7 +170,6 @@ def _predict(model, w: Windows, offsets=None):
     field = model.replay_field(w.servo)  # built once per evaluation (e.g. M^-1)
     index = [model.channel_index(c) for c in w.channels]
     corrected = jnp.array([model.channel_index("r"), model.channel_index("psi")])
-    simulator = Simulator(max_step=math.inf, substeps=w.substeps)
     holds = dict(w.holds)
 
     def one(start, records, dt, offset):
@@ -178,8 +180,8 @@ def _predict(model, w: Windows, offsets=None):
         observe = lambda y, _: jnp.stack([model.measure(c, y[i]) for c, i in
                                           zip(w.channels, index)])
         out, _ = integrate(lambda t, y, a: field(t, y, a[0].at(t - a[1])), y0,
-                           replay_policy(records, dt, holds), None, 0.0, dt, num, simulator,
-                           w.substeps, observe, emit="end")
+                           replay_policy(records, dt, holds), None, 0.0, dt, num,
+                           w.simulator, w.substeps, observe, emit="end")
         return out  # (L, C)
 
     out = sharded_vmap(one, w.start, w.records, w.dt, offsets, batch_dims=2)
@@ -434,14 +436,15 @@ def _prepare(model, dataset, estimator):
                 f"{', '.join(needed)} (and `wind=True` replays the measured wind), so these "
                 "must be measured (or smoothed: `initial=jaxship.smooth_states(...)`; or fit "
                 "a steering model instead).")
-    if int(estimator.substeps) < 1:
-        raise ValueError(f"`substeps` must be a positive integer, got {estimator.substeps}.")
+    if not isinstance(estimator.simulator, Simulator):
+        raise ValueError(f"`simulator` must be a jaxship.Simulator, got "
+                         f"{type(estimator.simulator).__name__}.")
     if not (smoothed or isinstance(estimator.initial, (MeasuredStates, EstimatedStarts))):
         raise ValueError(f"`initial` must be MeasuredStates(), EstimatedStarts() or a list of "
                          f"SmoothedStates, got {estimator.initial!r}.")
     windows, layout = build_windows(ds, horizon=estimator.horizon, channels=channels,
                                     weights=estimator.weights, rudder=estimator.rudder,
-                                    substeps=int(estimator.substeps), starts=starts,
+                                    simulator=estimator.simulator, starts=starts,
                                     hold=estimator.hold, wind=bool(estimator.wind))
     return ds, windows, layout
 

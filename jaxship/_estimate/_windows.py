@@ -19,6 +19,7 @@ import numpy as np
 
 from .._models._steering._base import AuxInputs, WindowStart
 from .._simulation._data import Dataset, Experiment
+from .._simulation._integrate import Simulator
 
 
 # fittable outputs: heading and yaw rate for every model; surge and sway velocity for
@@ -150,7 +151,8 @@ class Windows(eqx.Module):
     mask: jax.Array
     weights: jax.Array
     channels: tuple[str, ...] = eqx.field(static=True)
-    substeps: int = eqx.field(static=True)
+    substeps: int = eqx.field(static=True)  # solver steps per sample interval
+    simulator: Simulator = Simulator(max_step=math.inf)  # its solver (no arrays: static)
     holds: tuple = eqx.field(static=True, default=())
     servo: bool = eqx.field(static=True, default=False)
 
@@ -201,7 +203,8 @@ def channel_weights(ds: Dataset, channels, weights) -> np.ndarray:
 
 
 def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "delta",
-                  substeps: int = 1, starts: dict | None = None, hold=None,
+                  simulator: Simulator = Simulator(max_step=math.inf),
+                  starts: dict | None = None, hold=None,
                   wind: bool = False):
     """`(Windows, layout)`; `layout` holds the NumPy index arrays to map window
     predictions back onto the samples: `target` (E, W, L) sample index, `mask`.
@@ -280,7 +283,8 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
         mask=jnp.asarray(mask),
         weights=f(weights),
         channels=tuple(channels),
-        substeps=int(substeps),
+        substeps=simulator.steps_per_sample(np.asarray(dt)),
+        simulator=simulator,
         holds=holds,
         servo=rudder == "delta_c",
     )

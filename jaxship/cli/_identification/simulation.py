@@ -5,6 +5,8 @@ measured first state: `simulate_records` for steering models and 3-DOF vessels,
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 import jaxship as js
@@ -30,8 +32,8 @@ def simulate_records(model, dataset: js.Dataset, rudder: str, channels=("psi", "
             raise ValueError(f"{type(model).__name__} has no output {unknown[0]!r}; its outputs "
                              f"are psi, r and its states {', '.join(model.state_names)}.")
     out = js.predict(model, dataset, estimator=js.PredictionError(
-        horizon=None, channels=tuple(channels), rudder=rudder, substeps=int(substeps),
-        wind=bool(wind)))
+        horizon=None, channels=tuple(channels), rudder=rudder, wind=bool(wind),
+        simulator=js.Simulator(max_step=math.inf, substeps=int(substeps))))
     return out.predictions, np.asarray(out.predicted, dtype=bool)
 
 

@@ -169,7 +169,8 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     report = progress if progress is not None else (lambda event: None)
     solver = js.LevenbergMarquardt(rtol=1e-9, atol=1e-9)
     estimator = js.PredictionError(horizon=horizon, channels=channels, rudder=rudder,
-                                substeps=int(substeps), solver=solver,
+                                simulator=js.Simulator(max_step=math.inf, substeps=int(substeps)),
+                                solver=solver,
                                 max_steps=int(max_steps),
                                 initial={"estimate": js.EstimatedStarts(),
                                          "measured": js.MeasuredStates()}[initial])

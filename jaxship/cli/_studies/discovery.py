@@ -105,7 +105,8 @@ def wind_records(truth, seed, *, speed=7.0, wind=(15.0, 60.0 * DEG), noise=(0.1,
     replaying the logged rudder through `truth` (output error, 10 substeps per
     sample, 8 passes) from the calm-water record turned to its heading."""
     rng = np.random.default_rng(seed)
-    replay = js.PredictionError(horizon=None, wind=True, substeps=10)
+    replay = js.PredictionError(horizon=None, wind=True,
+                                simulator=js.Simulator(max_step=math.inf, substeps=10))
 
     def one(manoeuvre, heading, name):
         calm = js.simulate(truth, dataclasses.replace(manoeuvre, rudder_rate=2.3 * DEG),

@@ -211,7 +211,8 @@ def nomoto_start(nomoto: js.Nomoto1, scales: dict) -> js.RossAutopilot:
 
 def _estimators(settings: Settings):
     solver = js.LevenbergMarquardt(rtol=settings.tolerance, atol=settings.tolerance)
-    common = dict(channels=("r",), substeps=settings.substeps, solver=solver,
+    common = dict(channels=("r",), solver=solver,
+                  simulator=js.Simulator(max_step=math.inf, substeps=settings.substeps),
                   max_steps=settings.max_steps)
     return (js.PredictionError(horizon=settings.horizon, **common),
             js.PredictionError(horizon=None, **common))
