@@ -8,7 +8,7 @@ The notebook reproduces the heading-autopilot study of the thesis (Odegard 2009,
 turning circles, zig-zags and the thesis manoeuvre) each give a PID with reference
 feed-forward that steers the true vessel at 300 and 400 rpm; the residuals next to the
 thesis' Tables 5.2-5.7 and the closed-loop figures (thesis figs. 5.1-5.6). The pipeline
-is `jaxship/cli/_studies/autopilot.py`.
+is `jaxship/cli/_studies/autopilot_thesis.py` (the runs: `autopilot.py`).
 """
 
 import pathlib
@@ -59,7 +59,7 @@ from IPython.display import Markdown, display
 
 import jaxship as js
 from jaxship.plotting import plot_autopilot
-from jaxship.cli._studies import autopilot as ap
+from jaxship.cli._studies import autopilot_thesis as ap
 
 
 jax.config.update("jax_enable_x64", True)

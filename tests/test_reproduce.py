@@ -131,7 +131,7 @@ def test_a_failed_reproduce_leaves_the_earlier_report(tmp_path, monkeypatch):
 def test_a_failed_fit_in_the_study_leaves_the_others(monkeypatch):
     # issue 13: in the batch of chapter-4 fits, one that fails is reported and the others
     # are returned; its autopilot is skipped
-    from jaxship.cli._studies import autopilot, thesis
+    from jaxship.cli._studies import autopilot_thesis as chapter5, thesis
 
     families = {"turning": ("turn:40",), "zigzag": ("zigzag:40/40",)}
     real = thesis.identify
@@ -151,6 +151,6 @@ def test_a_failed_fit_in_the_study_leaves_the_others(monkeypatch):
     K = study["parameters"]["merged/nomoto/turning"]["K"]  # -67.6 %: as in fig. 4.20
     assert K["value"] > 0 and K["unit"] == "1/s"  # issue 31: value, std and unit
     assert 0 < K["std"] < K["value"] and K["std_robust"] > 0
-    closed = autopilot.autopilot_study(identification=study, models=("nomoto",),
+    closed = chapter5.autopilot_study(identification=study, models=("nomoto",),
                                        rpms=(300.0,))
     assert {r["family"] for r in closed["table"]} == {"turning"}

@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 import scipy.stats
 
-from jaxship.cli._studies import autopilot, reproduce_report, thesis
+from jaxship.cli._studies import autopilot, autopilot_thesis as chapter5, reproduce_report, thesis
 from jaxship.plotting import plot_model_outputs
 
 
-KEYS = [(m, f) for m in ("nomoto", "ross") for f in autopilot.FAMILIES]
+KEYS = [(m, f) for m in ("nomoto", "ross") for f in chapter5.FAMILIES]
 
 
 def _study(ff, fb):
@@ -23,27 +23,27 @@ def _study(ff, fb):
     table = []
     for model, family in KEYS:
         for controller, values in (("pid+ff", ff), ("pid", fb)):
-            for rpm, x in zip(autopilot.RPMS, values[(model, family)]):
-                paper = (autopilot.THESIS_RESIDUALS[model][family][autopilot.RPMS.index(rpm)]
+            for rpm, x in zip(chapter5.RPMS, values[(model, family)]):
+                paper = (chapter5.THESIS_RESIDUALS[model][family][chapter5.RPMS.index(rpm)]
                          if controller == "pid+ff" else None)
                 table.append(dict(model=model, family=family, controller=controller, rpm=rpm,
                                   speed=1.0, sum_abs_error_deg=x, rms_error_deg=x / 100,
                                   thesis=paper, fit_family=80.0 if family == "thesis" else 50.0))
-    study = {"table": table, "rpms": list(autopilot.RPMS), "models": ["nomoto", "ross"],
+    study = {"table": table, "rpms": list(chapter5.RPMS), "models": ["nomoto", "ross"],
              "quick": False, "reference": [
                  dict(controller=c, rpm=r, sum_abs_error_deg=5.0) for c in autopilot.CONTROLLERS
-                 for r in autopilot.RPMS],
+                 for r in chapter5.RPMS],
              "design": {"natural_frequency": 0.5, "damping": 1.0, "design_rpm": 350.0,
                         "reference_frequency": 0.2, "reference_damping": 1.0, "step": 45.0,
                         "step_time": 100.0, "max_rudder_deg": 45.0,
                         "max_rudder_rate_deg_s": 15.0, "sample_interval": 1.0,
                         "window_s": [100.0, 200.0]}}
-    study["goals"] = autopilot.goals(study)
+    study["goals"] = chapter5.goals(study)
     return study
 
 
 def _thesis_scaled(factor, reverse=False):
-    values = [autopilot.THESIS_RESIDUALS[m][f] for m, f in KEYS]
+    values = [chapter5.THESIS_RESIDUALS[m][f] for m, f in KEYS]
     if reverse:  # the same numbers, the best and worst swapped in rank
         means = [np.mean(v) for v in values]
         order = np.argsort(means)
@@ -60,28 +60,28 @@ def test_the_thesis_ordering_is_met_only_when_its_rank_correlation_says_so():
     reverse = _study(_thesis_scaled(0.5, reverse=True), fb)
     o = reverse["goals"]["thesis_ordering"]
     assert o["spearman"] == pytest.approx(-1.0) and not o["met"]
-    text = autopilot.comparison_text(reverse)
+    text = chapter5.comparison_text(reverse)
     assert "Reproducing the thesis' ordering: NOT met (Spearman rank correlation -1.00" in text
     # the issue's case: a weak negative correlation is not met either, and said so
     rng = np.random.default_rng(3)
     ff = {k: (float(x), float(x) / 2) for k, x in zip(KEYS, rng.uniform(20, 200, 6))}
     study = _study(ff, fb)
     rho = scipy.stats.spearmanr([np.mean(ff[k]) for k in KEYS],
-                                [np.mean(autopilot.THESIS_RESIDUALS[m][f]) for m, f in KEYS])[0]
+                                [np.mean(chapter5.THESIS_RESIDUALS[m][f]) for m, f in KEYS])[0]
     o = study["goals"]["thesis_ordering"]
     assert o["spearman"] == pytest.approx(rho)
     assert o["met"] == (rho > 0 and o["p_value"] < 0.05)
-    assert f"Spearman rank correlation {rho:+.2f}" in autopilot.comparison_text(study)
+    assert f"Spearman rank correlation {rho:+.2f}" in chapter5.comparison_text(study)
 
 
 def test_goal_1_is_met_only_when_feed_forward_measures_lower():
     fb = {k: (100.0, 50.0) for k in KEYS}
     ff = {k: (90.0, 60.0) for k in KEYS}  # better at 300 rpm, worse at 400 rpm
-    text = autopilot.comparison_text(_study(ff, fb))
+    text = chapter5.comparison_text(_study(ff, fb))
     assert "beats feedback only at every speed: NOT met (pid+ff 90.00, 60.00 against pid " \
            "100.00, 50.00 deg, differences -10.00, +10.00 deg at 300, 400 rpm)" in text
     ff = {k: (90.0, 40.0) for k in KEYS}
-    text = autopilot.comparison_text(_study(ff, fb))
+    text = chapter5.comparison_text(_study(ff, fb))
     assert "every speed: met (pid+ff" in text
     # goal 2 beside the thesis' own tables (Tables 5.3, 5.6: Ross worse at both speeds)
     assert "The thesis' tables give zig-zags: Ross 125.2, 145.3 vs Nomoto 108.1, 17.4 (Ross " \
@@ -93,22 +93,22 @@ def test_the_best_run_is_named_against_the_thesis_number():
     ff = _thesis_scaled(0.5)
     fb = {k: (1000.0, 1000.0) for k in KEYS}
     fb["nomoto", "thesis"] = (30.0, 7.5)  # the issue's case: feedback only, Nomoto, thesis
-    text = autopilot.best_run_text(_study(ff, fb))
-    paper = autopilot.THESIS_RESIDUALS["nomoto"]["thesis"][1]
+    text = chapter5.best_run_text(_study(ff, fb))
+    paper = chapter5.THESIS_RESIDUALS["nomoto"]["thesis"][1]
     assert text.startswith("The best run of the table is pid (feedback only) with the Nomoto "
                            "model from the merged thesis manoeuvre at 400 rpm: residual 7.50 deg")
     assert f"gives {0.5 * paper:.2f} deg here (difference {0.5 * paper - 7.5:+.2f} deg) and " \
            f"{paper:.2f} in the thesis' Table 5.4" in text
     # the thesis' best (Nomoto, zig-zags, 400 rpm: Table 5.3) and ours there
-    best = autopilot.THESIS_RESIDUALS["nomoto"]["zigzag"][1]
+    best = chapter5.THESIS_RESIDUALS["nomoto"]["zigzag"][1]
     assert f"The thesis' best is Nomoto from the zig-zags at 400 rpm ({best:.2f}, " \
            f"Table 5.3); ours there {0.5 * best:.2f} deg." in text
     # a pid+ff best run: its ratio to the thesis' number
-    text = autopilot.best_run_text(_study(ff, {k: (1000.0, 1000.0) for k in KEYS}))
+    text = chapter5.best_run_text(_study(ff, {k: (1000.0, 1000.0) for k in KEYS}))
     assert text.startswith("The best run of the table is pid+ff (the thesis' controller) with "
                            "the Nomoto model from the merged zig-zags at 400 rpm")
     assert f"Table 5.3 gives {best:.2f} for it (ours 0.5 times that)" in text
-    assert text in autopilot.report_section(_study(ff, {k: (1000.0, 1000.0) for k in KEYS}))
+    assert text in chapter5.report_section(_study(ff, {k: (1000.0, 1000.0) for k in KEYS}))
 
 
 def _fit(names, values, std, robust, units):
@@ -127,7 +127,7 @@ def test_identified_coefficients_carry_std_and_unit_and_sign_flips_are_stated():
                                       [0.05, np.inf, 0.01], [0.1, np.nan, 0.02],
                                       ("-", "-", "1/rad")))
     assert b["n_rrr"]["std"] == "inf"
-    flips = reproduce_report.sign_flips({"merged/ross/turning": a, "merged/ross/zigzag": b,
+    flips = thesis.sign_flips({"merged/ross/turning": a, "merged/ross/zigzag": b,
                                          "merged/ross/thesis": None})
     by = {f["parameter"]: f for f in flips}
     assert set(by) == {"n_ur", "n_rrr"}  # n_delta keeps its sign

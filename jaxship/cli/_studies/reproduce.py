@@ -8,7 +8,7 @@ thesis vessel, written up as `report.md` with the thesis' numbers beside ours.
    the single 40 deg / 500 rpm record of each family and from the merged records
    (200 + 500 rpm) of each family; their yaw-rate fit % next to the fit % in the
    legends of the thesis' figs. 4.8-4.30 (`identification.json`).
-3. **Heading autopilot** (chapter 5, `jaxship.cli._studies.autopilot`): a PID with reference
+3. **Heading autopilot** (chapter 5, `jaxship.cli._studies.autopilot_thesis`): a PID with reference
    feed-forward from each merged model, run on the vessel at 300 and 400 rpm; our
    residuals next to the thesis' Tables 5.2-5.7 (`autopilot.json`).
 4. **Discovery** (`jaxship.discover`): a synthetic Nomoto case with cubic yaw damping
@@ -44,7 +44,7 @@ import jaxship as js
 from jaxship._foundation._files import staged_folder
 from jaxship.cli._trials import trial_indices
 
-from . import autopilot, discovery, thesis
+from . import autopilot_thesis as chapter5, discovery, thesis
 from .reproduce_report import (
     DISCOVERY_HIDDEN,
     DISCOVERY_SEED,
@@ -55,7 +55,6 @@ from .reproduce_report import (
     header,
     identification_section,
     left_out,
-    sign_flips,
     trials_section,
 )
 
@@ -154,10 +153,10 @@ def _run(out, quick, progress, identification, closed_loop, discover, parallel) 
         if identification and closed_loop:
             clock = (time.perf_counter(), time.process_time())
             stage = _Stage("chapter 5: closed loop", 2 * 3 + 1, progress)
-            evaluation = autopilot.autopilot_study(vessel, identification=study,
+            evaluation = chapter5.autopilot_study(vessel, identification=study,
                                                    progress=stage)
             stage.close()
-            results["autopilot"] = autopilot.to_json(evaluation)
+            results["autopilot"] = chapter5.to_json(evaluation)
             sections.append(autopilot_section(evaluation, study, out, quick))
             stage_done("autopilot", clock)
         if discover:
@@ -254,7 +253,7 @@ def _identification_json(study):
     for row in data["table"]:
         key = (row["case"], row["model"], row["family"])
         row["thesis_figure"] = THESIS_FIGURE.get(key)
-    data["sign_flips"] = sign_flips(study["parameters"])
+    data["sign_flips"] = thesis.sign_flips(study["parameters"])
     return data
 
 

@@ -13,7 +13,7 @@ from jaxship.plotting import (
     plot_trial_vs_thesis,
 )
 
-from . import autopilot, thesis
+from . import autopilot, autopilot_thesis as chapter5, thesis
 
 
 DISCOVERY_HIDDEN = 300.0  # beta of the hidden cubic yaw damping [s/rad^2]
@@ -304,7 +304,7 @@ def identification_section(study, experiments, out, quick):
                  else ".\n"))
     lines.append("The estimates, with their standard errors and units, are in "
                  "`identification.json` (\"parameters\"). " + sign_flip_text(
-                     sign_flips(study["parameters"])))
+                     thesis.sign_flips(study["parameters"])))
     for family in study_families(study):
         name = f"fits_{family}"
         _fit_figure(study, experiments, family, out / "figures" / f"{name}.png")
@@ -320,37 +320,6 @@ def identification_section(study, experiments, out, quick):
                      f"figure's legend value (its curves are not available, so none is "
                      f"drawn).*\n")
     return "\n".join(lines) + "\n"
-
-
-def sign_flips(parameters: dict) -> list[dict]:
-    """The coefficients whose estimated sign differs between the fits of one model
-    (`parameters`: `{"case/model/family": thesis.parameter_entries(...) or None}`):
-    one dict per coefficient, `{model, parameter, unit, estimates: [{fit, value, std}],
-    determined}`, `std` the quoted one (`thesis.quoted_std`). `determined`: a positive
-    and a negative estimate both lie more than 2 std from zero (their 95 % intervals
-    exclude zero on opposite sides), so the flip is not within the uncertainty."""
-    by = {}
-    for key, entries in parameters.items():
-        if not entries:
-            continue
-        model = key.split("/")[1]
-        for name, e in entries.items():
-            by.setdefault((model, name), []).append(
-                {"fit": key, "value": e["value"], "std": thesis.quoted_std(e),
-                 "unit": e.get("unit")})
-    out = []
-    for (model, name), estimates in by.items():
-        signs = {np.sign(e["value"]) for e in estimates if e["value"] != 0}
-        if signs != {-1.0, 1.0}:
-            continue
-        sure = lambda sign: any(np.sign(e["value"]) == sign and abs(e["value"]) > 2 * e["std"]
-                                for e in estimates)
-        out.append({"model": model, "parameter": name, "unit": estimates[0]["unit"],
-                    "estimates": [{k: e[k] for k in ("fit", "value", "std")} | {
-                        "std": None if not np.isfinite(e["std"]) else e["std"]}
-                        for e in estimates],
-                    "determined": bool(sure(1.0) and sure(-1.0))})
-    return out
 
 
 def _fit_name(key):
@@ -411,7 +380,7 @@ def _fit_figure(study, experiments, family, path):
 
 
 def autopilot_section(study, identification, out, quick):
-    section = autopilot.report_section({**study, "quick": False}, level=2)
+    section = chapter5.report_section({**study, "quick": False}, level=2)
     lines = [section]
     if quick:
         lines.append("Quick design: the models come from one record per family (the 40 deg "
@@ -429,11 +398,11 @@ def autopilot_section(study, identification, out, quick):
     fits = {(r["model"], r["family"]): r["fit_family"] for r in identification["table"]
             if r["case"] == "merged"}
     vessel_pid = [r["sum_abs_error_deg"] for r in study["reference"] if r["controller"] == "pid"]
-    for (model, family), table in autopilot.THESIS_TABLES.items():
+    for (model, family), table in chapter5.THESIS_TABLES.items():
         rows = {c: [r for r in study["table"] if r["model"] == model and r["family"] == family
                     and r["controller"] == c] for c in autopilot.CONTROLLERS}
         if rows["pid+ff"]:
-            lines.append(f"- **Table {table}** ({autopilot.MODEL_NAMES[model]} from the merged "
+            lines.append(f"- **Table {table}** ({chapter5.MODEL_NAMES[model]} from the merged "
                          f"{FAMILY_NAMES[family]}): "
                          + _closed_loop_sentence(model, family, rows, fits.get((model, family)),
                                                  median, vessel_pid))
@@ -442,7 +411,7 @@ def autopilot_section(study, identification, out, quick):
         name = f"autopilot_{model}_300rpm"
         if _heading_figure(study, model, figs, out / "figures" / f"{name}.png"):
             lines.append(
-                f"![{model} autopilots](figures/{name}.png)\n\n*The {autopilot.MODEL_NAMES[model]}"
+                f"![{model} autopilots](figures/{name}.png)\n\n*The {chapter5.MODEL_NAMES[model]}"
                 f" autopilots (pid+ff) at 300 rpm, as in thesis figs. {figs}, 100-200 s; "
                 f"orange bars beside the axes: the range of those figures' axes (heading "
                 f"0-60 deg, error +-4 deg; no tolerance); the thesis' curves are not "
@@ -456,7 +425,7 @@ def _closed_loop_sentence(model, family, rows, fit, median, vessel_pid):
     ff = [r["sum_abs_error_deg"] for r in rows["pid+ff"]]
     fb = [r["sum_abs_error_deg"] for r in rows["pid"]]
     rpms = [f"{r['rpm']:.0f}" for r in rows["pid+ff"]]
-    paper = autopilot.THESIS_RESIDUALS[model][family]
+    paper = chapter5.THESIS_RESIDUALS[model][family]
     paper_fit = thesis.THESIS_FIT["merged"][model][family]
     figure = THESIS_FIGURE[("merged", model, family)]
     fits = (f"chapter-4 fit {_cell(fit, 1)} %, the thesis' {paper_fit:.1f} % in fig. "
@@ -507,8 +476,8 @@ def _closed_loop_sentence(model, family, rows, fit, median, vessel_pid):
 def _heading_figure(study, model, figs, path):
     evaluations = study["evaluations"]
     runs, t, desired = [], None, None
-    for key, label in [(f"{model}/{f}", f"{autopilot.MODEL_NAMES[model]} from the "
-                        f"merged {FAMILY_NAMES[f]}") for f in autopilot.FAMILIES] + [
+    for key, label in [(f"{model}/{f}", f"{chapter5.MODEL_NAMES[model]} from the "
+                        f"merged {FAMILY_NAMES[f]}") for f in chapter5.FAMILIES] + [
                        ("vessel", "the vessel's own yaw equation")]:
         if key not in evaluations:
             continue
@@ -524,7 +493,7 @@ def _heading_figure(study, model, figs, path):
         t, desired, runs, window=tuple(d["window_s"]),
         bands={"heading": [(0.0, 60.0, f"thesis figs. {figs}: axis 0-60 deg")],
                "error": [(-4.0, 4.0, f"thesis figs. {figs}: axis +-4 deg")]},
-        title=f"{autopilot.MODEL_NAMES[model]} autopilots (pid+ff), 300 rpm "
+        title=f"{chapter5.MODEL_NAMES[model]} autopilots (pid+ff), 300 rpm "
               f"(thesis figs. {figs})")
     fig.savefig(path, dpi=100)
     plt.close(fig)

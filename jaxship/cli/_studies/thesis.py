@@ -389,3 +389,34 @@ def markdown_table(study: dict) -> str:
         lines.append(f"| {row['case']} | {names[row['model']]} | {row['family']} | "
                      f"{cell(row['fit'])} | {cell(row['fit_family'])} | {thesis} |")
     return "\n".join(lines) + "\n"
+
+
+def sign_flips(parameters: dict) -> list[dict]:
+    """The coefficients whose estimated sign differs between the fits of one model
+    (`parameters`: `{"case/model/family": thesis.parameter_entries(...) or None}`):
+    one dict per coefficient, `{model, parameter, unit, estimates: [{fit, value, std}],
+    determined}`, `std` the quoted one (`thesis.quoted_std`). `determined`: a positive
+    and a negative estimate both lie more than 2 std from zero (their 95 % intervals
+    exclude zero on opposite sides), so the flip is not within the uncertainty."""
+    by = {}
+    for key, entries in parameters.items():
+        if not entries:
+            continue
+        model = key.split("/")[1]
+        for name, e in entries.items():
+            by.setdefault((model, name), []).append(
+                {"fit": key, "value": e["value"], "std": quoted_std(e),
+                 "unit": e.get("unit")})
+    out = []
+    for (model, name), estimates in by.items():
+        signs = {np.sign(e["value"]) for e in estimates if e["value"] != 0}
+        if signs != {-1.0, 1.0}:
+            continue
+        sure = lambda sign: any(np.sign(e["value"]) == sign and abs(e["value"]) > 2 * e["std"]
+                                for e in estimates)
+        out.append({"model": model, "parameter": name, "unit": estimates[0]["unit"],
+                    "estimates": [{k: e[k] for k in ("fit", "value", "std")} | {
+                        "std": None if not np.isfinite(e["std"]) else e["std"]}
+                        for e in estimates],
+                    "determined": bool(sure(1.0) and sure(-1.0))})
+    return out
