@@ -14,7 +14,15 @@ Commands (the README's examples):
 
 Also `python -c "import jaxship"` (the import alone), for the part no cache can save.
 
-Run: `python benchmarks/cli.py [--repeats N]` (the median of N runs of each; default 1).
+`--table` times every example of the README's command table instead, as written there
+(the placeholders filled with the data they stand for: the first Esso Osaka zig-zags for
+`$1`-`$5`, the 11 HSVA KVLCC2 zig-zags other than the 10/10 runs for `TRAIN...` and the two
+10/10 runs for `TEST...`), each twice in a new process with an empty cache folder of its
+own: the first run compiles (the README's time), the second reads the cache. It prints the
+table's time column with the date and the number of CPU cores.
+
+Run: `python benchmarks/cli.py [--repeats N] [--table]` (the median of N runs of each;
+default 1).
 """
 
 import argparse
@@ -51,12 +59,62 @@ def commands(out: Path) -> dict:
     return found
 
 
+def table_commands(out: Path) -> dict:
+    """The README's command table, in its order, placeholders filled (module text)."""
+    data = js.shared_data_dir()
+    if data is None:
+        sys.exit("--table needs ../shared/data (set JAXSHIP_DATA).")
+    esso = sorted((data / "esso_osaka_frt" / "zigzag").glob("*.csv"))
+    hsva = sorted((data / "kvlcc2_simman2008_hsva").glob("*_Z_*.dat"))
+    held = [p for p in hsva if "_Z_10_10_" in p.name]
+    identify = ["jaxship", "identify", *map(str, esso[:3]), "--horizon", "10", "--validate",
+                *map(str, esso[3:5]), "--quiet"]
+    autopilot = ["jaxship", "autopilot", "--model", str(out / "fit" / "result.json"),
+                 "--vessel", "thesis", "--rpm", "300", "400", "--quiet"]
+    return {
+        "vessels": ["jaxship", "vessels"],
+        "simulate": ["jaxship", "simulate", "--vessel", "mariner", "--manoeuvre",
+                     "zigzag:20/20", "--out", str(out / "zz")],
+        "identify (nomoto1)": identify + ["--model", "nomoto1", "--out", str(out / "fit")],
+        "identify (esso_osaka 3-DOF)": identify + ["--model", "esso_osaka", "--out",
+                                                   str(out / "esso")],
+        "autopilot": autopilot + ["--out", str(out / "ap")],
+        "autopilot --tune": autopilot + ["--tune", "--out", str(out / "ap-tune")],
+        "discover (kvlcc2)": ["jaxship", "discover", *map(str, (p for p in hsva
+                                                               if p not in held)),
+                              "--holdout", *map(str, held), "--model", "kvlcc2", "--out",
+                              str(out / "disc"), "--quiet"],
+        "reproduce --quick": ["jaxship", "reproduce", "--quick", "--out", str(out / "rq")],
+        "reproduce": ["jaxship", "reproduce", "--out", str(out / "r")],
+    }
+
+
+def table(repeats: int, tmp: Path) -> None:
+    """The README's time column: first run (empty cache) and second (the cache read)."""
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    print(f"{time.strftime('%Y-%m-%d')}, {cores} CPU cores, each command in a new process")
+    print("| command | first run (compiles) | second run (cache) |")
+    print("|---|---:|---:|")
+    for i, (name, command) in enumerate(table_commands(tmp).items()):
+        first, second = [], []
+        for k in range(repeats):  # an empty cache folder of its own
+            cache = os.environ | {"JAXSHIP_CACHE_DIR": str(tmp / f"table-cache-{i}-{k}")}
+            first.append(timed(command, cache, tmp))
+            second.append(timed(command, cache, tmp))
+        print(f"| `{name}` | {statistics.median(first):.0f} s | "
+              f"{statistics.median(second):.0f} s |", flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=1)
+    parser.add_argument("--table", action="store_true",
+                        help="time every example of the README's command table")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
+        if args.table:
+            return table(args.repeats, tmp)
         off = os.environ | {"JAXSHIP_CACHE_DIR": "off"}
         importing = [timed([sys.executable, "-c", "import jaxship"], off, tmp)
                      for _ in range(args.repeats)]
