@@ -215,8 +215,9 @@ def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> Ship
     Vessels without a propeller term keep `n` as given and `speed` as given.
 
     Raises `ValueError` where no such state exists: the surge force left at the state
-    found exceeds $10^{-3}\\,m_{11} u^2/L$ (0.25 % off its nominal speed on the Mariner,
-    whose surge equation has no propeller and balances only at that speed).
+    found exceeds $10^{-3}\\,m_{11} U^2/L$, $U$ the larger of u and the nominal speed
+    (0.45 % off its nominal speed on the Mariner, whose surge equation has no propeller
+    and balances only at that speed).
     """
     if speed is None and n is None:
         speed, n = vessel.nominal_speed, vessel.nominal_n
@@ -227,7 +228,8 @@ def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> Ship
             lambda uu: surge_force(vessel, uu, jnp.asarray(n, float)), vessel.nominal_speed
         )
     residual = float(surge_force(vessel, jnp.asarray(speed, float), jnp.asarray(n, float)))
-    scale = float(vessel.mass_matrix()[0, 0]) * float(speed) ** 2 / float(vessel.length)
+    reference = max(abs(float(speed)), float(vessel.nominal_speed))  # at rest too
+    scale = float(vessel.mass_matrix()[0, 0]) * reference**2 / float(vessel.length)
     if not abs(residual) <= 1e-3 * scale:
         raise ValueError(
             f"{type(vessel).__name__} has no straight run at u = {float(speed):.4g} m/s, n = "
