@@ -96,7 +96,8 @@ $U_0 = 1.543$ m/s, $n_0$ = 500 rpm)."""),
     new_code_cell("""for family in ti.FAMILIES:
     for name in ("ross", "ross_speed_rudder"):
         p = study["parameters"][f"merged/{name}/{family}"]
-        print(f"{family:8s} {name:18s}", "  ".join(f"{k}={v:.3g}" for k, v in p.items()))"""),
+        print(f"{family:8s} {name:18s}", "  ".join(
+            f"{k}={e['value']:.3g} +- {ti.quoted_std(e):.2g}" for k, e in p.items()))"""),
     new_code_cell("""merged = [r for r in study["table"] if r["case"] == "merged"]
 for name in ("ross", "ross_speed_rudder"):
     fits = {r["family"]: r["fit"] for r in merged if r["model"] == name}

@@ -308,7 +308,7 @@ def test_chapter_5_study_has_every_table_row(tmp_path):
     assert all(r["thesis"] is not None for r in ff) and all(r["thesis"] is None for r in fb)
     assert all(r["success"] and math.isfinite(r["sum_abs_error_deg"]) for r in table)
     assert len(result["reference"]) == 4
-    assert set(result["goals"]) == {"feedforward", "ross_vs_nomoto"}
+    assert set(result["goals"]) == {"feedforward", "ross_vs_nomoto", "thesis_ordering"}
     section = chapter5.report_section(result)
     for number in ("5.2", "5.3", "5.4", "5.5", "5.6", "5.7"):
         assert f"| {number} |" in section
