@@ -91,11 +91,12 @@ def table_commands(out: Path) -> dict:
 
 def table(repeats: int, tmp: Path) -> None:
     """The README's time column: first run (empty cache) and second (the cache read)."""
+    commands = table_commands(tmp)
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     print(f"{time.strftime('%Y-%m-%d')}, {cores} CPU cores, each command in a new process")
     print("| command | first run (compiles) | second run (cache) |")
     print("|---|---:|---:|")
-    for i, (name, command) in enumerate(table_commands(tmp).items()):
+    for i, (name, command) in enumerate(commands.items()):
         first, second = [], []
         for k in range(repeats):  # an empty cache folder of its own
             cache = os.environ | {"JAXSHIP_CACHE_DIR": str(tmp / f"table-cache-{i}-{k}")}
