@@ -82,8 +82,9 @@ def table_commands(out: Path) -> dict:
         "autopilot --tune": autopilot + ["--tune", "--out", str(out / "ap-tune")],
         "discover (kvlcc2)": ["jaxship", "discover", *map(str, (p for p in hsva
                                                                if p not in held)),
-                              "--holdout", *map(str, held), "--model", "kvlcc2", "--out",
-                              str(out / "disc"), "--quiet"],
+                              "--holdout", *map(str, held), "--model", "kvlcc2",
+                              "--sample-interval", "0.2", "--out", str(out / "disc"),
+                              "--quiet"],
         "reproduce --quick": ["jaxship", "reproduce", "--quick", "--out", str(out / "rq")],
         "reproduce": ["jaxship", "reproduce", "--out", str(out / "r")],
     }

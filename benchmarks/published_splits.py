@@ -31,7 +31,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))  # benchmar
 
 import jaxship as js  # noqa: E402
 from benchmarks.studies.published_splits import SPLITS, free_run_score, read_runs  # noqa: E402
-from benchmarks.studies.real_data import ESSO_FREE, decimate  # noqa: E402
+from benchmarks.studies.real_data import ESSO_FREE  # noqa: E402
 
 
 GOAL = 0.40  # issue 32: r RMSE cut by at least 40 % on every non-berthing test run
@@ -44,7 +44,7 @@ FREE_SETS = {"": ESSO_FREE, " + I_zz, k_x": ESSO_FREE + ("i_zz_j_zz", "k_x")}
 
 def identified(train_names, horizon, free):
     """The `free` coefficients of the preset fitted on `train_names` (2 Hz)."""
-    train = [decimate(r, 5) for r in read_runs(train_names)]
+    train = [r.decimate(5) for r in read_runs(train_names)]
     estimator = js.PredictionError(horizon=horizon, wind=True, max_steps=100,
                                    simulator=js.Simulator(max_step=math.inf, substeps=2),
                                    solver=optx.LevenbergMarquardt(rtol=1e-6, atol=1e-6))

@@ -4,6 +4,7 @@ are written whole or not at all, fits that do not converge say so and exit with 
 
 import json
 import os
+import pathlib
 
 import numpy as np
 import pytest
@@ -258,6 +259,47 @@ def test_identify_rejects_nonsense_numbers(record, tmp_path, capsys, args, messa
                  str(tmp_path / "out")]) == 2
     assert message in _error_line(capsys)
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("command", ["identify", "discover"])
+@pytest.mark.parametrize("value", ["0", "-0.5", "nan"])
+def test_a_sample_interval_that_is_no_interval_is_one_line(command, value, record, tmp_path,
+                                                           capsys):
+    assert main([command, record, "--model", "nomoto1", "--sample-interval", value, "--out",
+                 str(tmp_path / "out")]) == 2
+    assert "the sample interval must be a positive number of seconds" in _error_line(capsys)
+    assert not (tmp_path / "out").exists()
+
+
+def test_discover_names_the_files_it_skips_even_when_quiet(record, tmp_path, capsys,
+                                                            monkeypatch):
+    """The trust audit: `discover --quiet` on a folder fitted fewer records than given and
+    said nothing. What is done to the records is a note, not a progress message."""
+    folder = tmp_path / "records"
+    folder.mkdir()
+    (folder / "zz.csv").write_text(pathlib.Path(record).read_text())
+    (folder / "open_water.csv").write_text("J,Kt\n0,0.3\n")
+
+    def stop(*args, **kwargs):
+        raise ValueError("stopped after reading")
+
+    monkeypatch.setattr("jaxship.cli._identification.discovery.identify", stop)
+    assert main(["discover", str(folder), "--model", "nomoto1", "--sample-interval", "1",
+                 "--quiet", "--out", str(tmp_path / "d")]) == 2
+    err = capsys.readouterr().err
+    assert "skipped 1 file(s) whose format is not a measurement record: open_water.csv" in err
+    assert "training records resampled to every k-th sample (0.5 s -> 1 s)" in err
+
+
+def test_identify_resamples_the_records_it_is_told_to(record, tmp_path, capsys):
+    """`--sample-interval 2` on a record at 0.5 s fits every 4th sample, and says so."""
+    out = tmp_path / "out"
+    assert main(["identify", record, "--model", "nomoto1", "--sample-interval", "2",
+                 "--out", str(out), "--no-figures", "--quiet"]) == 0
+    assert "training records resampled to every k-th sample (0.5 s -> 2 s)" in \
+        capsys.readouterr().err
+    (data,) = json.loads((out / "result.json").read_text())["data"]["train"]
+    assert data["dt_s"] == 2.0 and data["samples"] == 100
 
 
 @pytest.mark.parametrize("name, content, message", [

@@ -701,10 +701,11 @@ def test_a_folder_reads_quoted_headers_and_refuses_utf16(tmp_path):
     quoted[0] = ",".join(f'"{h}"' for h in quoted[0].split(","))
     (tmp_path / "quoted.csv").write_text("\n".join(quoted) + "\n")
     assert [e.name for e in read_experiments([tmp_path])] == ["a", "quoted"]
-    (tmp_path / "wide.csv").write_bytes(GOOD.encode("utf-16"))
-    with pytest.raises(ValueError, match=r"wide\.csv: the file is UTF-16 text; save it as "
-                                         r"UTF-8"):
-        read_experiments([tmp_path])
+    for encoding in ("utf-16", "utf-16-le", "utf-16-be"):  # with a byte-order mark, without
+        (tmp_path / "wide.csv").write_bytes(GOOD.encode(encoding))
+        with pytest.raises(ValueError, match=r"wide\.csv: the file is UTF-16 text; save it "
+                                             r"as UTF-8"):
+            read_experiments([tmp_path])
 
 
 def test_a_held_out_record_named_as_a_training_one_is_told_apart(tmp_path):
@@ -717,3 +718,16 @@ def test_a_held_out_record_named_as_a_training_one_is_told_apart(tmp_path):
     held = read_experiments([tmp_path / "test" / "trial.csv"], role="held-out",
                             taken=[e.name for e in train])
     assert [e.name for e in train] == ["trial"] and [e.name for e in held] == ["test/trial"]
+
+
+def test_decimate_keeps_measured_channels_and_extra_signals():
+    t = np.arange(10) * 0.1
+    e = js.Experiment(t, np.sin(t), psi=t, u=np.ones(10), name="x",
+                      extra={"gust": 2 * t, "setting": np.array([1.0, 2.0])})
+    d = e.decimate(3)
+    np.testing.assert_allclose(d.t, t[::3])
+    assert d.channels == e.channels and d.name == "x" and d.derived == ("r",)
+    np.testing.assert_allclose(d.extra["gust"], 2 * t[::3])
+    np.testing.assert_allclose(d.extra["setting"], [1.0, 2.0])
+    with pytest.raises(ValueError, match="positive integer"):
+        e.decimate(0)

@@ -110,6 +110,86 @@ def test_a_refit_that_fails_numerically_rejects_that_candidate_not_the_run(monke
     assert report.to_markdown() and json.dumps(report.to_dict())
 
 
+def test_the_audits_discover_command_on_a_coarse_zigzag_runs_to_its_end(tmp_path, capsys):
+    """The trust audit's case 6: a Mariner 20/20 zig-zag logged at 1 s (t, delta, psi, r),
+    a CRLF copy held out, `discover --model nomoto1`. The scores were computed with one
+    RK4 step per sample although a probe (the rudder delay's own state) needs more, so a
+    delay of 0.18 s was named and the next scoring ended the run in "SVD did not
+    converge" (exit 2). The scores now take the step the fit takes: the run ends, exit 0,
+    and names no delay (the logged rudder is the actual angle)."""
+    assert main(["simulate", "--vessel", "mariner", "--manoeuvre", "zigzag:20/20",
+                 "--duration", "300", "--dt", "1", "--out", str(tmp_path / "zz")]) == 0
+    rows = (tmp_path / "zz" / "trial.csv").read_text().splitlines()
+    keep = [i for i, h in enumerate(rows[0].split(",")) if h.split(" ")[0] in
+            ("t", "delta", "psi", "r")]
+    lines = [",".join(row.split(",")[i] for i in keep) for row in rows]
+    (tmp_path / "good.csv").write_text("\n".join(lines) + "\n")
+    (tmp_path / "crlf.csv").write_bytes(("\r\n".join(lines) + "\r\n").encode())
+    out = tmp_path / "d"
+    capsys.readouterr()
+    assert main(["discover", str(tmp_path / "good.csv"), "--holdout", str(tmp_path / "crlf.csv"),
+                 "--model", "nomoto1", "--out", str(out), "--quiet"]) == 0
+    assert "error" not in capsys.readouterr().err
+    report = json.loads((out / "discovery.json").read_text())
+    assert "rudder_delay" not in [e["id"] for e in report["effects"]], report["effects"]
+
+
+def test_a_candidate_whose_sensitivities_are_not_finite_is_rejected_not_the_run(monkeypatch):
+    """A candidate whose model blows up in the scoring is rejected with that reason and
+    the others are scored (the offset is still named); a score computation that fails
+    numerically rejects the iteration's candidates, not the run."""
+    from jaxship._analysis._discover import _workflow
+
+    sensitivities = _workflow.sensitivities
+
+    def broken(*args, **kwargs):
+        sens = sensitivities(*args, **kwargs)
+        jac = sens.jacobian.copy()
+        jac[:, sens.names.index("yaw_cubic_damping.beta")] = np.nan
+        return dataclasses.replace(sens, jacobian=jac)
+
+    monkeypatch.setattr(_workflow, "sensitivities", broken)
+    report = run_case((js.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
+    assert report.names_or_classes() and "rudder_offset" in report.names_or_classes()[0]
+    why = [r.why for r in report.rejected if r.id == "yaw_cubic_damping"]
+    assert why and why[0] == ("not scored: its sensitivities at the current fit are not "
+                              "finite (the model with it blows up on these records)",)
+    assert json.loads(json.dumps(report.to_dict(), allow_nan=False))
+
+    def failing(*args, **kwargs):
+        raise np.linalg.LinAlgError("SVD did not converge")
+
+    monkeypatch.setattr(_workflow, "sensitivities", sensitivities)
+    monkeypatch.setattr(_workflow, "score_tests", failing)
+    report = run_case((js.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
+    assert report.verdict == "nothing_missing" and report.rejected
+    assert all(r.why == ("not scored: the scores failed numerically (SVD did not "
+                         "converge)",) for r in report.rejected)
+    assert json.dumps(report.to_dict(), allow_nan=False)
+
+
+def test_a_held_out_prediction_that_blows_up_rejects_that_candidate(monkeypatch):
+    """The trust audit's case 6: a refit whose held-out prediction is not finite ended the
+    run in a ValueError; now that candidate is rejected with the reason."""
+    from jaxship._analysis._discover import _workflow
+    from jaxship._foundation._validate import NonFiniteError
+
+    check = _workflow.holdout_check
+    offset = {"rudder_offset", "yaw_moment_bias"}  # one class on a Nomoto model
+
+    def blowing_up(model, *args, **kwargs):
+        if offset & {e.id for e in getattr(model, "effects", ())}:
+            raise NonFiniteError("channel 'r': non-finite values at 12 valid samples.")
+        return check(model, *args, **kwargs)
+
+    monkeypatch.setattr(_workflow, "holdout_check", blowing_up)
+    report = run_case((js.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
+    failed = [r for r in report.rejected if r.id in offset and r.iteration == 1]
+    assert failed and failed[0].why == ("a prediction with it is not finite (channel 'r': "
+                                        "non-finite values at 12 valid samples.)",)
+    assert not offset & set(report.named)
+
+
 def test_the_held_out_rise_and_its_standard_error_over_stretches():
     rng = np.random.default_rng(0)
     t = np.tile(np.arange(0.0, 150.0, 0.5), (2, 1))
@@ -558,7 +638,7 @@ def test_the_missing_loads_count_the_logged_wind_where_asked():
     assert calm > 1e5 and replayed < 0.02 * calm, (calm, replayed)
 
 
-def test_a_report_says_first_when_the_base_model_does_not_describe_the_records():
+def test_a_report_says_first_when_the_base_model_does_not_describe_the_records(monkeypatch):
     """The trust audit: `discover` "found" an effect while the held-out fit stayed at
     -2158 %. Where a held-out channel is predicted worse than its mean, the report's
     first sentence says so, with the fits before and after."""
@@ -570,9 +650,12 @@ def test_a_report_says_first_when_the_base_model_does_not_describe_the_records()
         train_cost_after=1.0, holdout_cost_before=9.0, holdout_cost_after=8.0,
         holdout_fit_percent_before={"psi": -2158.0, "r": 12.0},
         holdout_fit_percent_after={"psi": -1900.0, "r": 15.0}, holdout_indices={},
-        alpha=0.01, channels=("psi", "r"), disagreement={})
+        alpha=0.01, channels=("psi", "r"), disagreement={"before": {}, "after": {}})
     first = report._base_does_not_describe()
     assert first[0].startswith("**The base model does not describe these records:**")
     assert "psi -2158 % (-1900 % after)" in first[0] and " r " not in first[0]
+    from jaxship._analysis._discover import _report
+    monkeypatch.setattr(_report, "_where", lambda before, after: [])  # no located residuals
+    assert report.to_markdown().splitlines()[:3] == ["# Discovery report", "", first[0]]
     fine = dataclasses.replace(report, holdout_fit_percent_before={"psi": 5.0, "r": 12.0})
     assert fine._base_does_not_describe() == []

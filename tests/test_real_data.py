@@ -6,7 +6,6 @@ import pytest
 import jaxship as js
 from benchmarks.studies.real_data import (
     ESSO_TEST,
-    decimate,
     esso_osaka_low_speed_discovery,
     esso_osaka_low_speed_steering,
     esso_osaka_low_speed_sway_yaw,
@@ -22,19 +21,6 @@ needs_esso = pytest.mark.skipif(DATA is None or not (DATA / "esso_osaka_frt").is
                                 reason="Esso Osaka data (shared/data/esso_osaka_frt) absent")
 needs_hsva = pytest.mark.skipif(DATA is None or not (DATA / "kvlcc2_simman2008_hsva").is_dir(),
                                 reason="HSVA KVLCC2 data (shared/data) absent")
-
-
-def test_decimate_keeps_measured_channels_and_extra_signals():
-    t = np.arange(10) * 0.1
-    e = js.Experiment(t, np.sin(t), psi=t, u=np.ones(10), name="x",
-                      extra={"gust": 2 * t, "setting": np.array([1.0, 2.0])})
-    d = decimate(e, 3)
-    np.testing.assert_allclose(d.t, t[::3])
-    assert d.channels == e.channels and d.name == "x" and d.derived == ("r",)
-    np.testing.assert_allclose(d.extra["gust"], 2 * t[::3])
-    np.testing.assert_allclose(d.extra["setting"], [1.0, 2.0])
-    with pytest.raises(ValueError, match="positive integer"):
-        decimate(e, 0)
 
 
 def test_missing_data_folder_raises(tmp_path):

@@ -19,7 +19,7 @@
 Validation is reported as fit % per channel on the held-out runs, for two predictors:
 `horizon` (the training horizon: restart from the measured state every T_p seconds)
 and free simulation (`horizon=None`, output error: one simulation of each whole run
-from its first sample). The records are decimated (every `decimate`-th sample) to
+from its first sample). The records are decimated (`Experiment.decimate`) to
 keep the fits fast; the raw data are 10 Hz (Esso Osaka) and 20 Hz (HSVA).
 """
 
@@ -27,7 +27,6 @@ import dataclasses
 import math
 from pathlib import Path
 
-import numpy as np
 import optimistix as optx
 
 import jaxship as js
@@ -46,24 +45,6 @@ HSVA_TEST = ("HSVA_CPMC_KVLCC2_Z_10_10_S", "HSVA_CPMC_KVLCC2_Z_20_10_S",
              "HSVA_CPMC_KVLCC2_Z_10_05", "HSVA_CPMC_KVLCC2_Z_20_05")
 
 
-def decimate(experiment: js.Experiment, factor: int) -> js.Experiment:
-    """Every `factor`-th sample of `experiment` (measured channels and `extra`)."""
-    factor = int(factor)
-    if factor < 1:
-        raise ValueError(f"`factor` must be a positive integer, got {factor}.")
-    return experiment if factor == 1 else _samples(experiment, slice(None, None, factor))
-
-
-def _samples(experiment: js.Experiment, index) -> js.Experiment:
-    """The samples `index` (a slice or mask) of `experiment`: its measured channels and
-    the `extra` signals logged at its samples."""
-    n = experiment.num_samples
-    extra = {k: a[index] if np.shape(a)[:1] == (n,) else a for k, a in experiment.extra.items()}
-    return js.Experiment(experiment.t[index], name=experiment.name, metadata=experiment.metadata,
-                         extra=extra,
-                         **{c: getattr(experiment, c)[index] for c in experiment.channels})
-
-
 def _root(root, folder):
     base = js.shared_data_dir() if root is None else Path(root)
     if base is None or not (base / folder).is_dir():
@@ -76,21 +57,21 @@ def esso_osaka_split(root=None, *, factor: int = 5) -> tuple[list, list]:
     """`(train, test)` experiments of the Esso Osaka split (module docstring),
     decimated by `factor` (10 Hz / 5 = 2 Hz by default)."""
     folder = _root(root, "esso_osaka_frt")
-    train = [decimate(js.read_esso_osaka(p), factor) for p in sorted(folder.glob("random/*.csv"))
+    train = [js.read_esso_osaka(p).decimate(factor) for p in sorted(folder.glob("random/*.csv"))
              if p.stem not in ESSO_TEST]
     test = []
     for name in ESSO_TEST:
         found = sorted(folder.glob(f"*/{name}.csv"))
         if not found:
             raise FileNotFoundError(f"held-out run {name}.csv not found under {folder}.")
-        test.append(decimate(js.read_esso_osaka(found[0]), factor))
+        test.append(js.read_esso_osaka(found[0]).decimate(factor))
     return train, test
 
 
 def hsva_split(root=None, *, factor: int = 4, train=HSVA_TRAIN, test=HSVA_TEST):
     """`(train, test)` HSVA KVLCC2 zig-zags, decimated by `factor` (20 Hz / 4 = 5 Hz)."""
     folder = _root(root, "kvlcc2_simman2008_hsva")
-    read = lambda names: [decimate(js.read_hsva_kvlcc2(folder / f"{n}.dat"), factor)
+    read = lambda names: [js.read_hsva_kvlcc2(folder / f"{n}.dat").decimate(factor)
                           for n in names]
     return read(train), read(test)
 
@@ -101,10 +82,10 @@ def kvlcc2_discovery_split(root=None) -> tuple[list, list]:
     (Froude-scaled to the 7 m HSVA model) held out, all at 5 Hz."""
     folder, marin = _root(root, "kvlcc2_simman2008_hsva"), _root(root, "kvlcc2_simman2008_marin")
     files = sorted(p for p in folder.glob("*.dat") if "_Z_" in p.name)
-    read = lambda paths: [decimate(js.read_hsva_kvlcc2(p), 4) for p in paths]  # 20 Hz
+    read = lambda paths: [js.read_hsva_kvlcc2(p).decimate(4) for p in paths]  # 20 Hz
     held = [p for p in files if "_Z_10_10_" in p.name]
     return read([p for p in files if p not in held]), read(held) + [
-        decimate(js.read_marin_kvlcc2(p, model_scale=True), 10)  # 50 Hz
+        js.read_marin_kvlcc2(p, model_scale=True).decimate(10)  # 50 Hz
         for p in sorted(marin.glob("*zz*.dat"))]
 
 
@@ -234,7 +215,7 @@ def esso_osaka_zigzag_split(root=None, *, factor: int = 5, trim: float = 20.0,
     folder = _root(root, "esso_osaka_frt")
     def read(path):
         run = js.read_esso_osaka(path)
-        return decimate(_samples(run, run.t >= run.t[0] + trim), factor)
+        return run.segment(start=run.t[0] + trim).decimate(factor)
 
     paths = sorted(folder.glob("zigzag/*.csv"))
     if turns:

@@ -19,6 +19,7 @@ from .._foundation._params import get_path, rebuild
 from .._simulation._simulate import _as_arrays as as_arrays
 from ._fit import _prepare, _residuals
 from ._lm import blockwise_jacfwd, value_and_jacfwd
+from ._step import MAX_SUBSTEPS, stable_substeps
 
 
 @dataclasses.dataclass(frozen=True)
@@ -73,11 +74,16 @@ def sensitivities(model, dataset, estimator, names, probes=None,
     `probes`: `{name: value}` for parameters differentiated by a secant to `value`.
     `start_offsets` (E, W, 2): the window-start corrections of a fit with
     `initial=EstimatedStarts()` (`FitResult.start_offsets`); they are differentiated too, as
-    the parameters `"start[k]"` (appended to `names`)."""
+    the parameters `"start[k]"` (appended to `names`). The integration step follows
+    the fastest mode of the model and of each probe, as in `fit`."""
     probes = dict(probes or {})
     ds, windows, layout = _prepare(model, dataset, estimator)
     base = as_arrays(model)
     names = tuple(names)
+    needed = min(MAX_SUBSTEPS, max(stable_substeps(m, windows, refuse=False) for m in
+                 [base] + [rebuild(base, (k,), (float(v),)) for k, v in probes.items()]))
+    if needed > windows.substeps:
+        windows = dataclasses.replace(windows, substeps=needed)
     p0 = jnp.asarray([float(get_path(model, n)) for n in names], dtype=float)
     shape = None
     if start_offsets is not None:

@@ -67,6 +67,10 @@ def _prepare(y, mask=None):
     return y, mask
 
 
+class NonFiniteError(ValueError):
+    """Measured or predicted values that are not finite (a prediction that blew up)."""
+
+
 @dataclasses.dataclass(frozen=True)
 class Correlation:
     """A correlation function with its 99 % test.
@@ -256,8 +260,8 @@ def validate(y, yhat, mask=None, *, num_params: int = 0, u=None, max_lag: int = 
         raise ValueError(f"channel {channel!r}: need at least 2 valid samples, got {num}.")
     bad = mask & ~(np.isfinite(y) & np.isfinite(yhat))
     if bad.any():
-        raise ValueError(f"channel {channel!r}: non-finite values at {int(bad.sum())} valid "
-                         "samples.")
+        raise NonFiniteError(f"channel {channel!r}: non-finite values at {int(bad.sum())} "
+                             "valid samples.")
     e = np.where(mask, y - yhat, 0.0)
     loss = float(np.sum(e**2) / num)
     d = int(num_params)

@@ -191,6 +191,20 @@ class Experiment(eqx.Module):
             keep &= self.t >= start
         if stop is not None:
             keep &= self.t <= stop
+        return self._kept(keep)
+
+    def decimate(self, factor: int) -> "Experiment":
+        """Every `factor`-th sample, from the first, as a new experiment (derived channels
+        recomputed). No anti-aliasing filter: the motions should lie well below the new
+        Nyquist frequency $1/(2\\,\\text{factor}\\,dt)$, as a ship's do at a few samples
+        per second."""
+        if isinstance(factor, bool) or not isinstance(factor, (int, np.integer)) or factor < 1:
+            raise ValueError(f"`factor` must be a positive integer, got {factor!r}.")
+        return self._kept(slice(None, None, int(factor)))
+
+    def _kept(self, keep) -> "Experiment":
+        """The samples `keep` (a mask or slice) of the measured channels and of the
+        `extra` signals logged at the samples."""
         measured = {k: a[keep] for k, a in self._measured().items()}
         extra = {
             k: (a[keep] if np.shape(a)[:1] == (self.num_samples,) else a)

@@ -292,7 +292,7 @@ def read_measured(path, **kwargs) -> Experiment:
                                      "(trial CSV, Esso Osaka CSV, HSVA or MARIN .dat).")
     except OSError as error:
         raise ValueError(f"{path}: cannot read the file ({error.strerror or error}).") from None
-    if first.lstrip(b"\n\r").startswith(UTF16_MARKS):
+    if first.lstrip(b"\n\r").startswith(UTF16_MARKS) or b"\x00" in first:  # with or without BOM
         raise ValueError(f"{path}: the file is UTF-16 text; save it as UTF-8 (or ASCII) text.")
     first = first.decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
     suffix = path.suffix.lower()

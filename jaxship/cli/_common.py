@@ -34,6 +34,14 @@ def check_operating_point(vessel, name, speeds, rpms):
                              f"of {name} ({service:.4g} rpm).")
 
 
+def add_sample_interval(parser) -> None:
+    """The `--sample-interval` option of the commands that fit records."""
+    parser.add_argument("--sample-interval", type=float, default=None, metavar="SECONDS",
+                        help="resample each record to about this interval (every k-th "
+                        "sample) before fitting: fewer samples, a faster fit (default: as "
+                        "recorded)")
+
+
 def positive(option, value):
     """`value` (a float or None) checked: finite and positive."""
     if value is not None and not (math.isfinite(value) and value > 0):

@@ -5,7 +5,7 @@ import sys
 
 from tqdm.auto import tqdm
 
-from ._common import check_out
+from ._common import add_sample_interval, check_out, note
 from ._identification.discovery import run_discovery
 
 
@@ -26,6 +26,7 @@ def register(sub) -> None:
     disc.add_argument("--max-effects", type=int, default=3, help="most effects added")
     disc.add_argument("--alpha", type=float, default=0.01,
                       help="family-wise false-alarm rate")
+    add_sample_interval(disc)
     disc.add_argument("--quiet", action="store_true", help="no progress messages")
     disc.set_defaults(run=run)
 
@@ -35,7 +36,8 @@ def run(args) -> int:
     say = (lambda message: None) if args.quiet else (
         lambda message: tqdm.write(f"jaxship: {message} ...", file=sys.stderr))
     report = run_discovery(args.train, args.holdout, model=args.model, out=args.out,
-                           max_effects=args.max_effects, alpha=args.alpha, progress=say)
+                           max_effects=args.max_effects, alpha=args.alpha,
+                           sample_interval=args.sample_interval, progress=say, note=note)
     print(report.to_markdown())
     print(f"wrote {args.out}/discovery.json, {args.out}/report.md, {args.out}/figures/")
     return 0

@@ -8,7 +8,7 @@ import sys
 
 from .._foundation._files import staged_folder
 from ..plotting import save_identification_figures
-from ._common import ProgressBar, check_out, note, one_line
+from ._common import ProgressBar, add_sample_interval, check_out, note, one_line
 from ._identification import MODELS, get_model_entry, identify, read_experiments
 
 
@@ -42,6 +42,7 @@ def register(sub) -> None:
                        help="window start states: measured, estimate or auto (estimate for "
                        "output error, else measured)")
     ident.add_argument("--max-steps", type=int, default=256, help="optimiser step limit")
+    add_sample_interval(ident)
     ident.add_argument("--no-figures", action="store_true", help="write result.json only")
     ident.add_argument("--quiet", action="store_true", help="no progress bar")
     ident.set_defaults(run=run)
@@ -68,9 +69,10 @@ def run(args) -> int:
         raise ValueError(f"--max-steps {args.max_steps}: give a positive number of optimiser "
                          "steps (default 256).")
     check_out(args.out)
-    train = read_experiments(args.train, role="training", note=note)
+    train = read_experiments(args.train, role="training", note=note,
+                             sample_interval=args.sample_interval)
     held_out = None if args.validate is None else read_experiments(
-        args.validate, role="validation", note=note)
+        args.validate, role="validation", note=note, sample_interval=args.sample_interval)
     bar = ProgressBar(not args.quiet)
     result = identify(train, model=args.model, horizon=horizon, validate=held_out,
                       rudder=args.rudder, channels=args.channels, initial=args.initial,

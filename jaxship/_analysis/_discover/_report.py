@@ -2,6 +2,7 @@
 the JSON of `jaxship discover`) and as a page (`to_markdown`)."""
 
 import dataclasses
+import math
 
 import equinox as eqx
 import jax
@@ -248,5 +249,7 @@ def _plain(x):
     if isinstance(x, (list, tuple)):
         return [_plain(v) for v in x]
     if isinstance(x, (np.generic, np.ndarray, jax.Array)) and np.ndim(x) == 0:
-        return x.item()
+        x = x.item()
+    if isinstance(x, float) and not math.isfinite(x):  # e.g. a candidate never scored
+        return None
     return x

@@ -45,6 +45,7 @@ from ..._estimate._sensitivity import sensitivities
 from ..._estimate._windows import as_dataset
 from ..._foundation._contract import AbstractComposite
 from ..._foundation._params import default_free, parameter_fields, rebuild
+from ..._foundation._validate import NonFiniteError
 from ..._models._effects import augment, family_unit
 from ._catalogue import DISCOVERY_CATALOGUE, applicable
 from ._forces import smoothed_vessel_states
@@ -232,7 +233,30 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         sens = sensitivities(scored, train, loss(scored), theta + sum(names.values(), ()),
                              probes, start_offsets=current.start_offsets)
         nuisance = tuple(n for n in sens.names if n.startswith("start["))
-        scores = score_tests(sens, theta + nuisance, names)
+        entry = {c.id: (c, e, pr) for c, e, pr in candidates}
+        # a candidate whose sensitivities are not finite (the model with it blows up on
+        # these records) is rejected, not the run; where the residuals or the base
+        # sensitivities are not finite, or the scores fail numerically, none is scored
+        finite = dict(zip(sens.names, np.isfinite(sens.jacobian).all(axis=0)))
+        unscored = [k for k in names if not all(finite[n] for n in names[k])]
+        rejected.extend(CandidateOutcome(
+            k, entry[k][0].name, iteration + 1, math.nan,
+            ("not scored: its sensitivities at the current fit are not finite (the model "
+             "with it blows up on these records)",)) for k in unscored)
+        names = {k: v for k, v in names.items() if k not in unscored}
+        failure = None
+        if not (np.isfinite(sens.residuals).all() and all(finite[n] for n in theta + nuisance)):
+            failure = "the residuals or the base model's sensitivities are not finite"
+        elif names:
+            try:
+                scores = score_tests(sens, theta + nuisance, names)
+            except np.linalg.LinAlgError as error:  # e.g. an SVD that does not converge
+                failure = f"the scores failed numerically ({error})"
+        if failure:
+            rejected.extend(CandidateOutcome(k, entry[k][0].name, iteration + 1, math.nan,
+                                             (f"not scored: {failure}",)) for k in names)
+        if failure or not names:
+            break
         # one test per candidate and one joint test per iteration (Bonferroni)
         level = alpha / ((len(candidates) + 1) * max_effects)
         threshold = lambda dof: float(stats.chi2.isf(level, dof))
@@ -246,21 +270,22 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         for k in ranked:
             if len(chosen) < top and not any(k in classes[c] for c in chosen):
                 chosen.append(k)
-        entry = {c.id: (c, e, pr) for c, e, pr in candidates}
 
         def judge(keys, s, limit, p_value=None):
             """Refit with the candidates `keys` (one, or a joint union) from their probe values
             and apply the gates (module text) against the score threshold `limit`. Returns
             (one record per candidate, with `why` where the refit fails a gate; the fit;
             its held-out check; whether that check alone failed). A refit that fails
-            numerically (an SVD that does not converge, an overflow) rejects these
-            candidates, not the run."""
+            numerically (an SVD that does not converge, an overflow, a held-out prediction
+            that blows up) rejects these candidates, not the run."""
             try:
                 return attempt(keys, s, limit, p_value)
             except (np.linalg.LinAlgError, OverflowError, FloatingPointError) as error:
                 why = (f"the refit failed numerically ({type(error).__name__}: {error})",)
-                return [CandidateOutcome(k, entry[k][0].name, iteration + 1, s.statistic, why)
-                        for k in keys], None, None, False
+            except NonFiniteError as error:
+                why = (f"a prediction with it is not finite ({error})",)
+            return [CandidateOutcome(k, entry[k][0].name, iteration + 1, s.statistic, why)
+                    for k in keys], None, None, False
 
         def attempt(keys, s, limit, p_value):
             start = augment(base, *effects, *(entry[k][1] for k in keys))

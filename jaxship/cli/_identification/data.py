@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Sequence
 from pathlib import Path
@@ -51,7 +52,7 @@ def is_measurement_file(path: Path) -> bool:
             raw = f.readline(4096)
     except OSError as error:
         raise ValueError(f"{path}: cannot read the file ({error.strerror or error}).") from None
-    if raw.startswith(UTF16_MARKS):  # read, so that `read_measured` says which encoding
+    if raw.startswith(UTF16_MARKS) or b"\x00" in raw:  # read: `read_measured` names UTF-16
         return True
     first = raw.decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
     if first.startswith(("MARIN", "HSVA")):
@@ -70,8 +71,8 @@ def _renamed(e: js.Experiment, name: str) -> js.Experiment:
     return js.Experiment(e.t, name=name, metadata=e.metadata, extra=e.extra, **measured)
 
 
-def read_experiments(paths, *, role: str = "training", note=None, taken=()
-                     ) -> list[js.Experiment]:
+def read_experiments(paths, *, role: str = "training", note=None, taken=(),
+                     sample_interval: float | None = None) -> list[js.Experiment]:
     """Read measurement files and folders into experiments.
 
     A file is read with `read_measured` (trial CSV, Esso Osaka CSV, HSVA and MARIN
@@ -81,6 +82,9 @@ def read_experiments(paths, *, role: str = "training", note=None, taken=()
     sentence to `note`, a callable, so that a fit never uses fewer records than the
     user meant without saying so), in name order. Experiments with equal names, or with
     a name in `taken` (those of another role's records), get their folder as a prefix.
+    With `sample_interval` [s], each record keeps every k-th sample, k the integer
+    nearest to `sample_interval / dt` (`Experiment.decimate`; 1 keeps the record), said
+    in one sentence to `note`.
 
     **Raises:** `ValueError` naming the file: missing, unreadable or malformed
     (the readers' messages name the column and row), or a folder with no records.
@@ -118,7 +122,20 @@ def read_experiments(paths, *, role: str = "training", note=None, taken=()
     for i, e in enumerate(out):  # still equal (same folder name): number them
         if names.count(e.name) > 1:
             out[i] = _renamed(e, f"{e.name}#{i}")
-    return out
+    return out if sample_interval is None else _resampled(out, sample_interval, role, note)
+
+
+def _resampled(experiments, interval: float, role: str, note) -> list[js.Experiment]:
+    """Every k-th sample of each record, k the integer nearest to `interval / dt`."""
+    if not (math.isfinite(interval) and interval > 0):
+        raise ValueError(f"the sample interval must be a positive number of seconds, got "
+                         f"{interval!r}.")
+    factors = [max(1, round(interval / e.dt)) for e in experiments]
+    if note is not None and any(k > 1 for k in factors):
+        changes = sorted({f"{e.dt:.3g} s -> {k * e.dt:.3g} s" for e, k in
+                          zip(experiments, factors) if k > 1})
+        note(f"{role} records resampled to every k-th sample ({', '.join(changes)}).")
+    return [e.decimate(k) for e, k in zip(experiments, factors)]
 
 
 def as_experiments(data, role: str) -> list[js.Experiment]:

@@ -17,20 +17,27 @@ from .workflow import identify, logs_wind
 
 
 def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
-                  max_effects: int = 3, alpha: float = 0.01, progress=None):
-    """Read the records, fit `model` (as `jaxship identify` does, for start values),
-    run discovery and write `out/discovery.json`, `out/report.md` and
-    `out/figures/`. Returns the `DiscoveryReport`."""
+                  max_effects: int = 3, alpha: float = 0.01, sample_interval=None,
+                  progress=None, note=None):
+    """Read the records (resampled to `sample_interval` [s] if given: `read_experiments`),
+    fit `model` (as `jaxship identify` does, for start values), run discovery and write
+    `out/discovery.json`, `out/report.md` and `out/figures/`. Returns the
+    `DiscoveryReport`. `progress` takes the stage messages, `note` (default `progress`)
+    what was done to the records (files skipped, resampling): the command prints notes
+    even when quiet."""
     say = progress or (lambda message: None)
+    note = note or say
     get_model_entry(model)  # an unknown model fails before any file is read
     if max_effects < 1:
         raise ValueError(f"--max-effects must be at least 1, got {max_effects}.")
     if not 0 < alpha < 1:
         raise ValueError(f"--alpha must be between 0 and 1, got {alpha}.")
-    train = read_experiments(train_paths, role="training", note=say)
+    train = read_experiments(train_paths, role="training", note=note,
+                             sample_interval=sample_interval)
     # a held-out record named as a training one (two `trial.csv`) is told apart by its folder
-    holdout = read_experiments(holdout_paths, role="held-out", note=say,
-                               taken=[e.name for e in train]) if holdout_paths else None
+    holdout = read_experiments(holdout_paths, role="held-out", note=note,
+                               taken=[e.name for e in train],
+                               sample_interval=sample_interval) if holdout_paths else None
     say(f"start values: identify {model} on {len(train)} training records")
     start = identify(train, model=model).fit.model
     report = js.discover(start, train, holdout, max_effects=max_effects, alpha=alpha,
