@@ -14,8 +14,10 @@ indices inside the same compiled call (`output=batch_turning_indices`), in chunk
 
 Duration and step: the run lasts until the slowest turn of the grid has passed 180 deg
 (checked: the script reports any run that did not), sampled every `--dt` with
-`--substeps` RK4 steps per sample. The accuracy of that step is reported against a
-reference with 8x the substeps on a few runs of the grid.
+`--substeps` RK4 steps per sample (`Simulator(substeps=..., max_step=inf)`: the library's
+default would split each sample into control steps of at most 0.1 s, five RK4 steps per
+0.5 s sample). The accuracy of that step is reported against a reference with 10x finer
+samples and steps on a few runs of the grid.
 
 Prints runs/s, the wall time (first call with compilation, then the best of
 `--repeats`), the peak resident memory of the process (`resource.getrusage`) and a
@@ -25,6 +27,7 @@ Run: `python benchmarks/sweep.py [--vessel thesis|mariner] [--devices N]`.
 """
 
 import argparse
+import math
 import os
 import resource
 import sys
@@ -114,7 +117,7 @@ def main(args):
     devices = jax.devices()
     vessel, manoeuvre, x0, grid = build(args, args.dt)
     runs = grid["angle"].size
-    simulator = js.Simulator(substeps=args.substeps)
+    simulator = js.Simulator(substeps=args.substeps, max_step=math.inf)  # module text
     print(f"jax {jax.__version__}, {jax.default_backend()}, {len(devices)} device(s), float64, "
           f"python {sys.version.split()[0]}")
     print(f"{runs} turning circles of the {args.vessel} vessel: {args.angles} rudder angles x "
@@ -160,7 +163,8 @@ def main(args):
                             in_axes=(0, 0, 0, None), output=js.batch_turning_indices)
     fine_dt = args.dt / 10
     v_f, m_f, x_f, _ = build(args, fine_dt)
-    fine = js.simulate_batch(take(v_f), take(m_f), take(x_f), simulator=js.Simulator(substeps=1),
+    fine = js.simulate_batch(take(v_f), take(m_f), take(x_f),
+                          simulator=js.Simulator(substeps=1, max_step=math.inf),
                           in_axes=(0, 0, 0, None), output=js.batch_turning_indices)
     print(f"\naccuracy on {pick.size} runs of the grid against dt = {fine_dt:g} s "
           f"(one RK4 step per sample), max relative difference:")
