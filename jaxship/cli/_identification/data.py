@@ -135,7 +135,7 @@ def _resampled(experiments, interval: float, role: str, note) -> list[js.Experim
         changes = sorted({f"{e.dt:.3g} s -> {k * e.dt:.3g} s" for e, k in
                           zip(experiments, factors) if k > 1})
         note(f"{role} records resampled to every k-th sample ({', '.join(changes)}).")
-    return [e.decimate(k) for e, k in zip(experiments, factors)]
+    return [e.decimate(k) if k > 1 else e for e, k in zip(experiments, factors)]
 
 
 def as_experiments(data, role: str) -> list[js.Experiment]:
