@@ -76,6 +76,8 @@ def test_autopilot_writes_gains_runs_report_and_figures(written):
     # report and figures; no temporary files left behind
     report = (written / "report.md").read_text()
     assert "| pid+ff | 300 |" in report and "K_p" in report
+    # the trust audit (case 3): the report says how the design was chosen from the model
+    assert "Chosen: omega_n = " in report and "from the model's yaw time constant T = " in report
     for figure in result["figures"]:
         assert f"]({figure})" in report
         assert (written / figure).stat().st_size > 20_000

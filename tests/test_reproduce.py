@@ -2,7 +2,13 @@
 as `report.md` with the thesis' numbers beside ours."""
 
 import json
+import os
+import pathlib
 import re
+import signal
+import subprocess
+import sys
+import time
 
 import pytest
 
@@ -154,3 +160,55 @@ def test_a_failed_fit_in_the_study_leaves_the_others(monkeypatch):
     closed = chapter5.autopilot_study(identification=study, models=("nomoto",),
                                        rpms=(300.0,))
     assert {r["family"] for r in closed["table"]} == {"turning"}
+
+
+def _children(pid: int) -> dict[int, str]:
+    """`{pid: command line}` of the live (not zombie) child processes of `pid` (Linux)."""
+    found = {}
+    for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+            if int(fields[1]) == pid and fields[0] != "Z":
+                cmdline = (stat.parent / "cmdline").read_bytes().replace(b"\0", b" ")
+                found[int(stat.parent.name)] = cmdline.decode(errors="replace")
+        except (OSError, IndexError, ValueError):
+            continue
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):
+        return False
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG is Linux's")
+@pytest.mark.parametrize("delay", [0.0, 5.0])  # while the worker imports; once it works
+def test_a_reproduce_killed_with_sigkill_leaves_no_worker(tmp_path, delay):
+    """The trust audit (case 8): SIGKILL on `reproduce` orphaned its worker, which went on
+    writing figures into the dead run's folder. The worker dies with its parent, also
+    when the parent dies while the worker is still importing."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    parent = subprocess.Popen([sys.executable, "-m", "jaxship.cli", "reproduce", "--quick",
+                               "--out", str(tmp_path / "r")], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL, env=env)
+    workers = {}
+    try:
+        deadline = time.monotonic() + 180
+        while not workers and time.monotonic() < deadline and parent.poll() is None:
+            time.sleep(0.2)
+            workers = {p: c for p, c in _children(parent.pid).items() if "spawn_main" in c}
+        assert workers, "reproduce started no worker"
+        time.sleep(delay)
+        parent.send_signal(signal.SIGKILL)
+        parent.wait(10)
+        deadline = time.monotonic() + 15
+        while any(map(_alive, workers)) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        assert not any(map(_alive, workers)), workers
+    finally:
+        parent.kill()
+        for pid in filter(_alive, workers):
+            os.kill(pid, signal.SIGKILL)

@@ -282,18 +282,21 @@ def _discovery(quick, out, say=None) -> dict:
 _QUEUE = None  # in the second process: where its progress messages go
 
 
-def _start_worker(queue, x64, cache):
+def _start_worker(queue, x64, cache, parent):
+    # the worker dies with its parent (Linux: PR_SET_PDEATHSIG = 1), so that a parent
+    # killed with SIGKILL leaves no orphan writing into its results; a parent that died
+    # while this process was still importing is gone already (it was reparented): end
+    # now. Ctrl-C is the parent's to handle (it ends the pool)
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)
+    if os.getppid() != parent:
+        os._exit(1)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     global _QUEUE
     _QUEUE = queue
     jax.config.update("jax_enable_x64", x64)  # as the parent (the CLI: float64)
     if cache:  # the parent's compilation cache
         js.enable_compilation_cache(cache)
-    # the worker dies with its parent (Linux: PR_SET_PDEATHSIG = 1), so that a parent
-    # killed with SIGKILL leaves no orphan writing into its results; Ctrl-C is the
-    # parent's to handle (it ends the pool)
-    with contextlib.suppress(OSError, AttributeError):
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _discovery_job(quick, out):
@@ -319,7 +322,8 @@ class _Worker:
         self.queue = context.Queue()
         self.pool = ProcessPoolExecutor(1, mp_context=context, initializer=_start_worker,
                                         initargs=(self.queue, bool(jax.config.jax_enable_x64),
-                                                  jax.config.jax_compilation_cache_dir))
+                                                  jax.config.jax_compilation_cache_dir,
+                                                  os.getpid()))
         self.pending, self.listeners = [], {}
 
     def submit(self, job, *args):
