@@ -177,9 +177,12 @@ def _run(out, quick, progress, identification, closed_loop, discover, parallel) 
                 timings["waiting for the discovery"] = timings["discovery"]
                 timings["discovery"] = data["case"]["seconds"]
                 cpu["discovery"] = data["case"]["cpu_seconds"]
-    finally:
+    except BaseException:  # Ctrl-C or an error: do not wait for the second process' job
         if worker is not None:
-            worker.close()
+            worker.close(wait=False)
+        raise
+    if worker is not None:
+        worker.close()
 
     results["run"] = {
         "quick": bool(quick), "seconds": time.perf_counter() - began,
@@ -363,8 +366,10 @@ class _Worker:
                 pass
         return here()
 
-    def close(self):
-        self.pool.shutdown(cancel_futures=True)
+    def close(self, wait: bool = True):
+        """End the process: after its job, or at once (`wait=False`: it dies with this
+        process, which is ending)."""
+        self.pool.shutdown(wait=wait, cancel_futures=True)
 
 
 def _combine(parts, families, models, cases) -> dict:
