@@ -80,8 +80,9 @@ def sensitivities(model, dataset, estimator, names, probes=None,
     ds, windows, layout = _prepare(model, dataset, estimator)
     base = as_arrays(model)
     names = tuple(names)
-    needed = min(MAX_SUBSTEPS, max(stable_substeps(m, windows, refuse=False) for m in
-                 [base] + [rebuild(base, (k,), (float(v),)) for k, v in probes.items()]))
+    probed = [rebuild(base, (k,), (float(v),)) for k, v in probes.items()]
+    needed = min(MAX_SUBSTEPS, max(stable_substeps(m, windows, refuse=False)
+                                   for m in [base, *probed]))
     if needed > windows.substeps:
         windows = dataclasses.replace(windows, substeps=needed)
     p0 = jnp.asarray([float(get_path(model, n)) for n in names], dtype=float)
