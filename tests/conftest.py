@@ -2,10 +2,21 @@ import gc
 import os
 import pathlib
 
-import jax
+
+# XLA's CPU compiler set for many small programs: most of a test's time is compiling
+# (66 % in test_contracts and test_kalman), and these two flags cut compile time by
+# about 55 % with the same numbers (no fast-math either way) and no slower runs
+# (measured 2026-11-26: LLVM's optimisation off, and the older loop emitters instead of
+# the MLIR fusion emitters). Set before JAX starts its backend; `jaxship` subprocesses
+# and notebook kernels inherit them.
+os.environ["XLA_FLAGS"] = " ".join([os.environ.get("XLA_FLAGS", ""),
+                                    "--xla_backend_optimization_level=0",
+                                    "--xla_cpu_use_fusion_emitters=false"]).strip()
+
+import jax  # noqa: E402
 import pytest
 
-import jaxship as js
+import jaxship as js  # noqa: E402
 
 
 jax.config.update("jax_enable_x64", True)

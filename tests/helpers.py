@@ -17,6 +17,17 @@ def tree_allclose(a, b, *, rtol=1e-10, atol=1e-10) -> bool:
     return all(np.allclose(x, y, rtol=rtol, atol=atol) for x, y in zip(leaves_a, leaves_b))
 
 
+def assert_equal_to_rounding(actual, desired, ulps=4):
+    """`actual` equals `desired` within `ulps` units in the last place of the largest
+    |desired|: what two compiled programs computing the same sums may differ by when
+    the compiler orders or fuses them differently (bit for bit under XLA's default
+    CPU pipeline; the tests' faster settings, `conftest.py`, fuse differently)."""
+    desired = np.asarray(desired)
+    scale = float(np.max(np.abs(desired), initial=0.0))
+    np.testing.assert_allclose(actual, desired, rtol=0.0,
+                               atol=ulps * np.finfo(desired.dtype).eps * scale)
+
+
 def central_difference(f, x, eps=1e-6):
     """Derivative of a scalar-input function by central differences."""
     return (f(x + eps) - f(x - eps)) / (2 * eps)

@@ -90,23 +90,25 @@ def test_the_held_out_check_vetoes_but_does_not_choose():
 def test_a_refit_that_fails_numerically_rejects_that_candidate_not_the_run(monkeypatch):
     """The trust audit ended a Mariner discover in "SVD did not converge" while refitting
     one candidate: now that candidate is rejected with the reason, and the search goes
-    on to the next (here the offset's refit fails; its class-mate is not refitted in the
-    same iteration, so nothing is named)."""
+    on to the next (here the refit of the offset's class fails: the offset and the
+    yaw-moment bias tie to rounding, so either may be the one refitted, and its
+    class-mate is not refitted in the same iteration, so nothing is named)."""
     from jaxship._analysis._discover import _workflow
 
     fit = _workflow.fit
+    one_class = {"rudder_offset", "yaw_moment_bias"}
 
     def failing(model, *args, **kwargs):
-        if "rudder_offset" in {e.id for e in getattr(model, "effects", ())}:
+        if one_class & {e.id for e in getattr(model, "effects", ())}:
             raise np.linalg.LinAlgError("SVD did not converge")
         return fit(model, *args, **kwargs)
 
     monkeypatch.setattr(_workflow, "fit", failing)
     report = run(js.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
-    failed = [r for r in report.rejected if r.id == "rudder_offset"]
+    failed = [r for r in report.rejected if r.id in one_class]
     assert failed and failed[0].why == (
         "the refit failed numerically (LinAlgError: SVD did not converge)",)
-    assert "rudder_offset" not in report.named
+    assert not one_class & set(report.named)
     assert report.to_markdown() and json.dumps(report.to_dict())
 
 
