@@ -8,6 +8,7 @@ import math
 import os
 import pathlib
 
+import jax
 import jax.numpy as jnp
 import matplotlib
 import numpy as np
@@ -338,6 +339,26 @@ def test_the_default_design_follows_the_models_time_constant():
     scaled = study.Design.scaled(0.5)
     assert (scaled.reference_frequency, scaled.step_time, scaled.duration) == (
         default.reference_frequency, default.step_time, default.duration)
+
+
+def test_the_default_design_keeps_the_feedforward_within_the_rudders_limits():
+    """Trust audit, case 3: the bandwidth also follows the rudder's limits. On the KVLCC2
+    (its own equations as the model, 35 deg and 15.8 deg/s) 1.25 / T would ask the
+    feed-forward of a 45 deg step for more rudder than half the limits; the design takes
+    the frequency at which the reference model (stepped by `ReferenceModel`, not the
+    closed form) asks for exactly half of one limit and less of the other, and says so."""
+    kvlcc2 = js.vessel("kvlcc2")
+    u0, n0 = study.operating_point(kvlcc2, speed=float(kvlcc2.nominal_speed))
+    omega, basis = study.natural_frequency_for(kvlcc2, kvlcc2, speed=u0, n=n0, step=45.0)
+    m, d = (float(x) for x in js.yaw_inertia(kvlcc2, speed=u0, n=n0))
+    assert omega < 1.25 * abs(d / m) and "within half the rudder's limits" in basis
+    reference, h = js.ReferenceModel(natural_frequency=0.4 * omega), 0.01 / (0.4 * omega)
+    step = lambda state, _: (reference.step(state, np.radians(45.0), h),) * 2
+    _, r_d, a_d = np.asarray(jax.lax.scan(step, jnp.zeros(3), length=3000)[1]).T
+    rudder = m * a_d + d * r_d
+    shares = (np.max(np.abs(rudder)) / float(kvlcc2.rudder.max_angle),
+              np.max(np.abs(np.diff(rudder) / h)) / float(kvlcc2.rudder.max_rate))
+    assert max(shares) == pytest.approx(0.5, rel=1e-3) and min(shares) < 0.5
 
 
 def test_a_rudder_on_its_limits_is_a_code_and_a_sentence(identified, tmp_path, capsys):

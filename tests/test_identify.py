@@ -5,6 +5,7 @@ held-out records, progress reporting and clear errors on bad input."""
 
 import json
 import math
+import re
 
 import equinox as eqx
 import numpy as np
@@ -476,3 +477,31 @@ def test_help_lists_every_model(capsys):
     listed = [line.split()[0] for line in out.split("models (--model):")[1].splitlines()
               if line.strip()]
     assert listed == [*STEERING_MODELS, *js.VESSELS]
+
+
+def test_a_speed_beyond_froude_1_for_the_preset_is_refused(tmp_path, capsys):
+    """Trust audit, case 4: a record whose u is beyond Froude number 1 for the model's
+    length (the Mariner's 7.7 m/s against the 3 m Esso Osaka model, Fn 1 at 5.42 m/s:
+    another ship's record, or a speed in knots) is refused before any fit, with the file,
+    column and likely cause, exit 2 and nothing written: `identify`'s records and
+    `discover`'s held-out ones."""
+    def trial(preset, path):
+        vessel = js.vessel(preset)
+        run_ = js.simulate(vessel, js.ZigZag(10 * DEG, 10 * DEG, duration=40.0, dt=1.0),
+                           js.straight_run(vessel))
+        js.write_trial_csv(path, js.Experiment.from_trajectory(run_))
+        return str(path)
+
+    fast = trial("mariner", tmp_path / "mariner.csv")
+    slow = trial("esso_osaka", tmp_path / "esso.csv")
+    expected = re.compile(r"mariner\.csv \((training|held-out) record 'mariner'\): column 'u' "
+                          r"reaches 7\.\d+ m/s at t = 0 s, Froude number 1\.\d+ for the 3 m "
+                          r"esso_osaka: no displacement ship runs beyond Fn 1 \(5\.42 m/s\)\. "
+                          r"Is the column in knots or km/h")
+    for command in (["identify", fast, "--model", "esso_osaka"],
+                    ["discover", slow, "--holdout", fast, "--model", "esso_osaka"]):
+        out = tmp_path / command[0]
+        code = main([*command, "--out", str(out)])
+        err = capsys.readouterr().err
+        assert code == 2 and expected.search(err), err
+        assert len(err.strip().splitlines()) == 1 and not out.exists()

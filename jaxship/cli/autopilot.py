@@ -39,7 +39,9 @@ def register(sub) -> None:
     auto.add_argument("--natural-frequency", default="auto",
                       help="the controller's omega_n [rad/s]; auto: 1.25 / T from "
                       "the model's yaw time constant T, at most half the rudder servo's "
-                      "bandwidth (0.5 rad/s on the thesis vessel); the reference model, step "
+                      "bandwidth (0.5 rad/s on the thesis vessel) and at most what keeps the "
+                      "step's feed-forward within half the rudder's limits; the reference "
+                      "model, step "
                       "time and window follow it in the thesis' proportions")
     auto.add_argument("--damping", default="1.0", help="the controller's zeta")
     auto.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -73,7 +75,8 @@ def run(args) -> int:
     if auto:  # from the model's yaw time constant at the mean operating point of the runs
         u0, n0 = autopilot_study.operating_point(
             vessel, **{"rpm" if by_rpm else "speed": sum(values) / len(values)})
-        omega, basis = autopilot_study.natural_frequency_for(model, vessel, speed=u0, n=n0)
+        omega, basis = autopilot_study.natural_frequency_for(model, vessel, speed=u0, n=n0,
+                                                             step=step)
     design = autopilot_study.Design.scaled(omega, step=step, damping=damping, basis=basis)
 
     bar = tqdm(total=2 + 2 * int(args.tune), desc="autopilot", unit="stage", leave=False,

@@ -156,6 +156,37 @@ def as_experiments(data, role: str) -> list[js.Experiment]:
                      f"Dataset or file paths, got {type(data).__name__}.")
 
 
+# No displacement ship runs beyond a Froude number U / sqrt(g L) of 1 (semi-planing
+# starts about 0.5; Lewis 1988, PNA vol. II ch. 5): a speed channel beyond it, for the
+# model's length, is in another unit (knots, km/h) or from another ship.
+MAX_FROUDE = 1.0
+GRAVITY = 9.80665  # [m/s^2]
+
+
+def preset_length(model: str) -> float | None:
+    """L_pp [m] of the vessel preset `model`; None for other models (no length)."""
+    vessel = js.vessel(model) if model in js.VESSELS else None
+    return float(vessel.length) if isinstance(vessel, js.AbstractVessel) else None
+
+
+def check_froude(experiments, length: float, role: str, model: str = "") -> None:
+    """A `ValueError` naming the file, column and time where a record's u or v beyond
+    Froude number `MAX_FROUDE` for a ship of `length` [m] (the model's)."""
+    limit = MAX_FROUDE * math.sqrt(GRAVITY * length)
+    for e in experiments:
+        for channel in ("u", "v"):
+            values = np.abs(np.asarray(getattr(e, channel))) if e.has(channel) else None
+            if values is None or not (values > limit).any():
+                continue
+            i = int(np.argmax(values > limit))
+            raise ValueError(
+                f"{source(e)} ({role} record {e.name!r}): column {channel!r} reaches "
+                f"{values[i]:.4g} m/s at t = {e.t[i]:.4g} s, Froude number "
+                f"{values[i] / math.sqrt(GRAVITY * length):.3g} for the {length:g} m {model}: "
+                f"no displacement ship runs beyond Fn {MAX_FROUDE:g} ({limit:.3g} m/s). Is the "
+                "column in knots or km/h rather than m/s, or is the record of another ship?")
+
+
 def check_experiments(experiments, rudder: str, role: str, model: str = "",
                       requires=()) -> None:
     """Errors naming the file, before any fitting: the replayed rudder and the

@@ -11,8 +11,8 @@ import numpy as np
 import jaxship as js
 
 from ..._foundation._files import staged_folder
-from .data import read_experiments
-from .registry import get_model_entry
+from .data import check_froude, preset_length, read_experiments
+from .registry import get_model_entry, model_key
 from .workflow import identify, logs_wind
 
 
@@ -38,6 +38,9 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
     holdout = read_experiments(holdout_paths, role="held-out", note=note,
                                taken=[e.name for e in train],
                                sample_interval=sample_interval) if holdout_paths else None
+    length = preset_length(model_key(model))
+    if holdout and length is not None:  # identify checks the training records
+        check_froude(holdout, length, "held-out", model_key(model))
     say(f"start values: identify {model} on {len(train)} training records")
     start = identify(train, model=model).fit.model
     report = js.discover(start, train, holdout, max_effects=max_effects, alpha=alpha,

@@ -26,7 +26,7 @@ import jaxship as js
 from ..._foundation._params import parameter_fields
 from ..._foundation._progress import Progress
 from .assessment import assess
-from .data import as_experiments, check_experiments, valid_samples
+from .data import as_experiments, check_experiments, check_froude, preset_length, valid_samples
 from .registry import MODELS, model_key
 from .result import IdentificationResult
 from .simulation import simulate_records
@@ -154,6 +154,10 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     if validate is not None:
         held_out = as_experiments(validate, "validation")
         check_experiments(held_out, rudder, "validation", name, entry.requires)
+    length = preset_length(name)
+    if length is not None:
+        check_froude(train_exps, length, "training", name)
+        check_froude(held_out or [], length, "validation", name)
     train_ds = js.Dataset.from_experiments(train_exps)
     valid_ds = None if held_out is None else js.Dataset.from_experiments(held_out)
     notes, caught = [], []

@@ -41,6 +41,9 @@ DEG = math.pi / 180.0
 REFERENCE_RATIO = 0.4
 STEP_TIME_RATIO = 50.0
 BANDWIDTH_TIMES_T = 1.25
+# the share of the rudder's angle and rate limits the reference step's feed-forward may
+# use (the rest is the feedback's)
+RUDDER_SHARE = 0.5
 CONTROLLERS = ("pid+ff", "pid")  # with and without the reference feed-forward
 # the columns of a run (`Evaluation.rows`, `autopilot.json` "runs")
 RUN_KEYS = ("controller", "rpm", "speed", "sum_abs_error_deg", "rms_error_deg",
@@ -196,12 +199,42 @@ def operating_point(plant, *, rpm=None, speed=None) -> tuple[float, float]:
     return float(state.u), float(state.n)
 
 
-def natural_frequency_for(model, plant, *, speed: float, n: float) -> tuple[float, str]:
+def reference_rudder_frequency(m: float, d: float, step: float, max_angle: float,
+                               max_rate: float, share: float = RUDDER_SHARE) -> float:
+    """The largest reference frequency $\\omega$ [rad/s] whose feed-forward rudder
+    for a heading step of `step` [rad] stays within `share` of the rudder's angle and
+    rate limits [rad, rad/s]. The reference model at damping 1 is $\\omega^3/(s+\\omega)^3$
+    (eq. 5.7): with $x = \\omega t$, $\\dot\\psi_d = A\\omega\\,\\tfrac{x^2}{2}e^{-x}$,
+    $\\ddot\\psi_d = A\\omega^2(x - \\tfrac{x^2}{2})e^{-x}$ and
+    $\\dddot\\psi_d = A\\omega^3(1 - 2x + \\tfrac{x^2}{2})e^{-x}$; the feed-forward of
+    $m\\dot r + d r = \\delta$ is $\\delta = m\\ddot\\psi_d + d\\dot\\psi_d$, its rate
+    $m\\dddot\\psi_d + d\\ddot\\psi_d$; both peaks grow with $\\omega$ (bisection)."""
+    x = np.linspace(0.0, 30.0, 3001)
+    g1, g2 = x * x / 2 * np.exp(-x), (x - x * x / 2) * np.exp(-x)
+    g3 = (1 - 2 * x + x * x / 2) * np.exp(-x)
+    a, m, d = abs(step), abs(m), abs(d)
+
+    def demand(w):  # the larger of the two peaks, as shares of their limits
+        angle = np.max(np.abs(m * w * w * g2 + d * w * g1)) * a / max_angle
+        rate = np.max(np.abs(m * w**3 * g3 + d * w * w * g2)) * a / max_rate
+        return max(angle, rate) / share
+
+    low, high = 1e-9, 1e3
+    for _ in range(200):  # on a log scale: 1e-9 to 1e3 to 1e-12 relative
+        mid = math.sqrt(low * high)
+        low, high = (mid, high) if demand(mid) <= 1.0 else (low, mid)
+    return low
+
+
+def natural_frequency_for(model, plant, *, speed: float, n: float,
+                          step: float = 45.0) -> tuple[float, str]:
     """`(omega_n, basis)`: the controller's natural frequency [rad/s] from the model's
     yaw time constant $T = m/|d|$ (`jaxship.yaw_inertia` about the straight run at
     `speed`, `n`), $\\omega_n = 1.25/T$ as the thesis design, at most half the rudder
     servo's bandwidth $0.5/T_s$ of the vessel `plant` (which the controller does not
-    model), with the sentence saying so."""
+    model) and at most what keeps the reference's feed-forward rudder for the `step`
+    [deg] within half the rudder's angle and rate limits (`reference_rudder_frequency`,
+    the reference at 0.4 omega_n), with the sentence saying which bound holds."""
     m, d = (float(x) for x in js.yaw_inertia(model, speed=speed, n=n))
     if not (m > 0 and d != 0 and math.isfinite(m / d)):
         raise ValueError(f"the {type(model).__name__} model has no yaw time constant at "
@@ -209,11 +242,18 @@ def natural_frequency_for(model, plant, *, speed: float, n: float) -> tuple[floa
                          "--natural-frequency.")
     T = abs(m / d)
     servo = float(plant.rudder.time_constant)
-    w = min(BANDWIDTH_TIMES_T / T, 0.5 / servo)
-    limited = "half the servo bandwidth" if w < BANDWIDTH_TIMES_T / T else "1.25 / T"
+    rudder = reference_rudder_frequency(
+        m, d, step * DEG, float(plant.rudder.max_angle),
+        float(plant.rudder.max_rate)) / REFERENCE_RATIO
+    bounds = {"1.25 / T": BANDWIDTH_TIMES_T / T, "half the servo bandwidth": 0.5 / servo,
+              f"the feed-forward of the {step:g} deg step within half the rudder's limits "
+              f"({math.degrees(float(plant.rudder.max_angle)):.3g} deg, "
+              f"{math.degrees(float(plant.rudder.max_rate)):.3g} deg/s)": rudder}
+    limited, w = min(bounds.items(), key=lambda item: item[1])
     return w, (f"omega_n = {w:.4g} rad/s from the model's yaw time constant T = {T:.4g} s at "
                f"{speed:.3g} m/s ({limited}; at most 0.5 / T_servo = {0.5 / servo:.3g} "
-               "rad/s), the reference and timing in the thesis' proportions")
+               f"rad/s and {rudder:.3g} rad/s for the rudder), the reference and timing in "
+               "the thesis' proportions")
 
 
 def design_controllers(model, plant, design: Design = Design(), *, speed: float,
