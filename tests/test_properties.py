@@ -187,10 +187,32 @@ VALID = ("t [s],delta [deg],psi [deg],r [deg/s],u [m/s]\n"
                    for k in range(12))).encode()
 
 
+def _heads(lines=12):
+    """The first `lines` lines of one record of each measured format in ../shared/data
+    (Esso Osaka CSV, HSVA and MARIN .dat), each a valid file of its format; none where
+    the data are absent (under CI they are always there: conftest.py)."""
+    root = js.shared_data_dir()
+    if root is None:
+        return []
+    found = []
+    for pattern in ("esso_osaka_frt/zigzag/*.csv", "kvlcc2_simman2008_hsva/*.dat",
+                    "kvlcc2_simman2008_marin/*.dat"):
+        path = sorted(root.glob(pattern))[0]
+        head = b"".join(path.read_bytes().splitlines(keepends=True)[:lines])
+        found.append((path.suffix, head))
+    return found
+
+
+# valid files to mutate: the trial CSV above and the head of each measured format
+SEEDS = [(".csv", VALID), *_heads()]
+
+
 @st.composite
 def mutated(draw):
-    """The bytes of a valid trial CSV with random bytes overwritten, inserted or cut."""
-    data = bytearray(VALID)
+    """(suffix, bytes) of a valid file of one of the formats read (`SEEDS`) with random
+    bytes overwritten, inserted or cut."""
+    suffix, valid = draw(st.sampled_from(SEEDS))
+    data = bytearray(valid)
     for _ in range(draw(st.integers(1, 6))):
         at = draw(st.integers(0, len(data)))
         piece = draw(st.binary(min_size=0, max_size=4))
@@ -201,16 +223,26 @@ def mutated(draw):
             del data[at:at + len(piece) + 1]
         else:
             data[at:at + len(piece)] = piece
-    return bytes(data)
+    return suffix, bytes(data)
 
 
-@settings(max_examples=150, deadline=None, database=None,
+@pytest.mark.parametrize("suffix, data", SEEDS, ids=lambda x: x if isinstance(x, str) else "")
+def test_the_fuzz_seeds_are_valid_files(tmp_path, suffix, data):
+    path = tmp_path / f"record{suffix}"
+    path.write_bytes(data)
+    assert js.read_measured(path).num_samples >= 1
+
+
+@settings(max_examples=400, deadline=None, database=None,
           suppress_health_check=[HealthCheck.too_slow])
-@given(st.one_of(st.binary(max_size=300), mutated()), st.sampled_from([".csv", ".dat", ".txt"]))
-def test_any_bytes_give_a_record_or_one_line_error(tmp_path_factory, data, suffix):
-    """Fuzzing the readers: random bytes, and random mutations of a valid file, are either
-    read into an `Experiment` or refused with a one-line `ValueError` naming the file;
-    never another exception."""
+@given(st.one_of(st.tuples(st.sampled_from([".csv", ".dat", ".txt"]), st.binary(max_size=300)),
+                 mutated()))
+def test_any_bytes_give_a_record_or_one_line_error(tmp_path_factory, case):
+    """Fuzzing the readers: random bytes, and random mutations of a valid file of each
+    format (trial CSV, Esso Osaka CSV, HSVA and MARIN .dat), are either read into an
+    `Experiment` or refused with a one-line `ValueError` naming the file; never another
+    exception."""
+    suffix, data = case
     path = tmp_path_factory.mktemp("fuzz") / f"record{suffix}"
     path.write_bytes(data)
     try:
