@@ -2,6 +2,8 @@
 of its command table (parsed by the `jaxship` parser, the names in it checked, the cheap
 ones run) and its links."""
 
+import json
+import math
 import os
 import pathlib
 import re
@@ -124,3 +126,67 @@ def test_the_links_resolve():
     for link in links:
         if "://" not in link:
             assert (ROOT / link).exists(), link
+
+
+def exit_statuses() -> dict[int, str]:
+    """{status: meaning} of the README's exit-status table."""
+    text = README.split("## Exit statuses", 1)[1].split("\n## ", 1)[0]
+    rows = (line.strip().strip("|").split("|", 1) for line in text.splitlines()
+            if re.match(r"^\| \d+ \|", line))
+    return {int(status): meaning.strip().rstrip("|").strip() for status, meaning in rows}
+
+
+def test_the_exit_statuses_hold_as_written(tmp_path, capsys, monkeypatch):
+    """Each row of the README's exit-status table, its own clauses checked through
+    `main`: 2 (one line on stderr, nothing written), 3 (results written, the reason on
+    stderr), 1 (a file system failure), 130 (earlier results left as they were), 0."""
+    import jaxship as js
+
+    table = exit_statuses()
+    assert set(table) == {0, 1, 2, 3, 130}
+    model = js.Nomoto1(K=0.05, T=10.0)
+    zigzag = js.simulate(model, js.ZigZag(10 * math.pi / 180, 10 * math.pi / 180,
+                                          duration=200.0, dt=1.0))
+    record = tmp_path / "zigzag.csv"
+    js.write_trial_csv(record, js.Experiment.from_trajectory(zigzag))
+    identify = ["identify", str(record), "--model", "nomoto1", "--no-figures", "--quiet"]
+
+    def run(args):
+        code = main(args)
+        return code, capsys.readouterr().err
+
+    assert "one line on stderr" in table[2] and "nothing written" in table[2]
+    code, err = run([*identify[:1], str(tmp_path / "missing.csv"), *identify[2:],
+                     "--out", str(tmp_path / "bad")])
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "missing.csv" in err
+    assert not (tmp_path / "bad").exists()
+
+    assert "did not converge" in table[3] and "results written, the reason on stderr" in table[3]
+    code, err = run([*identify, "--max-steps", "1", "--out", str(tmp_path / "short")])
+    assert code == 3 and "not a converged estimate" in err
+    assert json.loads((tmp_path / "short" / "result.json").read_text())["fit"]["code"] != \
+        "successful"
+
+    assert table[0] == "done"
+    earlier = tmp_path / "earlier"
+    code, _ = run([*identify, "--out", str(earlier)])
+    assert code == 0
+    before = {p: p.read_bytes() for p in earlier.rglob("*") if p.is_file()}
+
+    assert "earlier results left as they were" in table[130]
+    monkeypatch.setattr("jaxship.cli.identify.identify",
+                        lambda *a, **k: (_ for _ in ()).throw(KeyboardInterrupt))
+    code, err = run([*identify, "--out", str(earlier)])
+    assert code == 130 and "interrupted" in err
+    assert {p: p.read_bytes() for p in earlier.rglob("*") if p.is_file()} == before
+
+    assert "the file system failed while writing" in table[1]
+    monkeypatch.undo()
+    monkeypatch.setattr("jaxship.cli.identify.staged_folder", _disk_full)
+    code, err = run([*identify, "--out", str(earlier)])
+    assert code == 1 and "No space left on device" in err
+    assert {p: p.read_bytes() for p in earlier.rglob("*") if p.is_file()} == before
+
+
+def _disk_full(*args, **kwargs):
+    raise OSError(28, "No space left on device")
