@@ -14,6 +14,7 @@ import numpy as np
 from ._data import Experiment
 from ._readers import (
     _HEADER,
+    UTF16_MARKS,
     _check_delimiter,
     _check_rows,
     _check_time,
@@ -254,9 +255,6 @@ def read_marin_kvlcc2(path, *, model_scale: bool = False, dt: float = MARIN_DT
             "title": text[1].strip() if len(text) > 1 else "",
         },
     )
-
-
-UTF16_MARKS = (b"\xff\xfe", b"\xfe\xff")  # the byte-order marks of UTF-16 text
 
 
 def header_names(line: str) -> list[str]:

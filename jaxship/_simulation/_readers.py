@@ -110,13 +110,16 @@ def _open_text(path: Path, encoding: str):
         raise ValueError(f"{path}: cannot read the file ({error.strerror or error}).") from None
 
 
+UTF16_MARKS = (b"\xff\xfe", b"\xfe\xff")  # the byte-order marks of UTF-16 text
+
+
 def _not_text(path: Path, encoding: str) -> ValueError:
     """The error for a file that is not `encoding` text, naming the first bad line."""
     try:
         data = path.read_bytes()
         data.decode(encoding)
     except UnicodeDecodeError as error:
-        if data[:2] in (b"\xff\xfe", b"\xfe\xff"):  # a UTF-16 byte-order mark
+        if data.startswith(UTF16_MARKS):
             return ValueError(f"{path}: the file is UTF-16 text; save it as UTF-8 (or ASCII) "
                               "text.")
         line = data.count(b"\n", 0, error.start) + 1

@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 import jaxship as js
-from jaxship._simulation._measured import UTF16_MARKS, header_names
+from jaxship._simulation._measured import header_names
+from jaxship._simulation._readers import UTF16_MARKS
 
 
 # file suffixes read from a folder (others, e.g. README.md, are skipped)
