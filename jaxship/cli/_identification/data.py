@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 import jaxship as js
+from jaxship._models._vessel.mmg import GRAVITY
 from jaxship._simulation._measured import header_names
 from jaxship._simulation._readers import UTF16_MARKS
 
@@ -157,11 +158,12 @@ def as_experiments(data, role: str) -> list[js.Experiment]:
                      f"Dataset or file paths, got {type(data).__name__}.")
 
 
-# No displacement ship runs beyond a Froude number U / sqrt(g L) of 1 (semi-planing
-# starts about 0.5; Lewis 1988, PNA vol. II ch. 5): a speed channel beyond it, for the
-# model's length, is in another unit (knots, km/h) or from another ship.
+# No displacement ship runs beyond a length Froude number U / sqrt(g L) of 1: merchant
+# ships run at 0.1-0.3, fast displacement hulls up to about 0.5, and beyond 1 a hull
+# planes (Faltinsen 2005, Hydrodynamics of High-Speed Marine Vehicles, ch. 1). A speed
+# channel beyond it, for the model's length, is in another unit (knots, km/h) or from
+# another ship.
 MAX_FROUDE = 1.0
-GRAVITY = 9.80665  # [m/s^2]
 
 
 def preset_length(model: str) -> float | None:
