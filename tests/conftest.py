@@ -19,17 +19,15 @@ js.enable_compilation_cache()
 
 def pytest_configure(config):
     """XLA's CPU compiler set for many small programs, before JAX starts its backend
-    (`jaxship` subprocesses and notebook kernels inherit it). The older loop emitters
-    instead of the MLIR fusion emitters compile in about 60 % of the time and run no
-    slower (the same numbers to rounding: `helpers.assert_equal_to_rounding`). LLVM's
-    optimisation off saves about a quarter of the rest where compiling is most of a
-    test, as in the fast tier, but slows long computations (a 3-DOF Esso Osaka fit
-    50 -> 71 s), so the slow tier (`-m slow`) keeps it. Measured 2026-11-26: fast tier 747 s with
-    the optimisation off alone, 461 s with both."""
+    (`jaxship` subprocesses and notebook kernels inherit it): LLVM's optimisation off
+    and the older loop emitters instead of the MLIR fusion emitters. Most of a test's
+    time is compiling (66 % in test_contracts and test_kalman); with both flags the
+    fast tier took 461 s instead of 747 s (the optimisation off alone) on 2026-11-26,
+    and the slow tier about as long as before (long computations run slower without
+    LLVM's optimisation: a 3-DOF Esso Osaka fit 42 -> 71 s with the loop emitters). The
+    numbers are the same to rounding (`helpers.assert_equal_to_rounding`)."""
     flags = os.environ.get("XLA_FLAGS", "").split()
-    wanted = ["--xla_cpu_use_fusion_emitters=false"]
-    if (config.option.markexpr or "").strip() != "slow":  # all but the slow tier
-        wanted.append("--xla_backend_optimization_level=0")
+    wanted = ["--xla_backend_optimization_level=0", "--xla_cpu_use_fusion_emitters=false"]
     os.environ["XLA_FLAGS"] = " ".join(flags + [f for f in wanted if f not in flags])
 
 
@@ -41,26 +39,23 @@ def pytest_sessionstart(session):
                                 "JAXSHIP_DATA or put shared/ beside the checkout).")
 
 
-# The modules that take longest (worker-seconds of a fast-tier run, 2026-11-26; the
-# notebooks in the slow tier, the discovery one first: 500 s alone), longest first:
-# xdist hands out tests in collection order, so these go first and the short ones fill
-# in at the end, and both workers finish together (alphabetical order left
-# test_real_data and test_low_speed_sway_yaw, 4-5 min together, to one worker at the
-# end while the other idled).
-LONGEST_FIRST = ("test_notebooks", "test_contracts", "test_discover", "test_real_data",
+# The modules that take longest (worker-seconds of a fast-tier run, 2026-11-26),
+# longest first: xdist hands each worker one module at a time in collection order, so
+# these go first and the short ones fill in at the end, and both workers finish
+# together (alphabetical order left test_real_data and test_low_speed_sway_yaw, 4-5 min
+# together, to one worker at the end while the other idled).
+LONGEST_FIRST = ("test_contracts", "test_discover", "test_real_data",
                  "test_effects", "test_low_speed_sway_yaw", "test_kalman", "test_autopilot",
                  "test_ross_autopilot", "test_sway_yaw_fit", "test_autopilot_cli",
                  "test_vessel_fit", "test_identify", "test_cli", "test_mariner",
                  "test_architecture", "test_reproduce", "test_joint_search", "test_estimate")
-LONGEST_TESTS = ("test_notebook_runs[discovery]",)
 
 
 def pytest_collection_modifyitems(session, config, items):
-    """Run the longest modules first (`LONGEST_FIRST`), in each the `LONGEST_TESTS`
-    first; the other modules and tests keep their order."""
+    """Run the longest modules first (`LONGEST_FIRST`); the others keep their order, and
+    so do the tests within each module."""
     rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
-    items.sort(key=lambda item: (rank.get(item.path.stem, len(rank)),
-                                 item.name not in LONGEST_TESTS))
+    items.sort(key=lambda item: rank.get(item.path.stem, len(rank)))
 
 
 MAX_MAPS = 30_000  # the kernel's default vm.max_map_count is 65,530
