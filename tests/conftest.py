@@ -39,13 +39,13 @@ def pytest_sessionstart(session):
                                 "JAXSHIP_DATA or put shared/ beside the checkout).")
 
 
-# The modules that take longest (worker-seconds of a fast-tier run, 2026-11-26),
-# longest first: xdist hands each worker one module at a time in collection order, so
-# these go first and the short ones fill in at the end, and both workers finish
-# together (alphabetical order left test_real_data and test_low_speed_sway_yaw, 4-5 min
-# together, to one worker at the end while the other idled).
-LONGEST_FIRST = ("test_contracts", "test_discover", "test_real_data",
-                 "test_effects", "test_low_speed_sway_yaw", "test_kalman", "test_autopilot",
+# The modules that take longest (worker-seconds of a fast-tier run, 2026-11-26), longest
+# first: xdist hands each worker one module at a time in collection order, so these go
+# first and the short ones fill in at the end, and both workers finish together
+# (alphabetical order left test_real_data and test_low_speed_sway_yaw, 4-5 min together,
+# to one worker at the end while the other idled).
+LONGEST_FIRST = ("test_contracts", "test_discover", "test_real_data", "test_effects",
+                 "test_low_speed_sway_yaw", "test_kalman", "test_autopilot",
                  "test_ross_autopilot", "test_sway_yaw_fit", "test_autopilot_cli",
                  "test_vessel_fit", "test_identify", "test_cli", "test_mariner",
                  "test_architecture", "test_reproduce", "test_joint_search", "test_estimate")
