@@ -38,9 +38,9 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
     holdout = read_experiments(holdout_paths, role="held-out", note=note,
                                taken=[e.name for e in train],
                                sample_interval=sample_interval) if holdout_paths else None
-    name = model_key(model)
-    if holdout and preset_length(name) is not None:  # identify checks the training records
-        check_froude(holdout, preset_length(name), "held-out", name)
+    name, length = model_key(model), preset_length(model_key(model))
+    if holdout and length is not None:  # identify checks the training records
+        check_froude(holdout, length, "held-out", name)
     say(f"start values: identify {model} on {len(train)} training records")
     start = identify(train, model=model).fit.model
     report = js.discover(start, train, holdout, max_effects=max_effects, alpha=alpha,
