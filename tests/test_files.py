@@ -2,7 +2,9 @@
 whole new set appears or none of it, and files of its own earlier run that a new run does
 not write are removed."""
 
+import json
 import os
+import signal
 import subprocess
 import sys
 
@@ -57,11 +59,11 @@ def test_a_file_of_the_users_in_the_way_is_refused_and_kept(tmp_path):
     assert not list(tmp_path.glob(".jaxship.*"))
 
 
-@pytest.mark.parametrize("fail_at", range(8))
+@pytest.mark.parametrize("fail_at", range(9))
 def test_a_failure_at_any_step_of_the_commit_leaves_one_whole_set(tmp_path, monkeypatch,
                                                                   fail_at):
-    """Fault injection: the k-th rename of the commit raises (every move, and the
-    manifest's own rename); afterwards `out` holds the whole old set with its manifest,
+    """Fault injection: the k-th rename of the commit raises (the journal's, every move,
+    the manifest's); afterwards `out` holds the whole old set with its manifest,
     the user's files untouched, and no staging folder."""
     for name, text in MINE.items():
         (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
@@ -78,7 +80,7 @@ def test_a_failure_at_any_step_of_the_commit_leaves_one_whole_set(tmp_path, monk
         return replace(source, target)
 
     monkeypatch.setattr(_files.os, "replace", failing)
-    steps = len(OLD) + len(NEW) + 1  # old files aside, new ones in, the manifest
+    steps = 1 + len(OLD) + len(NEW) + 1  # journal, old files aside, new ones in, manifest
     if fail_at < steps:
         with pytest.raises(OSError, match="No space left"):
             write(tmp_path, NEW)
@@ -88,6 +90,64 @@ def test_a_failure_at_any_step_of_the_commit_leaves_one_whole_set(tmp_path, monk
         write(tmp_path, NEW)
         assert files(tmp_path) == NEW | MINE
     assert not list(tmp_path.glob(".jaxship.*"))
+
+
+KILLED_COMMIT = """
+import importlib.util, json, os, pathlib, signal, sys
+spec = importlib.util.spec_from_file_location("files", sys.argv[1])
+files = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(files)
+out, kill_at = pathlib.Path(sys.argv[2]), int(sys.argv[3])
+calls, replace = [], os.replace
+
+def killed(source, target):  # SIGKILL before (even kill_at) or after (odd) a rename
+    calls.append(target)
+    if len(calls) == kill_at // 2 + 1 and kill_at % 2 == 0:
+        os.kill(os.getpid(), signal.SIGKILL)
+    replace(source, target)
+    if len(calls) == kill_at // 2 + 1:
+        os.kill(os.getpid(), signal.SIGKILL)
+
+files.os.replace = killed
+with files.staged_folder(out) as stage:
+    for name, text in json.loads(sys.argv[4]).items():
+        (stage / name).parent.mkdir(parents=True, exist_ok=True)
+        (stage / name).write_text(text)
+"""
+
+
+@pytest.mark.parametrize("kill_at", range(2 * (1 + len(OLD) + len(NEW) + 1)))
+def test_a_run_killed_at_any_step_of_the_commit_is_finished_or_undone_by_the_next(
+        tmp_path, kill_at):
+    """SIGKILL (no handler runs) just before or just after each rename of the commit
+    (journal, old files aside, new ones in, manifest): the next run on the folder finds
+    the whole old set, or the whole new set once the manifest was written, the user's
+    files untouched, and then commits its own results as usual."""
+    for name, text in MINE.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(text)
+    write(tmp_path, OLD)
+    run = subprocess.run([sys.executable, "-c", KILLED_COMMIT, _files.__file__, str(tmp_path),
+                          str(kill_at), json.dumps(NEW)], capture_output=True, text=True)
+    assert run.returncode == -signal.SIGKILL, run.stderr
+    manifest_written = kill_at == 2 * (1 + len(OLD) + len(NEW)) + 1
+    _files.recover(tmp_path)
+    whole = NEW if manifest_written else OLD
+    assert files(tmp_path) == whole | MINE
+    assert sorted(read_manifest(tmp_path)) == sorted(whole)
+    assert not (tmp_path / _files.JOURNAL).exists()
+    write(tmp_path, {"result.json": "newer"})
+    assert files(tmp_path) == {"result.json": "newer"} | MINE
+    assert not list(tmp_path.glob(".jaxship.*"))
+
+
+def test_a_journal_that_is_not_jaxships_stops_the_run_and_is_kept(tmp_path):
+    (tmp_path / _files.JOURNAL).write_text(json.dumps(
+        {"pid": 1 << 30, "commit": "x", "stage": ".jaxship.1", "backup": "..", "old": [],
+         "new": []}))
+    with pytest.raises(ValueError, match="names files outside"):
+        write(tmp_path, NEW)
+    assert files(tmp_path) == {_files.JOURNAL: (tmp_path / _files.JOURNAL).read_text()}
 
 
 def test_staging_folders_of_dead_runs_are_removed(tmp_path):

@@ -212,3 +212,46 @@ def test_a_reproduce_killed_with_sigkill_leaves_no_worker(tmp_path, delay):
         parent.kill()
         for pid in filter(_alive, workers):
             os.kill(pid, signal.SIGKILL)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("delay", [0.0, 5.0])  # while the worker imports; once it works
+def test_ctrl_c_on_reproduce_ends_it_with_130_and_leaves_nothing_behind(tmp_path, delay):
+    """The trust audit (case 7): Ctrl-C on `reproduce` segfaulted once, printed a worker
+    traceback, took 60-67 s while the pool waited for its worker, and (ending without
+    the interpreter's teardown) left the resource tracker warning of leaked semaphores
+    and a staging folder in --out. Now: status 130 within `GRACE` seconds, "jaxship:
+    interrupted." as the last line and no traceback or warning, the worker gone, and no
+    staging folder."""
+    from jaxship.cli import GRACE
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    out = tmp_path / "r"
+    parent = subprocess.Popen([sys.executable, "-m", "jaxship.cli", "reproduce", "--quick",
+                               "--out", str(out)], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.PIPE, text=True, env=env)
+    workers = {}
+    try:
+        deadline = time.monotonic() + 180
+        while not workers and time.monotonic() < deadline and parent.poll() is None:
+            time.sleep(0.2)
+            workers = {p: c for p, c in _children(parent.pid).items() if "spawn_main" in c}
+        assert workers, "reproduce started no worker"
+        time.sleep(delay)
+        sent = time.monotonic()
+        parent.send_signal(signal.SIGINT)
+        err = parent.communicate(timeout=60)[1]
+        took = time.monotonic() - sent
+        assert parent.returncode == 130, (parent.returncode, err[-2000:])
+        assert took < GRACE + 3.0, took
+        assert err.rstrip().endswith("jaxship: interrupted."), err[-2000:]
+        assert "Traceback" not in err and "Warning" not in err, err[-2000:]
+        deadline = time.monotonic() + 15
+        while any(map(_alive, workers)) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        assert not any(map(_alive, workers)), workers
+        assert not list(out.glob(".jaxship.*")) if out.exists() else True
+    finally:
+        parent.kill()
+        for pid in filter(_alive, workers):
+            os.kill(pid, signal.SIGKILL)

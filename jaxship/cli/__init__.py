@@ -3,6 +3,7 @@ Each command is one module of this package, owning its parser (`register`) and i
 function (`run`); `main` registers them and turns errors into exit statuses."""
 
 import argparse
+import gc
 import importlib.metadata
 import os
 import signal
@@ -17,6 +18,7 @@ import matplotlib
 matplotlib.use("Agg")  # the command writes files; it never opens a window
 
 from .._foundation._cache import enable_compilation_cache  # noqa: E402
+from .._foundation._files import discard_open_stages  # noqa: E402
 from . import autopilot, discover, identify, reproduce, simulate, vessels  # noqa: E402
 from ._common import one_line  # noqa: E402
 from ._identification.workflow import FitDivergedError  # noqa: E402
@@ -31,7 +33,8 @@ interrupted. JAXSHIP_CACHE_DIR: where compiled programs are kept for later runs 
 
 COMMANDS = (vessels, simulate, reproduce, identify, autopilot, discover)
 GRACE = 5.0  # [s] after Ctrl-C, the longest the process takes to end
-_INTERRUPTED = threading.Event()
+_INTERRUPTED = threading.Event()  # Ctrl-C was pressed
+_RAISED = threading.Event()  # and raised as KeyboardInterrupt in the main thread
 
 
 class _ShowsDefaults:
@@ -106,11 +109,28 @@ def run() -> None:
 
 
 def _interrupt(signum, frame):
-    if _INTERRUPTED.is_set():
+    if not _INTERRUPTED.is_set():
+        _INTERRUPTED.set()
+        threading.Thread(target=_watchdog, daemon=True).start()
+    elif _RAISED.is_set():
         return  # a second Ctrl-C: the watchdog is already on its way
-    _INTERRUPTED.set()
-    threading.Thread(target=_watchdog, daemon=True).start()
+    if _swallowed(frame):  # raise it again once the main thread is out of there
+        threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGINT)).start()
+        return
+    _RAISED.set()
     raise KeyboardInterrupt
+
+
+def _swallowed(frame) -> bool:
+    """Whether an exception raised at `frame` would be swallowed: inside a garbage-
+    collection callback (XLA has one) or a finaliser, where Python prints "Exception
+    ignored in ..." with a traceback and goes on."""
+    callbacks = {getattr(callback, "__code__", None) for callback in gc.callbacks}
+    while frame is not None:
+        if frame.f_code in callbacks or frame.f_code.co_name == "__del__":
+            return True
+        frame = frame.f_back
+    return False
 
 
 def _watchdog():
@@ -122,4 +142,5 @@ def _watchdog():
 def _end(status: int):
     sys.stdout.flush()
     sys.stderr.flush()
+    discard_open_stages()  # unwinding would have removed them
     os._exit(status)

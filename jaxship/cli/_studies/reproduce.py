@@ -35,6 +35,7 @@ import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
+from multiprocessing import resource_tracker
 
 import jax
 import numpy as np
@@ -72,7 +73,9 @@ def _file_name(spec, rpm):
 
 
 class _Stage:
-    """A tqdm bar fed by a study's progress messages (each message starts a step)."""
+    """A tqdm bar fed by a study's progress messages (each message starts a step); as a
+    context, filled on success and closed as it stands after an error or Ctrl-C (so
+    that nothing redraws it after the command's last line)."""
 
     def __init__(self, desc, total, enabled):
         self.bar = tqdm(desc=desc, total=total, disable=not enabled, unit="step")
@@ -84,10 +87,13 @@ class _Stage:
         self.started = True
         self.bar.set_postfix_str(str(message)[:60])
 
-    def close(self):
-        if self.bar.total is not None:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, error, traceback):
+        if kind is None and self.bar.total is not None:
             self.bar.update(max(self.bar.total - self.bar.n, 0))
-        elif self.started:
+        elif kind is None and self.started:
             self.bar.update()
         self.bar.close()
 
@@ -152,24 +158,22 @@ def _run(out, quick, progress, identification, closed_loop, discover, parallel) 
             stage_done("identification", clock)
         if identification and closed_loop:
             clock = (time.perf_counter(), time.process_time())
-            stage = _Stage("chapter 5: closed loop", 2 * 3 + 1, progress)
-            evaluation = chapter5.autopilot_study(vessel, identification=study,
-                                                   progress=stage)
-            stage.close()
+            with _Stage("chapter 5: closed loop", 2 * 3 + 1, progress) as stage:
+                evaluation = chapter5.autopilot_study(vessel, identification=study,
+                                                       progress=stage)
             results["autopilot"] = chapter5.to_json(evaluation)
             sections.append(autopilot_section(evaluation, study, out, quick))
             stage_done("autopilot", clock)
         if discover:
             clock = (time.perf_counter(), time.process_time())
-            stage = _Stage("discovery", None, progress)
-            here = lambda: _discovery(quick, out, stage)
-            if discovery_job is not None:
-                worker.listen("discovery", stage)
-                data = worker.result(discovery_job, here)
-                second_cpu += data["case"]["cpu_seconds"]
-            else:
-                data = here()
-            stage.close()
+            with _Stage("discovery", None, progress) as stage:
+                here = lambda: _discovery(quick, out, stage)
+                if discovery_job is not None:
+                    worker.listen("discovery", stage)
+                    data = worker.result(discovery_job, here)
+                    second_cpu += data["case"]["cpu_seconds"]
+                else:
+                    data = here()
             results["discovery"] = data
             sections.append(discovery_section(data))
             stage_done("discovery", clock)
@@ -213,9 +217,9 @@ def _finite(d):
 def _trials(vessel, families, out, progress):
     """Simulate the experiment design of chapter 4 (no noise); write the trial CSVs;
     returns the design and the indices `{file name: indices}` (200 rpm first)."""
-    stage = _Stage("thesis trials", len(RPMS) * sum(map(len, families.values())), progress)
-    design = thesis.simulate_design(vessel, families=families, progress=stage)
-    stage.close()
+    with _Stage("thesis trials", len(RPMS) * sum(map(len, families.values())),
+                progress) as stage:
+        design = thesis.simulate_design(vessel, families=families, progress=stage)
     indices = {}
     for family, spec, rpm, manoeuvre, traj in sorted(design.values(), key=lambda d: d[2]):
         name = _file_name(spec, rpm)
@@ -228,24 +232,23 @@ def _identification(vessel, design, families, quick, progress, worker):
     """Chapter 4 on noisy records of the trials; the last family in `worker` (if any)."""
     models = QUICK_MODELS if quick else thesis.MODELS
     cases = QUICK_CASES if quick else ("single", "merged")
-    stage = _Stage("chapter 4: identification", len(cases) * len(families) * len(models),
-                   progress)
-    experiments = thesis.noisy_records(design)
-    here, there, future = dict(families), {}, None
-    if worker is not None and len(families) > 1:
-        name = list(families)[-1]
-        there = {name: here.pop(name)}
-        records = {k: e for k, e in experiments.items() if dict(e.metadata)["family"] == name}
-        future = worker.submit(_identification_job, records, there, models, cases)
-        worker.listen("identification", stage)
-    say = (lambda message: (stage(message), worker.poll())) if future else stage
-    run = lambda part, report: thesis.identification_study(
-        vessel, experiments=experiments, progress=report, families=part, models=models,
-        cases=cases)
-    parts = [run(here, say)]
-    if there:
-        parts.append(worker.result(future, lambda: run(there, stage)))
-    stage.close()
+    with _Stage("chapter 4: identification", len(cases) * len(families) * len(models),
+                progress) as stage:
+        experiments = thesis.noisy_records(design)
+        here, there, future = dict(families), {}, None
+        if worker is not None and len(families) > 1:
+            name = list(families)[-1]
+            there = {name: here.pop(name)}
+            records = {k: e for k, e in experiments.items() if dict(e.metadata)["family"] == name}
+            future = worker.submit(_identification_job, records, there, models, cases)
+            worker.listen("identification", stage)
+        say = (lambda message: (stage(message), worker.poll())) if future else stage
+        run = lambda part, report: thesis.identification_study(
+            vessel, experiments=experiments, progress=report, families=part, models=models,
+            cases=cases)
+        parts = [run(here, say)]
+        if there:
+            parts.append(worker.result(future, lambda: run(there, stage)))
     second_cpu = sum(p.get("cpu_seconds", 0.0) for p in parts)
     study = _combine(parts, families, models, cases) | {"quick": bool(quick)}
     return study, experiments, second_cpu
@@ -321,6 +324,7 @@ class _Worker:
     messages come back tagged with their stage."""
 
     def __init__(self):
+        _start_quiet_resource_tracker()
         context = multiprocessing.get_context("spawn")
         self.queue = context.Queue()
         self.pool = ProcessPoolExecutor(1, mp_context=context, initializer=_start_worker,
@@ -367,9 +371,27 @@ class _Worker:
         return here()
 
     def close(self, wait: bool = True):
-        """End the process: after its job, or at once (`wait=False`: it dies with this
-        process, which is ending)."""
+        """End the process: after its job, or at once (`wait=False`: killed, before the
+        semaphores it shares are unlinked, which a process still starting would meet
+        with a traceback)."""
+        if not wait:  # `kill_workers` is Python 3.14's; the pool's processes until then
+            for process in list(getattr(self.pool, "_processes", {}).values()):
+                process.kill()
+                process.join(1.0)
         self.pool.shutdown(wait=wait, cancel_futures=True)
+
+
+def _start_quiet_resource_tracker():
+    """Start multiprocessing's resource tracker (the process that unlinks the pool's
+    semaphores when this one ends without its finalizers, as after Ctrl-C: `os._exit`)
+    with its warnings off: it would report those semaphores as leaked while it cleans
+    them up. No-op if it runs already."""
+    options = list(sys.warnoptions)
+    sys.warnoptions.append("ignore::UserWarning")  # passed on to the tracker's command line
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        sys.warnoptions[:] = options
 
 
 def _combine(parts, families, models, cases) -> dict:
