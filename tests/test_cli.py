@@ -553,3 +553,39 @@ def test_help_shows_defaults_and_which_options_are_required(capsys):
     assert "most effects added (default: 3)" in seen["discover"]
     assert "the controller's zeta (default: 1.0)" in seen["autopilot"]
     assert "(default: None)" not in " ".join(seen.values())
+
+
+GC_INTERRUPT = """
+import gc, os, signal, sys, time
+from jaxship import cli
+signal.signal(signal.SIGINT, cli._interrupt)
+
+def callback(phase, info):  # Ctrl-C arriving while a garbage-collection callback runs
+    if phase == "start" and not cli._INTERRUPTED.is_set():
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.01)  # the handler runs here, inside the callback
+
+gc.callbacks.append(callback)
+try:
+    gc.collect()
+    time.sleep(2.0)
+    print("went on")
+except KeyboardInterrupt:
+    print("interrupted", flush=True)
+os._exit(0)  # before the watchdog
+"""
+
+
+def test_ctrl_c_inside_a_garbage_collection_callback_is_not_swallowed():
+    """The trust audit (case 7): a SIGINT that landed in XLA's garbage-collection callback
+    was swallowed ("Exception ignored in: <function _xla_gc_callback ...>
+    KeyboardInterrupt", with a traceback) and the run went on. The handler now raises it
+    again once the main thread is out of the callback."""
+    import subprocess
+    import sys
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    run = subprocess.run([sys.executable, "-c", GC_INTERRUPT], capture_output=True, text=True,
+                         env=env, timeout=120)
+    assert run.stdout.strip() == "interrupted", (run.stdout, run.stderr)
+    assert "Exception ignored" not in run.stderr and "Traceback" not in run.stderr, run.stderr
