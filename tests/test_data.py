@@ -487,7 +487,13 @@ def test_read_measured_dispatch(tmp_path):
     trial.write_text(GOOD)
     cases[trial] = "trial csv"
     for path, kind in cases.items():
-        assert read_measured(path).meta["format"] == kind
+        record = read_measured(path)
+        assert record.meta["format"] == kind
+        # the measured data sets log u, v over ground (GNSS track, carriage); a trial
+        # CSV (jaxship's simulation) through the water
+        assert record.over_ground == (kind != "trial csv"), path
+        assert js.Dataset.from_experiments([record]).over_ground.tolist() == [
+            record.over_ground]
     with pytest.raises(ValueError, match="zz_-20_m.dat: no such file"):
         read_measured(tmp_path / "zz_-20_m.dat")
 

@@ -232,20 +232,24 @@ def _interval_map(model, substeps, holds):
     return f
 
 
-def _measure(model, channels):
+def _measure(model, channels, ground):
+    """h(z): the channels' sensors, u and v over ground where `ground` is 1."""
     index = [model.channel_index(c) for c in channels]
 
     def h(z):
+        z = model.with_current(z, ground)
         return jnp.stack([model.measure(c, z[i]) for c, i in zip(channels, index)])
 
     return h
 
 
-def _filter(model, inputs, y, mask, dt, z0, P0, Q, q_rudder, R, channels, substeps, holds):
+def _filter(model, inputs, y, mask, dt, z0, P0, Q, q_rudder, R, channels, substeps, holds,
+            ground=0.0):
     """The EKF over one record (module docstring); `inputs` `{name: (N,)}`, `mask`:
-    (N,); `y`: (N, C). Returns a `KalmanOutput`."""
+    (N,); `y`: (N, C); `ground`: 1 where its u, v are over ground. Returns a
+    `KalmanOutput`."""
     F = _interval_map(model, substeps, dict(holds))
-    h = _measure(model, channels)
+    h = _measure(model, channels, ground)
     jac = jax.jacfwd(F, argnums=(0, 1))
     n = z0.shape[0]
     eye = jnp.eye(n, dtype=z0.dtype)
@@ -279,7 +283,7 @@ def _filter(model, inputs, y, mask, dt, z0, P0, Q, q_rudder, R, channels, subste
     _, (zp, Pp, zf, Pf, e, S, A, nll) = jax.lax.scan(step, (z0, P0), scanned)
     first = lambda a0, a: jnp.concatenate([a0[None], a])
     c = y.shape[1]
-    S0 = _measure_cov0(model, channels, z0, P0, R)
+    S0 = _measure_cov0(model, channels, z0, P0, R, ground)
     return KalmanOutput(
         predicted=first(z0, zp), predicted_cov=first(P0, Pp), filtered=first(z0, zf),
         filtered_cov=first(P0, Pf), innovations=first(jnp.zeros(c, z0.dtype), e),
@@ -288,8 +292,8 @@ def _filter(model, inputs, y, mask, dt, z0, P0, Q, q_rudder, R, channels, subste
     )
 
 
-def _measure_cov0(model, channels, z0, P0, R):
-    H = jax.jacfwd(_measure(model, channels))(z0)
+def _measure_cov0(model, channels, z0, P0, R, ground):
+    H = jax.jacfwd(_measure(model, channels, ground))(z0)
     return H @ P0 @ H.T + R
 
 
@@ -338,7 +342,8 @@ def _records(ds, channels, rudder, substeps, hold=None) -> _Records:
     start = WindowStart(r=first("r"), psi=first("psi"), delta=first(rudder), r_first=first("r"),
                         psi_first=first("psi"), delta_integral=zero, elapsed=zero,
                         aux=AuxInputs(u=first("u"), v=first("v"), n=first("n")),
-                        rudder_angle=first("delta"), x=first("x"), y=first("y"))
+                        rudder_angle=first("delta"), x=first("x"), y=first("y"),
+                        ground=f(ds.over_ground))
     return _Records(
         inputs={name: f(getattr(ds, rudder if name == "delta" else name)) for name in REPLAYED},
         y=f(np.stack([np.asarray(getattr(ds, c)) for c in channels], axis=-1)),
@@ -353,7 +358,7 @@ def _prior(model, start, channels, R, P0):
     (`replay_state`: a steering model's `window_state` and the measured heading; a
     vessel's measured states); covariance `P0`, or by default R on the measured
     entries and 0 on the others."""
-    z0 = model.replay_state(start)
+    z0 = model.with_current(model.replay_state(start), -start.ground)  # through the water
     if P0 is not None:
         return z0, P0
     diag = jnp.zeros(z0.shape[0], dtype=z0.dtype)
@@ -368,7 +373,7 @@ def _batch_filter(model, rec: _Records, Q, q_rudder, R, P0=None):
     def one(inputs, y, mask, dt, start):
         z0, p0 = _prior(model, start, rec.channels, R, P0)
         return _filter(model, inputs, y, mask, dt, z0, p0, Q, q_rudder, R, rec.channels,
-                       rec.substeps, rec.holds)
+                       rec.substeps, rec.holds, start.ground)
 
     # plain vmap: reverse mode (the ML Hessian) of a scan inside shard_map fails in
     # jax 0.10 ("context mesh ... should match"); records are few, windows are many

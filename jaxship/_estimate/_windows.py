@@ -272,6 +272,7 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
                         for c in ("u", "v", "n", "wind_u", "wind_v"))),
         rudder_angle=f(at("delta", start_index, rows2)),
         x=f(at("x", start_index, rows2)), y=f(at("y", start_index, rows2)),
+        ground=f(np.broadcast_to(ds.over_ground[:, None], (num_exp, num_w))),
     )
     records = {name: f(rud[rows, record_index] if name == "delta" else
                        at(name, record_index, rows)) for name in names}

@@ -48,6 +48,12 @@ class AbstractModel(eqx.Module):
         sensor effects change it)."""
         return value
 
+    def with_current(self, y, scale):
+        """The replayed state `y` with `scale` times the current's body components
+        added to its u, v: through the water to over ground (`scale` 1), back (-1),
+        unchanged (0: a record logged through the water). No current here."""
+        return y
+
     def lookup(self, name: str):
         """The parameter (or part) called `name`: a field here."""
         return getattr(self, name)

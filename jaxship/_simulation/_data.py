@@ -30,6 +30,9 @@ def _cumulative_trapezoid(y: np.ndarray, t: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(t))])
 
 
+OVER_GROUND = ("velocities", "over ground")  # metadata of records whose u, v are over ground
+
+
 class Experiment(eqx.Module):
     """One trial, measured or simulated: SI channels sampled at the times `t`.
 
@@ -43,7 +46,10 @@ class Experiment(eqx.Module):
     - anything else missing: zeros.
 
     Filled-in `psi`/`r` are listed in `derived`. `name` and `metadata` (a tuple of
-    `(key, value)` pairs with hashable values; see `meta`) are static; `extra` holds
+    `(key, value)` pairs with hashable values; see `meta`) are static; the metadata
+    `("velocities", "over ground")` says that `u`, `v` are the track's velocity over
+    ground in body axes (GNSS, a basin's carriage: every reader of measured data sets
+    it), not through the water (`over_ground`); `extra` holds
     further measured signals that are not part of the simulation state (relative wind,
     thrust, torque, roll), as SI arrays unless stated otherwise in the reader.
 
@@ -134,6 +140,14 @@ class Experiment(eqx.Module):
     @property
     def num_samples(self) -> int:
         return int(np.shape(self.t)[0])
+
+    @property
+    def over_ground(self) -> bool:
+        """Whether `u`, `v` are over ground (metadata `("velocities", "over ground")`);
+        else through the water, as a simulation's. They differ by the current, which
+        `fit` adds to a vessel's predicted u, v of such a record
+        (`jaxship.UniformCurrent`)."""
+        return dict(self.metadata).get("velocities") == OVER_GROUND[1]
 
     @property
     def dt(self) -> float:
@@ -351,6 +365,13 @@ class Dataset(eqx.Module):
     @property
     def num_experiments(self) -> int:
         return len(self.lengths)
+
+    @property
+    def over_ground(self) -> np.ndarray:
+        """(E,) bool: whether each experiment's u, v are over ground
+        (`Experiment.over_ground`)."""
+        return np.array([dict(m).get("velocities") == OVER_GROUND[1]
+                         for m in self.experiment_metadata], dtype=bool)
 
     @property
     def num_samples(self) -> int:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._data import Experiment
+from ._data import OVER_GROUND, Experiment
 from ._readers import (
     _HEADER,
     UTF16_MARKS,
@@ -72,9 +72,11 @@ def read_esso_osaka(path) -> Experiment:
     Osaka University 2020; Wakita et al. 2022), model scale, SI.
 
     The files are already SI, body-fixed u, v at midship and in our sign convention
-    (positive delta gives positive r). The heading `psi_hat` is wrapped to
-    [-pi, pi] in the files (the README's "not wrapped" is wrong: every turning run
-    jumps by 2 pi); it is unwrapped here with `np.unwrap`. x, y are the pond's
+    (positive delta gives positive r). u, v are over ground (derived from the GNSS
+    receiver's track, UPSTREAM_README: the model logs no speed through the water).
+    The heading `psi_hat` is wrapped to [-pi, pi] in the files (the README's "not
+    wrapped" is wrong: every turning run jumps by 2 pi); it is unwrapped here with
+    `np.unwrap`. x, y are the pond's
     earth-fixed x0, y0 axes (not north/east; psi is measured from x0).
     `wind_speed`/`wind_dir` are the TRUE wind, the direction it comes from, measured
     from x0 (checked: the logged apparent
@@ -114,7 +116,7 @@ def read_esso_osaka(path) -> Experiment:
         metadata={
             "file": str(path), "format": "esso_osaka", "vessel": "Esso Osaka 3 m model",
             "source": "FRT-DS-ESSO, Osaka University (2020)", "scale": "model",
-            "lpp": 3.0, "frame": "pond x0/y0 axes",
+            "lpp": 3.0, "frame": "pond x0/y0 axes", "velocities": OVER_GROUND[1],
         },
     )
 
@@ -190,7 +192,7 @@ def read_hsva_kvlcc2(path) -> Experiment:
         metadata={
             "file": str(path), "format": "hsva_kvlcc2", "vessel": "KVLCC2",
             "source": "HSVA CPMC, SIMMAN 2008", "scale": "model", "lambda": KVLCC2_SCALE,
-            "lpp": 7.0,
+            "lpp": 7.0, "velocities": OVER_GROUND[1],
             "title": " ".join(s.strip() for s in text[1:3]),
         },
     )
@@ -251,7 +253,7 @@ def read_marin_kvlcc2(path, *, model_scale: bool = False, dt: float = MARIN_DT
         metadata={
             "file": str(path), "format": "marin_kvlcc2", "vessel": "KVLCC2",
             "source": "MARIN, SIMMAN 2008", "scale": "model" if model_scale else "full",
-            "lambda": KVLCC2_SCALE, "lpp": 320.0 / scale,
+            "lambda": KVLCC2_SCALE, "lpp": 320.0 / scale, "velocities": OVER_GROUND[1],
             "title": text[1].strip() if len(text) > 1 else "",
         },
     )

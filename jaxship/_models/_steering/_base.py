@@ -45,7 +45,8 @@ class WindowStart(eqx.Module):
     `delta_integral` $= \\int_{t_0}^{t_s}\\delta\\,dt$ [rad s] (exact for the
     replayed rudder, held or interpolated) and `elapsed` $= t_s - t_0$ [s];
     `rudder_angle`: the measured rudder angle at $t_s$ (where a servo replays the
-    command); `x`, `y`: the measured position at $t_s$ (None: not given)."""
+    command); `x`, `y`: the measured position at $t_s$ (None: not given); `ground`: 1
+    where the record's u, v are over ground, 0 through the water (`with_current`)."""
 
     r: ArrayLike
     psi: ArrayLike
@@ -58,6 +59,7 @@ class WindowStart(eqx.Module):
     rudder_angle: ArrayLike | None = None  # the measured rudder angle there [rad]
     x: ArrayLike | None = None  # the measured earth-fixed position there [m], if any
     y: ArrayLike | None = None
+    ground: ArrayLike = 0.0
 
 
 class AbstractSteeringModel(AbstractModel):

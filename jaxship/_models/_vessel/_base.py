@@ -91,6 +91,18 @@ class AbstractVessel(AbstractModel):
         return jnp.stack([start.aux.u, start.aux.v, start.r, x, y, start.psi, delta + zero,
                           start.aux.n + zero])
 
+    def with_current(self, y, scale):
+        """`y` with `scale` times the current of `environment` in body axes added to
+        u, v: over ground $u_g = u + V_N\\cos\\psi + V_E\\sin\\psi$,
+        $v_g = v - V_N\\sin\\psi + V_E\\cos\\psi$ (the current in body axes,
+        $\\nu_c = R(\\psi)^\\top v_c^n$, Fossen 2021 ch. 10; `scale` 1); through the
+        water from over ground (-1)."""
+        north, east = self.environment(Environment()).current.velocity()
+        psi = y[STATE_FIELDS.index("psi")]
+        c, s = jnp.cos(psi), jnp.sin(psi)
+        return y.at[0].add(scale * (north * c + east * s)).at[1].add(
+            scale * (east * c - north * s))
+
     def replay_field(self, servo: bool = False):
         """`f(t, y, inputs)`: the state derivative with the measured rudder angle and
         propeller rate replayed (`inputs["delta"]`, `inputs["n"]`; their states do not
