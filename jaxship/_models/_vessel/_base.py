@@ -234,14 +234,13 @@ def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> Ship
     if speed is None and n is None:
         speed, n = vessel.nominal_speed, vessel.nominal_n
     if n is None:
-        n = _newton(lambda nn: surge_force(vessel, jnp.asarray(speed, float), nn), vessel.nominal_n)
+        n = _newton(lambda nn: _surge_and_slope(vessel, _f(speed), nn, "n"), vessel.nominal_n)
     elif speed is None:
-        speed = _newton(
-            lambda uu: surge_force(vessel, uu, jnp.asarray(n, float)), vessel.nominal_speed
-        )
-    residual = float(surge_force(vessel, jnp.asarray(speed, float), jnp.asarray(n, float)))
+        speed = _newton(lambda uu: _surge_and_slope(vessel, uu, _f(n), "u"),
+                        vessel.nominal_speed)
+    residual = float(_surge_and_slope(vessel, _f(speed), _f(n), "n")[0])
     reference = max(abs(float(speed)), float(vessel.nominal_speed))  # at rest too
-    scale = float(vessel.mass_matrix()[0, 0]) * reference**2 / float(vessel.length)
+    scale = float(_surge_mass(vessel)) * reference**2 / float(vessel.length)
     if not abs(residual) <= 1e-3 * scale:
         raise ValueError(
             f"{type(vessel).__name__} has no straight run at u = {float(speed):.4g} m/s, n = "
@@ -253,16 +252,33 @@ def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> Ship
 
 def _has_propeller(vessel) -> bool:
     """Whether the surge force depends on the propeller rate at the nominal speed."""
-    u = jnp.asarray(vessel.nominal_speed, float)
-    return float(jax.grad(lambda nn: surge_force(vessel, u, nn))(
-        jnp.asarray(vessel.nominal_n, float) + 1.0)) != 0.0
+    return float(_surge_and_slope(vessel, _f(vessel.nominal_speed),
+                                  _f(vessel.nominal_n) + 1.0, "n")[1]) != 0.0
+
+
+def _f(x):
+    return jnp.asarray(x, dtype=float)
+
+
+@eqx.filter_jit
+def _surge_and_slope(vessel, u, n, wrt: str):
+    """`surge_force(vessel, u, n)` and its derivative with respect to `wrt` ("u" or
+    "n"), as one compiled program (op by op, the trim compiled dozens of small ones in
+    every new process)."""
+    if wrt == "n":
+        return jax.value_and_grad(lambda nn: surge_force(vessel, u, nn))(n)
+    return jax.value_and_grad(lambda uu: surge_force(vessel, uu, n))(u)
+
+
+_surge_mass = eqx.filter_jit(lambda vessel: vessel.mass_matrix()[0, 0])  # m_11 [kg]
 
 
 def _newton(f, x0, iterations=50):
-    """Scalar Newton iteration with a guard for functions that do not depend on x."""
-    x = jnp.asarray(x0, dtype=float)
+    """Scalar Newton iteration on `f(x) = (value, slope)`, with a guard for functions
+    that do not depend on x."""
+    x = _f(x0)
     for _ in range(iterations):
-        fx, dfx = jax.value_and_grad(f)(x)
+        fx, dfx = f(x)
         if float(abs(dfx)) < 1e-300:
             return x
         step = fx / dfx
