@@ -305,16 +305,15 @@ class UniformCurrent(AbstractVesselPropertyEffect):
     $\\dot x = R(\\psi)\\nu + V_c$ (Fossen 2021, Property 10.1), and it changes the
     relative wind (where wind acts on wind areas).
 
-    Measured u, v in jaxship are through the water by convention (log, or the
-    simulation's), where a current does not show: it is seen in the positions
+    A record's u, v are through the water (a log, or the simulation's), where a
+    current does not show, or over ground (`Experiment.over_ground`: GNSS, a basin's
+    carriage; every measured data set), where `fit` predicts
+    $u_g = u + V_N\\cos\\psi + V_E\\sin\\psi$,
+    $v_g = v - V_N\\sin\\psi + V_E\\cos\\psi$ and starts each window through the
+    water (`AbstractVessel.with_current`). It is also seen in the positions
     (`PredictionError(channels=(..., "x", "y"))`, which `discover` fits where every
-    record logs them) or through wind on wind areas. A
-    record whose u, v come from GPS (over ground) would need the current in the
-    output map, $u_g = u + V_N\\cos\\psi + V_E\\sin\\psi$,
-    $v_g = v - V_N\\sin\\psi + V_E\\cos\\psi$, and the window starts through the
-    water, $u = u_g - \\dots$: a measurement effect that sees psi, which
-    `measure(channel, value)` does not. Plausible $|V| \\le 3$ m/s per component
-    (tidal streams). Vessels only."""
+    record logs them) and through wind on wind areas. Plausible $|V| \\le 3$ m/s per
+    component (tidal streams). Vessels only."""
 
     north: ArrayLike = param(0.0, lower=-3.0, upper=3.0, scale=0.5, unit="m/s")
     east: ArrayLike = param(0.0, lower=-3.0, upper=3.0, scale=0.5, unit="m/s")
