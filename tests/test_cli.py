@@ -589,3 +589,46 @@ def test_ctrl_c_inside_a_garbage_collection_callback_is_not_swallowed():
                          env=env, timeout=120)
     assert run.stdout.strip() == "interrupted", (run.stdout, run.stderr)
     assert "Exception ignored" not in run.stderr and "Traceback" not in run.stderr, run.stderr
+
+
+LONG_XLA_CALL = """
+import jax
+import jax.numpy as jnp
+from jaxship import cli
+
+def main(argv=None):  # one XLA computation of tens of seconds: Python's handler waits
+    loop = jax.jit(lambda x: jax.lax.fori_loop(0, 2_000_000_000,
+                                               lambda i, x: jnp.sin(x) + 1e-9, x))
+    print("started", flush=True)
+    loop(jnp.float32(0.0)).block_until_ready()
+    return 0
+
+cli.main = main
+cli.run()
+"""
+
+
+def test_ctrl_c_during_a_long_xla_computation_ends_the_command_within_grace():
+    """The trust audit (case 7): on an Esso Osaka `discover`, SIGINT took up to 27 s to
+    end the process: Python's signal handler, which started the watchdog, runs only
+    once the main thread leaves the XLA computation it is in. The watchdog now starts
+    from the signal's wakeup byte, so the command ends with 130 within `GRACE`."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from jaxship.cli import GRACE
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    process = subprocess.Popen([sys.executable, "-c", LONG_XLA_CALL], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, env=env)
+    assert process.stdout.readline().strip() == "started"
+    time.sleep(1.0)  # compiled and running
+    sent = time.monotonic()
+    process.send_signal(signal.SIGINT)
+    err = process.communicate(timeout=60)[1]
+    took = time.monotonic() - sent
+    assert process.returncode == 130, (process.returncode, err)
+    assert took < GRACE + 2.0, took
+    assert err.rstrip().endswith("jaxship: interrupted.") and "Traceback" not in err, err

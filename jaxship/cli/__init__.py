@@ -101,6 +101,7 @@ def run() -> None:
     inside a garbage-collection callback is swallowed, a watchdog ends the process
     `GRACE` seconds after the signal whatever the main thread is doing. Results are
     committed whole or not at all (`staged_folder`), so ending there loses nothing."""
+    _listen_for_interrupts()
     signal.signal(signal.SIGINT, _interrupt)
     status = main()
     if _INTERRUPTED.is_set():
@@ -108,12 +109,26 @@ def run() -> None:
     sys.exit(status)
 
 
+def _listen_for_interrupts():
+    """Start the watchdog from the byte the C-level signal handler writes (the wakeup
+    fd) as soon as SIGINT arrives: Python's own handler runs only when the main thread
+    is back in Python, which a long XLA computation can delay by many seconds."""
+    read, write = os.pipe()
+    os.set_blocking(write, False)
+    signal.set_wakeup_fd(write, warn_on_full_buffer=False)
+
+    def listen():
+        while signal.SIGINT not in os.read(read, 64):
+            pass
+        _watchdog()
+
+    threading.Thread(target=listen, daemon=True).start()
+
+
 def _interrupt(signum, frame):
-    if not _INTERRUPTED.is_set():
-        _INTERRUPTED.set()
-        threading.Thread(target=_watchdog, daemon=True).start()
-    elif _RAISED.is_set():
+    if _RAISED.is_set():
         return  # a second Ctrl-C: the watchdog is already on its way
+    _INTERRUPTED.set()
     if _swallowed(frame):  # raise it again once the main thread is out of there
         threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGINT)).start()
         return
