@@ -3,6 +3,7 @@ optimistix's, each of which a fit once reported as converged, and no warning or 
 from the library on the way."""
 
 
+import jax
 import numpy as np
 import pytest
 from helpers import per_sample
@@ -55,6 +56,11 @@ def test_a_start_that_never_moves_is_not_converged():
     # a start at the optimum does not move either, and is converged
     exact = js.fit(js.Nomoto1(K=0.06, T=25.0), data)
     assert exact.success and exact.cost < 1e-12
+    # in float32 (JAX's default, where the audit met it again): the start of 1e-12 is
+    # stored as 9.99999996e-13, which a tolerance of 1e-10 relative did not see as the start
+    with jax.enable_x64(False):
+        single = js.fit(js.Nomoto1(K=1e-12, T=1e6), data)
+    assert not single.success and single.code == js.RESULTS.did_not_move, single.message
 
 
 def test_a_simulation_that_blows_up_is_not_converged():
