@@ -365,12 +365,19 @@ def test_a_rudder_on_its_limits_is_a_code_and_a_sentence(identified, tmp_path, c
     """omega_n = 5 rad/s and a 180 deg step on the thesis vessel: the ship cannot turn
     that fast and the rudder sits at its limit for most of the window; each such run
     has the code rudder_saturated, the report says so first and stderr warns (exit 0:
-    the runs are finite)."""
+    the runs are finite). The model file gives its parameters as bare numbers, which the
+    loader accepts (the trust audit: the command then ended in a TypeError traceback)."""
+    report = json.loads(identified.read_text())
+    report["parameters"] = {k: e["value"] for k, e in report["parameters"].items()}
+    bare = tmp_path / "bare.json"
+    bare.write_text(json.dumps(report))
     out = tmp_path / "fast"
-    assert main(["autopilot", "--model", str(identified), "--vessel", "thesis", "--rpm",
+    assert main(["autopilot", "--model", str(bare), "--vessel", "thesis", "--rpm",
                  "400", "--natural-frequency", "5", "--step", "180", "--out", str(out),
                  "--quiet"]) == 0
-    runs = json.loads((out / "autopilot.json").read_text())["runs"]
+    written = json.loads((out / "autopilot.json").read_text())
+    assert written["model"]["parameters"] == report["parameters"]
+    runs = written["runs"]
     assert {r["code"] for r in runs} == {"rudder_saturated"}
     assert all(r["time_saturated_s"] > 0.5 * 10.0 for r in runs)  # window 10-20 s
     assert "rudder_saturated" in (out / "report.md").read_text().split("##")[0]

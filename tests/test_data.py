@@ -193,6 +193,11 @@ ERROR_CASES = {
         "t [s],delta [deg],psi [deg],psi [rad]\n0,0,0,0\n0.1,0,0,0\n",
         r"bad\.csv: column 'psi \[rad\]' \(header row, line 1\): column 'psi' appears twice",
     ),
+    "unclosed quote": (  # the message was the rest of the file, newlines and all
+        't [s],"delta [deg],psi [deg]\n0,1,2\n1,2,3\n',
+        r"bad\.csv: header row \(line 1\): the quote opened in column 'delta \[deg\],psi "
+        r"\[deg\]' is never closed, so the header runs on over 3 lines\.$",
+    ),
     "header without unit": (
         "t,delta [deg],psi [deg]\n0,0,0\n0.1,0,0\n",
         r"bad\.csv: column 't' \(header row, line 1\): a header must read 'name \[unit\]'",

@@ -278,6 +278,12 @@ def _check_time(path, header, t, lines, require_uniform, rtol):
 
 
 def _split_header(path, line, text):
+    if "\n" in text or "\r" in text:  # a quote never closed: the header ran on
+        lines = text.splitlines()
+        raise ValueError(
+            f"{path}: header row (line {line - len(lines) + 1}): the quote opened in column "
+            f"'{lines[0][:40]}' is never closed, so the header runs on over {len(lines)} lines."
+        )
     match = _HEADER.match(text)
     if match is None:
         raise ValueError(

@@ -124,7 +124,8 @@ def run(args) -> int:
         result = {
             "model": {"file": str(args.model), "name": report["model"],
                       "class": type(model).__name__,
-                      "parameters": {k: e["value"] for k, e in report["parameters"].items()}},
+                      "parameters": {k: float(e["value"] if isinstance(e, dict) else e)
+                                     for k, e in report["parameters"].items()}},
             "vessel": args.vessel,
             **evaluation.to_dict(),
             "figures": figures,

@@ -97,13 +97,18 @@ def read_experiments(paths, *, role: str = "training", note=None, taken=(),
     for path in paths:
         path = Path(path)
         if path.is_dir():
-            candidates = [item for item in sorted(path.iterdir()) if item.is_file()
-                          and item.suffix.lower() in DATA_SUFFIXES]
+            listed = [item for item in sorted(path.iterdir())
+                      if item.suffix.lower() in DATA_SUFFIXES and not item.is_dir()]
+            candidates = [item for item in listed if item.is_file()]
             found = [item for item in candidates if is_measurement_file(item)]
             skipped = [item.name for item in candidates if item not in found]
+            special = [item.name for item in listed if not item.is_file()]  # never opened
             if skipped and note is not None:
                 note(f"{path}: skipped {len(skipped)} file(s) whose format is not a "
                      f"measurement record: {', '.join(skipped)}.")
+            if special and note is not None:
+                note(f"{path}: skipped {len(special)} file(s) that are not regular files (a "
+                     f"FIFO, a device, a broken link): {', '.join(special)}.")
             if not found:
                 raise ValueError(f"{path}: the {role} folder holds no measurement file "
                                  "(trial CSV, Esso Osaka CSV, HSVA or MARIN .dat).")
