@@ -177,3 +177,30 @@ def test_identify_keeps_the_users_figure_and_drops_its_own_stale_ones(tmp_path, 
                  "--out", str(out), "--quiet", "--no-figures"]) == 0
     assert sorted(p.name for p in (out / "figures").iterdir()) == ["mine.png"]
     capsys.readouterr()
+
+
+def test_a_file_of_the_users_in_the_way_is_refused_before_the_work(tmp_path, capsys,
+                                                                   monkeypatch):
+    """The trust audit: a user's `report.md` in `discover`'s --out, or a file named
+    `figures` in `identify`'s, was found only at the commit, after the whole run (and
+    the second ended with exit 1, "File exists"). Now: exit 2, one line, before any
+    record is read, and the file kept."""
+    def never(*args, **kwargs):
+        raise AssertionError("the work started")
+
+    monkeypatch.setattr("jaxship.cli.identify.read_experiments", never)
+    monkeypatch.setattr("jaxship.cli.discover.run_discovery", never)
+    cases = {"discover": ("report.md", "exists and jaxship did not write it"),
+             "identify": ("figures", "is a file of yours where jaxship writes its figures/")}
+    for command, (name, message) in cases.items():
+        out = tmp_path / command
+        out.mkdir()
+        (out / name).write_text("mine")
+        assert main([command, "any.csv", "--model", "nomoto1", "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert message in err and len(err.strip().splitlines()) == 1, err
+        assert files(out) == {name: "mine"}
+    # where jaxship wrote it itself (its manifest), the same name is its to replace
+    write(tmp_path / "ours", {"report.md": "old"})
+    with pytest.raises(AssertionError, match="the work started"):
+        main(["discover", "any.csv", "--model", "nomoto1", "--out", str(tmp_path / "ours")])

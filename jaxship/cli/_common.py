@@ -8,6 +8,7 @@ import tempfile
 
 from tqdm.auto import tqdm
 
+from .._foundation._files import read_manifest
 from .._models._vessel._base import surge_force
 
 
@@ -62,9 +63,12 @@ def numbers(option, texts) -> list[float]:
     return values
 
 
-def check_out(out: pathlib.Path):
-    """`ValueError` unless `out` is (or can be made) a folder we can write into;
-    writes nothing that stays."""
+def check_out(out: pathlib.Path, writes: tuple[str, ...] = ()):
+    """`ValueError` unless `out` is (or can be made) a folder we can write into, and
+    none of the results the command always `writes` there (file names; a folder as
+    `"name/"`) is in the way as a file of the user's (not in jaxship's manifest), so
+    that the clash is told before the work, not at the commit; writes nothing that
+    stays."""
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out {out} is a file, not a folder; give a folder (it is made if "
                          "need be).")
@@ -79,6 +83,16 @@ def check_out(out: pathlib.Path):
     except OSError as error:
         raise ValueError(f"--out {out}: cannot write in {parent} "
                          f"({error.strerror or error}).") from None
+    ours = set(read_manifest(out)) if out.is_dir() else set()
+    for name in writes:
+        target = out / name.rstrip("/")
+        if name.endswith("/") and (target.is_file() or target.is_symlink()
+                                   and not target.is_dir()):
+            raise ValueError(f"{target} is a file of yours where jaxship writes its {name} "
+                             "folder; move it or choose another --out.")
+        if not name.endswith("/") and target.exists() and name not in ours:
+            raise ValueError(f"{target} exists and jaxship did not write it; move it or "
+                             "choose another --out (jaxship replaces only its own files).")
 
 
 def note(sentence: str) -> None:

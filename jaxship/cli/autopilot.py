@@ -70,7 +70,7 @@ def run(args) -> int:
     check_operating_point(vessel, args.vessel, [] if by_rpm else values,
                           values if by_rpm else [])
     model, report = read_result(args.model)
-    check_out(args.out)
+    check_out(args.out, writes=("autopilot.json", "report.md", "figures/"))
     basis = ""
     if auto:  # from the model's yaw time constant at the mean operating point of the runs
         u0, n0 = autopilot_study.operating_point(

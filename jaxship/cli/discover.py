@@ -32,7 +32,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    check_out(args.out)  # before any long work
+    check_out(args.out, writes=("discovery.json", "report.md", "figures/"))
     say = (lambda message: None) if args.quiet else (
         lambda message: tqdm.write(f"jaxship: {message} ...", file=sys.stderr))
     report = run_discovery(args.train, args.holdout, model=args.model, out=args.out,

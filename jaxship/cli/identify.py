@@ -68,7 +68,7 @@ def run(args) -> int:
     if args.max_steps < 1:
         raise ValueError(f"--max-steps {args.max_steps}: give a positive number of optimiser "
                          "steps (default 256).")
-    check_out(args.out)
+    check_out(args.out, writes=("result.json",) + (() if args.no_figures else ("figures/",)))
     train = read_experiments(args.train, role="training", note=note,
                              sample_interval=args.sample_interval)
     held_out = None if args.validate is None else read_experiments(

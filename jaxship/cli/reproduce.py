@@ -14,6 +14,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    check_out(args.out)
+    check_out(args.out, writes=("report.md", "figures/", "trials/"))
     reproduce(args.out, quick=args.quick, progress=True)
     return 0

@@ -63,7 +63,7 @@ def run(args) -> int:
         raise ValueError(f"--duration/--dt: {samples:.3g} samples ({duration or 100 * tau:.4g} s "
                          f"at {dt or tau / 20:.3g} s), more than {MAX_SAMPLES:.0e}; give a "
                          "larger --dt or a shorter --duration.")
-    check_out(args.out)
+    check_out(args.out, writes=("trial.csv", "indices.json"))
     with staged_folder(args.out) as stage:
         indices = simulate_to_folder(vessel, spec, stage, speed=speed, rpm=rpm,
                                      duration=duration, dt=dt,
