@@ -637,3 +637,38 @@ def test_ctrl_c_during_a_long_xla_computation_ends_the_command_within_grace():
     assert process.returncode == 130, (process.returncode, err)
     assert took < GRACE + 2.0, took
     assert err.rstrip().endswith("jaxship: interrupted.") and "Traceback" not in err, err
+
+
+TEARDOWN = """
+import atexit, time
+from jaxship import cli
+
+atexit.register(time.sleep, 5.0)  # a slow interpreter teardown after the results
+
+def main(argv=None):
+    print("done", flush=True)
+    return 0
+
+cli.main = main
+cli.run()
+"""
+
+
+def test_ctrl_c_after_the_results_ends_with_130_and_its_line():
+    """The audit of the trust fixes: a Ctrl-C that lands after the command returned, in
+    the interpreter's teardown, killed the process by the signal without "jaxship:
+    interrupted."; now it ends with 130 and that line."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    process = subprocess.Popen([sys.executable, "-c", TEARDOWN], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, env=env)
+    assert process.stdout.readline().strip() == "done"
+    time.sleep(0.5)
+    process.send_signal(signal.SIGINT)
+    err = process.communicate(timeout=60)[1]
+    assert process.returncode == 130, (process.returncode, err)
+    assert err.rstrip().endswith("jaxship: interrupted.") and "Traceback" not in err, err

@@ -35,6 +35,7 @@ COMMANDS = (vessels, simulate, reproduce, identify, autopilot, discover)
 GRACE = 5.0  # [s] after Ctrl-C, the longest the process takes to end
 _INTERRUPTED = threading.Event()  # Ctrl-C was pressed
 _RAISED = threading.Event()  # and raised as KeyboardInterrupt in the main thread
+_RETURNED = threading.Event()  # `main` has returned: the process is ending
 
 
 class _ShowsDefaults:
@@ -104,6 +105,7 @@ def run() -> None:
     _listen_for_interrupts()
     signal.signal(signal.SIGINT, _interrupt)
     status = main()
+    _RETURNED.set()
     if _INTERRUPTED.is_set():
         _end(130)
     sys.exit(status)
@@ -129,6 +131,9 @@ def _interrupt(signum, frame):
     if _RAISED.is_set():
         return  # a second Ctrl-C: the watchdog is already on its way
     _INTERRUPTED.set()
+    if _RETURNED.is_set():  # in the interpreter's teardown, where raising would kill
+        print("jaxship: interrupted.", file=sys.stderr)  # the process by the signal
+        _end(130)
     if _swallowed(frame):  # raise it again once the main thread is out of there
         threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGINT)).start()
         return
