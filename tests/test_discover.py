@@ -18,6 +18,7 @@ from jaxship._analysis._discover._holdout import cost_rise, record_indices
 from jaxship._analysis._discover._plausible import rudder_equivalent
 from jaxship._analysis._discover._workflow import heldout_rise
 from jaxship._estimate._windows import as_dataset
+from jaxship._foundation._files import MANIFEST, staged_folder
 from jaxship.cli import main
 from jaxship.cli._studies.discovery import (
     condition_records,
@@ -518,8 +519,8 @@ def test_an_interrupted_discover_command_leaves_the_earlier_results(tmp_path, ca
     record = tmp_path / "a.csv"
     js.write_trial_csv(record, hidden_effect_records(js.Nomoto1(K=K, T=25.0), 0)[0][0])
     out = tmp_path / "out"
-    out.mkdir()
-    (out / "report.md").write_text("earlier\n")
+    with staged_folder(out) as stage:  # an earlier run's results (jaxship's: its manifest)
+        (stage / "report.md").write_text("earlier\n")
 
     def half_written(report, train, holdout, folder):
         folder.mkdir(parents=True)
@@ -530,7 +531,7 @@ def test_an_interrupted_discover_command_leaves_the_earlier_results(tmp_path, ca
     monkeypatch.setattr(command, "save_discovery_figures", half_written)
     assert main(["discover", str(record), "--model", "nomoto1", "--out", str(out),
                  "--quiet"]) == 130
-    assert sorted(p.name for p in out.iterdir()) == ["report.md"]
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "report.md"]
     assert (out / "report.md").read_text() == "earlier\n"
 
 

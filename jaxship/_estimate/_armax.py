@@ -23,6 +23,7 @@ import math
 
 import numpy as np
 import optimistix as optx
+from scipy.signal import lfilter
 
 from .._foundation._covariance import parameter_report
 from .._foundation._params import parameter_fields
@@ -31,13 +32,6 @@ from ._discrete import continuous_parameters
 from ._fit import AbstractEstimator, excitation_flags
 from ._result import FitResult, Prediction, assemble_result
 from ._windows import as_dataset, check_data
-
-
-def lfilter(*args, **kwargs):
-    """`scipy.signal.lfilter`, imported at the first call (scipy.signal takes 0.5 s)."""
-    from scipy.signal import lfilter as scipy_lfilter
-
-    return scipy_lfilter(*args, **kwargs)
 
 
 def _lags(x, lags, start):

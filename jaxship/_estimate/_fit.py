@@ -176,11 +176,12 @@ def _predict(model, w: Windows, offsets=None):
         y0 = model.replay_state(start, w.servo)
         if offset is not None:
             y0 = y0.at[corrected].add(offset)
-        y0 = model.with_current(y0, -start.ground)  # over-ground u, v: through the water
+        ground = 0.0 if start.ground is None else start.ground
+        y0 = model.with_current(y0, -ground)  # over-ground u, v: through the water
         num = records["delta"].shape[0] - 1
 
         def observe(y, _):  # and u, v over ground again where the record's are
-            y = model.with_current(y, start.ground)
+            y = model.with_current(y, ground)
             return jnp.stack([model.measure(c, y[i]) for c, i in zip(w.channels, index)])
 
         out, _ = integrate(lambda t, y, a: field(t, y, a[0].at(t - a[1])), y0,

@@ -8,6 +8,7 @@ armax` wraps it.
 
 import equinox as eqx
 import numpy as np
+from scipy.signal import lfilter, lfiltic
 
 from .._foundation._params import param
 
@@ -56,8 +57,6 @@ def simulate_armax(model: ARMAXModel, delta, r0) -> np.ndarray:
     first sample is `r0`.
 
     Samples are causal: padding at the end of a row affects nothing before it."""
-    from scipy.signal import lfilter, lfiltic  # imported here: scipy.signal takes 0.5 s
-
     delta = np.asarray(delta, dtype=np.float64)
     rows = np.atleast_2d(delta)
     r0 = np.broadcast_to(np.asarray(r0, dtype=np.float64), rows.shape[:1])

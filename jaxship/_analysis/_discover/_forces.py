@@ -17,6 +17,7 @@ the states, so a filter that trusted the model would hide them.
 import jax
 import jax.numpy as jnp
 import numpy as np
+from scipy.signal import savgol_filter
 
 from ..._estimate._kalman import _augmented_names, smooth_states
 from ..._estimate._windows import as_dataset
@@ -36,8 +37,6 @@ FILTERED = ("psi", "r", "u", "x", "y")  # what the filter measures where v is no
 def _noise(a, span) -> float:
     """Measurement-noise variance of one channel: the variance of what a cubic
     Savitzky-Golay smoother over `span` samples leaves (floored for exact data)."""
-    from scipy.signal import savgol_filter  # imported here: it takes 0.5 s
-
     rest = a - savgol_filter(a, span, 3)
     return max(float(np.var(rest)), 1e-12 * (float(np.var(a)) + 1e-12))
 
@@ -82,8 +81,6 @@ def residual_loads(vessel, data, *, smoothing: float = 10.0, wind: bool = False,
     ds = as_dataset(data)
     mass = np.asarray(vessel.mass_matrix())
     out = {name: [] for name, _ in LOADS}
-    from scipy.signal import savgol_filter  # imported here: it takes 0.5 s
-
     logged = all({"u", "v", "r"} <= set(have) for have in ds.experiment_channels)
     if not logged:
         smoothed = smoothed or smoothed_vessel_states(vessel, ds, smoothing=smoothing)

@@ -40,6 +40,7 @@ candidates' scores; a Gaussian multiplier bootstrap, Chernozhukov, Chetverikov &
 import dataclasses
 
 import numpy as np
+from scipy.stats import chi2
 
 from ..._foundation._covariance import _auto_lags, bartlett_long_run
 
@@ -156,9 +157,6 @@ def forward_path(g, v, gram, blocks, equivalent, lower, top, enter=0.05):
     (p, p): the scores' variance and the projected sensitivities' Gram matrix;
     `blocks`: each candidate's columns; `equivalent` (m, m) bool; `lower` (p,) bool:
     parameters that may not go negative. Returns (draws, m) bool."""
-    from scipy.stats import chi2  # imported here: scipy.stats takes 0.3 s
-
-
     draws, m = g.shape[0], len(blocks)
     chosen = np.zeros((draws, m), bool)
     for _ in range(top):

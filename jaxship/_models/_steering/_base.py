@@ -46,7 +46,8 @@ class WindowStart(eqx.Module):
     replayed rudder, held or interpolated) and `elapsed` $= t_s - t_0$ [s];
     `rudder_angle`: the measured rudder angle at $t_s$ (where a servo replays the
     command); `x`, `y`: the measured position at $t_s$ (None: not given); `ground`: 1
-    where the record's u, v are over ground, 0 through the water (`with_current`)."""
+    where the record's u, v are over ground, 0 or None through the water
+    (`with_current`)."""
 
     r: ArrayLike
     psi: ArrayLike
@@ -59,7 +60,7 @@ class WindowStart(eqx.Module):
     rudder_angle: ArrayLike | None = None  # the measured rudder angle there [rad]
     x: ArrayLike | None = None  # the measured earth-fixed position there [m], if any
     y: ArrayLike | None = None
-    ground: ArrayLike = 0.0
+    ground: ArrayLike | None = None  # None (or 0): u, v through the water
 
 
 class AbstractSteeringModel(AbstractModel):
