@@ -190,28 +190,41 @@ def test_a_reproduce_killed_with_sigkill_leaves_no_worker(tmp_path, delay):
     """The trust audit (case 8): SIGKILL on `reproduce` orphaned its worker, which went on
     writing figures into the dead run's folder. The worker dies with its parent, also
     when the parent dies while the worker is still importing."""
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    parent = subprocess.Popen([sys.executable, "-m", "jaxship.cli", "reproduce", "--quick",
-                               "--out", str(tmp_path / "r")], stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL, env=env)
-    workers = {}
+    parent, workers = _reproduce_with_its_worker(tmp_path / "r", subprocess.DEVNULL)
     try:
-        deadline = time.monotonic() + 180
-        while not workers and time.monotonic() < deadline and parent.poll() is None:
-            time.sleep(0.2)
-            workers = {p: c for p, c in _children(parent.pid).items() if "spawn_main" in c}
-        assert workers, "reproduce started no worker"
         time.sleep(delay)
         parent.send_signal(signal.SIGKILL)
         parent.wait(10)
-        deadline = time.monotonic() + 15
-        while any(map(_alive, workers)) and time.monotonic() < deadline:
-            time.sleep(0.2)
-        assert not any(map(_alive, workers)), workers
+        assert _gone(workers), workers
     finally:
         parent.kill()
         for pid in filter(_alive, workers):
             os.kill(pid, signal.SIGKILL)
+
+
+def _reproduce_with_its_worker(out, stderr):
+    """A `reproduce --quick` into `out` and its worker once started: the process and
+    {worker pid: command line}."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    parent = subprocess.Popen([sys.executable, "-m", "jaxship.cli", "reproduce", "--quick",
+                               "--out", str(out)], stdout=subprocess.DEVNULL, stderr=stderr,
+                              text=True, env=env)
+    workers, deadline = {}, time.monotonic() + 180
+    while not workers and time.monotonic() < deadline and parent.poll() is None:
+        time.sleep(0.2)
+        workers = {p: c for p, c in _children(parent.pid).items() if "spawn_main" in c}
+    if not workers:
+        parent.kill()
+    assert workers, "reproduce started no worker"
+    return parent, workers
+
+
+def _gone(workers, within: float = 15.0) -> bool:
+    """Whether every process of `workers` has ended within `within` seconds."""
+    deadline = time.monotonic() + within
+    while any(map(_alive, workers)) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    return not any(map(_alive, workers))
 
 
 @pytest.mark.slow
@@ -225,18 +238,9 @@ def test_ctrl_c_on_reproduce_ends_it_with_130_and_leaves_nothing_behind(tmp_path
     staging folder."""
     from jaxship.cli import GRACE
 
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     out = tmp_path / "r"
-    parent = subprocess.Popen([sys.executable, "-m", "jaxship.cli", "reproduce", "--quick",
-                               "--out", str(out)], stdout=subprocess.DEVNULL,
-                              stderr=subprocess.PIPE, text=True, env=env)
-    workers = {}
+    parent, workers = _reproduce_with_its_worker(out, subprocess.PIPE)
     try:
-        deadline = time.monotonic() + 180
-        while not workers and time.monotonic() < deadline and parent.poll() is None:
-            time.sleep(0.2)
-            workers = {p: c for p, c in _children(parent.pid).items() if "spawn_main" in c}
-        assert workers, "reproduce started no worker"
         time.sleep(delay)
         sent = time.monotonic()
         parent.send_signal(signal.SIGINT)
@@ -246,10 +250,7 @@ def test_ctrl_c_on_reproduce_ends_it_with_130_and_leaves_nothing_behind(tmp_path
         assert took < GRACE + 3.0, took
         assert err.rstrip().endswith("jaxship: interrupted."), err[-2000:]
         assert "Traceback" not in err and "Warning" not in err, err[-2000:]
-        deadline = time.monotonic() + 15
-        while any(map(_alive, workers)) and time.monotonic() < deadline:
-            time.sleep(0.2)
-        assert not any(map(_alive, workers)), workers
+        assert _gone(workers), workers
         assert not list(out.glob(".jaxship.*")) if out.exists() else True
     finally:
         parent.kill()
