@@ -157,7 +157,8 @@ json.dump(dict(
 
 def test_sharded_equals_single_device(batch):
     """Four XLA host devices in a subprocess: same numbers as one device (padding 6 -> 8)."""
-    env = dict(os.environ, XLA_FLAGS="--xla_force_host_platform_device_count=4",
+    flags = os.environ.get("XLA_FLAGS", "")  # the test run's compiler flags (conftest)
+    env = dict(os.environ, XLA_FLAGS=f"{flags} --xla_force_host_platform_device_count=4",
                JAX_PLATFORMS="cpu", JAX_ENABLE_X64="1")
     code = textwrap.dedent(_SHARDED.format(tests=str(Path(__file__).parent)))
     done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,

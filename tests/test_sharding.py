@@ -84,7 +84,8 @@ def _windows(records):
 def test_sharded_fits_equal_single_device():
     single = results()
     assert single["devices"] == 1 and not single["sharded"]
-    env = dict(os.environ, XLA_FLAGS="--xla_force_host_platform_device_count=4",
+    flags = os.environ.get("XLA_FLAGS", "")  # the test run's compiler flags (conftest)
+    env = dict(os.environ, XLA_FLAGS=f"{flags} --xla_force_host_platform_device_count=4",
                JAX_PLATFORMS="cpu", JAX_ENABLE_X64="1")
     code = textwrap.dedent(f"""
         import json, sys
