@@ -25,13 +25,9 @@ def pytest_configure(config):
     fast tier took 461 s instead of 747 s (the optimisation off alone) on 2026-11-26,
     and the slow tier about as long as before (long computations run slower without
     LLVM's optimisation: a 3-DOF Esso Osaka fit 42 -> 71 s with the loop emitters). The
-    numbers are the same to rounding (`helpers.assert_equal_to_rounding`). Eigen's
-    thread pool is off: two Mariner discover runs side by side took 32 s each with it
-    and 29 s without (21.6 and 20.4 s alone), 2026-11-26."""
+    numbers are the same to rounding (`helpers.assert_equal_to_rounding`)."""
     flags = os.environ.get("XLA_FLAGS", "").split()
-    wanted = ["--xla_backend_optimization_level=0", "--xla_cpu_use_fusion_emitters=false",
-              # one thread per process: the two workers of a tier do not contend
-              "--xla_cpu_multi_thread_eigen=false"]
+    wanted = ["--xla_backend_optimization_level=0", "--xla_cpu_use_fusion_emitters=false"]
     os.environ["XLA_FLAGS"] = " ".join(flags + [f for f in wanted if f not in flags])
 
 
@@ -47,11 +43,9 @@ def pytest_sessionstart(session):
 # first: xdist hands each worker one module at a time in collection order, so these go
 # first and the short ones fill in at the end, and both workers finish together
 # (alphabetical order left test_real_data and test_low_speed_sway_yaw, 4-5 min together,
-# to one worker at the end while the other idled). test_notebooks has slow tests only:
-# in the slow tier its notebooks (about 13 min) take one worker while the other takes
-# the rest.
-LONGEST_FIRST = ("test_notebooks", "test_contracts", "test_discover", "test_real_data",
-                 "test_effects", "test_low_speed_sway_yaw", "test_kalman", "test_autopilot",
+# to one worker at the end while the other idled).
+LONGEST_FIRST = ("test_contracts", "test_discover", "test_real_data", "test_effects",
+                 "test_low_speed_sway_yaw", "test_kalman", "test_autopilot",
                  "test_ross_autopilot", "test_sway_yaw_fit", "test_autopilot_cli",
                  "test_vessel_fit", "test_identify", "test_cli", "test_mariner",
                  "test_architecture", "test_reproduce", "test_joint_search", "test_estimate")

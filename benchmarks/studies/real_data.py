@@ -76,17 +76,18 @@ def hsva_split(root=None, *, factor: int = 4, train=HSVA_TRAIN, test=HSVA_TEST):
     return read(train), read(test)
 
 
-def kvlcc2_discovery_split(root=None) -> tuple[list, list]:
+def kvlcc2_discovery_split(root=None, *, marin: bool = True) -> tuple[list, list]:
     """`(train, holdout)` of the KVLCC2 discovery check: the 11 HSVA zig-zags other than
-    the two 10/10 runs to train, and both HSVA 10/10 runs and the four MARIN zig-zags
-    (Froude-scaled to the 7 m HSVA model) held out, all at 5 Hz."""
-    folder, marin = _root(root, "kvlcc2_simman2008_hsva"), _root(root, "kvlcc2_simman2008_marin")
+    the two 10/10 runs to train, and both HSVA 10/10 runs and (with `marin`) the four
+    MARIN zig-zags (Froude-scaled to the 7 m HSVA model) held out, all at 5 Hz."""
+    folder = _root(root, "kvlcc2_simman2008_hsva")
+    folder_marin = _root(root, "kvlcc2_simman2008_marin")
     files = sorted(p for p in folder.glob("*.dat") if "_Z_" in p.name)
     read = lambda paths: [js.read_hsva_kvlcc2(p).decimate(4) for p in paths]  # 20 Hz
     held = [p for p in files if "_Z_10_10_" in p.name]
     return read([p for p in files if p not in held]), read(held) + [
         js.read_marin_kvlcc2(p, model_scale=True).decimate(10)  # 50 Hz
-        for p in sorted(marin.glob("*zz*.dat"))]
+        for p in (sorted(folder_marin.glob("*zz*.dat")) if marin else ())]
 
 
 @dataclasses.dataclass(frozen=True)
