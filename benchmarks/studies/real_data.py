@@ -81,13 +81,13 @@ def kvlcc2_discovery_split(root=None, *, marin: bool = True) -> tuple[list, list
     the two 10/10 runs to train, and both HSVA 10/10 runs and (with `marin`) the four
     MARIN zig-zags (Froude-scaled to the 7 m HSVA model) held out, all at 5 Hz."""
     folder = _root(root, "kvlcc2_simman2008_hsva")
-    folder_marin = _root(root, "kvlcc2_simman2008_marin")
     files = sorted(p for p in folder.glob("*.dat") if "_Z_" in p.name)
     read = lambda paths: [js.read_hsva_kvlcc2(p).decimate(4) for p in paths]  # 20 Hz
     held = [p for p in files if "_Z_10_10_" in p.name]
     return read([p for p in files if p not in held]), read(held) + [
         js.read_marin_kvlcc2(p, model_scale=True).decimate(10)  # 50 Hz
-        for p in (sorted(folder_marin.glob("*zz*.dat")) if marin else ())]
+        for p in (sorted(_root(root, "kvlcc2_simman2008_marin").glob("*zz*.dat"))
+                  if marin else ())]
 
 
 @dataclasses.dataclass(frozen=True)

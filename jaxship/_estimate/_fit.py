@@ -176,7 +176,7 @@ def _predict(model, w: Windows, offsets=None):
         y0 = model.replay_state(start, w.servo)
         if offset is not None:
             y0 = y0.at[corrected].add(offset)
-        ground = 0.0 if start.ground is None else start.ground
+        ground = start.ground_scale
         y0 = model.with_current(y0, -ground)  # over-ground u, v: through the water
         num = records["delta"].shape[0] - 1
 

@@ -358,8 +358,7 @@ def _prior(model, start, channels, R, P0):
     (`replay_state`: a steering model's `window_state` and the measured heading; a
     vessel's measured states); covariance `P0`, or by default R on the measured
     entries and 0 on the others."""
-    ground = 0.0 if start.ground is None else start.ground
-    z0 = model.with_current(model.replay_state(start), -ground)  # through the water
+    z0 = model.with_current(model.replay_state(start), -start.ground_scale)  # through the water
     if P0 is not None:
         return z0, P0
     diag = jnp.zeros(z0.shape[0], dtype=z0.dtype)
@@ -374,8 +373,7 @@ def _batch_filter(model, rec: _Records, Q, q_rudder, R, P0=None):
     def one(inputs, y, mask, dt, start):
         z0, p0 = _prior(model, start, rec.channels, R, P0)
         return _filter(model, inputs, y, mask, dt, z0, p0, Q, q_rudder, R, rec.channels,
-                       rec.substeps, rec.holds,
-                       0.0 if start.ground is None else start.ground)
+                       rec.substeps, rec.holds, start.ground_scale)
 
     # plain vmap: reverse mode (the ML Hessian) of a scan inside shard_map fails in
     # jax 0.10 ("context mesh ... should match"); records are few, windows are many

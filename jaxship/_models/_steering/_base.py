@@ -62,6 +62,11 @@ class WindowStart(eqx.Module):
     y: ArrayLike | None = None
     ground: ArrayLike | None = None  # None (or 0): u, v through the water
 
+    @property
+    def ground_scale(self) -> ArrayLike:
+        """`ground` with None read as 0 (the scale of `with_current`)."""
+        return 0.0 if self.ground is None else self.ground
+
 
 class AbstractSteeringModel(AbstractModel):
     """A response model $\\dot x = f(x, \\delta, a)$, $r = h(x)$, $\\dot\\psi = r$.
