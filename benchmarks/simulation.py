@@ -242,7 +242,7 @@ class Case:
     def jaxship_args(self, angles, second):
         u0, n0 = self.starts(second)
         # the rudder reversed at the first step after the crossing, as the hand scan and
-        # SciPy do (jaxship's default reverses it at the step nearest to the crossing)
+        # SciPy do (jaxship's default reverses it at the crossing, inside the step)
         manoeuvre = js.ZigZag(angles, angles, duration=self.duration, dt=DT,
                               n=None if self.name == "mariner" else n0, switch_at="after")
         x0 = js.straight_state(u0, n0)

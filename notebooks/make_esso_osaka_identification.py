@@ -68,7 +68,18 @@ if os.environ.get("CI") and not (HAVE_ESSO and HAVE_HSVA):
 reference. The heading fit % of a free simulation is dominated by the heading drift of a
 long run."""),
     new_code_cell("""if HAVE_ESSO:
-    display(Markdown(esso.table()))"""),
+    display(Markdown(esso.table()))
+    # the slow test tier runs this notebook, and this is its test of the 3-DOF fit: it
+    # simulates the held-out runs better than the preset in every channel and predicts
+    # them 20 s ahead better in psi, r and v (not in u: the fit trades surge accuracy
+    # over short windows for the steering channels, 78.7 % against the preset's 87.8 %)
+    fitted = esso.models[0]
+    assert fitted.result.success, fitted.result.message
+    for key, channels in (("simulation", ("psi", "r", "u", "v")),
+                          ("T_p = 20 s", ("psi", "r", "v"))):
+        for c in channels:
+            assert (fitted.validation[key].metrics[c].fit_percent
+                    > esso.baseline[key].metrics[c].fit_percent), (key, c)"""),
     new_markdown_cell("## Measured and predicted, held-out runs (3-DOF model)"),
     new_code_cell("""UNITS = {"psi": ("deg", np.rad2deg), "r": ("deg/s", np.rad2deg), "u": ("m/s", lambda a: a),
          "v": ("m/s", lambda a: a)}

@@ -148,7 +148,12 @@ def test_vessel_contract(name):
     vessel = js.vessel(name)
     coefficient = default_free(vessel)[0]
     p0 = float(get_path(vessel, coefficient))
-    check_contract(vessel_final(vessel, coefficient), p0, eps=1e-5, rtol=1e-4, atol=1e-9)
+    # a relative step of 1e-7: the zig-zag's rudder reverses at the heading crossing inside
+    # its control step, so psi is continuous in the coefficients, its slope jumping by
+    # up to 0.5 % where the crossing or the servo's end of saturation passes a step
+    # boundary (measured on sea_stratus_linear: one within 1e-6 of the preset's y_v);
+    # the central difference must see one piece
+    check_contract(vessel_final(vessel, coefficient), p0, eps=1e-7, rtol=1e-4, atol=1e-9)
 
 
 def steering_final(model, name):

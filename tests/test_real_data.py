@@ -11,7 +11,6 @@ from benchmarks.studies.real_data import (
     esso_osaka_low_speed_sway_yaw,
     esso_osaka_split,
     hsva_split,
-    identify_esso_osaka,
     identify_kvlcc2_hsva,
 )
 
@@ -54,21 +53,9 @@ def test_hsva_nomoto_generalises_to_held_out_zigzags():
     assert "| Nomoto2 | simulation | all |" in report.table()
 
 
-@pytest.mark.slow
-@needs_esso
-def test_esso_osaka_3dof_beats_the_preset_on_held_out_runs():
-    """The identified 3-DOF model simulates the held-out runs better than the unfitted
-    preset in every channel, and predicts them 20 s ahead better in psi, r and v. Not
-    in u at 20 s (measured: 78.7 % against the preset's 87.8 %): the fit trades surge
-    accuracy over short windows for the steering channels."""
-    report = identify_esso_osaka()
-    fitted = report.models[0]
-    assert fitted.result.success
-    checks = (("simulation", ("psi", "r", "u", "v")), ("T_p = 20 s", ("psi", "r", "v")))
-    for key, channels in checks:
-        for c in channels:
-            assert (fitted.validation[key].metrics[c].fit_percent
-                    > report.baseline[key].metrics[c].fit_percent), (key, c)
+# The 3-DOF Esso Osaka fit against the preset on the held-out runs (`identify_esso_osaka`)
+# is asserted by notebooks/esso_osaka_identification.ipynb, which runs that fit for its
+# readers (`test_notebooks`): one run, not two.
 
 
 @needs_esso

@@ -75,6 +75,22 @@ class Command(eqx.Module):
                        self.delta_rate, self.n_rate)
 
 
+class Switched(eqx.Module):
+    """Inputs that change once inside a control step: `before` from its start to `at`
+    seconds into it, `after` from there to its end (`at` >= the step: no change).
+    `integrate` takes two solver steps split at `at`, so that a switch on an event
+    predicted inside the step (a zig-zag's heading crossing) acts at the event, not at
+    the nearest step boundary."""
+
+    before: object
+    after: object
+    at: ArrayLike  # [s] into the step
+
+    def at_start(self):
+        """The inputs at the step's start (`after` where the switch is there)."""
+        return jax.tree.map(lambda b, a: jnp.where(self.at > 0, b, a), self.before, self.after)
+
+
 def tree_axpy(a: ArrayLike, x, y):
     """Return `a * x + y` leaf by leaf for two pytrees of the same structure."""
     return jax.tree.map(lambda xi, yi: a * xi + yi, x, y)

@@ -17,7 +17,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import ArrayLike
 
-from .._foundation._state import Command
+from .._foundation._state import Command, Switched
 from ._control import AbstractController, HeadingAutopilot, HeadingSteps, YawRateLevels
 
 
@@ -137,10 +137,14 @@ class ZigZag(AbstractTrial):
 
     The rudder goes to `angle` at `execute` (negative `angle`: port first) and is
     reversed whenever the heading change from the initial heading passes
-    `heading` on the side the rudder is turning the ship to: at the control step
-    nearest to the crossing (`switch_at="nearest"`, within half a step, 0.05 s by
-    default) or at the first control step after it (`"after"`, as MSS `zigzag.m` and
-    sampled-logic implementations do, late by up to one step). `rudder_rate` [rad/s]:
+    `heading` on the side the rudder is turning the ship to: at the crossing itself
+    (`switch_at="exact"`, the default: the time in the control step where the heading
+    change extrapolated over the step reaches it; the step is integrated in two parts,
+    so that the overshoots do not depend on the control step), at the control step
+    nearest to it (`"nearest"`, within half a step) or at the first control step after
+    it (`"after"`, as MSS `zigzag.m` and sampled-logic implementations do, late by up
+    to one step). A steering model's rudder moves once
+    per control step, so `"exact"` acts there as `"nearest"`. `rudder_rate` [rad/s]:
     the steering gear's rate limit for the trial (a vessel's servo rate too applies,
     the smaller wins; None: the servo's alone).
     """
@@ -153,16 +157,40 @@ class ZigZag(AbstractTrial):
     start: ArrayLike = 0.0
     n: ArrayLike | None = None
     num_samples: int | None = eqx.field(static=True, default=None)
-    switch_at: str = eqx.field(static=True, default="nearest")
+    switch_at: str = eqx.field(static=True, default="exact")
     rudder_rate: ArrayLike | None = None  # |d delta/dt| limit [rad/s]; None: none
 
     def __check_init__(self):
-        if self.switch_at not in ("nearest", "after"):
-            raise ValueError(f"`switch_at` must be 'nearest' or 'after', got {self.switch_at!r}.")
+        if self.switch_at not in ("exact", "nearest", "after"):
+            raise ValueError(f"`switch_at` must be 'exact', 'nearest' or 'after', got "
+                             f"{self.switch_at!r}.")
         _check_rate(self.rudder_rate)
 
     def init_memory(self, x0):
-        return jnp.sign(jnp.asarray(self.angle, dtype=float))
+        side = jnp.sign(jnp.asarray(self.angle, dtype=float))
+        return (side, x0.r) if self.switch_at == "exact" else side
+
+    def command(self, t, state, memory, h):
+        """The command for the control step `[t, t + h]`: with `switch_at="exact"` a
+        `Switched` one where the heading change, extrapolated over the step with the yaw
+        rate and its change since the last step, $\\Delta\\psi + r\\tau +
+        \\dot r\\tau^2/2 = \\pm\\psi_s$, crosses the switch angle."""
+        if self.switch_at != "exact":
+            return super().command(t, state, memory, h)
+        n0, psi0, (side, r_last) = memory
+        tau = t - self.start
+        a, b, c = state.psi - psi0 - side * self.heading, state.r, 0.5 * (state.r - r_last) / h
+        crossed = (side * (a + b * h + c * h * h) >= 0) & (tau >= self.execute)
+        disc = b * b - 4 * a * c  # the root of a + b s + c s^2 nearest zero, stable as c -> 0
+        root = jnp.where(disc > 0, jnp.sqrt(jnp.where(disc > 0, disc, 1.0)), 0.0)
+        q = b + jnp.where(b >= 0, 1.0, -1.0) * root
+        at = jnp.clip(-2 * a / jnp.where(q == 0, 1.0, q), 0.0, h)
+        new = jnp.where(crossed, -side, side)
+        n = n0 if self.n is None else self.n
+        size = jnp.abs(self.angle) * _step(tau, self.execute)
+        switched = Switched(Command(side * size, n), Command(new * size, n),
+                            jnp.where(crossed, at, h))
+        return switched, (n0, psi0, (new, state.r))
 
     def rudder(self, tau, state, psi0, side, h):
         change = state.psi - psi0

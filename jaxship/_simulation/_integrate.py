@@ -22,6 +22,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._foundation._state import Switched
 from .._models._manoeuvres import interpolate
 
 
@@ -139,7 +140,8 @@ def integrate(field, y0, policy, policy_state, t0, dt, num, simulator: Simulator
     - `field(t, y, (inputs, t_k))`: the vector field, with the inputs held from the
       control step's start `t_k` (evaluate them at `t` with `inputs.at(t - t_k)`).
     - `policy(t, y, policy_state, h) -> (inputs, policy_state)`: called at the start
-      of each of the `steps` control steps of length `h = dt / steps` per sample.
+      of each of the `steps` control steps of length `h = dt / steps` per sample. Inputs
+      that change inside the step (`Switched`) split it into two solver steps there.
     - `observe(y, inputs)`: what to record for each sample interval (default
       `(y, inputs)`), with the inputs at the interval's start and the state at its
       start (`emit="start"`: sample 0 is the initial state; the last interval is
@@ -159,6 +161,11 @@ def integrate(field, y0, policy, policy_state, t0, dt, num, simulator: Simulator
             y, ps, ok = carry
             t = t_sample + j * h
             inputs, ps = policy(t, y, ps, h)
+            if isinstance(inputs, Switched):  # two solver steps, split at the switch
+                s = jnp.clip(inputs.at, 0.0, h)
+                y, before = simulator.step(field, t, s, y, (inputs.before, t))
+                y, after = simulator.step(field, t + s, h - s, y, (inputs.after, t))
+                return (y, ps, ok & before & after), inputs.at_start()
             y, success = simulator.step(field, t, h, y, (inputs, t))
             return (y, ps, ok & success), inputs
 

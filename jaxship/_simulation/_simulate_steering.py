@@ -8,6 +8,8 @@ first-order hold (a `jaxship.Replay`), or the rudder is ordered by a manoeuvre's
 controller that sees the model's heading and yaw rate.
 """
 
+import dataclasses
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -16,7 +18,7 @@ from jaxtyping import Array
 
 from .._foundation._params import as_arrays
 from .._foundation._state import Command, ShipState, Trajectory
-from .._models._manoeuvres import Replay
+from .._models._manoeuvres import Replay, ZigZag
 from .._models._steering._base import AbstractSteeringModel, AuxInputs
 from ._integrate import Held, Simulator, integrate, replay_policy
 
@@ -136,7 +138,10 @@ def _replay(model, manoeuvre, x0, aux, simulator, steps):
 @eqx.filter_jit
 def _steer(model, manoeuvre, x0, simulator, steps):
     """The jitted body of a steering model through a closed-loop manoeuvre: the rudder
-    moves towards the order by at most `manoeuvre.rudder_rate * h` per control step."""
+    moves towards the order by at most `manoeuvre.rudder_rate * h` per control step
+    (so a zig-zag reverses it at the step nearest to the crossing)."""
+    if isinstance(manoeuvre, ZigZag) and manoeuvre.switch_at == "exact":
+        manoeuvre = dataclasses.replace(manoeuvre, switch_at="nearest")
     dt = jnp.asarray(manoeuvre.dt, float)
     psi0 = x0.psi
     zero = jnp.zeros_like(psi0)

@@ -12,6 +12,7 @@ gusts cause, which colours the residuals without being physics to name.
 """
 
 import dataclasses
+import functools
 import math
 import time
 
@@ -183,10 +184,12 @@ def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02,
                              r=truth.measure("r", noisy["r"]), u=noisy["u"], v=noisy["v"],
                              x=noisy["x"], y=noisy["y"], n=e.n, name=name, **logged)
 
-    train = [one(js.ZigZag(a * DEG, s * a * DEG, duration=duration, dt=0.5),
+    # the helm reverses the rudder at the control step nearest to the crossing (10 Hz), as
+    # a sampled autopilot does, not inside a step (the default)
+    zigzag = functools.partial(js.ZigZag, duration=duration, dt=0.5, switch_at="nearest")
+    train = [one(zigzag(a * DEG, s * a * DEG),
                  f"zigzag {a}/{a} {'starboard' if s > 0 else 'port'}") for a, s in TRAIN]
     holdout = [one(js.Turn(a * DEG, duration=duration, dt=0.5), f"turn {a:+d}")
                for a in (35, -35)]
-    holdout.append(one(js.ZigZag(15 * DEG, 15 * DEG, duration=duration, dt=0.5),
-                       "zigzag 15/15"))
+    holdout.append(one(zigzag(15 * DEG, 15 * DEG), "zigzag 15/15"))
     return train, holdout
