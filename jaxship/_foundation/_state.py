@@ -87,7 +87,7 @@ class Switched(eqx.Module):
     at: ArrayLike  # [s] into the step
 
     def at_start(self):
-        """The inputs at the step's start (`after` where the switch is there)."""
+        """The inputs at the step's start (`after` where the switch is at the start)."""
         return jax.tree.map(lambda b, a: jnp.where(self.at > 0, b, a), self.before, self.after)
 
 

@@ -143,10 +143,10 @@ class ZigZag(AbstractTrial):
     so that the overshoots do not depend on the control step), at the control step
     nearest to it (`"nearest"`, within half a step) or at the first control step after
     it (`"after"`, as MSS `zigzag.m` and sampled-logic implementations do, late by up
-    to one step). A steering model's rudder moves once
-    per control step, so `"exact"` acts there as `"nearest"`. `rudder_rate` [rad/s]:
-    the steering gear's rate limit for the trial (a vessel's servo rate too applies,
-    the smaller wins; None: the servo's alone).
+    to one step). A steering model's rudder moves once per control step, so `"exact"`
+    acts there as `"nearest"`. `rudder_rate` [rad/s]: the steering gear's rate limit
+    for the trial (a vessel's servo rate too applies, the smaller wins; None: the
+    servo's alone).
     """
 
     angle: ArrayLike  # delta_0 [rad], sign gives the first side
