@@ -35,18 +35,22 @@ the cells below do nothing when it is absent).
 
 The records are decimated to 2 Hz (every 5th sample) to keep the notebook fast."""),
     new_code_cell("""import os
-import time
-import jax
-jax.config.update("jax_enable_x64", True)
-import numpy as np
-import matplotlib.pyplot as plt
-from IPython.display import Markdown, display
-import jaxship as js
 import pathlib
 import sys
+import time
 
+import jax
+import matplotlib.pyplot as plt
+import numpy as np
+from IPython.display import Markdown, display
+
+import jaxship as js
+
+
+jax.config.update("jax_enable_x64", True)
 sys.path.insert(0, str(pathlib.Path.cwd().parent))  # the project root: benchmarks.studies
-from benchmarks.studies.real_data import identify_esso_osaka, identify_kvlcc2_hsva
+from benchmarks.studies.real_data import identify_esso_osaka, identify_kvlcc2_hsva  # noqa: E402
+
 
 data = js.shared_data_dir()
 HAVE_ESSO = data is not None and (data / "esso_osaka_frt").is_dir()
@@ -90,7 +94,6 @@ def plot_runs(report, label, channels, predictors):
     runs = first.experiment_names
     fig, axes = plt.subplots(len(channels), len(runs), figsize=(5 * len(runs), 2.2 * len(channels)),
                              squeeze=False, sharex="col")
-    from benchmarks.studies.real_data import esso_osaka_split, hsva_split
     for j, run in enumerate(runs):
         for i, c in enumerate(channels):
             ax = axes[i, j]

@@ -2,6 +2,7 @@
 
 import json
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -32,6 +33,17 @@ def test_fit_percent_perfect_mean_and_worse():
     assert fit_percent(y, -y) < 0
     # 100 (1 - |y - yhat| / |y - mean y|) on a hand example: y = (0, 2), yhat = (1, 1)
     assert fit_percent([0.0, 2.0], [0.5, 2.0]) == pytest.approx(100 * (1 - 0.5 / math.sqrt(2)))
+
+
+def test_a_prediction_that_blew_up_fits_minus_infinity_without_a_warning():
+    """The thesis study's diverged simulations: the squared error overflows to inf and
+    the fit % is -inf (the tables print "diverges"), with no RuntimeWarning."""
+    y = np.sin(np.linspace(0, 10, 200))
+    blown = y.copy()
+    blown[-1] = 1e300
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert fit_percent(y, blown) == -math.inf
 
 
 def test_fit_percent_uses_each_experiments_mean():

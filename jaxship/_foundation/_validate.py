@@ -222,7 +222,8 @@ def fit_percent(y, yhat, mask=None) -> float:
     experiments with each experiment's own mean (see `ValidationReport`)."""
     y, mask = _prepare(y, mask)
     yhat, _ = _prepare(yhat, mask)
-    err = np.sum(np.where(mask, (y - yhat) ** 2, 0.0))
+    with np.errstate(over="ignore"):  # a prediction that blew up: inf, fit -inf
+        err = np.sum(np.where(mask, (y - yhat) ** 2, 0.0))
     count = np.maximum(mask.sum(axis=1, keepdims=True), 1)
     mean = np.sum(np.where(mask, y, 0.0), axis=1, keepdims=True) / count
     spread = np.sum(np.where(mask, (y - mean) ** 2, 0.0))
