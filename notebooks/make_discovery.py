@@ -136,7 +136,7 @@ nb.cells = [
         "than the two 10/10 runs, misses the first overshoots of those by 3-4 deg, too "
         "large to one side and too small to the other. `discover` trains on the 11, holds "
         "out both HSVA 10/10 runs and, as a second check, the four MARIN zig-zags (another "
-        "basin, another model of the same hull). About 3 minutes."),
+        "basin, another model of the same hull). The cell prints its time (5-7 min on 2 shared cores)."),
     nbf.v4.new_code_cell(
         "if HAVE['kvlcc2_simman2008_hsva'] and HAVE['kvlcc2_simman2008_marin']:\n"
         "    train, holdout = kvlcc2_discovery_split(data)\n"
@@ -191,7 +191,7 @@ nb.cells = [
         "and the propeller race falls just short of its threshold; the joint step tests the two together, against a threshold simulated "
         "with its search, and accepts them: each one's robust interval excludes zero and "
         "the held-out cost halves. A lag then scores high but points the wrong way (a "
-        "negative time constant), and is not accepted. About 3 minutes."),
+        "negative time constant), and is not accepted. The cell prints its time (2-3 min on 2 shared cores)."),
     nbf.v4.new_code_cell(
         "if HAVE['esso_osaka_frt']:\n"
         "    train, holdout = esso_osaka_split(data)\n"
