@@ -307,6 +307,32 @@ def test_identify_resamples_the_records_it_is_told_to(record, tmp_path, capsys):
     assert data["dt_s"] == 2.0 and data["samples"] == 100
 
 
+def test_velocities_states_the_reference_of_the_trial_csvs_u_v(record, tmp_path, capsys):
+    """The real-data issue (point 5): a trial CSV's u, v are through the water unless
+    `--velocities over-ground` says they are a track's (then a fitted current is added
+    to the predicted u, v, `test_over_ground_velocities_recover_a_current`); result.json
+    states the reference of every record, and a measured data set's reader, which states
+    its own (over ground), is not overruled."""
+    for option, stated in [([], "through the water"),
+                           (["--velocities", "over-ground"], "over ground")]:
+        out = tmp_path / stated.replace(" ", "_")
+        assert main(["identify", record, "--model", "nomoto1", *option, "--validate", record,
+                     "--out", str(out), "--no-figures", "--quiet"]) == 0
+        data = json.loads((out / "result.json").read_text())["data"]
+        assert [d["velocities"] for d in data["train"] + data["validation"]] == [stated] * 2
+    capsys.readouterr()
+    esso = tmp_path / "esso.csv"
+    esso.write_text("t [s],x_position_mid [m],u_velo [m/s],y_position_mid [m],vm_velo [m/s],"
+                    "psi_hat [rad],r_angvelo [rad/s],n_prop [rps],delta_rudder [rad]\n"
+                    + "".join(f"{0.1 * k:.1f},1,0.5,2,0,0,0.01,10,0.1\n" for k in range(50)))
+    for command in ("identify", "discover"):
+        assert main([command, str(esso), "--model", "nomoto1", "--velocities", "through-water",
+                     "--out", str(tmp_path / command)]) == 2
+        assert (f"{esso}: its reader states that u, v are over ground; --velocities applies "
+                "to trial CSV files only") in _error_line(capsys)
+        assert not (tmp_path / command).exists()
+
+
 @pytest.mark.parametrize("name, content, message", [
     ("empty.csv", "", "the file is empty"),
     ("semicolons.csv", "t [s];delta [deg];psi [deg]\n0;0;0\n1;0;0\n",

@@ -12,7 +12,7 @@ header `name [unit]`:
 | `delta_c` | commanded rudder angle | deg, rad |
 | `psi` | heading, not wrapped | deg, rad |
 | `r` | yaw rate | deg/s, rad/s |
-| `u`, `v` | surge and sway velocity through the water (body axes, midship) | m/s |
+| `u`, `v` | surge and sway velocity, body axes, midship (through the water) | m/s |
 | `x`, `y` | north and east position | m |
 | `n` | propeller rate | rpm, rps |
 | `wind_speed` | true wind speed | m/s |
@@ -23,7 +23,8 @@ free. Rows are numbered from 1 after the header ("row 3" is the third data row) 
 every error message names the file, the column, the row and its line. Blank lines and
 trailing rows whose cells are all empty (spreadsheet exports) are skipped; an empty or
 non-finite cell anywhere else is an error. Unknown column names are an error unless
-`allow_unknown=True`, which keeps them, unconverted, in `Experiment.extra`.
+`allow_unknown=True`, which keeps them, unconverted, in `Experiment.extra`. `u`, `v` are
+through the water unless read with `over_ground=True` (a GNSS track, a basin's carriage).
 """
 
 import csv
@@ -34,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from .._foundation._state import Trajectory
-from ._data import CHANNELS, Experiment
+from ._data import CHANNELS, OVER_GROUND, Experiment
 
 
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
@@ -294,7 +295,8 @@ def _split_header(path, line, text):
 
 
 def read_trial_csv(path, *, require_uniform: bool = False, allow_unknown: bool = False,
-                   name: str | None = None, rtol: float = 1e-6) -> Experiment:
+                   name: str | None = None, rtol: float = 1e-6,
+                   over_ground: bool = False) -> Experiment:
     """Read a trial CSV (format in the module docstring) into an `Experiment` (SI).
 
     **Arguments:**
@@ -304,6 +306,8 @@ def read_trial_csv(path, *, require_uniform: bool = False, allow_unknown: bool =
     - `allow_unknown`: keep columns with unknown names in `extra` (values as written)
       instead of failing.
     - `name`: experiment name; the file's stem by default.
+    - `over_ground`: the file's `u`, `v` are over ground (a GNSS track, a basin's
+      carriage: `Experiment.over_ground`), not through the water (the default).
 
     **Raises:** `ValueError` naming the file, column and row for a malformed header,
     missing required column, unknown unit or column, empty, unreadable or non-finite
@@ -351,7 +355,8 @@ def read_trial_csv(path, *, require_uniform: bool = False, allow_unknown: bool =
             _check_plausible(path, headers[j], key, unit, values[key], lines)
     return Experiment(
         name=path.stem if name is None else name,
-        metadata={"file": str(path), "format": "trial csv"},
+        metadata={"file": str(path), "format": "trial csv",
+                  **dict([OVER_GROUND] if over_ground else [])},
         extra={k: data[:, j] for k, j in extra_columns.items()},
         **values,
     )

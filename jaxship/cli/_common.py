@@ -43,6 +43,19 @@ def add_sample_interval(parser) -> None:
                         "recorded)")
 
 
+VELOCITIES = {"through-water": False, "over-ground": True}
+
+
+def add_velocities(parser) -> None:
+    """The `--velocities` option of the commands that fit records: the reference of the
+    trial CSVs' u, v (`read_experiments`' `over_ground`)."""
+    parser.add_argument("--velocities", choices=VELOCITIES, default=None,
+                        help="the trial CSVs' u, v: through-water (default) or over-ground "
+                        "(a GNSS track, a basin's carriage: a fitted current is added to "
+                        "the predicted u, v); the measured data sets' readers state their "
+                        "own (over ground)")
+
+
 def positive(option, value):
     """`value` (a float or None) checked: finite and positive."""
     if value is not None and not (math.isfinite(value) and value > 0):

@@ -5,7 +5,7 @@ import sys
 
 from tqdm.auto import tqdm
 
-from ._common import add_sample_interval, check_out, note
+from ._common import VELOCITIES, add_sample_interval, add_velocities, check_out, note
 from ._identification.discovery import run_discovery
 
 
@@ -27,6 +27,7 @@ def register(sub) -> None:
     disc.add_argument("--alpha", type=float, default=0.01,
                       help="family-wise false-alarm rate")
     add_sample_interval(disc)
+    add_velocities(disc)
     disc.add_argument("--quiet", action="store_true", help="no progress messages")
     disc.set_defaults(run=run)
 
@@ -37,7 +38,9 @@ def run(args) -> int:
         lambda message: tqdm.write(f"jaxship: {message} ...", file=sys.stderr))
     report = run_discovery(args.train, args.holdout, model=args.model, out=args.out,
                            max_effects=args.max_effects, alpha=args.alpha,
-                           sample_interval=args.sample_interval, progress=say, note=note)
+                           sample_interval=args.sample_interval,
+                           over_ground=VELOCITIES.get(args.velocities), progress=say,
+                           note=note)
     print(report.to_markdown())
     print(f"wrote {args.out}/discovery.json, {args.out}/report.md, {args.out}/figures/")
     return 0

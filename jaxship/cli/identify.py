@@ -8,7 +8,15 @@ import sys
 
 from .._foundation._files import staged_folder
 from ..plotting import save_identification_figures
-from ._common import ProgressBar, add_sample_interval, check_out, note, one_line
+from ._common import (
+    VELOCITIES,
+    ProgressBar,
+    add_sample_interval,
+    add_velocities,
+    check_out,
+    note,
+    one_line,
+)
 from ._identification import MODELS, get_model_entry, identify, read_experiments
 
 
@@ -43,6 +51,7 @@ def register(sub) -> None:
                        "output error, else measured)")
     ident.add_argument("--max-steps", type=int, default=256, help="optimiser step limit")
     add_sample_interval(ident)
+    add_velocities(ident)
     ident.add_argument("--no-figures", action="store_true", help="write result.json only")
     ident.add_argument("--quiet", action="store_true", help="no progress bar")
     ident.set_defaults(run=run)
@@ -69,10 +78,12 @@ def run(args) -> int:
         raise ValueError(f"--max-steps {args.max_steps}: give a positive number of optimiser "
                          "steps (default 256).")
     check_out(args.out, writes=("result.json",) + (() if args.no_figures else ("figures/",)))
+    over_ground = VELOCITIES.get(args.velocities)
     train = read_experiments(args.train, role="training", note=note,
-                             sample_interval=args.sample_interval)
+                             sample_interval=args.sample_interval, over_ground=over_ground)
     held_out = None if args.validate is None else read_experiments(
-        args.validate, role="validation", note=note, sample_interval=args.sample_interval)
+        args.validate, role="validation", note=note, sample_interval=args.sample_interval,
+        over_ground=over_ground)
     bar = ProgressBar(not args.quiet)
     result = identify(train, model=args.model, horizon=horizon, validate=held_out,
                       rudder=args.rudder, channels=args.channels, initial=args.initial,

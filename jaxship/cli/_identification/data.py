@@ -12,6 +12,7 @@ import numpy as np
 
 import jaxship as js
 from jaxship._models._vessel.mmg import GRAVITY
+from jaxship._simulation._data import OVER_GROUND
 from jaxship._simulation._measured import header_names
 from jaxship._simulation._readers import UTF16_MARKS
 
@@ -68,13 +69,31 @@ def is_measurement_file(path: Path) -> bool:
     return len(fields) > 1 and "," not in first and any(_HEADER.match(f) for f in fields)
 
 
-def _renamed(e: js.Experiment, name: str) -> js.Experiment:
+def _renamed(e: js.Experiment, name: str, metadata=None) -> js.Experiment:
     measured = {k: getattr(e, k) for k in e.channels}
-    return js.Experiment(e.t, name=name, metadata=e.metadata, extra=e.extra, **measured)
+    return js.Experiment(e.t, name=name, metadata=e.metadata if metadata is None else metadata,
+                         extra=e.extra, **measured)
+
+
+def _with_velocities(e: js.Experiment, over_ground: bool | None) -> js.Experiment:
+    """`e` with the reference of its u, v stated by the user (`--velocities`): a trial
+    CSV's as given; a measured data set's reader states its own (over ground), and a
+    contradiction is a `ValueError` naming the file."""
+    if over_ground is None or e.over_ground == over_ground:
+        return e
+    if e.meta.get("format") != "trial csv":
+        raise ValueError(f"{source(e)}: its reader states that u, v are "
+                         f"{'over ground' if e.over_ground else 'through the water'}; "
+                         "--velocities applies to trial CSV files only.")
+    metadata = dict(e.metadata) | dict([OVER_GROUND] if over_ground else [])
+    if not over_ground:
+        metadata.pop(OVER_GROUND[0], None)
+    return _renamed(e, e.name, metadata)
 
 
 def read_experiments(paths, *, role: str = "training", note=None, taken=(),
-                     sample_interval: float | None = None) -> list[js.Experiment]:
+                     sample_interval: float | None = None,
+                     over_ground: bool | None = None) -> list[js.Experiment]:
     """Read measurement files and folders into experiments.
 
     A file is read with `read_measured` (trial CSV, Esso Osaka CSV, HSVA and MARIN
@@ -86,7 +105,8 @@ def read_experiments(paths, *, role: str = "training", note=None, taken=(),
     a name in `taken` (those of another role's records), get their folder as a prefix.
     With `sample_interval` [s], each record keeps every k-th sample, k the integer
     nearest to `sample_interval / dt` (`Experiment.decimate`; 1 keeps the record), said
-    in one sentence to `note`.
+    in one sentence to `note`. `over_ground` states the reference of the trial CSVs' u, v
+    (None: through the water, as `read_trial_csv` reads them; `_with_velocities`).
 
     **Raises:** `ValueError` naming the file: missing, unreadable or malformed
     (the readers' messages name the column and row), or a folder with no records.
@@ -112,11 +132,12 @@ def read_experiments(paths, *, role: str = "training", note=None, taken=(),
             if not found:
                 raise ValueError(f"{path}: the {role} folder holds no measurement file "
                                  "(trial CSV, Esso Osaka CSV, HSVA or MARIN .dat).")
-            experiments.extend(js.read_measured(item) for item in found)
+            experiments.extend(_with_velocities(js.read_measured(item), over_ground)
+                               for item in found)
         elif not path.exists():
             raise ValueError(f"{path}: no such {role} file or folder.")
         else:
-            experiments.append(js.read_measured(path))
+            experiments.append(_with_velocities(js.read_measured(path), over_ground))
     if not experiments:
         raise ValueError(f"no {role} files given.")
     names = [e.name for e in experiments] + list(taken)

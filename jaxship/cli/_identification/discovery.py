@@ -18,8 +18,9 @@ from .workflow import identify, logs_wind
 
 def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
                   max_effects: int = 3, alpha: float = 0.01, sample_interval=None,
-                  progress=None, note=None):
-    """Read the records (resampled to `sample_interval` [s] if given: `read_experiments`),
+                  over_ground=None, progress=None, note=None):
+    """Read the records (resampled to `sample_interval` [s] if given, the trial CSVs' u, v
+    over ground if `over_ground`: `read_experiments`),
     fit `model` (as `jaxship identify` does, for start values), run discovery and write
     `out/discovery.json`, `out/report.md` and `out/figures/`. Returns the
     `DiscoveryReport`. `progress` takes the stage messages, `note` (default `progress`)
@@ -33,11 +34,12 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
     if not 0 < alpha < 1:
         raise ValueError(f"--alpha must be between 0 and 1, got {alpha}.")
     train = read_experiments(train_paths, role="training", note=note,
-                             sample_interval=sample_interval)
+                             sample_interval=sample_interval, over_ground=over_ground)
     # a held-out record named as a training one (two `trial.csv`) is told apart by its folder
     holdout = read_experiments(holdout_paths, role="held-out", note=note,
                                taken=[e.name for e in train],
-                               sample_interval=sample_interval) if holdout_paths else None
+                               sample_interval=sample_interval,
+                               over_ground=over_ground) if holdout_paths else None
     name, length = model_key(model), preset_length(model_key(model))
     if holdout and length is not None:  # identify checks the training records
         check_froude(holdout, length, "held-out", name)

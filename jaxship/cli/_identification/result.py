@@ -98,7 +98,8 @@ class IdentificationResult:
                      "samples": int(ds.lengths[i]),
                      "dt_s": float(ds.dt[i]),
                      "duration_s": float(ds.dt[i] * (ds.lengths[i] - 1)),
-                     "channels": list(ds.experiment_channels[i])}
+                     "channels": list(ds.experiment_channels[i]),
+                     "velocities": "over ground" if ds.over_ground[i] else "through the water"}
                     for i in range(ds.num_experiments)]
 
         return {
