@@ -45,6 +45,12 @@ from ._analysis._indices import (
     zigzag_indices as zigzag_indices,
 )
 from ._estimate._armax import ARMAX as ARMAX
+from ._estimate._bands import (
+    Disturbance as Disturbance,
+    PredictionBands as PredictionBands,
+    calibrate_disturbance as calibrate_disturbance,
+    prediction_bands as prediction_bands,
+)
 from ._estimate._discrete_estimator import (
     DiscreteResponse as DiscreteResponse,
     LeastSquaresRegression as LeastSquaresRegression,

@@ -47,7 +47,7 @@ def pytest_sessionstart(session):
 LONGEST_FIRST = ("test_contracts", "test_discover", "test_real_data", "test_effects",
                  "test_low_speed_sway_yaw", "test_kalman", "test_autopilot",
                  "test_ross_autopilot", "test_sway_yaw_fit", "test_autopilot_cli",
-                 "test_vessel_fit", "test_identify", "test_cli", "test_mariner",
+                 "test_vessel_fit", "test_bands", "test_identify", "test_cli", "test_mariner",
                  "test_architecture", "test_reproduce", "test_joint_search", "test_estimate")
 
 

@@ -1,0 +1,282 @@
+"""Prediction bands: what a fitted model predicts for a record, with the spread that its
+parameter uncertainty, an unlogged disturbance and the sensors give, by Monte Carlo.
+
+Each of `num_samples` runs draws the free parameters from $N(\\hat\\theta, \\Sigma)$ (the
+fit's covariance; by default the robust one, $\\Sigma = D_r C D_r$ with the robust
+standard errors $D_r$ and the correlation $C$) and the measured start values it begins
+from (r, psi and the position, with the sensor noise), and predicts the record as
+`predict` does with the estimator given (a free simulation from the first measured state
+for `horizon=None`). Onto each run's outputs it adds the disturbance and the sensor noise
+(`measurement_std`); the band of a channel at a sample is the central `level` interval of
+the runs there.
+
+The disturbance is what the model does not explain (gusts, current, waves, the model's
+own error), as an output disturbance of the yaw rate (the $H(q)e$ of a Box-Jenkins model,
+Ljung 1999, *System Identification*, sec. 4.2): a first-order Gauss-Markov process from
+zero at the window's measured start, stationary standard deviation $\\sigma$, correlation
+time $\\tau$, sampled exactly, $b_{k+1} = a b_k + \\sigma\\sqrt{1 - a^2}\\,e_k$,
+$a = e^{-\\Delta t/\\tau}$, $e_k \\sim N(0, 1)$ (Fossen 2011, *Handbook of Marine Craft
+Hydrodynamics and Motion Control*, sec. 8.2), added to r and, integrated (trapezoid), to
+psi. `calibrate_disturbance` chooses $\\sigma$ and $\\tau$ on training records, so that the
+bands cover `level` of their r and of their psi samples; held-out records then test it.
+"""
+
+import dataclasses
+import math
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .._foundation._params import as_arrays, rebuild
+from .._simulation._data import Dataset
+from ._fit import PredictionError, _predict, _predict_jit, _prepare
+from ._result import FitResult
+from ._step import MAX_SUBSTEPS, stable_substeps
+from ._windows import to_timeline
+
+
+START = ("r", "psi", "x", "y")  # the measured start values drawn with their sensor noise
+
+
+class Disturbance(eqx.Module):
+    """The output disturbance of the yaw rate (module docstring): a first-order
+    Gauss-Markov process of stationary standard deviation `std` [rad/s] and correlation
+    time `tau` [s], integrated into the heading; `std=0` is none."""
+
+    std: float = 0.0
+    tau: float = 30.0
+
+    def __check_init__(self):
+        if not (math.isfinite(self.std) and self.std >= 0):
+            raise ValueError(f"Disturbance: `std` must be a non-negative yaw rate [rad/s], "
+                             f"got {self.std!r}.")
+        if not (math.isfinite(self.tau) and self.tau > 0):
+            raise ValueError(f"Disturbance: `tau` must be a positive number of seconds, got "
+                             f"{self.tau!r}.")
+
+
+@dataclasses.dataclass(frozen=True)
+class PredictionBands:
+    """The bands of `prediction_bands` on a dataset's records (E) and samples (N):
+    `nominal` (the fitted model's prediction), `lower`, `upper` `{channel: (E, N)}`,
+    `t` (E, N), `predicted` (E, N) (the samples predicted: not the start values, not
+    the padding), `level` (nominal coverage), `disturbance`, `num_samples` and
+    `num_dropped` (runs whose simulation was not finite, left out of the bands)."""
+
+    names: tuple[str, ...]
+    t: np.ndarray
+    predicted: np.ndarray
+    nominal: dict
+    lower: dict
+    upper: dict
+    level: float
+    disturbance: Disturbance
+    num_samples: int
+    num_dropped: int
+
+    def coverage(self, dataset) -> dict[str, np.ndarray]:
+        """`{channel: (E,)}` the fraction of each record's predicted samples whose
+        measured value lies inside the band."""
+        ds = dataset if isinstance(dataset, Dataset) else Dataset.from_experiments(
+            list(dataset) if isinstance(dataset, (list, tuple)) else [dataset])
+        out = {}
+        for c in self.lower:
+            y = np.asarray(getattr(ds, c))[:, : self.t.shape[1]]
+            inside = (y >= self.lower[c]) & (y <= self.upper[c]) & self.predicted
+            out[c] = inside.sum(axis=1) / np.maximum(self.predicted.sum(axis=1), 1)
+        return out
+
+
+@eqx.filter_jit
+def _runs(model, names, values, windows, key, noise_std, start_std):
+    """(S, C, E, W, L) outputs of the runs: parameters `values` (S, d), the start's
+    `START` values and the outputs with sensor noise of `start_std` (4,) and `noise_std`
+    (C,)."""
+    k_start, k_noise = jax.random.split(key)
+    shape = (values.shape[0],) + windows.dt.shape
+    jitter = jax.random.normal(k_start, (len(START),) + shape) * start_std[:, None, None, None]
+
+    def one(p, jit):
+        start = windows.start
+        for i, c in enumerate(START):
+            if getattr(start, c) is not None:
+                start = eqx.tree_at(lambda s, c=c: getattr(s, c), start,
+                                    getattr(start, c) + jit[i])
+        return _predict(rebuild(model, names, p), dataclasses.replace(windows, start=start))
+
+    out = jax.vmap(one, in_axes=(0, 1))(values, jitter)
+    return out + jax.random.normal(k_noise, out.shape) * noise_std[None, :, None, None, None]
+
+
+def _unit_disturbance(e, dt, tau):
+    """(S, E, W, L) Gauss-Markov samples of unit std from zero at the window start, from
+    the normal draws `e` (S, E, W, L) and the intervals `dt` (E, W) (module docstring),
+    and their trapezoid integral."""
+    a = np.exp(-dt / tau)[..., None]
+    gain = np.sqrt(1.0 - a**2)
+    b = np.empty_like(e)
+    prev = np.zeros(e.shape[:-1])
+    for k in range(e.shape[-1]):
+        prev = a[..., 0] * prev + gain[..., 0] * e[..., k]
+        b[..., k] = prev
+    before = np.concatenate([np.zeros(b.shape[:-1] + (1,)), b[..., :-1]], axis=-1)
+    return b, np.cumsum(0.5 * (before + b), axis=-1) * dt[..., None]
+
+
+class _Runs:
+    """The runs of one set of draws, to which disturbances are added (`bands`)."""
+
+    def __init__(self, result, dataset, *, covariance, measurement_std, num_samples,
+                 estimator, seed):
+        if num_samples < 2:
+            raise ValueError(f"`num_samples` must be at least 2, got {num_samples!r}.")
+        if not isinstance(estimator, PredictionError):
+            raise ValueError(f"`estimator` must be a PredictionError (its replay of the "
+                             f"records), got {type(estimator).__name__}.")
+        model = as_arrays(result.model if isinstance(result, FitResult) else result)
+        ds, windows, self.layout = _prepare(model, dataset, estimator)
+        needed = min(stable_substeps(model, windows, refuse=False), MAX_SUBSTEPS)
+        if needed > windows.substeps:
+            windows = dataclasses.replace(windows, substeps=needed)
+        rng = np.random.default_rng(seed)
+        names, values = _parameter_draws(result, covariance, num_samples, rng)
+        noise = dict(measurement_std or {})
+        unknown = sorted(set(noise) - set(windows.channels))
+        if unknown:
+            raise ValueError(f"`measurement_std` names {unknown}, which the estimator does "
+                             f"not predict ({windows.channels}).")
+        noise_std = jnp.asarray([float(noise.get(c, 0.0)) for c in windows.channels])
+        start_std = jnp.asarray([float(noise.get(c, 0.0)) for c in START])
+        out = np.asarray(_runs(model, names, jnp.asarray(values), windows,
+                               jax.random.key(seed), noise_std, start_std), dtype=np.float64)
+        finite = np.all(np.isfinite(out), axis=tuple(range(1, out.ndim)))
+        if finite.sum() < 2:
+            raise ValueError(f"{num_samples - int(finite.sum())} of {num_samples} runs were "
+                             "not finite: the draws leave the region where the model can be "
+                             "simulated; check the fit's covariance.")
+        self.ds, self.channels, self.runs = ds, windows.channels, out[finite]
+        self.num_samples, self.num_dropped = num_samples, int(num_samples - finite.sum())
+        self.nominal = np.asarray(_predict_jit(model, windows), dtype=np.float64)
+        self.dt = np.asarray(windows.dt, dtype=np.float64)
+        self.normals = rng.standard_normal(self.runs.shape[:1] + self.runs.shape[2:])
+
+    def bands(self, level, disturbance) -> PredictionBands:
+        if not 0 < level < 1:
+            raise ValueError(f"`level` must be between 0 and 1, got {level!r}.")
+        if not isinstance(disturbance, Disturbance):
+            raise ValueError(f"`disturbance` must be a jaxship.Disturbance, got "
+                             f"{type(disturbance).__name__}.")
+        b, integral = _unit_disturbance(self.normals, self.dt, disturbance.tau)
+        added = {"r": disturbance.std * b, "psi": disturbance.std * integral}
+        shape = (self.ds.num_experiments, self.ds.num_samples)
+        nominal, lower, upper = {}, {}, {}
+        for c, name in enumerate(self.channels):
+            runs = self.runs[:, c] + added.get(name, 0.0)
+            lo, hi = np.quantile(runs, [(1 - level) / 2, (1 + level) / 2], axis=0)
+            nominal[name], hit = to_timeline(self.nominal[c], self.layout, shape)
+            lower[name], _ = to_timeline(lo, self.layout, shape)
+            upper[name], _ = to_timeline(hi, self.layout, shape)
+        return PredictionBands(
+            names=tuple(self.ds.names), t=np.asarray(self.ds.t), predicted=np.asarray(hit),
+            nominal=nominal, lower=lower, upper=upper, level=float(level),
+            disturbance=disturbance, num_samples=self.num_samples,
+            num_dropped=self.num_dropped)
+
+
+def _parameter_draws(result, covariance, num_samples, rng) -> tuple[tuple, np.ndarray]:
+    """`(names, (S, d) draws)` of the free parameters of a `FitResult`; none of a model
+    taken as known."""
+    if not isinstance(result, FitResult):
+        if covariance is not None and not isinstance(covariance, str):
+            raise ValueError("a `covariance` array needs the `FitResult` of its parameters.")
+        return (), np.zeros((num_samples, 0))
+    report = result.parameters
+    values = np.asarray(report.values, dtype=np.float64)
+    if covariance is None:
+        return report.names, np.broadcast_to(values, (num_samples, values.size))
+    if isinstance(covariance, str):
+        if covariance not in ("robust", "white"):
+            raise ValueError(f"`covariance` must be 'robust', 'white', an array or None, got "
+                             f"{covariance!r}.")
+        std = report.std_robust if covariance == "robust" and report.std_robust is not None \
+            else report.std
+        std = np.asarray(std, dtype=np.float64)
+        bad = [n for n, s in zip(report.names, std) if not np.isfinite(s)]
+        if bad:
+            raise ValueError(f"the fit does not determine {', '.join(bad)} (infinite standard "
+                             "error): no band from its covariance; fix them or pass "
+                             "`covariance=None`.")
+        cov = np.asarray(report.correlation) * np.outer(std, std)
+    else:
+        cov = np.asarray(covariance, dtype=np.float64)
+        if cov.shape != (values.size, values.size):
+            raise ValueError(f"`covariance` must be ({values.size}, {values.size}) for the "
+                             f"free parameters {report.names}, got {cov.shape}.")
+    return report.names, rng.multivariate_normal(values, cov, size=num_samples, method="eigh")
+
+
+def prediction_bands(result, dataset, *, level: float = 0.9,
+                     disturbance: Disturbance = Disturbance(), covariance="robust",
+                     measurement_std: dict | None = None, num_samples: int = 200,
+                     estimator: PredictionError = PredictionError(horizon=None),
+                     seed: int = 0) -> PredictionBands:
+    """The central `level` band of the outputs that `result`'s model predicts for
+    `dataset`, from its parameter uncertainty, the `disturbance` and sensor noise (module
+    docstring), by `num_samples` runs.
+
+    **Arguments:**
+
+    - `result`: a `FitResult` (its model, free parameters and covariance), or a model
+      taken as known (no parameter uncertainty);
+    - `dataset`: the records (`Experiment`s or a `Dataset`), replayed as `estimator`
+      (a `PredictionError`: its horizon, channels, wind and holds) replays them;
+    - `covariance`: `"robust"` (default), `"white"` (the usual standard errors), a (d, d)
+      array for the free parameters, or None (the estimates only);
+    - `measurement_std`: `{channel: std}` of the sensors in SI (none by default);
+    - `seed`: of the random draws (the same seed, the same bands).
+
+    **Raises:** `ValueError` for a bad level or sample count, a covariance that leaves a
+    parameter undetermined, and what `predict` raises for bad data.
+    """
+    return _Runs(result, dataset, covariance=covariance, measurement_std=measurement_std,
+                 num_samples=num_samples, estimator=estimator, seed=seed
+                 ).bands(level, disturbance)
+
+
+def calibrate_disturbance(result, train, *, level: float = 0.9, covariance="robust",
+                          measurement_std: dict | None = None, num_samples: int = 200,
+                          estimator: PredictionError = PredictionError(horizon=None),
+                          seed: int = 0, iterations: int = 14) -> Disturbance:
+    """The `Disturbance` whose bands (`prediction_bands` with these arguments) cover
+    `level` of the training records' r samples (its `std`) and of their psi samples (its
+    `tau`, the heading's spread growing with it): nested bisections on $\\log\\tau$ over
+    1 s .. 1e4 s and $\\log\\sigma$ over 1e-7 .. 1 rad/s, on one set of draws. The records
+    should be those the model was fitted on; held-out records then test it. A model whose
+    bands already cover `level` of both without a disturbance gets none."""
+    runs = _Runs(result, train, covariance=covariance, measurement_std=measurement_std,
+                 num_samples=num_samples, estimator=estimator, seed=seed)
+    hits = lambda bands: bands.predicted.sum(axis=1)
+
+    def covered(std, tau, channel):
+        bands = runs.bands(level, Disturbance(std=std, tau=tau))
+        return float(np.sum(bands.coverage(runs.ds)[channel] * hits(bands))
+                     / np.sum(hits(bands)))
+
+    def bisect(lo, hi, below):  # exp of the log-midpoint where `below` turns False
+        for _ in range(iterations):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if below(math.exp(mid)) else (lo, mid)
+        return math.exp(hi)
+
+    def std_for(tau):
+        if covered(0.0, tau, "r") >= level:
+            return 0.0
+        return bisect(math.log(1e-7), 0.0, lambda std: covered(std, tau, "r") < level)
+
+    if "psi" not in runs.channels or "r" not in runs.channels:
+        raise ValueError("calibrating the disturbance needs the estimator to predict r and "
+                         f"psi, not {runs.channels}.")
+    tau = bisect(0.0, math.log(1e4), lambda tau: covered(std_for(tau), tau, "psi") < level)
+    return Disturbance(std=std_for(tau), tau=tau)
