@@ -85,10 +85,7 @@ def _with_velocities(e: js.Experiment, over_ground: bool | None) -> js.Experimen
         raise ValueError(f"{source(e)}: its reader states that u, v are "
                          f"{'over ground' if e.over_ground else 'through the water'}; "
                          "--velocities applies to trial CSV files only.")
-    metadata = dict(e.metadata) | dict([OVER_GROUND] if over_ground else [])
-    if not over_ground:
-        metadata.pop(OVER_GROUND[0], None)
-    return _renamed(e, e.name, metadata)
+    return _renamed(e, e.name, dict(e.metadata) | dict([OVER_GROUND]))  # read through the water
 
 
 def read_experiments(paths, *, role: str = "training", note=None, taken=(),
