@@ -161,6 +161,7 @@ class _Runs:
         self.nominal = np.asarray(_predict_jit(model, windows), dtype=np.float64)
         self.dt = np.asarray(windows.dt, dtype=np.float64)
         self.normals = rng.standard_normal(self.runs.shape[:1] + self.runs.shape[2:])
+        self.unit = {}  # tau -> the unit disturbance and its integral (calibration reuses them)
 
     def bands(self, level, disturbance) -> PredictionBands:
         if not 0 < level < 1:
@@ -168,7 +169,10 @@ class _Runs:
         if not isinstance(disturbance, Disturbance):
             raise ValueError(f"`disturbance` must be a jaxship.Disturbance, got "
                              f"{type(disturbance).__name__}.")
-        b, integral = _unit_disturbance(self.normals, self.dt, disturbance.tau)
+        if disturbance.tau not in self.unit:
+            self.unit[disturbance.tau] = _unit_disturbance(self.normals, self.dt,
+                                                           disturbance.tau)
+        b, integral = self.unit[disturbance.tau]
         added = {"r": disturbance.std * b, "psi": disturbance.std * integral}
         shape = (self.ds.num_experiments, self.ds.num_samples)
         nominal, lower, upper = {}, {}, {}
