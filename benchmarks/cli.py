@@ -21,7 +21,12 @@ Also `python -c "import jaxship"` (the import alone), for the part no cache can 
 own: the first run compiles (the README's time), the second reads the cache. It prints the
 table's time column with the date and the number of CPU cores.
 
-Run: `python benchmarks/cli.py [--repeats N] [--table]` (the median of N runs of each;
+`--flags` times the first run (empty cache) of every example of the table twice, with the
+command's own XLA compiler setting (`jaxship.cli.SMALL_PROGRAMS`: LLVM's optimisation off,
+the loop emitters) and with XLA's defaults (set in `$XLA_FLAGS`, which the command then
+leaves as they are), and prints the ratio default / own.
+
+Run: `python benchmarks/cli.py [--repeats N] [--table | --flags]` (the median of N runs of each;
 default 1).
 """
 
@@ -35,6 +40,11 @@ import time
 from pathlib import Path
 
 import jaxship as js
+from jaxship.cli import SMALL_PROGRAMS
+
+
+# XLA's own values of the flags `SMALL_PROGRAMS` sets
+XLA_DEFAULTS = {"--xla_backend_optimization_level": "3", "--xla_cpu_use_fusion_emitters": "true"}
 
 
 def timed(command, env, out):
@@ -107,16 +117,41 @@ def table(repeats: int, tmp: Path) -> None:
               f"{statistics.median(second):.0f} s |", flush=True)
 
 
+def flags(repeats: int, tmp: Path) -> None:
+    """Each table command's first run with XLA's defaults and with the command's setting."""
+    default = " ".join(f.split("=")[0] + "=" + XLA_DEFAULTS[f.split("=")[0]]
+                       for f in SMALL_PROGRAMS)
+    print(f"{time.strftime('%Y-%m-%d')}, first runs (empty cache), each in a new process")
+    print("| command | XLA's defaults | jaxship's setting | ratio |")
+    print("|---|---:|---:|---:|")
+    for i, (name, command) in enumerate(table_commands(tmp).items()):
+        times = {}
+        for label, xla in (("default", default), ("own", "")):
+            runs = []
+            for k in range(repeats):
+                env = os.environ | {"JAXSHIP_CACHE_DIR": str(tmp / f"flags-{i}-{label}-{k}"),
+                                    "XLA_FLAGS": xla}
+                runs.append(timed(command, env, tmp))
+            times[label] = statistics.median(runs)
+        print(f"| `{name}` | {times['default']:.1f} s | {times['own']:.1f} s | "
+              f"{times['default'] / times['own']:.2f}x |", flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=1)
-    parser.add_argument("--table", action="store_true",
-                        help="time every example of the README's command table")
+    which = parser.add_mutually_exclusive_group()
+    which.add_argument("--table", action="store_true",
+                       help="time every example of the README's command table")
+    which.add_argument("--flags", action="store_true",
+                       help="the table's first runs with XLA's defaults and with jaxship's")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         if args.table:
             return table(args.repeats, tmp)
+        if args.flags:
+            return flags(args.repeats, tmp)
         off = os.environ | {"JAXSHIP_CACHE_DIR": "off"}
         importing = [timed([sys.executable, "-c", "import jaxship"], off, tmp)
                      for _ in range(args.repeats)]

@@ -6,6 +6,7 @@ import jax
 import pytest
 
 import jaxship as js
+from jaxship.cli import compile_for_small_programs
 
 
 jax.config.update("jax_enable_x64", True)
@@ -26,9 +27,7 @@ def pytest_configure(config):
     and the slow tier about as long as before (long computations run slower without
     LLVM's optimisation: a 3-DOF Esso Osaka fit 42 -> 71 s with the loop emitters). The
     numbers are the same to rounding (`helpers.assert_equal_to_rounding`)."""
-    flags = os.environ.get("XLA_FLAGS", "").split()
-    wanted = ["--xla_backend_optimization_level=0", "--xla_cpu_use_fusion_emitters=false"]
-    os.environ["XLA_FLAGS"] = " ".join(flags + [f for f in wanted if f not in flags])
+    compile_for_small_programs()  # the `jaxship` command's own setting
 
 
 def pytest_sessionstart(session):

@@ -11,6 +11,7 @@ import pytest
 from helpers import per_sample
 
 import jaxship as js
+import jaxship.cli as cli
 from jaxship._foundation._files import MANIFEST
 from jaxship._foundation._params import parameter_fields, resolve_free
 from jaxship.cli import main
@@ -75,6 +76,33 @@ def test_mariner_zigzag_overshoots_match_reference(tmp_path):
 def test_bad_input_is_a_clear_error(tmp_path, capsys, args, message):
     assert main(["simulate", *args, "--out", str(tmp_path / "x")]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_each_command_chooses_its_compiler_setting(tmp_path, capsys, monkeypatch):
+    """XLA's setting for many small programs is chosen where a command runs such programs
+    (a steering model's identify, simulate), not for a vessel's identify, discover or
+    `vessels` (`benchmarks/cli.py --flags`)."""
+    chosen = []
+    monkeypatch.setattr(cli, "compile_for_small_programs", lambda: chosen.append(True))
+    missing = str(tmp_path / "none.csv")
+    for argv, small in ((["vessels"], False),
+                        (["identify", missing, "--model", "nomoto1", "--out", "o"], True),
+                        (["identify", missing, "--model", "esso_osaka", "--out", "o"], False),
+                        (["discover", missing, "--model", "kvlcc2", "--out", "o"], False),
+                        (["simulate", "--vessel", "mariner", "--manoeuvre", "turn:400",
+                          "--out", "o"], True)):
+        chosen.clear()
+        main(argv)
+        assert chosen == ([True] if small else []), argv
+    capsys.readouterr()
+
+
+def test_the_compiler_setting_keeps_the_users_xla_flags(monkeypatch):
+    monkeypatch.setenv("XLA_FLAGS", "--xla_backend_optimization_level=2 --xla_dump_to=x")
+    cli.compile_for_small_programs()
+    assert os.environ["XLA_FLAGS"].split() == [
+        "--xla_backend_optimization_level=2", "--xla_dump_to=x",
+        "--xla_cpu_use_fusion_emitters=false"]
 
 
 def test_version(capsys):

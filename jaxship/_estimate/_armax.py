@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 import optimistix as optx
-from scipy.signal import lfilter
+import scipy  # scipy.signal loads on first use (an import-time saving)
 
 from .._foundation._covariance import parameter_report
 from .._foundation._params import parameter_fields
@@ -77,7 +77,7 @@ class ARMAXResult:
 
     def simulate(self, u) -> np.ndarray:
         """The noise-free output $y = (B/A)\\,u(t - n_k)$ from rest."""
-        return lfilter(self.B, self.A, _delay(np.asarray(u, float), self.nk))
+        return scipy.signal.lfilter(self.B, self.A, _delay(np.asarray(u, float), self.nk))
 
     def nomoto(self) -> dict | None:
         """The continuous model whose zero-order-hold sampling this is, where the orders
@@ -106,8 +106,8 @@ def _delay(u, nk):
 
 
 def _residuals(y, u, A, B, C, nk):
-    w = lfilter(A, [1.0], y) - lfilter(B, [1.0], _delay(u, nk))
-    return lfilter([1.0], C, w)
+    w = scipy.signal.lfilter(A, [1.0], y) - scipy.signal.lfilter(B, [1.0], _delay(u, nk))
+    return scipy.signal.lfilter([1.0], C, w)
 
 
 def _check(y, u, na, nb, nc, nk):
@@ -181,9 +181,9 @@ def fit_armax(y, u, *, na: int = 2, nb: int = 2, nc: int = 2, nk: int = 1,
     def jacobian(th, eps):
         A, B, C = polys(th)
         # d eps / d theta = -phi / C with phi = (-y lags, u lags, eps lags)
-        cols = [lfilter([1.0], C, _delay(y, i)) for i in a_lags]
-        cols += [-lfilter([1.0], C, _delay(ud, j)) for j in b_lags]
-        cols += [-lfilter([1.0], C, _delay(eps, i)) for i in c_lags]
+        cols = [scipy.signal.lfilter([1.0], C, _delay(y, i)) for i in a_lags]
+        cols += [-scipy.signal.lfilter([1.0], C, _delay(ud, j)) for j in b_lags]
+        cols += [-scipy.signal.lfilter([1.0], C, _delay(eps, i)) for i in c_lags]
         return np.stack(cols, axis=1)[start:]
 
     if nc and np.any(np.abs(np.roots(polys(theta)[2])) >= 1.0):

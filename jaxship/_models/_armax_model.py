@@ -8,7 +8,7 @@ armax` wraps it.
 
 import equinox as eqx
 import numpy as np
-from scipy.signal import lfilter, lfiltic
+import scipy  # scipy.signal loads on first use (an import-time saving)
 
 from .._foundation._params import param
 
@@ -64,9 +64,9 @@ def simulate_armax(model: ARMAXModel, delta, r0) -> np.ndarray:
     b = np.concatenate([np.zeros(int(round(float(model.nk)))), B])  # delay as leading zeros
     # filter state of the past, linear in its values: r(0), r(-1), ... = r0 and
     # delta(0), delta(-1), ... = delta[..., 0]
-    from_r = lfiltic(b, A, np.ones(A.size - 1), np.zeros(b.size - 1))
-    from_delta = lfiltic(b, A, np.zeros(A.size - 1), np.ones(b.size - 1))
+    from_r = scipy.signal.lfiltic(b, A, np.ones(A.size - 1), np.zeros(b.size - 1))
+    from_delta = scipy.signal.lfiltic(b, A, np.zeros(A.size - 1), np.ones(b.size - 1))
     zi = r0[:, None] * from_r + rows[:, :1] * from_delta
-    rest = lfilter(b, A, rows[:, 1:], axis=1, zi=zi)[0]
+    rest = scipy.signal.lfilter(b, A, rows[:, 1:], axis=1, zi=zi)[0]
     out = np.concatenate([r0[:, None], rest], axis=1)
     return out.reshape(delta.shape)

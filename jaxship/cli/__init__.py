@@ -32,6 +32,13 @@ interrupted. JAXSHIP_CACHE_DIR: where compiled programs are kept for later runs 
 ~/.cache/jaxship/jax; "off" disables)."""
 
 COMMANDS = (vessels, simulate, reproduce, identify, autopilot, discover)
+# XLA's CPU compiler set for many small programs: LLVM's optimisation off and the loop
+# emitters instead of the MLIR fusion emitters. Each command says whether it compiles many
+# programs that run briefly (`small_programs(args)`, set in its `register`): first runs of
+# simulate, identify of a steering model, autopilot and reproduce took 1.3-1.6x less time
+# with it, a vessel's identify and autopilot --tune 1.1-1.25x more, discover the same
+# (`python benchmarks/cli.py --flags`, 2026-11-27).
+SMALL_PROGRAMS = ("--xla_backend_optimization_level=0", "--xla_cpu_use_fusion_emitters=false")
 GRACE = 5.0  # [s] after Ctrl-C, the longest the process takes to end
 _INTERRUPTED = threading.Event()  # Ctrl-C was pressed
 _RAISED = threading.Event()  # and raised as KeyboardInterrupt in the main thread
@@ -76,6 +83,8 @@ def main(argv=None) -> int:
         raw = issubclass(command_parser.formatter_class, argparse.RawDescriptionHelpFormatter)
         command_parser.formatter_class = RawHelpFormatter if raw else HelpFormatter
     args = parser.parse_args(argv)
+    if args.small_programs(args):
+        compile_for_small_programs()
     jax.config.update("jax_enable_x64", True)
     enable_compilation_cache()  # second runs skip compilation ($JAXSHIP_CACHE_DIR moves it)
     try:
@@ -93,6 +102,14 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("jaxship: interrupted.", file=sys.stderr)
         return 130
+
+
+def compile_for_small_programs(flags=SMALL_PROGRAMS) -> None:
+    """Add `flags` to $XLA_FLAGS, each unless $XLA_FLAGS sets it already. XLA reads them
+    when JAX starts its backend (at the first computation): later calls change nothing."""
+    given = os.environ.get("XLA_FLAGS", "").split()
+    named = {f.split("=")[0] for f in given}
+    os.environ["XLA_FLAGS"] = " ".join(given + [f for f in flags if f.split("=")[0] not in named])
 
 
 def run() -> None:

@@ -45,7 +45,8 @@ def register(sub) -> None:
                       "time and window follow it in the thesis' proportions")
     auto.add_argument("--damping", default="1.0", help="the controller's zeta")
     auto.add_argument("--quiet", action="store_true", help="no progress bar")
-    auto.set_defaults(run=run)
+    # --tune runs long gradient programs, which XLA's defaults compile to run faster
+    auto.set_defaults(run=run, small_programs=lambda args: not args.tune)
 
 
 def _point_name(row, by_rpm) -> str:

@@ -7,6 +7,7 @@ import pathlib
 import sys
 
 from .._foundation._files import staged_folder
+from .._models._vessel.catalogue import VESSELS
 from ..plotting import save_identification_figures
 from ._common import (
     VELOCITIES,
@@ -54,7 +55,8 @@ def register(sub) -> None:
     add_velocities(ident)
     ident.add_argument("--no-figures", action="store_true", help="write result.json only")
     ident.add_argument("--quiet", action="store_true", help="no progress bar")
-    ident.set_defaults(run=run)
+    # a vessel's fit runs long programs, which XLA's defaults compile to run faster
+    ident.set_defaults(run=run, small_programs=lambda args: args.model not in VESSELS)
 
 
 def _horizon(text):

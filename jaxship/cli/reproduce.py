@@ -10,7 +10,7 @@ def register(sub) -> None:
     rep = sub.add_parser("reproduce", help="the thesis pipeline on the built-in thesis vessel")
     rep.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/reproduce"))
     rep.add_argument("--quick", action="store_true", help="fewer trials (for smoke tests)")
-    rep.set_defaults(run=run)
+    rep.set_defaults(run=run, small_programs=lambda args: True)
 
 
 def run(args) -> int:

@@ -27,7 +27,7 @@ def register(sub) -> None:
     sim.add_argument("--dt", type=float, help="sample interval [s]")
     sim.add_argument("--length", type=float, metavar="L", help="Froude-scale the preset to "
                      "this length between perpendiculars [m] (e.g. 320 for the KVLCC2 ship)")
-    sim.set_defaults(run=run)
+    sim.set_defaults(run=run, small_programs=lambda args: True)
 
 
 def run(args) -> int:

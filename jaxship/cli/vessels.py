@@ -5,7 +5,7 @@ from .._models._vessel.catalogue import VESSELS, get_vessel
 
 def register(sub) -> None:
     vessels = sub.add_parser("vessels", help="list the vessel presets and their sources")
-    vessels.set_defaults(run=run)
+    vessels.set_defaults(run=run, small_programs=lambda args: False)
 
 
 def run(args) -> int:

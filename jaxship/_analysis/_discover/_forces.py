@@ -17,7 +17,7 @@ the states, so a filter that trusted the model would hide them.
 import jax
 import jax.numpy as jnp
 import numpy as np
-from scipy.signal import savgol_filter
+import scipy  # scipy.signal loads on first use (an import-time saving)
 
 from ..._estimate._kalman import _augmented_names, smooth_states
 from ..._estimate._windows import as_dataset
@@ -37,7 +37,7 @@ FILTERED = ("psi", "r", "u", "x", "y")  # what the filter measures where v is no
 def _noise(a, span) -> float:
     """Measurement-noise variance of one channel: the variance of what a cubic
     Savitzky-Golay smoother over `span` samples leaves (floored for exact data)."""
-    rest = a - savgol_filter(a, span, 3)
+    rest = a - scipy.signal.savgol_filter(a, span, 3)
     return max(float(np.var(rest)), 1e-12 * (float(np.var(a)) + 1e-12))
 
 
@@ -94,7 +94,7 @@ def residual_loads(vessel, data, *, smoothing: float = 10.0, wind: bool = False,
         get = lambda c: np.asarray(getattr(ds, c)[e, :n], dtype=np.float64)
         nu = np.stack([get("u"), get("v"), get("r")] if logged else
                       [smoothed[e].state(c) for c in ("u", "v", "r")])
-        nu_dot = savgol_filter(nu, span, 3, deriv=1, delta=dt, axis=1)
+        nu_dot = scipy.signal.savgol_filter(nu, span, 3, deriv=1, delta=dt, axis=1)
         signals = [jnp.asarray(a) for a in (get("t"), *nu, get("delta"), get("n"))]
         tau = np.asarray(jax.vmap(vessel.loads)(*signals)).T  # sample by sample
         if wind:

@@ -40,7 +40,7 @@ candidates' scores; a Gaussian multiplier bootstrap, Chernozhukov, Chetverikov &
 import dataclasses
 
 import numpy as np
-from scipy.stats import chi2
+import scipy  # scipy.stats loads on first use (an import-time saving)
 
 from ..._foundation._covariance import _auto_lags, bartlett_long_run
 
@@ -177,7 +177,7 @@ def forward_path(g, v, gram, blocks, equivalent, lower, top, enter=0.05):
                 step = -gk @ np.linalg.pinv(gram[np.ix_(b, b)] - coef @ gram[np.ix_(a, b)],
                                             rcond=1e-12)
                 logp = np.where((lower[b] & (step < 0)).any(axis=1), 0.0,
-                                chi2.logsf(stat, b.size))
+                                scipy.stats.chi2.logsf(stat, b.size))
                 better = logp < best_p[rows]
                 best[rows[better]], best_p[rows[better]] = k, logp[better]
         took = best >= 0
