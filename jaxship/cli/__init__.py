@@ -37,8 +37,8 @@ COMMANDS = (vessels, simulate, reproduce, identify, autopilot, discover)
 # programs that run briefly (`small_programs(args)`, set in its `register`): first runs of
 # simulate, identify of a steering model and autopilot took 1.3-1.6x less time with it, a
 # vessel's identify and autopilot --tune 1.1-1.25x more, discover the same; reproduce's
-# first run 1.3x less, its second (from the cache) 1.5x more (`python benchmarks/cli.py
-# --flags` and `--table`, 2026-11-27).
+# first run 1.4x less, its second (from the cache) 1.4x more (`python benchmarks/cli.py
+# --flags` and `--table`, 2026-11-27): the first counts, a new user's.
 SMALL_PROGRAMS = ("--xla_backend_optimization_level=0", "--xla_cpu_use_fusion_emitters=false")
 GRACE = 5.0  # [s] after Ctrl-C, the longest the process takes to end
 _INTERRUPTED = threading.Event()  # Ctrl-C was pressed
