@@ -75,8 +75,8 @@ def manoeuvres(rpm):
     return [
         ("turn35", js.Turn(35 * DEG, duration=120.0, execute=5.0, n=n)),
         ("turn-20", js.Turn(-20 * DEG, duration=120.0, execute=5.0, n=n)),
-        ("zigzag10", js.ZigZag(10 * DEG, 10 * DEG, duration=150.0, n=n)),
-        ("zigzag-20", js.ZigZag(-20 * DEG, 20 * DEG, duration=150.0, n=n)),
+        ("zigzag10", js.ZigZag(10 * DEG, 10 * DEG, duration=150.0, n=n, switch_at="nearest")),
+        ("zigzag-20", js.ZigZag(-20 * DEG, 20 * DEG, duration=150.0, n=n, switch_at="nearest")),
         ("thesis", js.thesis_manoeuvre((10, 25), hold_per_deg=1.0, ramp_deg_per_s=1.0,
                                        end_hold=20.0, n=n)),
         ("prbs", js.prbs(15 * DEG, 5.0, 150.0, n=n)),
