@@ -107,22 +107,33 @@ class RunScore:
     fit_percent: dict
 
 
-def free_run_score(model, runs, *, wind: bool = True) -> list[RunScore]:
-    """Score `model` on each of `runs` by a free simulation from the run's first measured
-    state (u, v, r, psi and position), replaying the logged rudder angle, propeller rate
-    and (with `wind`, where the model feels it) true wind, at the runs' own samples."""
+def free_run(model, run, *, wind: bool = True) -> dict:
+    """A free simulation of `run` from its first measured state (u, v, r, psi and
+    position), replaying the logged rudder angle, propeller rate and (with `wind`, where
+    the model feels it) true wind, at the run's own samples: `{channel: values}` for u,
+    v, r, psi, x and y at the samples the simulation reaches (all but the first), `"t"`
+    their times and `"hit"` the run's samples they are (a boolean mask)."""
     channels = SCORED + ("x", "y")
     estimator = js.PredictionError(horizon=None, channels=channels,
                                    wind=bool(wind and model.wind_loads))
+    pred = js.predict(model, [run], estimator=estimator)
+    hit = pred.predicted[0, :run.num_samples]
+    out = {c: pred.predictions[c][0, :run.num_samples][hit] for c in channels}
+    return {"hit": hit, "t": run.t[hit], **out}
+
+
+def free_run_score(model, runs, *, wind: bool = True) -> list[RunScore]:
+    """Score `model` on each of `runs` by its `free_run`: RMSE of u, v, r and psi, mean
+    and final position error, and fit % per channel (`jaxship.fit_percent`)."""
     scores = []
     for run in runs:
-        pred = js.predict(model, [run], estimator=estimator)
-        hit = pred.predicted[0, :run.num_samples]
-        error = {c: (pred.predictions[c][0, :run.num_samples] - getattr(run, c))[hit]
-                 for c in channels}
+        sim = free_run(model, run, wind=wind)
+        hit = sim["hit"]
+        error = {c: sim[c] - getattr(run, c)[hit] for c in SCORED + ("x", "y")}
         distance = np.hypot(error["x"], error["y"])
         scores.append(RunScore(
             run=run.name, rmse={c: float(np.sqrt(np.mean(error[c] ** 2))) for c in SCORED},
             position_mean=float(np.mean(distance)), position_final=float(distance[-1]),
-            fit_percent={c: float(pred.metrics[c].fit_per_experiment[0]) for c in SCORED}))
+            fit_percent={c: js.fit_percent(getattr(run, c)[hit], sim[c]) for c in SCORED}))
     return scores
+
