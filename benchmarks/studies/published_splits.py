@@ -122,18 +122,18 @@ def free_run(model, run, *, wind: bool = True) -> dict:
     return {"hit": hit, "t": run.t[hit], **out}
 
 
-def free_run_score(model, runs, *, wind: bool = True) -> list[RunScore]:
-    """Score `model` on each of `runs` by its `free_run`: RMSE of u, v, r and psi, mean
-    and final position error, and fit % per channel (`jaxship.fit_percent`)."""
-    scores = []
-    for run in runs:
-        sim = free_run(model, run, wind=wind)
-        hit = sim["hit"]
-        error = {c: sim[c] - getattr(run, c)[hit] for c in SCORED + ("x", "y")}
-        distance = np.hypot(error["x"], error["y"])
-        scores.append(RunScore(
-            run=run.name, rmse={c: float(np.sqrt(np.mean(error[c] ** 2))) for c in SCORED},
-            position_mean=float(np.mean(distance)), position_final=float(distance[-1]),
-            fit_percent={c: js.fit_percent(getattr(run, c)[hit], sim[c]) for c in SCORED}))
-    return scores
+def run_score(run, sim) -> RunScore:
+    """The score of `sim` (a `free_run` of `run`): RMSE of u, v, r and psi, mean and
+    final position error, and fit % per channel (`jaxship.fit_percent`)."""
+    hit = sim["hit"]
+    error = {c: sim[c] - getattr(run, c)[hit] for c in SCORED + ("x", "y")}
+    distance = np.hypot(error["x"], error["y"])
+    return RunScore(
+        run=run.name, rmse={c: float(np.sqrt(np.mean(error[c] ** 2))) for c in SCORED},
+        position_mean=float(np.mean(distance)), position_final=float(distance[-1]),
+        fit_percent={c: js.fit_percent(getattr(run, c)[hit], sim[c]) for c in SCORED})
 
+
+def free_run_score(model, runs, *, wind: bool = True) -> list[RunScore]:
+    """Score `model` on each of `runs` by its `free_run` (`run_score`)."""
+    return [run_score(run, free_run(model, run, wind=wind)) for run in runs]
