@@ -23,12 +23,12 @@ experiment here), channels psi, r, u, v weighted by 1/std of the measured channe
 The SciPy side rebuilds these windows and weights in plain NumPy (`ScipyProblem`).
 
 - jaxship: `jaxship.fit(vessel, data, estimator=PredictionError(horizon=10.0,
-  rudder="delta_c", max_steps=500), free=FREE)`: its default solver, optimistix's LM with MINPACK's
-  cost test added (`jaxship.LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-10)`: it
-  stops once an accepted step lowers the cost by at most 1e-10 relative, SciPy's
-  `ftol` below), forward-mode Jacobian through the fixed-step RK4 scan, vmapped over
-  all windows. Timed with compilation (first call in the process) and without (second
-  call, same start).
+  rudder="delta_c", max_steps=500), free=FREE)`: its default solver, optimistix's LM
+  with Nielsen's damping update and MINPACK's cost test
+  (`jaxship.LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-10)`: it stops once an
+  accepted step lowers the cost by at most 1e-10 relative, SciPy's `ftol` below),
+  forward-mode Jacobian through the fixed-step RK4 scan, vmapped over all windows. Timed
+  with compilation (first call in the process) and without (second call, same start).
 - SciPy: `scipy.optimize.least_squares(method="lm")` (MINPACK LM) with forward finite
   differences (`diff_step=1e-6`), residuals by `scipy.integrate.solve_ivp` (RK45,
   rtol 1e-9, atol 1e-12) on a right-hand side written in NumPy (checked against

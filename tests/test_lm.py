@@ -1,14 +1,16 @@
 """jaxship's Levenberg-Marquardt (MINPACK's cost test on top of optimistix's) and the
 stored-Jacobian residuals of `jaxship/_estimate/_lm.py`."""
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
+import lineax as lx
 import numpy as np
 import optimistix as optx
 import pytest
 
 from jaxship import LevenbergMarquardt
-from jaxship._estimate._lm import solve_least_squares, stored_jacobian
+from jaxship._estimate._lm import NielsenDamping, solve_least_squares, stored_jacobian
 
 
 T = jnp.linspace(0.0, 10.0, 200)
@@ -30,12 +32,38 @@ def solve(solver):
     return sol, 0.5 * float(r @ r)
 
 
-def test_ftol_zero_is_optimistix_levenberg_marquardt():
+def test_ftol_zero_with_the_classical_trust_region_is_optimistix_levenberg_marquardt():
+    """The cost test adds nothing at ftol=0: with optimistix's own damping rule in place
+    of Nielsen's, the solver is optimistix's, step for step."""
     ref, cost_ref = solve(optx.LevenbergMarquardt(rtol=1e-12, atol=1e-12))
-    sol, cost = solve(LevenbergMarquardt(rtol=1e-12, atol=1e-12, ftol=0.0))
+    classical = eqx.tree_at(lambda s: s.search,
+                            LevenbergMarquardt(rtol=1e-12, atol=1e-12, ftol=0.0),
+                            optx.ClassicalTrustRegion())
+    sol, cost = solve(classical)
     assert int(sol.stats["num_steps"]) == int(ref.stats["num_steps"])
     np.testing.assert_array_equal(sol.value, ref.value)
     assert cost == cost_ref
+
+
+def test_nielsens_damping_reaches_the_same_cost_in_fewer_steps():
+    """On the sum of exponentials, from the same start: the classical trust region and
+    Nielsen's damping update (the default) end at the same cost, Nielsen's in fewer
+    steps; a step that is not finite is rejected and the damping raised."""
+    classical = eqx.tree_at(lambda s: s.search, LevenbergMarquardt(rtol=1e-12, atol=1e-12),
+                            optx.ClassicalTrustRegion())
+    ref, cost_ref = solve(classical)
+    sol, cost = solve(LevenbergMarquardt(rtol=1e-12, atol=1e-12))
+    assert isinstance(LevenbergMarquardt(rtol=1e-9, atol=1e-9).search, NielsenDamping)
+    assert sol.result == optx.RESULTS.successful
+    assert int(sol.stats["num_steps"]) < int(ref.stats["num_steps"])
+    assert abs(cost - cost_ref) <= 1e-9 * cost_ref
+    damping = NielsenDamping()
+    state = damping.init(Z0, None)
+    info = optx.FunctionInfo.ResidualJac(residuals(Z0, None),
+                                         lx.MatrixLinearOperator(jax.jacfwd(residuals)(Z0, None)))
+    bad = optx.FunctionInfo.Residual(jnp.full(T.shape, jnp.nan))
+    step, accept, _, after = damping.step(jnp.array(False), Z0, Z0 + 0.1, info, bad, state)
+    assert not accept and float(step) == 0.5 and float(after.nu) == 4.0
 
 
 def test_cost_test_stops_earlier_at_the_same_cost():
