@@ -16,9 +16,10 @@ predicted one, so its predicted reduction is small too, as MINPACK requires).
 Damping. optimistix's trust region (`ClassicalTrustRegion`) changes the damping only by
 fixed factors and leaves it alone while the gain ratio $\\rho$ (actual over predicted
 cost reduction) lies between 0.01 and 0.99, which on these fits it mostly does: the
-20-coefficient vessel fit of `benchmarks/fit.py` walked its valley for 50 steps at one
-damping. `NielsenDamping` updates it from $\\rho$ at every step (Nielsen 1999), which took
-the same fit to the same cost (8.625501298) in 34 steps instead of 61.
+20-coefficient vessel fit of `benchmarks/fit.py` walked its valley at one damping for
+about 20 steps at a time. `NielsenDamping` updates it from $\\rho$ at every step
+(Nielsen 1999), which took the same fit to the same cost (8.625501298) in 34 steps
+instead of 61.
 
 Jacobians. For `jac="fwd"` optimistix calls `jax.linearize` on the residuals and
 materialises the linear map column by column; through a long `lax.scan` that costs
