@@ -324,9 +324,9 @@ def main(args):
     start_vessel = with_values(truth_vessel, names, start)
     est = js.PredictionError(horizon=HORIZON, rudder="delta_c", max_steps=500)
 
-    def jax_fit():
+    def jax_fit(estimator=est):
         t = time.perf_counter()
-        res = js.fit(start_vessel, data, estimator=est, free=names)
+        res = js.fit(start_vessel, data, estimator=estimator, free=names)
         return res, time.perf_counter() - t
 
     res, t_first = jax_fit()
@@ -334,6 +334,13 @@ def main(args):
     assert np.array_equal(res.values, res2.values)
     print(f"jaxship: {res.message}, {res.num_steps} LM steps; {t_first:.2f} s with "
           f"compilation, {t_second:.2f} s without")
+    # the option: geodesic acceleration (a program of its own, so it compiles again)
+    geodesic = eqx.tree_at(lambda e: e.solver, est, js.LevenbergMarquardt(
+        rtol=1e-9, atol=1e-9, ftol=1e-10, geodesic=True))
+    (res_g, t_g1), (_, t_g2) = jax_fit(geodesic), jax_fit(geodesic)
+    print(f"jaxship with LevenbergMarquardt(geodesic=True): {res_g.message}, "
+          f"{res_g.num_steps} LM steps, cost {res_g.cost:.9f} (default: {res.cost:.9f}); "
+          f"{t_g1:.2f} s with compilation, {t_g2:.2f} s without")
 
     scale = np.abs(start)
     problem = ScipyProblem(truth_vessel, data, names, scale)
@@ -384,6 +391,8 @@ def main(args):
     print(f"{'time incl. compilation [s]':26}{t_first:14.2f}{t_sp:14.1f}{t_sp / t_first:15.1f}")
     print(f"{'time excl. compilation [s]':26}{t_second:14.2f}{t_sp:14.1f}"
           f"{t_sp / t_second:15.1f}")
+    print(f"{'  geodesic=True, incl.':26}{t_g1:14.2f}{t_sp:14.1f}{t_sp / t_g1:15.1f}")
+    print(f"{'  geodesic=True, excl.':26}{t_g2:14.2f}{t_sp:14.1f}{t_sp / t_g2:15.1f}")
     print(f"{'final cost (SciPy resid.)':26}{cost_jax_sp:14.6f}{cost_sp:14.6f}"
           f"{cost_sp / cost_jax_sp:15.4f}")
     print(f"{'final cost (own resid.)':26}{res.cost:14.6f}{cost_sp:14.6f}")
