@@ -283,7 +283,7 @@ def solve_least_squares(fn, solver, z0, args, max_steps, to_physical,
     residuals and Jacobian are those of its last accepted step (no second compilation
     of the forward pass); other solvers evaluate them once more. `jacobian(f, z)`
     computes `(f, J)` (default `value_and_jacfwd`; `blockwise_jacfwd`). Call under jit."""
-    if isinstance(solver, LevenbergMarquardt) and solver.residuals is None:
+    if isinstance(solver, LevenbergMarquardt) and solver.geodesic and solver.residuals is None:
         # geodesic acceleration evaluates the plain residuals, not the stored Jacobian
         solver = eqx.tree_at(lambda s: s.residuals, solver, fn, is_leaf=lambda x: x is None)
     fn = stored_jacobian(fn, jacobian)
