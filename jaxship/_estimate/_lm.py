@@ -255,9 +255,21 @@ def blockwise_jacfwd(num_params: int, blocks: tuple[int, ...]):
     return value_and_jac
 
 
+@eqx.filter_jit
+def _traced_once(z, fn, args, jacobian):
+    """`jacobian(fn(., args), z)` under `filter_jit`: the solver's closure conversion
+    calls it, then the custom JVP's rule, and the second call reuses the first trace
+    (the vessel fit of `benchmarks/fit.py` traced it for 1.7 s each time)."""
+    return jacobian(lambda x: fn(x, args), z)
+
+
 @eqx.filter_custom_jvp
 def _value_and_jacobian(z, fn, args, jacobian):
-    return jacobian(lambda x: fn(x, args), z)
+    # JAX keys its trace cache on the tracing context, and the rule's call runs with an
+    # abstract mesh set where the first ran without: setting the current one (a no-op
+    # for the computation) makes the two contexts equal
+    with jax.sharding.use_abstract_mesh(jax.sharding.get_abstract_mesh()):
+        return _traced_once(z, fn, args, jacobian)
 
 
 @_value_and_jacobian.def_jvp
