@@ -27,7 +27,9 @@ materialises the linear map column by column; through a long `lax.scan` that cos
 about twice a plain `jax.jacfwd` (measured on the 20-coefficient vessel fit:
 1.15 s against 0.50 s per Jacobian). `stored_jacobian` gives the residual function a
 custom JVP that computes the full forward-mode Jacobian once and multiplies by it,
-so linearising costs one `jacfwd` and materialising one small matrix product.
+so linearising costs one `jacfwd` and materialising one small matrix product; and it
+is traced once per fit (`_traced_once`), not once for the solver's closure conversion
+and again for the rule.
 """
 
 import math
