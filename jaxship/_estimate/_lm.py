@@ -139,7 +139,8 @@ class LevenbergMarquardt(optx.AbstractGaussNewton):
         return y, new, aux
 
     def _accelerate(self, residuals, y, args, state, h=0.1, alpha=0.75):
-        """`state` with the proposal $y + v$ moved to $y + v + a/2$ (class docstring)."""
+        """`state` with the proposal $y + v$ moved to $y + v + a/2$ (class docstring);
+        `y` is a flat array, as in every jaxship fit."""
         info = state.f_info
         v = state.y_eval - y
         f_vv = (2 / h) * ((residuals(y + h * v, args) - info.residual) / h - info.jac.mv(v))
