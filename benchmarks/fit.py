@@ -335,8 +335,7 @@ def main(args):
     print(f"jaxship: {res.message}, {res.num_steps} LM steps; {t_first:.2f} s with "
           f"compilation, {t_second:.2f} s without")
     # the option: geodesic acceleration (a program of its own, so it compiles again)
-    geodesic = eqx.tree_at(lambda e: e.solver, est, js.LevenbergMarquardt(
-        rtol=1e-9, atol=1e-9, ftol=1e-10, geodesic=True))
+    geodesic = eqx.tree_at(lambda e: e.solver.geodesic, est, True)
     (res_g, t_g1), (_, t_g2) = jax_fit(geodesic), jax_fit(geodesic)
     print(f"jaxship with LevenbergMarquardt(geodesic=True): {res_g.message}, "
           f"{res_g.num_steps} LM steps, cost {res_g.cost:.9f} (default: {res.cost:.9f}); "

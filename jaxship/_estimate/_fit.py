@@ -105,8 +105,8 @@ class PredictionError(AbstractEstimator):
       $\\rho\\,dt/\\text{steps} \\le 2.5$ (RK4 is stable to 2.785 on the real axis).
     - `solver`: an `optimistix` least-squares solver; by default jaxship's
       `LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-10)`: optimistix's solver with
-      Nielsen's damping update (and optional geodesic acceleration) that also stops, like MINPACK,
-      once an accepted step lowers the cost by at most `ftol` relative
+      Nielsen's damping update (and optional geodesic acceleration) that also stops,
+      like MINPACK, once an accepted step lowers the cost by at most `ftol` relative
       (`jaxship/_estimate/_lm.py`).
     - `max_steps`: optimiser step limit (0: the start values are the estimates).
     - `start`: a start-value strategy run before the optimiser, `LinearStart()` (the
