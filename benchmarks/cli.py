@@ -26,8 +26,10 @@ command's own XLA compiler setting (`jaxship.cli.SMALL_PROGRAMS`: LLVM's optimis
 the loop emitters) and with XLA's defaults (set in `$XLA_FLAGS`, which the command then
 leaves as they are), and prints the ratio default / own.
 
-Run: `python benchmarks/cli.py [--repeats N] [--table | --flags]` (the median of N runs of each;
-default 1).
+Run: `python benchmarks/cli.py [--repeats N] [--table | --flags] [--only TEXT]` (the median
+of N runs of each, default 1; `--only`: the table's rows whose name contains TEXT, e.g.
+`--only discover` after a change to `discover` alone; the `autopilot` rows read the
+`identify (nomoto1)` row's result).
 """
 
 import argparse
@@ -100,9 +102,11 @@ def table_commands(out: Path) -> dict:
     }
 
 
-def table(repeats: int, tmp: Path) -> None:
-    """The README's time column: first run (empty cache) and second (the cache read)."""
-    commands = table_commands(tmp)
+def table(repeats: int, tmp: Path, only: str | None = None) -> None:
+    """The README's time column: first run (empty cache) and second (the cache read), of
+    the rows whose name contains `only` (None: all)."""
+    commands = {name: command for name, command in table_commands(tmp).items()
+                if only is None or only in name}
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     print(f"{time.strftime('%Y-%m-%d')}, {cores} CPU cores, each command in a new process")
     print("| command | first run (compiles) | second run (cache) |")
@@ -145,11 +149,12 @@ def main():
                        help="time every example of the README's command table")
     which.add_argument("--flags", action="store_true",
                        help="the table's first runs with XLA's defaults and with jaxship's")
+    parser.add_argument("--only", help="with --table: the rows whose name contains this text")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         if args.table:
-            return table(args.repeats, tmp)
+            return table(args.repeats, tmp, args.only)
         if args.flags:
             return flags(args.repeats, tmp)
         off = os.environ | {"JAXSHIP_CACHE_DIR": "off"}

@@ -14,9 +14,11 @@ import numpy as np
 import pytest
 
 import jaxship as js
+from jaxship._analysis._discover import _workflow as discover_workflow
 from jaxship._analysis._discover._holdout import cost_rise, record_indices
 from jaxship._analysis._discover._plausible import rudder_equivalent
 from jaxship._analysis._discover._workflow import heldout_rise
+from jaxship._estimate._sensitivity import sensitivities
 from jaxship._estimate._windows import as_dataset
 from jaxship._foundation._files import MANIFEST, staged_folder
 from jaxship.cli import main
@@ -322,9 +324,21 @@ def test_a_rudder_offset_is_named_with_its_class_and_the_gap_shrinks():
     assert "## Where the base model disagrees" in report.to_markdown()
 
 
-def test_cubic_damping_is_named_and_closes_the_held_out_gap():
+def test_cubic_damping_is_named_and_closes_the_held_out_gap(monkeypatch):
+    """... and every iteration scores the same program: the effects (the accepted one and
+    the candidates at zero) in the catalogue's order, the same parameters in the same
+    order, so the second iteration reuses the first's compilation."""
+    scored = []
+
+    def recording(model, dataset, estimator, names, *args, **kwargs):
+        scored.append(([type(e) for e in model.effects], tuple(names)))
+        return sensitivities(model, dataset, estimator, names, *args, **kwargs)
+
+    monkeypatch.setattr(discover_workflow, "sensitivities", recording)
     report = run(js.YawCubicDamping(beta=300.0), seed=4)
     assert report.named == ("yaw_cubic_damping",)
+    assert len(scored) == 2 and scored[0] == scored[1]
+    assert [type(e) for e in report.model_after.effects] == [js.YawCubicDamping]
     p = report.effects[0].parameters["yaw_cubic_damping.beta"]
     assert abs(p.value - 300.0) < 4 * p.std
     assert report.holdout_cost_after < 0.5 * report.holdout_cost_before

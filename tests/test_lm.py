@@ -126,6 +126,32 @@ def test_negative_ftol_raises():
         LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=-1.0)
 
 
+@pytest.mark.parametrize("damping", [0.0, -1.0, float("inf"), float("nan")])
+def test_a_damping_that_is_not_positive_and_finite_raises(damping):
+    with pytest.raises(ValueError, match="damping"):
+        LevenbergMarquardt(rtol=1e-9, atol=1e-9, damping=damping)
+
+
+def test_a_warm_start_with_light_damping_reaches_the_optimum_in_fewer_steps():
+    """From the optimum with one term removed (as `discover` refits a model with a new
+    term at zero), a first damping of 1e-3 reaches the same cost in under half the steps
+    of the default 1, which Nielsen's update lowers only threefold per step."""
+    optimum = optx.least_squares(residuals, LevenbergMarquardt(rtol=1e-12, atol=1e-12), Z0,
+                                 max_steps=1000)
+    warm = optimum.value.at[2].set(0.0)
+    steps, costs = [], []
+    for damping in (1.0, 1e-3):
+        sol = optx.least_squares(residuals, LevenbergMarquardt(rtol=1e-12, atol=1e-12,
+                                                               damping=damping),
+                                 warm, max_steps=1000, throw=False)
+        assert sol.result == optx.RESULTS.successful
+        r = residuals(sol.value, None)
+        steps.append(int(sol.stats["num_steps"]))
+        costs.append(0.5 * float(r @ r))
+    assert 2 * steps[1] < steps[0]
+    np.testing.assert_allclose(costs[1], costs[0], rtol=1e-12)
+
+
 def test_stored_jacobian_values_and_linearisation():
     f = stored_jacobian(residuals)
     z = jnp.array([1.7, 0.4, 0.3, 2.0])

@@ -57,10 +57,12 @@ class NielsenDamping(optx.ClassicalTrustRegion):
     \\leftarrow \\nu\\lambda$, $\\nu \\leftarrow 2\\nu$. The predicted reduction is the
     Gauss-Newton model's for the Gauss-Newton step, as in optimistix's
     `ClassicalTrustRegion` (with geodesic acceleration: for the step without it, as
-    Transtrum & Sethna 2012 do)."""
+    Transtrum & Sethna 2012 do). `damping` is the first step's $\\lambda$."""
+
+    damping: float = 1.0
 
     def init(self, y, f_info_struct):
-        return _DampingState(step_size=jnp.array(1.0), nu=jnp.array(2.0),
+        return _DampingState(step_size=jnp.array(1.0 / self.damping), nu=jnp.array(2.0),
                              correction=jax.tree.map(jnp.zeros_like, y))
 
     def step(self, first_step, y, y_eval, f_info, f_eval_info, state):
@@ -102,6 +104,15 @@ class LevenbergMarquardt(optx.AbstractGaussNewton):
     (`benchmarks/fit.py`: 34 -> 20 steps, about 9 -> 6 s without compilation) and costs
     where it does not (the KVLCC2 `identify` of `benchmarks/studies/real_data.py`: 87 ->
     85 steps, 25 -> 30 s, most of it compiling the extra residual evaluation).
+
+    `damping` is the first step's $\\lambda$ in the fit's internal coordinates (the
+    default 1, optimistix's). A start far from the optimum needs it: from 1e-2 or 1e-3
+    the 20-coefficient fit of `benchmarks/fit.py` took 88 and 96 steps instead of 34.
+    A warm start, a fitted model with one term added at zero, does not: there the
+    damping of 1 is far above the optimum's (about 1e-6) and Nielsen's update lowers it
+    only threefold per step, so the first steps crawl: `discover`'s first three refits on
+    the README's KVLCC2 case took 15, 15 and 49 steps from 1, and 8, 10 and 24 from 1e-3
+    (`discover`'s `REFIT_DAMPING`), to costs equal to 1e-8 relative.
     """
 
     rtol: float
@@ -115,15 +126,18 @@ class LevenbergMarquardt(optx.AbstractGaussNewton):
     residuals: object
 
     def __init__(self, rtol: float, atol: float, ftol: float = 1e-10, norm=optx.max_norm,
-                 linear_solver=None, verbose=False, geodesic: bool = False, residuals=None):
+                 linear_solver=None, verbose=False, geodesic: bool = False, residuals=None,
+                 damping: float = 1.0):
         if not ftol >= 0.0:
             raise ValueError(f"`ftol` must be >= 0, got {ftol}.")
+        if not 0.0 < damping < math.inf:
+            raise ValueError(f"`damping` must be positive and finite, got {damping}.")
         self.rtol, self.atol, self.ftol, self.norm = rtol, atol, ftol, norm
         base = optx.LevenbergMarquardt(rtol=rtol, atol=atol, norm=norm, verbose=verbose,
                                        **({} if linear_solver is None else
                                           dict(linear_solver=linear_solver)))
         self.descent, self.verbose = base.descent, base.verbose
-        self.search = NielsenDamping()
+        self.search = NielsenDamping(damping=damping)
         self.geodesic, self.residuals = geodesic, residuals
 
     def step(self, fn, y, args, options, state, tags):

@@ -29,12 +29,14 @@ One iteration (design: ../shared/reference/discovery-design.md, sec. 4):
    with the search (`joint_null`), each member's interval excluding zero;
 5. of the candidates that pass, the one that lowers the cost most joins the model
    (a joint set joins whole), which becomes the base of the next iteration, until
-   nothing passes.
+   nothing passes. Effects sit in the model in the catalogue's order (after the start
+   model's own), whatever the order they joined in.
 """
 
 import dataclasses
 import math
 
+import equinox as eqx
 import numpy as np
 import scipy  # scipy.stats loads on first use (an import-time saving)
 
@@ -80,6 +82,9 @@ REFIT_STEPS = 100
 # (2026-11-26): the same effects named, estimates and costs equal to 1e-7 relative,
 # 18 % fewer steps (base fit 54 -> 40); the README's command 269 -> 246 s (first run).
 FIT_SOLVER = LevenbergMarquardt(rtol=1e-9, atol=1e-9, ftol=1e-7)
+# a refit starts from the current fit with the new terms at zero (a warm start): its first
+# step is damped lightly (`LevenbergMarquardt.damping`), not at 1 as a fit from afar is
+REFIT_DAMPING = 1e-3
 
 
 def _split(model):
@@ -172,7 +177,8 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
       windows, so that the window-clustered score variance holds for coloured
       residuals, each starting from an estimated correction of the measured r and psi,
       so that the noise of a start sample does not run through its window, and
-      Levenberg-Marquardt stopping at 1e-7 relative cost change, `FIT_SOLVER`; a
+      Levenberg-Marquardt stopping at 1e-7 relative cost change, `FIT_SOLVER`, its
+      refits from the current fit starting with the damping `REFIT_DAMPING`; a
       steering model's other states, e.g. the sway velocity of the sway-yaw models,
       start from their measured values, whose noise does run through); `free`:
       the base parameters fitted (default the model's). Where every training record
@@ -225,6 +231,12 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
     base_fit = fit(model, train, estimator=loss(model), free=free)
     channels = tuple(base_fit.metrics)
     current, theta, cost = base_fit, free, base_fit.cost
+    # effects join in one order, the start model's first, then the catalogue's: each
+    # iteration's scored model (every effect, the candidates at zero) then has the
+    # structure of the first, and its compiled program is reused
+    rank = {c.id: i for i, c in enumerate(catalogue)} | {e.id: -1 for e in _split(model)[1]}
+    ordered = lambda effects: tuple(sorted(effects, key=lambda e: rank[e.id]))
+    effect_names = {}  # {id: its fitted parameters} of the effects added
     before = held = check(base_fit.model) if holdout else None
     accepted, rejected, first_scores = [], [], None
     for iteration in range(max_effects):
@@ -237,10 +249,11 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
             break
         names = {c.id: _free_names(c, e) for c, e, _ in candidates}
         probes = {f"{c.id}.{k}": v for c, _, pr in candidates for k, v in pr.items()}
-        scored = augment(base, *effects, *(e for _, e, _ in candidates))
+        scored = augment(base, *ordered(effects + tuple(e for _, e, _ in candidates)))
         say(f"iteration {iteration + 1}: scoring {len(candidates)} candidates")
-        sens = sensitivities(scored, train, loss(scored), theta + sum(names.values(), ()),
-                             probes, start_offsets=current.start_offsets)
+        every = free + sum(((effect_names | names).get(e.id, ()) for e in scored.effects), ())
+        sens = sensitivities(scored, train, loss(scored), every, probes,
+                             start_offsets=current.start_offsets)
         nuisance = tuple(n for n in sens.names if n.startswith("start["))
         entry = {c.id: (c, e, pr) for c, e, pr in candidates}
         # a candidate whose sensitivities are not finite (the model with it blows up on
@@ -297,13 +310,16 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                     for k in keys], None, None, False
 
         def attempt(keys, s, limit, p_value):
-            start = augment(base, *effects, *(entry[k][1] for k in keys))
+            start = augment(base, *ordered(effects + tuple(entry[k][1] for k in keys)))
             for k in keys:
                 for field, value in entry[k][2].items():
                     start = _set(start, f"{k}.{field}", value)
             free = sum((names[k] for k in keys), ())
             refit = dataclasses.replace(loss(start), max_steps=min(estimator.max_steps,
                                                                    REFIT_STEPS))
+            if isinstance(refit.solver, LevenbergMarquardt):
+                refit = dataclasses.replace(refit, solver=eqx.tree_at(
+                    lambda solver: solver.search.damping, refit.solver, REFIT_DAMPING))
             trial = fit(start, train, estimator=refit, free=theta + free)
             lr = 2 * (cost - trial.cost) / sigma2 / max(s.inflation, 1.0)
             z = float(scipy.stats.norm.isf(level / 2))
@@ -413,6 +429,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         records, trial, held = min(passed, key=lambda row: row[1].cost)
         accepted.extend(records)
         say(f"accepted {' + '.join(r.id for r in records)}")
+        effect_names |= {r.id: names[r.id] for r in records}
         current, theta, cost = trial, theta + sum((names[r.id] for r in records), ()), trial.cost
     after = check(current.model) if holdout else None
     say("locating the disagreement before and after")
