@@ -230,7 +230,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
     say("fitting the base model")
     base_fit = fit(model, train, estimator=loss(model), free=free)
     channels = tuple(base_fit.metrics)
-    current, theta, cost = base_fit, free, base_fit.cost
+    current, cost = base_fit, base_fit.cost
     # effects join in one order, the start model's first, then the catalogue's: each
     # iteration's scored model (every effect, the candidates at zero) then has the
     # structure of the first, and its compiled program is reused
@@ -247,6 +247,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         candidates = applicable(base, data, catalogue, exclude=done)
         if not candidates:
             break
+        theta = free + sum(effect_names.values(), ())  # fitted: the base's and the added
         names = {c.id: _free_names(c, e) for c, e, _ in candidates}
         probes = {f"{c.id}.{k}": v for c, _, pr in candidates for k, v in pr.items()}
         scored = augment(base, *ordered(effects + tuple(e for _, e, _ in candidates)))
@@ -430,7 +431,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
         accepted.extend(records)
         say(f"accepted {' + '.join(r.id for r in records)}")
         effect_names |= {r.id: names[r.id] for r in records}
-        current, theta, cost = trial, theta + sum((names[r.id] for r in records), ()), trial.cost
+        current, cost = trial, trial.cost
     after = check(current.model) if holdout else None
     say("locating the disagreement before and after")
     disagreement = {label: locate_disagreement(r.model, train, channels,
