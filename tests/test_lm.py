@@ -10,7 +10,12 @@ import optimistix as optx
 import pytest
 
 from jaxship import LevenbergMarquardt
-from jaxship._estimate._lm import NielsenDamping, solve_least_squares, stored_jacobian
+from jaxship._estimate._lm import (
+    BlockDampedNewtonDescent,
+    NielsenDamping,
+    solve_least_squares,
+    stored_jacobian,
+)
 
 
 T = jnp.linspace(0.0, 10.0, 200)
@@ -180,3 +185,33 @@ def test_solve_least_squares_returns_physical_jacobian(solver):
     np.testing.assert_allclose(q, [2.02014445, 0.30187279, 0.48552742, 1.83116784], rtol=1e-6)
     np.testing.assert_allclose(res, residuals(q, None), rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(jac, jax.jacfwd(residuals)(q, None), rtol=1e-12, atol=1e-15)
+
+
+def test_the_block_descent_is_optimistix_damped_newton_step():
+    """Shared parameters and two nuisance parameters per block (residuals of 2 channels x
+    2 x 3 blocks x 5 samples, one block all zero as a padded window is): the block
+    elimination gives optimistix's damped Gauss-Newton step (one QR of the whole
+    stacked matrix) to rounding, from a damping that is almost nothing to a large one."""
+    rng = np.random.default_rng(3)
+    n, k, blocks, shape = 3, 2, (2, 3), (2, 2, 3, 5)
+    count = int(np.prod(blocks))
+    shared = rng.standard_normal(shape + (n,))
+    own = rng.standard_normal(shape + (k,))
+    own[:, 1, 2] = shared[:, 1, 2] = 0.0  # a padded block: no rows move
+    eye = np.eye(count).reshape((1,) + blocks + (1, count, 1))
+    spread = (own[..., None, :] * eye).reshape(shape + (count * k,))
+    jac = jnp.asarray(np.concatenate([shared, spread], axis=-1))
+    residual = jnp.asarray(rng.standard_normal(shape))
+    operator = lx.FunctionLinearOperator(lambda t: jac @ t,
+                                         jax.ShapeDtypeStruct((jac.shape[-1],), jac.dtype))
+    info = optx.FunctionInfo.ResidualJac(residual, operator)
+    y = jnp.zeros(jac.shape[-1])
+
+    def steps(descent):
+        state = descent.query(y, info, descent.init(y, info))
+        return [descent.step(jnp.asarray(1 / lam), state)[0] for lam in (1e-12, 1e-2, 1e4)]
+
+    for got, want in zip(steps(BlockDampedNewtonDescent(n, blocks)),
+                         steps(optx.DampedNewtonDescent())):
+        assert np.linalg.norm(want) > 0
+        np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)

@@ -38,6 +38,7 @@ from ._kalman import SmoothedStates
 from ._linear import LinearStart
 from ._lm import (
     RESULTS,
+    BlockDampedNewtonDescent,
     LevenbergMarquardt,
     as_code,
     blockwise_jacfwd,
@@ -228,8 +229,13 @@ def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
         p = transform.to_physical(p)
         return p if offsets is None else jnp.concatenate([p, jnp.reshape(offsets, (-1,))])
 
-    jacobian = value_and_jacfwd if offset_scale is None else blockwise_jacfwd(
-        len(transform.names), windows.start.r.shape)  # each window's start corrections
+    jacobian = value_and_jacfwd
+    if offset_scale is not None:  # each window's start corrections: block-sparse columns
+        shared_and_blocks = (len(transform.names), windows.start.r.shape)
+        jacobian = blockwise_jacfwd(*shared_and_blocks)
+        if isinstance(solver, LevenbergMarquardt):  # and its step solved block by block
+            solver = eqx.tree_at(lambda s: s.descent, solver,
+                                 BlockDampedNewtonDescent(*shared_and_blocks))
     z, result, steps, q, residual, jac = solve_least_squares(
         _residual_fn, solver, z0, (model, transform, windows, offset_scale), max_steps,
         physical, jacobian)

@@ -29,7 +29,9 @@ about twice a plain `jax.jacfwd` (measured on the 20-coefficient vessel fit:
 custom JVP that computes the full forward-mode Jacobian once and multiplies by it,
 so linearising costs one `jacfwd` and materialising one small matrix product; and it
 is traced once per fit (`_traced_once`), not once for the solver's closure conversion
-and again for the rule.
+and again for the rule. Where each prediction window's start is estimated too
+(`EstimatedStarts`), those columns are block-sparse: `blockwise_jacfwd` computes them
+with a few seeded JVPs and `BlockDampedNewtonDescent` solves each step block by block.
 """
 
 import math
@@ -244,6 +246,17 @@ def value_and_jacfwd(f, z):
     return jax.vmap(lambda t: jax.jvp(f, (z,), (t,)), out_axes=(None, -1))(basis)
 
 
+def _compressed_basis(num_params: int, count: int, size: int) -> jax.Array:
+    """The `num_params` unit vectors of the shared parameters, then k seeds, the j-th
+    with a one at the j-th nuisance parameter of each of the `count` blocks (`z = (p,
+    n_1, ..., n_B)`, each `n_b` of length k): `(num_params + k, size)`."""
+    k = (size - num_params) // count
+    seeds = jnp.zeros((k, size))
+    for j in range(k):
+        seeds = seeds.at[j, num_params + j::k].set(1.0)
+    return jnp.concatenate([jnp.eye(num_params, size), seeds])
+
+
 def blockwise_jacfwd(num_params: int, blocks: tuple[int, ...]):
     """A `value_and_jacfwd` for residuals `(..., *blocks, L)` whose last inputs are
     per-block nuisance parameters, k for each of the B = `prod(blocks)` blocks in
@@ -257,10 +270,7 @@ def blockwise_jacfwd(num_params: int, blocks: tuple[int, ...]):
 
     def value_and_jac(f, z):
         k = (z.shape[0] - num_params) // count
-        seeds = jnp.zeros((k, z.shape[0]), dtype=z.dtype)
-        for j in range(k):
-            seeds = seeds.at[j, num_params + j::k].set(1.0)
-        basis = jnp.concatenate([jnp.eye(num_params, z.shape[0], dtype=z.dtype), seeds])
+        basis = _compressed_basis(num_params, count, z.shape[0]).astype(z.dtype)
         value, cols = jax.vmap(lambda t: jax.jvp(f, (z,), (t,)), out_axes=(None, -1))(basis)
         lead = value.ndim - len(blocks) - 1  # axes before the blocks (e.g. channels)
         # spread each seeded column back onto its own block: (..., *blocks, L, B, k)
@@ -270,6 +280,65 @@ def blockwise_jacfwd(num_params: int, blocks: tuple[int, ...]):
         return value, jnp.concatenate([cols[..., :num_params], spread], axis=-1)
 
     return value_and_jac
+
+
+class BlockDampedNewtonDescent(optx.AbstractDescent):
+    """optimistix's damped Gauss-Newton step, $\\min_d \\|J d - f\\|^2 + \\lambda
+    \\|d\\|^2$, for the residuals of `blockwise_jacfwd` (shared parameters p, then k
+    nuisance parameters per block that move their own block's rows only), solved by
+    eliminating each block's nuisance step first. For block b with rows
+    $[J_{n,b}; \\sqrt\\lambda I_k] = Q_b R_b$ (a small QR), the shared step x solves
+    the least-squares problem of the projected rows $(I - Q_b Q_b^T)[J_{p,b}; 0]$
+    against $(I - Q_b Q_b^T)[f_b; 0]$ with $\\sqrt\\lambda I$ below, and then
+    $y_b = R_b^{-1} Q_b^T [f_b - J_{p,b} x; 0]$: the same solution as one QR of the
+    whole stacked matrix (optimistix's `DampedNewtonDescent`), in
+    $O(R (n + k)^2)$ operations for R residuals instead of $O(R (n + kB)^2)$.
+    `discover`'s fits with 60 s windows on 90 minutes of Esso Osaka records (288
+    start corrections, 2 shared parameters) spent 0.6 s of each 0.65 s step in that
+    one QR."""
+
+    num_params: int
+    blocks: tuple[int, ...]
+
+    def init(self, y, f_info_struct):
+        return optx.DampedNewtonDescent().init(y, f_info_struct)
+
+    def query(self, y, f_info, state):
+        return optx.DampedNewtonDescent().query(y, f_info, state)
+
+    def step(self, step_size, state):
+        info, n, count = state.f_info, self.num_params, int(math.prod(self.blocks))
+        f = info.residual
+        size = info.jac.in_structure().shape[0]
+        cols = jax.vmap(info.jac.mv, out_axes=-1)(
+            _compressed_basis(n, count, size).astype(f.dtype))
+        lead = f.ndim - len(self.blocks) - 1
+
+        def by_block(a):  # (..., *blocks, L, *rest) -> (B, rows of a block, *rest)
+            rest = a.shape[f.ndim:]
+            a = a.reshape(a.shape[:lead] + (count,) + a.shape[lead + len(self.blocks):])
+            return jnp.moveaxis(a, lead, 0).reshape((count, -1) + rest)
+
+        # optimistix's damping: lambda = 1 / step size, the largest float once that is tiny
+        positive = step_size > jnp.finfo(f.dtype).eps
+        root = jnp.sqrt(jnp.where(positive, 1 / jnp.where(positive, step_size, 1.0),
+                                  jnp.finfo(f.dtype).max))
+        jp, jn, fb = by_block(cols[..., :n]), by_block(cols[..., n:]), by_block(f)
+        k = jn.shape[-1]
+        pad = lambda a: jnp.concatenate([a, jnp.zeros((count, k) + a.shape[2:], a.dtype)], 1)
+        q, r = jnp.linalg.qr(jnp.concatenate(
+            [jn, jnp.broadcast_to(root * jnp.eye(k, dtype=f.dtype), (count, k, k))], 1))
+        project = lambda a: a - q @ (jnp.swapaxes(q, 1, 2) @ a)
+        jp0, fb0 = pad(jp), pad(fb[..., None])
+        shared = jnp.concatenate([project(jp0).reshape(-1, n), root * jnp.eye(n, dtype=f.dtype)])
+        rhs = jnp.concatenate([project(fb0).reshape(-1), jnp.zeros(n, f.dtype)])
+        x = jnp.zeros(0, f.dtype)
+        if n:
+            q_s, r_s = jnp.linalg.qr(shared)
+            x = jax.scipy.linalg.solve_triangular(r_s, q_s.T @ rhs)
+        y = jax.scipy.linalg.solve_triangular(
+            r, jnp.swapaxes(q, 1, 2) @ (fb0 - jp0 @ x[:, None]))[..., 0]
+        return -jnp.concatenate([x, y.reshape(-1)]), optx.RESULTS.successful
 
 
 @eqx.filter_jit
