@@ -172,6 +172,29 @@ def test_interval_coverage_under_measurement_noise_without_retracing():
     assert res.metrics["r"].white  # output error with white measurement noise
 
 
+def test_estimated_starts_solved_window_by_window_equal_one_qr():
+    """Windowed output error with estimated starts on three noisy records of different
+    lengths (padded windows among them): the steps solved window by window (the
+    default) and by one QR of the whole matrix take the same steps to the same estimate
+    and start corrections."""
+    rng = np.random.default_rng(7)
+    exps = []
+    for seed, num in ((1, 400), (2, 300), (3, 240)):
+        clean = record(Nomoto1(K=0.06, T=25.0), zigzag_like(num, seed))
+        exps.append(js.Experiment(clean.t, clean.delta,
+                                  psi=clean.psi + 0.005 * rng.standard_normal(num),
+                                  r=clean.r + 0.0005 * rng.standard_normal(num)))
+    fits = [fit(Nomoto1(K=0.05, T=20.0), exps, estimator=PredictionError(
+        horizon=30.0, initial=js.EstimatedStarts(),
+        solver=js.LevenbergMarquardt(rtol=1e-9, atol=1e-9, blockwise=blockwise)))
+        for blockwise in (True, False)]
+    assert fits[0].success and fits[0].num_steps == fits[1].num_steps
+    np.testing.assert_allclose(fits[0].values, fits[1].values, rtol=1e-9)
+    np.testing.assert_allclose(fits[0].start_offsets, fits[1].start_offsets, rtol=1e-7,
+                               atol=1e-12)
+    assert fits[0].start_offsets.size == 2 * 3 * math.ceil(400 / 60)
+
+
 def test_assert_max_traces_for_new_parameter_and_data_values():
     """The jitted solve traces once for new start values and new data values."""
     counted = eqx.filter_jit(eqx.debug.assert_max_traces(_fit._solve.__wrapped__,

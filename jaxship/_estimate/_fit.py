@@ -233,7 +233,7 @@ def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
     if offset_scale is not None:  # each window's start corrections: block-sparse columns
         shared_and_blocks = (len(transform.names), windows.start.r.shape)
         jacobian = blockwise_jacfwd(*shared_and_blocks)
-        if isinstance(solver, LevenbergMarquardt):  # and its step solved block by block
+        if isinstance(solver, LevenbergMarquardt) and solver.blockwise:  # block by block
             solver = eqx.tree_at(lambda s: s.descent, solver,
                                  BlockDampedNewtonDescent(*shared_and_blocks))
     z, result, steps, q, residual, jac = solve_least_squares(
