@@ -17,7 +17,7 @@ import pytest
 import jaxship as js
 from jaxship.cli import main
 from jaxship.cli._identification import model_from_report, read_result
-from jaxship.cli._studies import autopilot as study, autopilot_thesis as chapter5
+from jaxship.cli._studies import autopilot as study
 from jaxship.plotting import plot_autopilot
 
 
@@ -296,28 +296,6 @@ def test_tune_adds_a_tuned_controller_that_tracks_better(identified, tmp_path):
     assert tuned["objective_after"] < tuned["objective_before"]
     by = {(r["controller"], r["rpm"]): r["rms_error_deg"] for r in result["runs"]}
     assert all(by["tuned", rpm] < by["pid+ff", rpm] for rpm in (300.0, 500.0))
-
-
-@pytest.mark.slow
-def test_chapter_5_study_has_every_table_row(tmp_path):
-    result = chapter5.autopilot_study(quick=True)
-    table = result["table"]
-    ff = [r for r in table if r["controller"] == "pid+ff"]
-    fb = [r for r in table if r["controller"] == "pid"]
-    assert len(ff) == 12 and len(fb) == 12  # Tables 5.2-5.7 at 300 and 400 rpm, both
-    assert {(r["model"], r["family"], r["rpm"]) for r in ff} == {
-        (m, f, rpm) for m in ("nomoto", "ross") for f in chapter5.FAMILIES
-        for rpm in (300.0, 400.0)}
-    assert all(r["thesis"] is not None for r in ff) and all(r["thesis"] is None for r in fb)
-    assert all(r["success"] and math.isfinite(r["sum_abs_error_deg"]) for r in table)
-    assert len(result["reference"]) == 4
-    assert set(result["goals"]) == {"feedforward", "ross_vs_nomoto", "thesis_ordering"}
-    section = chapter5.report_section(result)
-    for number in ("5.2", "5.3", "5.4", "5.5", "5.6", "5.7"):
-        assert f"| {number} |" in section
-    assert "sampled every 1 s over 100-200 s" in section
-    json.dumps(chapter5.to_json(result))  # JSON-ready
-    pathlib.Path(tmp_path / "section.md").write_text(section)
 
 
 def test_the_default_design_follows_the_models_time_constant():

@@ -2,6 +2,7 @@
 as `report.md` with the thesis' numbers beside ours."""
 
 import json
+import math
 import os
 import pathlib
 import re
@@ -13,7 +14,12 @@ import time
 import pytest
 
 from jaxship.cli import main
-from jaxship.cli._studies import reproduce as rp, reproduce_report
+from jaxship.cli._studies import (
+    autopilot_thesis as chapter5,
+    reproduce as rp,
+    reproduce_report,
+    thesis,
+)
 from jaxship.cli._studies.thesis import THESIS_FIT
 
 
@@ -103,8 +109,19 @@ def test_quick_reproduce_command_writes_the_report(tmp_path, capsys):
     assert "| ours 300 | thesis 300 | ours 400 | thesis 400 |" in report
     for table in ("5.2", "5.3", "5.4", "5.5", "5.6", "5.7"):
         assert f"| {table} |" in report and f"**Table {table}**" in report
-    ff = [r for r in data["autopilot"]["table"] if r["controller"] == "pid+ff"]
-    assert len(ff) == 12 and all(r["thesis"] is not None for r in ff)
+    assert "sampled every 1 s over 100-200 s" in report
+    closed = data["autopilot"]
+    ff = [r for r in closed["table"] if r["controller"] == "pid+ff"]
+    fb = [r for r in closed["table"] if r["controller"] == "pid"]
+    assert len(ff) == 12 and len(fb) == 12  # both controllers at 300 and 400 rpm
+    assert {(r["model"], r["family"], r["rpm"]) for r in ff} == {
+        (m, f, rpm) for m in ("nomoto", "ross") for f in chapter5.FAMILIES
+        for rpm in (300.0, 400.0)}
+    assert all(r["thesis"] is not None for r in ff) and all(r["thesis"] is None for r in fb)
+    assert all(r["success"] and math.isfinite(r["sum_abs_error_deg"])
+               for r in closed["table"])
+    assert len(closed["reference"]) == 4
+    assert set(closed["goals"]) == {"feedforward", "ross_vs_nomoto", "thesis_ordering"}
 
     # discovery: the hidden cubic yaw damping is named and the held-out cost falls
     disc = data["discovery"]
@@ -137,8 +154,6 @@ def test_a_failed_reproduce_leaves_the_earlier_report(tmp_path, monkeypatch):
 def test_a_failed_fit_in_the_study_leaves_the_others(monkeypatch):
     # issue 13: in the batch of chapter-4 fits, one that fails is reported and the others
     # are returned; its autopilot is skipped
-    from jaxship.cli._studies import autopilot_thesis as chapter5, thesis
-
     families = {"turning": ("turn:40",), "zigzag": ("zigzag:40/40",)}
     real = thesis.identify
 

@@ -198,16 +198,3 @@ def test_recovery_from_the_thesis_vessel_zigzag():
     assert fit_percent >= 95.0, fit_percent
     nomoto = ti.identify("nomoto", [record_], vessel, settings=settings)
     assert fit_percent > ti.simulation_fit(nomoto.model, [record_])[0]
-
-
-@pytest.mark.slow
-def test_thesis_study_merged_fits_reach_90_percent():
-    """Reproduction 1 of issue 3 (quick design): the merged Ross fits reach 90 % on
-    every family and the speed-dependent rudder does at least as well."""
-    study = ti.identification_study(quick=True)
-    rows = {(r["case"], r["model"], r["family"]): r for r in study["table"]}
-    for family in ti.FAMILIES:
-        ross = rows[("merged", "ross", family)]
-        speed = rows[("merged", "ross_speed_rudder", family)]
-        assert ross["fit"] >= 90.0, (family, ross["fit"])
-        assert speed["fit_family"] >= ross["fit_family"] - 0.5, family
