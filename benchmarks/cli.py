@@ -22,9 +22,9 @@ own: the first run compiles (the README's time), the second reads the cache. It 
 table's time column with the date and the number of CPU cores.
 
 `--flags` times the first run (empty cache) of every example of the table twice, with the
-command's own XLA compiler setting (`jaxship.cli.SMALL_PROGRAMS`: LLVM's optimisation off,
-the loop emitters) and with XLA's defaults (set in `$XLA_FLAGS`, which the command then
-leaves as they are), and prints the ratio default / own.
+command's own XLA compiler setting (`jaxship.cli.SMALL_PROGRAMS`: the loop emitters
+instead of the MLIR fusion emitters) and with XLA's defaults (set in `$XLA_FLAGS`, which
+the command then leaves as they are), and prints the ratio default / own.
 
 Run: `python benchmarks/cli.py [--repeats N] [--table | --flags] [--only TEXT]` (the median
 of N runs of each, default 1; `--only`: the table's rows whose name contains TEXT, e.g.

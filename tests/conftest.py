@@ -20,13 +20,14 @@ js.enable_compilation_cache()
 
 def pytest_configure(config):
     """XLA's CPU compiler set for many small programs, before JAX starts its backend
-    (`jaxship` subprocesses and notebook kernels inherit it): LLVM's optimisation off
-    and the older loop emitters instead of the MLIR fusion emitters. Most of a test's
-    time is compiling (66 % in test_contracts and test_kalman); with both flags the
-    fast tier took 461 s instead of 747 s (the optimisation off alone) on 2026-11-26,
-    and the slow tier about as long as before (long computations run slower without
-    LLVM's optimisation: a 3-DOF Esso Osaka fit 42 -> 71 s with the loop emitters). The
-    numbers are the same to rounding (`helpers.assert_equal_to_rounding`)."""
+    (`jaxship` subprocesses and notebook kernels inherit it): the loop emitters instead
+    of the MLIR fusion emitters, as the `jaxship` command's `SMALL_PROGRAMS`. Most of a
+    test's time is compiling. LLVM's optimisation stays on: turned off as well (the
+    setting until 2026-11-27) it gave wrong derivatives once `RK4`'s stages became a
+    loop, and long computations ran slower (with the loop and the optimisation on, the
+    slow tier went from 1407 to 876 s on 2026-11-27, about 120 s of it from two studies
+    that ran twice; the fast tier 571 -> 594 s). The numbers are the same to rounding
+    (`helpers.assert_equal_to_rounding`)."""
     compile_for_small_programs()  # the `jaxship` command's own setting
 
 

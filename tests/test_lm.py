@@ -8,6 +8,7 @@ import lineax as lx
 import numpy as np
 import optimistix as optx
 import pytest
+from helpers import assert_equal_to_rounding
 
 from jaxship import LevenbergMarquardt
 from jaxship._estimate._lm import (
@@ -161,7 +162,7 @@ def test_stored_jacobian_values_and_linearisation():
     f = stored_jacobian(residuals)
     z = jnp.array([1.7, 0.4, 0.3, 2.0])
     value, jac = f(z, None)
-    np.testing.assert_array_equal(value, residuals(z, None))
+    assert_equal_to_rounding(value, residuals(z, None))  # one program with the JVP, one without
     np.testing.assert_allclose(jac, jax.jacfwd(residuals)(z, None), rtol=1e-13, atol=1e-15)
     # the JVP through the custom rule equals the JVP of the plain function
     dz = jnp.array([0.3, -1.0, 2.0, 0.5])

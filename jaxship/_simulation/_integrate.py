@@ -37,10 +37,11 @@ class RK4(dfx.AbstractSolver):
     `diffrax.diffeqsolve` with `ConstantStepSize` too.
 
     `rolled=True` (default): the four stages are one loop, $k_i = f(t + c_i h,
-    y + c_i h k_{i-1})$, so XLA compiles the vector field once instead of four times:
-    a vessel's first simulation and its derivatives compile 2-3x faster, and a batch of
-    simulations runs 1.4-1.6x slower once compiled (`python benchmarks/rk4_stages.py`).
-    `False`: the stages written out, for long batched runs.
+    y + c_i h k_{i-1})$, so XLA compiles the vector field once instead of four times.
+    On the Mariner, KVLCC2 and Esso Osaka a first simulation or derivative took
+    1.7-3.3x less time, later ones 1.3-2.9x less, and a batch of 64 turning circles
+    1.4x more once compiled (`python benchmarks/rk4_stages.py`, 2026-11-27). `False`:
+    the stages written out, for long batched runs.
     """
 
     rolled: bool = eqx.field(static=True, default=True)
