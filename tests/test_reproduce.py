@@ -20,7 +20,6 @@ from jaxship.cli._studies import (
     reproduce_report,
     thesis,
 )
-from jaxship.cli._studies.thesis import THESIS_FIT
 
 
 def test_quick_trials_match_thesis_ranges_and_open_the_report(tmp_path):
@@ -62,7 +61,7 @@ def test_quick_trials_match_thesis_ranges_and_open_the_report(tmp_path):
 
 
 def test_every_large_fit_difference_gets_a_sentence():
-    for case, models in THESIS_FIT.items():
+    for case, models in thesis.THESIS_FIT.items():
         for model, families in models.items():
             for family, paper in families.items():
                 for ours in (paper - 20.0, paper - 2.0, paper + 2.0, paper + 20.0):
@@ -98,7 +97,7 @@ def test_quick_reproduce_command_writes_the_report(tmp_path, capsys):
     rows = {(r["model"], r["family"]): r for r in data["identification"]["table"]}
     assert len(rows) == 6 and {r["case"] for r in rows.values()} == {"merged"}
     for (model, family), row in rows.items():
-        assert row["thesis"] == THESIS_FIT["merged"][model][family]
+        assert row["thesis"] == thesis.THESIS_FIT["merged"][model][family]
         assert row["thesis_figure"] in report
     for family in ("turning", "zigzag", "thesis"):  # Ross follows the speed change
         assert rows["ross", family]["fit"] > rows["nomoto", family]["fit"]
