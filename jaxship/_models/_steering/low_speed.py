@@ -101,9 +101,9 @@ class LowSpeedSwayYaw(AbstractSteeringModel):
         def residual(x):
             return self.rhs(jnp.stack([r, x[0]]), x[1], aux)
 
-        x = jnp.zeros(2)
-        for _ in range(12):
-            x = x - jnp.linalg.solve(jax.jacfwd(residual)(x), residual(x))
+        x = jax.lax.fori_loop(  # one loop: written out, compiled twelve times
+            0, 12, lambda _, x: x - jnp.linalg.solve(jax.jacfwd(residual)(x), residual(x)),
+            jnp.zeros(2))
         return x[0], x[1]
 
     def initial_state(self, r: ArrayLike) -> Array:

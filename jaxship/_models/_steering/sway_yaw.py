@@ -217,8 +217,9 @@ def _steady_turn(vessel, r, V):
     linear = eqx.tree_at(lambda s: s.cross_flow, vessel, 0.0)
     jac = jax.jacfwd(lambda x: linear.forces(V, x[0], r, x[1], 0.0)[1:])(jnp.zeros(2))
     x = -jnp.linalg.solve(jac, linear.forces(V, 0.0, r, 0.0, 0.0)[1:])
-    for _ in range(12):
-        x = x - jnp.linalg.solve(jax.jacfwd(residual)(x), residual(x))
+    # the iterations in one loop: written out, they were compiled twelve times
+    x = jax.lax.fori_loop(
+        0, 12, lambda _, x: x - jnp.linalg.solve(jax.jacfwd(residual)(x), residual(x)), x)
     return x[0], x[1]
 
 
