@@ -40,7 +40,7 @@ candidates' scores; a Gaussian multiplier bootstrap, Chernozhukov, Chetverikov &
 import dataclasses
 
 import numpy as np
-import scipy  # scipy.stats loads on first use (an import-time saving)
+import scipy  # scipy.stats and scipy.special load on first use (an import-time saving)
 
 from ..._foundation._covariance import _auto_lags, bartlett_long_run
 
@@ -176,8 +176,12 @@ def forward_path(g, v, gram, blocks, equivalent, lower, top, enter=0.05):
                 stat = np.einsum("di,ij,dj->d", gk, np.linalg.pinv(vk, rcond=1e-12), gk)
                 step = -gk @ np.linalg.pinv(gram[np.ix_(b, b)] - coef @ gram[np.ix_(a, b)],
                                             rcond=1e-12)
-                logp = np.where((lower[b] & (step < 0)).any(axis=1), 0.0,
-                                scipy.stats.chi2.logsf(stat, b.size))
+                # log of the chi2 tail, as `scipy.stats.chi2.logsf` computes it above the
+                # median (below it the p-value is over 0.5: never entered); the special
+                # function skips the distribution's per-call checks (a third of the time)
+                with np.errstate(divide="ignore"):
+                    tail = np.log(scipy.special.chdtrc(b.size, stat))
+                logp = np.where((lower[b] & (step < 0)).any(axis=1), 0.0, tail)
                 better = logp < best_p[rows]
                 best[rows[better]], best_p[rows[better]] = k, logp[better]
         took = best >= 0
