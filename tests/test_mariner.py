@@ -8,6 +8,7 @@ and delta_m = -delta (MSS: delta_c = -ui). Cross-check numbers are from
 """
 
 import dataclasses
+import math
 
 import equinox as eqx
 import jax
@@ -18,7 +19,7 @@ import jaxship as js
 from jaxship._models._vessel.mariner import mariner
 
 
-DEG = np.pi / 180
+DEG = math.pi / 180
 DT = 0.05  # sample interval = RK4 step [s], as in vessel-models.md sec. 6
 
 
@@ -39,12 +40,14 @@ REF = dict(
 
 
 def mariner_rhs(x, ui, U0=7.7175, c=REF):
-    """d/dt [u_pert, v, r, x, y, psi, delta_m] for the commanded rudder `ui` (MSS sign)."""
+    """d/dt [u_pert, v, r, x, y, psi, delta_m] for the commanded rudder `ui` (MSS sign),
+    in Python floats (three times faster than NumPy scalars for 16,000 steps)."""
     L = 160.93
-    U = np.sqrt((U0 + x[0]) ** 2 + x[1] ** 2)
+    x, ui = [float(xi) for xi in x], float(ui)
+    U = math.sqrt((U0 + x[0]) ** 2 + x[1] ** 2)
     u, v, r, psi, d = x[0] / U, x[1] / U, x[2] * L / U, x[5], x[6]
-    dc = np.clip(-ui, -40 * DEG, 40 * DEG)
-    d_dot = np.clip(dc - d, -5 * DEG, 5 * DEG)
+    dc = min(max(-ui, -40 * DEG), 40 * DEG)
+    d_dot = min(max(dc - d, -5 * DEG), 5 * DEG)
     X = (c["Xu"] * u + c["Xuu"] * u**2 + c["Xuuu"] * u**3 + c["Xvv"] * v**2 + c["Xrr"] * r**2
          + c["Xrv"] * r * v + c["Xdd"] * d**2 + c["Xudd"] * u * d**2 + c["Xvd"] * v * d
          + c["Xuvd"] * u * v * d)
@@ -65,8 +68,8 @@ def mariner_rhs(x, ui, U0=7.7175, c=REF):
         X * U**2 / L / m11,
         (m33 * Y - m23 * N) * U**2 / L / det,
         (-m32 * Y + m22 * N) * U**2 / L**2 / det,
-        np.cos(psi) * (U0 + x[0]) - np.sin(psi) * x[1],
-        np.sin(psi) * (U0 + x[0]) + np.cos(psi) * x[1],
+        math.cos(psi) * (U0 + x[0]) - math.sin(psi) * x[1],
+        math.sin(psi) * (U0 + x[0]) + math.cos(psi) * x[1],
         x[2],
         d_dot,
     ])
