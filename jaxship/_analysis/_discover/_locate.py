@@ -4,6 +4,7 @@ signals a missing effect would follow (the first step of the discovery workflow;
 Ljung 1999, sec. 16.6, residual analysis; Astrom & Kallstrom 1979, sec. 5)."""
 
 import numpy as np
+import scipy.signal
 
 from ..._estimate._fit import MeasuredStates, PredictionError
 from ..._estimate._predict import predict
@@ -170,24 +171,46 @@ def _describe_load(per_record, sig, ds, unit) -> dict:
             "correlations": {k: _largest_correlation(per_record, sig[k], ds) for k in sig}}
 
 
-def _lagged(residuals, signals, lag, centre) -> float:
-    """|correlation| of the residuals with the signals `lag` samples earlier, pooled
-    over records (the signals' mean removed when `centre`); 0 when either is zero."""
-    a = np.concatenate([e[lag:] for e in residuals])
-    b = np.concatenate([s[:s.size - lag] for s in signals])
-    b = b - np.mean(b) if centre else b
-    denominator = np.sqrt(np.sum(a * a) * np.sum(b * b))
-    return abs(float(np.sum(a * b) / denominator)) if denominator > 0 else 0.0
+def _lagged(residuals, signals, max_lag, centre) -> np.ndarray:
+    """|correlation| of the residuals with the signals `lag` samples earlier, for each
+    lag 0..`max_lag`, pooled over records (the signals' mean over the samples paired
+    at that lag removed when `centre`); 0 where either is zero. The sums over lags
+    come from each record's cross-correlation (`scipy.signal.correlate`) and prefix
+    sums, not from a copy of the records per lag."""
+    lags = np.arange(max_lag + 1)
+    ab, aa, a1, bb, b1, num = (np.zeros(lags.size) for _ in range(6))
+    # centring is unchanged by a shift: the pooled mean first, so that the sums below
+    # do not cancel
+    shift = float(np.mean(np.concatenate(signals))) if centre else 0.0
+    for e, x in zip(residuals, signals):
+        x = x - shift
+        n = e.size
+        keep = lags < n  # lags a record is too short for add nothing
+        k = lags[keep]
+        ab[keep] += scipy.signal.correlate(e, x, mode="full")[n - 1 + k]
+        tail = lambda v: np.cumsum(v[::-1])[::-1]  # tail(v)[k] = sum of v[k:]
+        head = lambda v: np.cumsum(v)[n - 1 - k]  # sum of v[:n - k]
+        aa[keep] += tail(e * e)[k]
+        a1[keep] += tail(e)[k]
+        bb[keep] += head(x * x)
+        b1[keep] += head(x)
+        num[keep] += n - k
+    if centre:  # sum a (b - m) and sum (b - m)^2 with m = sum b / num
+        mean = np.divide(b1, num, out=np.zeros_like(b1), where=num > 0)
+        varied = bb - mean * b1
+        # a constant signal (a logged rpm held fixed) centres to rounding: zero
+        ab, bb = ab - mean * a1, np.where(varied > 1e-12 * bb, varied, 0.0)
+    denominator = np.sqrt(aa * bb)
+    return np.abs(np.divide(ab, denominator, out=np.zeros_like(ab), where=denominator > 0))
 
 
 def _largest_correlation(residuals, signals, ds) -> float:
     """The largest |correlation| of residual and signal over lags 0..10 % of the
     shortest record (signal leading), pooled over records."""
     lags = max(1, min(int(n) for n in ds.lengths) // 10)
-    return max(_lagged(residuals, signals, lag, True) for lag in range(lags + 1))
+    return float(np.max(_lagged(residuals, signals, lags, True)))
 
 
 def _outside_band(residuals, band, lags=25) -> float:
     """Fraction of the residual autocorrelations at lags 1..`lags` outside the band."""
-    return sum(_lagged(residuals, residuals, lag, False) > band
-               for lag in range(1, lags + 1)) / lags
+    return float(np.sum(_lagged(residuals, residuals, lags, False)[1:] > band)) / lags
