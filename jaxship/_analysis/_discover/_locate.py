@@ -4,7 +4,7 @@ signals a missing effect would follow (the first step of the discovery workflow;
 Ljung 1999, sec. 16.6, residual analysis; Astrom & Kallstrom 1979, sec. 5)."""
 
 import numpy as np
-import scipy.signal
+import scipy  # scipy.signal loads on first use (an import-time saving)
 
 from ..._estimate._fit import MeasuredStates, PredictionError
 from ..._estimate._predict import predict
