@@ -45,7 +45,7 @@ import warnings
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.linalg import expm
+import scipy  # scipy.linalg loads on first use (an import-time saving)
 
 from .._models._effects import nonlinear_nomoto2
 from .._models._steering.nomoto import Nomoto1, Nomoto2, NonlinearNomoto
@@ -112,7 +112,7 @@ def _zoh2_ps(K, P, S, T3, h):
     m = np.zeros((3, 3))
     m[0, 1] = 1.0
     m[1, :] = [-1.0 / P, -S / P, 1.0 / P]
-    e = expm(m * h)
+    e = scipy.linalg.expm(m * h)
     phi, gamma = e[:2, :2], e[:2, 2]
     c = np.array([K, K * T3])
     adj = np.array([[-phi[1, 1], phi[0, 1]], [phi[1, 0], -phi[0, 0]]])

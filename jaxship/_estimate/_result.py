@@ -4,10 +4,10 @@ not converge."""
 
 import contextlib
 import dataclasses
+import statistics
 
 import equinox as eqx
 import numpy as np
-from scipy.special import ndtri
 
 from .._foundation._covariance import ParameterReport
 from .._foundation._frames import fit_to_dataframe
@@ -98,7 +98,7 @@ class FitResult(SolverOutcome):
     def interval(self, level: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
         """Normal confidence intervals `(lower, upper)` of the estimates at `level`
         (two-sided), from the standard errors."""
-        z = float(ndtri(0.5 + level / 2))
+        z = statistics.NormalDist().inv_cdf(0.5 + level / 2)
         return self.values - z * self.std, self.values + z * self.std
 
     def summary(self) -> str:
