@@ -6,7 +6,7 @@ import jax
 import pytest
 
 import jaxship as js
-from jaxship.cli import compile_for_small_programs
+from jaxship.cli import SMALL_PROGRAMS, compile_for_small_programs
 
 
 jax.config.update("jax_enable_x64", True)
@@ -18,20 +18,25 @@ os.environ.setdefault("JAXSHIP_CACHE_DIR", str(pathlib.Path(__file__).parent.par
 js.enable_compilation_cache()
 
 
+# the fast tier's addition: LLVM's optimisation at level 1 (XLA's default 3). Its tests
+# compile many programs and run each briefly: on 2026-11-27 the whole tier took 465 s
+# instead of 518 s (895 against 992 worker-seconds), each run from a fresh clone. The slow
+# tier keeps XLA's level: its notebooks run long computations (a batch of 128 KVLCC2
+# zig-zags ran 1.47x slower at level 1). Level 0 with the loop emitters gave wrong
+# derivatives of a closed-loop run (benchmarks/README.md section 5); level 1 gives the
+# central differences' value.
+FAST_TIER = ("--xla_backend_optimization_level=1",)
+
+
 def pytest_configure(config):
     """XLA's CPU compiler set for many small programs, before JAX starts its backend
     (`jaxship` subprocesses and notebook kernels inherit it): the loop emitters instead
-    of the MLIR fusion emitters, as the `jaxship` command's `SMALL_PROGRAMS`. Most of a
-    test's time is compiling. LLVM's optimisation stays on: turned off as well (the
-    setting until 2026-11-27) it gave wrong derivatives once `RK4`'s stages became a
-    loop, and long computations ran slower (with the loop and the optimisation on, the
-    slow tier went from 1407 to 876 s on 2026-11-27, about 120 s of it from two studies
-    that ran twice; the fast tier 571 -> 594 s). The numbers are the same to rounding
+    of the MLIR fusion emitters, as the `jaxship` command's `SMALL_PROGRAMS`, and in the
+    fast tier (`-m 'not slow'`, the default) `FAST_TIER` as well. Most of a test's time
+    is compiling. The numbers are the same to rounding
     (`helpers.assert_equal_to_rounding`)."""
-    # the `jaxship` command's own setting (LLVM's optimisation level 1 of 0-3 was tried
-    # on 2026-11-27: programs compiled 13 % faster, but a batch of 128 KVLCC2 zig-zags
-    # ran 1.47x slower, and the fast tier gained too little to tell)
-    compile_for_small_programs()
+    fast = "not slow" in (config.getoption("markexpr", "") or "")
+    compile_for_small_programs(SMALL_PROGRAMS + (FAST_TIER if fast else ()))
 
 
 def pytest_sessionstart(session):
@@ -42,16 +47,18 @@ def pytest_sessionstart(session):
                                 "JAXSHIP_DATA or put shared/ beside the checkout).")
 
 
-# The modules that take longest (worker-seconds of a fast-tier run, 2026-11-26), longest
-# first: xdist hands each worker one module at a time in collection order, so these go
-# first and the short ones fill in at the end, and both workers finish together
-# (alphabetical order left test_real_data and test_low_speed_sway_yaw, 4-5 min together,
-# to one worker at the end while the other idled).
-LONGEST_FIRST = ("test_contracts", "test_discover", "test_real_data", "test_effects",
-                 "test_low_speed_sway_yaw", "test_kalman", "test_autopilot",
-                 "test_ross_autopilot", "test_sway_yaw_fit", "test_autopilot_cli",
-                 "test_vessel_fit", "test_bands", "test_identify", "test_cli", "test_mariner",
-                 "test_architecture", "test_reproduce", "test_joint_search", "test_estimate")
+# The modules that take longest (worker-seconds of a fast-tier run, 2026-11-27), longest
+# first: each worker takes one module at a time in this order (`--no-loadscope-reorder`
+# in pyproject.toml: xdist would otherwise start with the modules of most tests), so the
+# long ones go first and the short ones fill in at the end, and both workers finish
+# together.
+LONGEST_FIRST = ("test_contracts", "test_discover", "test_kalman", "test_cli", "test_effects",
+                 "test_low_speed_sway_yaw", "test_simulate", "test_autopilot",
+                 "test_manoeuvres", "test_bands", "test_estimate", "test_identify",
+                 "test_batch", "test_ross_autopilot", "test_reproduce", "test_architecture",
+                 "test_sway_yaw", "test_joint_search", "test_autopilot_cli", "test_vessel_fit",
+                 "test_sway_yaw_fit", "test_mmg", "test_lm", "test_real_data", "test_readme",
+                 "test_mariner")
 
 
 def pytest_collection_modifyitems(session, config, items):
@@ -61,7 +68,10 @@ def pytest_collection_modifyitems(session, config, items):
     items.sort(key=lambda item: rank.get(item.path.stem, len(rank)))
 
 
-MAX_MAPS = 30_000  # the kernel's default vm.max_map_count is 65,530
+# the kernel's default vm.max_map_count is 65,530; the most one module added in a
+# fast-tier run was 19,737 (test_contracts, 2026-11-27), so a module that starts
+# below this limit ends below the kernel's
+MAX_MAPS = 40_000
 
 
 def _memory_maps() -> int:
