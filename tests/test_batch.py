@@ -17,6 +17,7 @@ import jaxship as js
 import jaxship._simulation._batch as jb
 from jaxship._analysis._indices import turning_indices
 from jaxship._models._vessel.mariner import mariner
+from jaxship._simulation._integrate import WRITTEN_OUT_BATCH
 
 
 DEG = np.pi / 180
@@ -55,6 +56,30 @@ def test_batch_equals_python_loop(batch):
         assert tree_allclose(jax.tree.map(lambda a: a[i], batch), one, rtol=1e-12, atol=1e-12)
     # the runs differ: the test compares something
     assert np.ptp(np.asarray(batch.state.psi[:, -1])) > 0.1
+
+
+def test_a_large_batch_takes_rk4s_stages_written_out_with_the_same_numbers(monkeypatch):
+    """From `WRITTEN_OUT_BATCH` runs, the default `RK4()` writes its stages out in a
+    batch: the solver the batch compiles is `RK4(rolled=False)`, and its runs equal
+    those of the rolled stages to rounding; a small batch keeps them rolled."""
+    vessel = mariner()
+    angles = np.linspace(-30.0, 30.0, WRITTEN_OUT_BATCH) * DEG
+    manoeuvres = js.ZigZag(angles, 10 * DEG, duration=20.0, dt=0.5)
+    x0 = js.straight_run(vessel)
+    seen = []
+    batched = jb._batched
+    monkeypatch.setattr(jb, "_batched", lambda *a: seen.append(a[4].solver) or batched(*a))
+    written = jb.simulate_batch(vessel, manoeuvres, x0, in_axes=(None, 0, None, None))
+    rolled = jb.simulate_batch(vessel, manoeuvres, x0, in_axes=(None, 0, None, None),
+                               simulator=js.Simulator(solver=js.RK4(rolled=True)))
+    assert seen == [js.RK4(rolled=False), js.RK4(rolled=True)]
+    # the same arithmetic, its sums in another order, over 40 steps: rounding, as a
+    # batch against its loop
+    assert tree_allclose(written, rolled, rtol=1e-12, atol=1e-12)
+    few = jb.simulate_batch(vessel, jb.stack([js.ZigZag(a, 10 * DEG, duration=20.0, dt=0.5)
+                                             for a in angles[:2]]), x0,
+                            in_axes=(None, 0, None, None))
+    assert seen[-1] == js.RK4() and few.state.psi.shape[0] == 2  # a small batch stays rolled
 
 
 def test_batched_vessel_and_shared_manoeuvre():

@@ -21,7 +21,7 @@ from .._models._environment import Environment
 from .._models._manoeuvres import Replay
 from .._models._steering._base import AbstractSteeringModel
 from .._models._vessel._base import straight_run, surge_force
-from ._integrate import Simulator
+from ._integrate import RK4, WRITTEN_OUT_BATCH, Simulator
 from ._simulate import _as_arrays, _is_static_zero, _simulate
 from ._simulate_steering import _replay, _steer, at_rest
 
@@ -71,7 +71,9 @@ def simulate_batch(
 
     **Arguments:**
 
-    - `model`, `manoeuvre`, `x0`, `environment`, `simulator`: as for `simulate` (a
+    - `model`, `manoeuvre`, `x0`, `environment`, `simulator`: as for `simulate` (with
+      the default `RK4()`, a batch of `WRITTEN_OUT_BATCH` = 256 runs or more takes its
+      stages written out: see `RK4`; a
       vessel or a steering model; `x0=None`: a vessel's `straight_run`, which needs an
       unbatched vessel, or a steering model at rest); the batched ones carry a
       leading batch axis on their array leaves (build them with `stack`, or with
@@ -133,6 +135,9 @@ def simulate_batch(
     mesh = batch_mesh(devices)
     b_dyn, b_static = eqx.partition(batched, eqx.is_array)
     s_dyn, s_static = eqx.partition(shared, eqx.is_array)
+    if isinstance(simulator.solver, RK4) and simulator.solver.rolled is None \
+            and size >= WRITTEN_OUT_BATCH:
+        simulator = eqx.tree_at(lambda s: s.solver, simulator, RK4(rolled=False))
     steps = simulator.steps_per_sample(manoeuvre.dt)
     return _batched(
         b_dyn, s_dyn, b_static, s_static, simulator, steps, output, wind, size, mesh, chunk_size

@@ -26,6 +26,12 @@ from .._foundation._state import Switched
 from .._models._manoeuvres import interpolate
 
 
+# the batch size from which `simulate_batch` writes out `RK4`'s stages (`rolled=None`): a
+# batch of 64 KVLCC2 turning circles compiled 0.5 s faster rolled but ran 0.13 s slower,
+# so from about 256 runs one call of the written-out stages takes less time
+WRITTEN_OUT_BATCH = 256
+
+
 class RK4(dfx.AbstractSolver):
     """The classical fourth-order Runge-Kutta method (Kutta 1901) as a diffrax solver.
 
@@ -36,15 +42,17 @@ class RK4(dfx.AbstractSolver):
     overhead dominates on a six-state ship, so it is the fast path's default. Works in
     `diffrax.diffeqsolve` with `ConstantStepSize` too.
 
-    `rolled=True` (default): the four stages are one loop, $k_i = f(t + c_i h,
+    `rolled=True`: the four stages are one loop, $k_i = f(t + c_i h,
     y + c_i h k_{i-1})$, so XLA compiles the vector field once instead of four times.
     On the Mariner, KVLCC2 and Esso Osaka a first simulation or derivative took
     1.7-3.3x less time, later ones 1.3-2.9x less, and a batch of 64 turning circles
     1.4x more once compiled (`python benchmarks/rk4_stages.py`, 2026-11-27). `False`:
-    the stages written out, for long batched runs.
+    the stages written out. `None` (default): rolled, except in `simulate_batch` of
+    `WRITTEN_OUT_BATCH` runs or more, where the written-out stages' faster runs repay
+    their longer compilation within one call.
     """
 
-    rolled: bool = eqx.field(static=True, default=True)
+    rolled: bool | None = eqx.field(static=True, default=None)
     term_structure: ClassVar = dfx.ODETerm
     interpolation_cls: ClassVar = dfx.LocalLinearInterpolation
 
@@ -59,7 +67,7 @@ class RK4(dfx.AbstractSolver):
         h = t1 - t0
         f = lambda t, y: terms.vf(t, y, args)
         axpy = lambda a, x, y: jax.tree.map(lambda xi, yi: yi + a * xi, x, y)
-        if self.rolled:
+        if self.rolled is not False:
             c, b = jnp.array([0.0, 0.5, 0.5, 1.0]), jnp.array([1.0, 2.0, 2.0, 1.0]) / 6
 
             def stage(i, carry):  # k_i and the weighted sum of k_1 .. k_i
