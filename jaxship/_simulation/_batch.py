@@ -71,14 +71,14 @@ def simulate_batch(
 
     **Arguments:**
 
-    - `model`, `manoeuvre`, `x0`, `environment`, `simulator`: as for `simulate` (with
-      the default `RK4()`, a batch of `WRITTEN_OUT_BATCH` = 256 runs or more takes its
-      stages written out: see `RK4`; a
+    - `model`, `manoeuvre`, `x0`, `environment`, `simulator`: as for `simulate` (a
       vessel or a steering model; `x0=None`: a vessel's `straight_run`, which needs an
       unbatched vessel, or a steering model at rest); the batched ones carry a
       leading batch axis on their array leaves (build them with `stack`, or with
       arrays in place of numbers, e.g. `straight_state(speeds)`). A steering model
-      takes no `aux` here: its replays run in calm water with zero speeds.
+      takes no `aux` here: its replays run in calm water with zero speeds. With the
+      default `RK4()`, a batch of 256 runs or more (`WRITTEN_OUT_BATCH`) takes its
+      stages written out (see `RK4`).
     - `in_axes`: which of `(model, manoeuvre, x0, environment)` are batched: `0` for
       a leading batch axis, `None` for shared by all runs, as in `jax.vmap`; each entry
       may also be a pytree prefix of its argument (e.g. a vessel with `0` on some
