@@ -183,18 +183,16 @@ def _lagged(residuals, signals, max_lag, centre) -> np.ndarray:
     # do not cancel
     shift = float(np.mean(np.concatenate(signals))) if centre else 0.0
     for e, x in zip(residuals, signals):
-        x = x - shift
-        n = e.size
-        keep = lags < n  # lags a record is too short for add nothing
-        k = lags[keep]
-        ab[keep] += scipy.signal.correlate(e, x, mode="full")[n - 1 + k]
-        tail = lambda v: np.cumsum(v[::-1])[::-1]  # tail(v)[k] = sum of v[k:]
+        x, n = x - shift, e.size
+        k = lags[lags < n]  # lags a record is too short for add nothing
+        tail = lambda v: np.cumsum(v[::-1])[::-1][k]  # sum of v[k:]
         head = lambda v: np.cumsum(v)[n - 1 - k]  # sum of v[:n - k]
-        aa[keep] += tail(e * e)[k]
-        a1[keep] += tail(e)[k]
-        bb[keep] += head(x * x)
-        b1[keep] += head(x)
-        num[keep] += n - k
+        ab[k] += scipy.signal.correlate(e, x, mode="full")[n - 1 + k]
+        aa[k] += tail(e * e)
+        a1[k] += tail(e)
+        bb[k] += head(x * x)
+        b1[k] += head(x)
+        num[k] += n - k
     if centre:  # sum a (b - m) and sum (b - m)^2 with m = sum b / num
         mean = np.divide(b1, num, out=np.zeros_like(b1), where=num > 0)
         varied = bb - mean * b1
