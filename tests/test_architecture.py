@@ -5,6 +5,7 @@ layer or the layers below it, there are no import cycles, no imports inside func
 import ast
 import pathlib
 import subprocess
+import sys
 
 import pytest
 
@@ -162,6 +163,23 @@ def test_one_assembler_builds_the_fit_result():
              if name == "FitResult" or name.endswith(".FitResult")]
     assert len(found) == 1, "\n".join(found) or "FitResult is never constructed"
     assert found[0].startswith("jaxship._estimate._result:"), found
+
+# loaded on first use only: the scipy parts cost 0.2-0.3 s each, pyplot 0.7 s
+NOT_AT_IMPORT = ("scipy.special", "scipy.stats", "scipy.signal", "scipy.linalg",
+                 "matplotlib", "pandas")
+
+
+def test_import_computes_nothing_and_changes_no_jax_setting():
+    """`import jaxship` (in a new process) loads none of the heavy optional parts, starts
+    no XLA backend and leaves float64 off (the brief: nothing changed on import)."""
+    code = ("import sys, jax, jaxship; from jax._src import xla_bridge as xb; "
+            f"print([m for m in {NOT_AT_IMPORT!r} if m in sys.modules], "
+            "bool(xb._backends), jax.config.jax_enable_x64)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=ROOT, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["[]", "False", "False"], done.stdout
+
 
 def test_the_library_never_prints_or_warns():
     """Outcomes are result codes and progress goes to a callable the caller passes: no
