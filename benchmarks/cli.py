@@ -12,7 +12,9 @@ Commands (the README's examples):
 - `jaxship identify` of Nomoto 1 on the Esso Osaka zig-zags, five to train and two held out
   (goal: second run <= half the first), when `../shared/data` is found.
 
-Also `python -c "import jaxship"` (the import alone), for the part no cache can save.
+Also `python -c "import jaxship"` (the import alone), for the part no cache can save, and
+the import of the libraries `simulate` loads before any jaxship code runs (`DEPENDENCIES`),
+the floor that no change to jaxship lowers.
 
 `--table` times every example of the README's command table instead, as written there
 (the placeholders filled with the data they stand for: the first Esso Osaka zig-zags for
@@ -45,6 +47,8 @@ import jaxship as js
 from jaxship.cli import SMALL_PROGRAMS
 
 
+# what `jaxship simulate` imports besides jaxship itself
+DEPENDENCIES = "import jax, equinox, diffrax, optimistix, matplotlib.pyplot"
 # XLA's own values of the flags `SMALL_PROGRAMS` sets
 XLA_DEFAULTS = {"--xla_backend_optimization_level": "3", "--xla_cpu_use_fusion_emitters": "true"}
 
@@ -160,7 +164,10 @@ def main():
         off = os.environ | {"JAXSHIP_CACHE_DIR": "off"}
         importing = [timed([sys.executable, "-c", "import jaxship"], off, tmp)
                      for _ in range(args.repeats)]
-        print(f"import jaxship: {statistics.median(importing):.2f} s")
+        libraries = [timed([sys.executable, "-c", DEPENDENCIES], off, tmp)
+                     for _ in range(args.repeats)]
+        print(f"import jaxship: {statistics.median(importing):.2f} s; `{DEPENDENCIES}` "
+              f"alone: {statistics.median(libraries):.2f} s")
         print("| command | no cache, 1st | no cache, 2nd | cache, 1st | cache, 2nd | "
               "1st / 2nd with the cache |")
         print("|---|---:|---:|---:|---:|---:|")
