@@ -28,6 +28,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+import scipy  # scipy.signal loads on first use (an import-time saving)
 
 from .._foundation._params import as_arrays, rebuild
 from .._simulation._data import Dataset
@@ -113,16 +114,31 @@ def _runs(model, names, values, windows, key, noise_std, start_std):
 def _unit_disturbance(e, dt, tau):
     """(S, E, W, L) Gauss-Markov samples of unit std from zero at the window start, from
     the normal draws `e` (S, E, W, L) and the intervals `dt` (E, W) (module docstring),
-    and their trapezoid integral."""
-    a = np.exp(-dt / tau)[..., None]
-    gain = np.sqrt(1.0 - a**2)
-    b = np.empty_like(e)
-    prev = np.zeros(e.shape[:-1])
-    for k in range(e.shape[-1]):
-        prev = a[..., 0] * prev + gain[..., 0] * e[..., k]
-        b[..., k] = prev
+    and their trapezoid integral. The recursion is a first-order filter along the samples,
+    run by `scipy.signal.lfilter` once per distinct interval."""
+    b = np.full_like(e, np.nan)  # NaN where an interval is not finite, as the recursion gives
+    for step in np.unique(dt[np.isfinite(dt)]):
+        a = math.exp(-step / tau)
+        where = dt == step
+        b[:, where] = scipy.signal.lfilter([math.sqrt(1.0 - a * a)], [1.0, -a],
+                                           e[:, where], axis=-1)
     before = np.concatenate([np.zeros(b.shape[:-1] + (1,)), b[..., :-1]], axis=-1)
     return b, np.cumsum(0.5 * (before + b), axis=-1) * dt[..., None]
+
+
+def _central_interval(runs, level):
+    """The `(1 - level) / 2` and `(1 + level) / 2` quantiles of `runs` along its last
+    axis, interpolated linearly between order statistics as `numpy.quantile` does by
+    default (Hyndman and Fan 1996, definition 7), from one sort."""
+    ordered = np.sort(runs, axis=-1)
+    out = []
+    for q in ((1 - level) / 2, (1 + level) / 2):
+        position = q * (ordered.shape[-1] - 1)
+        k = min(int(position), ordered.shape[-1] - 2)
+        low, high, t = ordered[..., k], ordered[..., k + 1], position - k
+        # numpy's lerp: from the nearer order statistic
+        out.append(low + t * (high - low) if t < 0.5 else high - (1 - t) * (high - low))
+    return out
 
 
 class _Runs:
@@ -156,12 +172,15 @@ class _Runs:
             raise ValueError(f"{num_samples - int(finite.sum())} of {num_samples} runs were "
                              "not finite: the draws leave the region where the model can be "
                              "simulated; check the fit's covariance.")
-        self.ds, self.channels, self.runs = ds, windows.channels, out[finite]
+        runs = out[finite]
+        # (C, E, W, L, S): the draws last and contiguous, as the quantiles sort along them
+        self.ds, self.channels = ds, windows.channels
+        self.runs = np.ascontiguousarray(np.moveaxis(runs, 0, -1))
         self.num_samples, self.num_dropped = num_samples, int(num_samples - finite.sum())
         self.nominal = np.asarray(_predict_jit(model, windows), dtype=np.float64)
         self.dt = np.asarray(windows.dt, dtype=np.float64)
-        self.normals = rng.standard_normal(self.runs.shape[:1] + self.runs.shape[2:])
-        self.unit = {}  # tau -> the unit disturbance and its integral (calibration reuses them)
+        self.normals = rng.standard_normal(runs.shape[:1] + runs.shape[2:])
+        self.unit = {}  # tau -> the unit disturbance and its integral, (E, W, L, S) each
 
     def bands(self, level, disturbance) -> PredictionBands:
         if not 0 < level < 1:
@@ -170,15 +189,15 @@ class _Runs:
             raise ValueError(f"`disturbance` must be a jaxship.Disturbance, got "
                              f"{type(disturbance).__name__}.")
         if disturbance.tau not in self.unit:
-            self.unit[disturbance.tau] = _unit_disturbance(self.normals, self.dt,
-                                                           disturbance.tau)
+            self.unit[disturbance.tau] = tuple(
+                np.ascontiguousarray(np.moveaxis(x, 0, -1))
+                for x in _unit_disturbance(self.normals, self.dt, disturbance.tau))
         b, integral = self.unit[disturbance.tau]
         added = {"r": disturbance.std * b, "psi": disturbance.std * integral}
         shape = (self.ds.num_experiments, self.ds.num_samples)
         nominal, lower, upper = {}, {}, {}
         for c, name in enumerate(self.channels):
-            runs = self.runs[:, c] + added.get(name, 0.0)
-            lo, hi = np.quantile(runs, [(1 - level) / 2, (1 + level) / 2], axis=0)
+            lo, hi = _central_interval(self.runs[c] + added.get(name, 0.0), level)
             nominal[name], hit = to_timeline(self.nominal[c], self.layout, shape)
             lower[name], _ = to_timeline(lo, self.layout, shape)
             upper[name], _ = to_timeline(hi, self.layout, shape)
