@@ -729,3 +729,59 @@ def test_ctrl_c_after_the_results_ends_with_130_and_its_line():
     err = process.communicate(timeout=60)[1]
     assert process.returncode == 130, (process.returncode, err)
     assert err.rstrip().endswith("jaxship: interrupted.") and "Traceback" not in err, err
+
+
+SLOW_TO_START = """
+import multiprocessing, time
+
+if multiprocessing.parent_process() is not None:
+    time.sleep(3.0)  # in the child, before it rebuilds the semaphores of its arguments
+
+def job(queue):
+    queue.put("started")
+"""
+
+CHILD_STARTING = """
+import multiprocessing, sys, time
+from jaxship import cli
+import slow_to_start
+
+def main(argv=None):
+    context = multiprocessing.get_context("spawn")
+    child = context.Process(target=slow_to_start.job, args=(context.Queue(),))
+    child.start()
+    print(child.pid, flush=True)
+    try:
+        time.sleep(60)
+    except KeyboardInterrupt:  # as the commands do
+        print("jaxship: interrupted.", file=sys.stderr)
+        return 130
+    return 0
+
+cli.main = main
+cli.run()
+"""
+
+
+def test_ctrl_c_while_a_worker_starts_leaves_no_worker_and_no_traceback(tmp_path):
+    """`reproduce`'s Ctrl-C test on a loaded machine (CI of 2026-11-28): a spawned worker
+    still importing when the command ended outlived it, found the semaphores of its
+    arguments unlinked and printed a FileNotFoundError traceback after "jaxship:
+    interrupted.". The command now kills its child processes as it ends."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    (tmp_path / "slow_to_start.py").write_text(SLOW_TO_START)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path), *sys.path]))
+    process = subprocess.Popen([sys.executable, "-c", CHILD_STARTING], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, env=env)
+    child = int(process.stdout.readline())
+    process.send_signal(signal.SIGINT)
+    err = process.communicate(timeout=60)[1]  # also waits for the child: it shares stderr
+    assert process.returncode == 130, (process.returncode, err)
+    assert err.rstrip().endswith("jaxship: interrupted.") and "Traceback" not in err, err
+    time.sleep(0.5)
+    stat = pathlib.Path(f"/proc/{child}/stat")
+    assert not stat.exists() or stat.read_text().rsplit(")", 1)[1].split()[0] == "Z", child

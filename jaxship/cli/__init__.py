@@ -5,6 +5,7 @@ function (`run`); `main` registers them and turns errors into exit statuses."""
 import argparse
 import gc
 import importlib.metadata
+import multiprocessing
 import os
 import signal
 import sys
@@ -178,7 +179,13 @@ def _watchdog():
 
 
 def _end(status: int):
+    """Leave now with `status`: the staging folders removed, and every child process
+    killed first. A child still starting (`reproduce`'s worker, unpickling its
+    arguments) would otherwise outlive this process, meet the semaphores it shares
+    unlinked by the resource tracker and print a traceback after "interrupted"."""
     sys.stdout.flush()
     sys.stderr.flush()
     discard_open_stages()  # unwinding would have removed them
+    for child in multiprocessing.active_children():
+        child.kill()
     os._exit(status)
