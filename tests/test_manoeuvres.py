@@ -30,7 +30,9 @@ def open_loop(manoeuvre, tau):
     """Rudder and propeller orders of an open-loop manoeuvre at `tau` s after its start."""
     state = js.straight_state(5.0, n=1.25)
     memory = manoeuvre.init(state)
-    command = jax.vmap(lambda s: manoeuvre.command(manoeuvre.start + s, state, memory, 0.1)[0])
+    # jitted: one compilation per manoeuvre, not one per primitive on each new shape
+    command = jax.jit(jax.vmap(
+        lambda s: manoeuvre.command(manoeuvre.start + s, state, memory, 0.1)[0]))
     out = command(np.asarray(tau, dtype=float))
     return np.asarray(out.delta), np.asarray(out.n)
 
