@@ -44,7 +44,7 @@ import time
 from pathlib import Path
 
 import jaxship as js
-from jaxship.cli import SMALL_PROGRAMS
+from jaxship.cli._compiler import SMALL_PROGRAMS, jaxlib_version, known_flags
 
 
 # what `jaxship simulate` imports besides jaxship itself
@@ -128,7 +128,10 @@ def table(repeats: int, tmp: Path, only: str | None = None) -> None:
 def flags(repeats: int, tmp: Path) -> None:
     """Each table command's first run with XLA's defaults and with the command's setting."""
     default = " ".join(f.split("=")[0] + "=" + XLA_DEFAULTS[f.split("=")[0]]
-                       for f in SMALL_PROGRAMS)
+                       for f in known_flags(SMALL_PROGRAMS))  # none this jaxlib lacks
+    if not default:
+        sys.exit(f"--flags: jaxlib {'.'.join(map(str, jaxlib_version()))} knows none of "
+                 f"{SMALL_PROGRAMS}, so the command adds no flag and there is nothing to compare.")
     print(f"{time.strftime('%Y-%m-%d')}, first runs (empty cache), each in a new process")
     print("| command | XLA's defaults | jaxship's setting | ratio |")
     print("|---|---:|---:|---:|")

@@ -1,6 +1,6 @@
 """jaxship: differentiable ship-manoeuvring simulation and steering-model identification."""
 
-import importlib.metadata
+__version__ = "0.1.0"  # the one place of the version (pyproject.toml reads it)
 
 from ._analysis._autopilot import (
     TunedAutopilot as TunedAutopilot,
@@ -209,8 +209,7 @@ from ._simulation._readers import (
 from ._simulation._simulate import simulate as simulate
 
 
-__version__ = importlib.metadata.version("jaxship")  # from pyproject.toml
-
+# isort: split
 # helpers of the application (jaxship.cli) and the notebooks
 from ._models._armax_model import ARMAXModel as ARMAXModel
 from ._models._steering.ross import (

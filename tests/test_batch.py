@@ -82,6 +82,25 @@ def test_a_large_batch_takes_rk4s_stages_written_out_with_the_same_numbers(monke
     assert seen[-1] == js.RK4() and few.state.psi.shape[0] == 2  # a small batch stays rolled
 
 
+def test_rk4_writes_its_stages_out_on_an_accelerator(monkeypatch):
+    """`RK4()` (rolled=None) chooses by the backend it is traced for: the vector field
+    traced once (rolled stages) on the CPU, four times (written out) on a GPU or TPU;
+    `rolled=True` and `False` whatever the backend (issue 56)."""
+    import diffrax as dfx
+    import jax.numpy as jnp
+
+    calls = []
+    term = dfx.ODETerm(lambda t, y, args: calls.append(1) or -y)
+    for backend, solver, traced in (("cpu", js.RK4(), 1), ("gpu", js.RK4(), 4),
+                                    ("tpu", js.RK4(), 4), ("gpu", js.RK4(rolled=True), 1),
+                                    ("cpu", js.RK4(rolled=False), 4)):
+        monkeypatch.setattr(jax, "default_backend", lambda b=backend: b)
+        calls.clear()
+        jax.make_jaxpr(lambda y, s=solver: s.step(term, 0.0, 0.1, y, None, None, False)[0])(
+            jnp.ones(2))
+        assert len(calls) == traced, (backend, solver)
+
+
 def test_batched_vessel_and_shared_manoeuvre():
     """A vessel batched over one coefficient (in_axes prefix), one manoeuvre for all."""
     vessel = mariner()

@@ -97,17 +97,6 @@ def test_each_command_chooses_its_compiler_setting(tmp_path, capsys, monkeypatch
     capsys.readouterr()
 
 
-def test_the_compiler_setting_keeps_the_users_xla_flags(monkeypatch):
-    monkeypatch.setenv("XLA_FLAGS", "--xla_dump_to=x")
-    cli.compile_for_small_programs()
-    assert os.environ["XLA_FLAGS"].split() == [
-        "--xla_dump_to=x", "--xla_cpu_use_fusion_emitters=false"]
-    monkeypatch.setenv("XLA_FLAGS", "--xla_cpu_use_fusion_emitters=true --xla_dump_to=x")
-    cli.compile_for_small_programs()
-    assert os.environ["XLA_FLAGS"].split() == [
-        "--xla_cpu_use_fusion_emitters=true", "--xla_dump_to=x"]
-
-
 def test_version(capsys):
     with pytest.raises(SystemExit) as stop:
         main(["--version"])

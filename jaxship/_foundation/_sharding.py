@@ -4,13 +4,14 @@ A one-axis `jax.sharding.Mesh` over the devices (all of `jax.devices()` by defau
 local CPU or GPUs, or every host's devices after `jax.distributed.initialize()`) and
 `jax.shard_map` over it. XLA shards only evenly, so a batch is padded to a multiple of the
 device count by repeating its last entry (a valid, finite run) and trimmed afterwards.
-With one device everything is a plain `jax.vmap`.
+With one device everything is a plain `jax.vmap`. A mesh that spans several processes
+(`jax.distributed.initialize`) hands every process the whole result (`gathered`).
 """
 
 import jax
 import jax.numpy as jnp
 import numpy as np
-from jax.sharding import Mesh, PartitionSpec as P
+from jax.sharding import Mesh, NamedSharding, PartitionSpec as P
 
 
 AXIS = "batch"  # name of the mesh axis a batch is split over
@@ -20,6 +21,15 @@ def batch_mesh(devices=None) -> Mesh | None:
     """A one-axis mesh over `devices` (default all), or None for a single device."""
     devices = tuple(jax.devices() if devices is None else devices)
     return Mesh(np.array(devices), (AXIS,)) if len(devices) > 1 else None
+
+
+def gathered(tree, mesh: Mesh | None):
+    """`tree` (inside `jit`) replicated on every device of `mesh` where the mesh spans
+    several processes, so that each process can read the whole result; else as it is
+    (a result that stays split keeps large batches off any one device)."""
+    if mesh is None or len({d.process_index for d in mesh.devices.flat}) == 1:
+        return tree
+    return jax.lax.with_sharding_constraint(tree, NamedSharding(mesh, P()))
 
 
 def pad_batch(tree, size: int, padded: int):
@@ -46,5 +56,5 @@ def sharded_vmap(f, *args, batch_dims: int = 1):
         padded = -(-size // mesh.devices.size) * mesh.devices.size
         out = jax.shard_map(jax.vmap(f), mesh=mesh, in_specs=P(AXIS), out_specs=P(AXIS),
                             check_vma=False)(*pad_batch(flat, size, padded))
-        out = jax.tree.map(lambda a: a[:size], out)
+        out = jax.tree.map(lambda a: a[:size], gathered(out, mesh))
     return jax.tree.map(lambda a: jnp.reshape(a, lead + a.shape[1:]), out)

@@ -15,7 +15,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax.sharding import PartitionSpec as P
 
-from .._foundation._sharding import AXIS, batch_mesh, pad_batch
+from .._foundation._sharding import AXIS, batch_mesh, gathered, pad_batch
 from .._foundation._state import Trajectory, straight_state
 from .._models._environment import Environment
 from .._models._manoeuvres import Replay
@@ -184,6 +184,7 @@ def _batched(b_dyn, s_dyn, b_static, s_static, simulator, steps, output, wind, s
     out = jax.shard_map(
         local, mesh=mesh, in_specs=(P(AXIS), P()), out_specs=P(AXIS), check_vma=False
     )(pad_batch(b_dyn, size, padded), s_dyn)
+    out = gathered(out, mesh)  # several processes: each gets the whole result
     # trimming the padding gathers the result (XLA shards only evenly): choose batch
     # sizes divisible by the device count to keep large outputs split over the devices
     return out if padded == size else jax.tree.map(lambda a: a[:size], out)

@@ -47,9 +47,10 @@ class RK4(dfx.AbstractSolver):
     On the Mariner, KVLCC2 and Esso Osaka a first simulation or derivative took
     1.7-3.3x less time, later ones 1.3-2.9x less, and a batch of 64 turning circles
     1.4x more once compiled (`python benchmarks/rk4_stages.py`, 2026-11-27). `False`:
-    the stages written out. `None` (default): rolled, except in `simulate_batch` of
-    `WRITTEN_OUT_BATCH` runs or more, where the written-out stages' faster runs repay
-    their longer compilation within one call.
+    the stages written out. `None` (default): on the CPU rolled, except in
+    `simulate_batch` of `WRITTEN_OUT_BATCH` runs or more, where the written-out stages'
+    faster runs repay their longer compilation within one call; on an accelerator
+    written out (`stages_rolled_by_default`).
     """
 
     rolled: bool | None = eqx.field(static=True, default=None)
@@ -67,7 +68,7 @@ class RK4(dfx.AbstractSolver):
         h = t1 - t0
         f = lambda t, y: terms.vf(t, y, args)
         axpy = lambda a, x, y: jax.tree.map(lambda xi, yi: yi + a * xi, x, y)
-        if self.rolled is not False:
+        if self.rolled or (self.rolled is None and stages_rolled_by_default()):
             c, b = jnp.array([0.0, 0.5, 0.5, 1.0]), jnp.array([1.0, 2.0, 2.0, 1.0]) / 6
 
             def stage(i, carry):  # k_i and the weighted sum of k_1 .. k_i
@@ -88,6 +89,14 @@ class RK4(dfx.AbstractSolver):
 
     def func(self, terms, t0, y0, args):
         return terms.vf(t0, y0, args)
+
+
+def stages_rolled_by_default() -> bool:
+    """Whether `RK4(rolled=None)` rolls its stages: on the CPU, where XLA then compiles
+    the vector field once (see `RK4`); not on an accelerator, where one 600 s Mariner
+    zig-zag ran in 192 ms with the stages written out against 773 ms rolled (one H200,
+    jax 0.11.2, 2026-11-28, issue 56). Read while tracing, from the default backend."""
+    return jax.default_backend() == "cpu"
 
 
 class Simulator(eqx.Module):

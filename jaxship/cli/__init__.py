@@ -4,7 +4,6 @@ function (`run`); `main` registers them and turns errors into exit statuses."""
 
 import argparse
 import gc
-import importlib.metadata
 import multiprocessing
 import os
 import signal
@@ -15,6 +14,8 @@ import time
 import jax
 import matplotlib
 
+from .. import __version__
+
 
 matplotlib.use("Agg")  # the command writes files; it never opens a window
 
@@ -22,6 +23,7 @@ from .._foundation._cache import enable_compilation_cache  # noqa: E402
 from .._foundation._files import discard_open_stages  # noqa: E402
 from . import autopilot, discover, identify, reproduce, simulate, vessels  # noqa: E402
 from ._common import one_line  # noqa: E402
+from ._compiler import SMALL_PROGRAMS, compile_for_small_programs  # noqa: E402, F401
 from ._identification.workflow import FitDivergedError  # noqa: E402
 
 
@@ -33,14 +35,6 @@ interrupted. JAXSHIP_CACHE_DIR: where compiled programs are kept for later runs 
 ~/.cache/jaxship/jax; "off" disables)."""
 
 COMMANDS = (vessels, simulate, reproduce, identify, autopilot, discover)
-# XLA's CPU compiler set for many small programs: the loop emitters instead of the MLIR
-# fusion emitters. Each command says whether it compiles many programs that run briefly
-# (`small_programs(args)`, set in its `register`). LLVM's optimisation stays on: with
-# `RK4`'s stages in a loop, turning it off as well gave wrong forward and reverse
-# derivatives of a closed-loop Mariner run (0.00286 against 0.00363 by central
-# differences, tests/test_contracts.py's user controller; either flag alone is right),
-# and the optimised code runs batches faster.
-SMALL_PROGRAMS = ("--xla_cpu_use_fusion_emitters=false",)
 GRACE = 5.0  # [s] after Ctrl-C, the longest the process takes to end
 _INTERRUPTED = threading.Event()  # Ctrl-C was pressed
 _RAISED = threading.Event()  # and raised as KeyboardInterrupt in the main thread
@@ -77,7 +71,7 @@ def main(argv=None) -> int:
                                      epilog=EXIT_STATUS,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version",
-                        version=f"jaxship {importlib.metadata.version('jaxship')}")
+                        version=f"jaxship {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     for command in COMMANDS:
         command.register(sub)
@@ -104,14 +98,6 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("jaxship: interrupted.", file=sys.stderr)
         return 130
-
-
-def compile_for_small_programs(flags=SMALL_PROGRAMS) -> None:
-    """Add `flags` to $XLA_FLAGS, each unless $XLA_FLAGS sets it already. XLA reads them
-    when JAX starts its backend (at the first computation): later calls change nothing."""
-    given = os.environ.get("XLA_FLAGS", "").split()
-    named = {f.split("=")[0] for f in given}
-    os.environ["XLA_FLAGS"] = " ".join(given + [f for f in flags if f.split("=")[0] not in named])
 
 
 def run() -> None:
