@@ -7,6 +7,7 @@ import os
 import signal
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -204,3 +205,69 @@ def test_a_file_of_the_users_in_the_way_is_refused_before_the_work(tmp_path, cap
     write(tmp_path / "ours", {"report.md": "old"})
     with pytest.raises(AssertionError, match="the work started"):
         main(["discover", "any.csv", "--model", "nomoto1", "--out", str(tmp_path / "ours")])
+
+
+RACING_RUN = """
+import importlib.util, os, pathlib, sys, time
+spec = importlib.util.spec_from_file_location("files", sys.argv[1])
+files = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(files)
+out, tag = pathlib.Path(sys.argv[2]), sys.argv[3]
+replace = os.replace
+
+def slow(source, target):  # a slow or network file system
+    time.sleep(0.1)
+    replace(source, target)
+
+files.os.replace = slow
+if tag == "holder":  # takes the lock and waits to be killed
+    with files.locked(out):
+        print("locked", flush=True)
+        time.sleep(60)
+with files.staged_folder(out) as stage:
+    for name in ("trial.csv", "indices.json", "trial.png", "figures/a.png"):
+        (stage / name).parent.mkdir(parents=True, exist_ok=True)
+        (stage / name).write_text(tag)
+    while not (out / "go").exists():  # both commit at once
+        time.sleep(0.01)
+"""
+
+
+def _racing(out, tag):
+    return subprocess.Popen([sys.executable, "-c", RACING_RUN, _files.__file__, str(out), tag],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def test_concurrent_runs_on_one_folder_take_turns_and_never_mix(tmp_path):
+    """Issue 57, case 6: two runs on one --out, each rename slowed (a network file
+    system), left the trial.csv of one beside the figure of the other under one
+    manifest. The commits now take turns under the folder's lock: the folder holds the
+    whole set of one run (the later), its manifest lists exactly those files, and
+    nothing of the staging is left."""
+    write(tmp_path, OLD)
+    runs = [_racing(tmp_path, tag) for tag in ("first", "second")]
+    deadline = time.monotonic() + 60
+    while len(list(tmp_path.glob(".jaxship.*.*"))) < 2 and time.monotonic() < deadline:
+        time.sleep(0.01)  # both staged
+    (tmp_path / "go").write_text("go")
+    for run in runs:
+        err = run.communicate(timeout=60)[1]
+        assert run.returncode == 0, err
+    (tmp_path / "go").unlink()
+    written = files(tmp_path)
+    assert len(set(written.values())) == 1, written
+    assert sorted(written) == sorted(read_manifest(tmp_path)) == sorted(
+        ["trial.csv", "indices.json", "trial.png", "figures/a.png"])
+    assert not list(tmp_path.glob(".jaxship.*"))
+
+
+def test_a_killed_holder_of_the_lock_leaves_it_free(tmp_path):
+    """The lock is the kernel's (`flock`): a run killed while it holds it (SIGKILL, no
+    handler runs) leaves no lock behind, and the next run commits at once."""
+    holder = _racing(tmp_path, "holder")
+    assert holder.stdout.readline().strip() == "locked"
+    holder.kill()
+    holder.communicate(timeout=60)
+    write(tmp_path, NEW)  # would wait for ever on a lock left behind
+    assert files(tmp_path) == NEW
+    assert not list(tmp_path.glob(".jaxship.*"))
