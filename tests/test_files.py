@@ -9,8 +9,10 @@ import subprocess
 import sys
 import time
 
+import numpy as np
 import pytest
 
+import jaxship as js
 from jaxship._foundation import _files
 from jaxship._foundation._files import MANIFEST, read_manifest, staged_folder
 from jaxship.cli import main
@@ -205,6 +207,44 @@ def test_a_file_of_the_users_in_the_way_is_refused_before_the_work(tmp_path, cap
     write(tmp_path / "ours", {"report.md": "old"})
     with pytest.raises(AssertionError, match="the work started"):
         main(["discover", "any.csv", "--model", "nomoto1", "--out", str(tmp_path / "ours")])
+
+
+def test_a_file_of_the_users_among_the_figures_is_refused_before_the_work(tmp_path, capsys,
+                                                                          monkeypatch):
+    """Issue 57: a file of the user's in `figures/` under a name jaxship draws was refused
+    only at the commit, after the whole fit or discovery. Now: exit 2, one line, after
+    the records are read (the names follow them) and before the fit, the file kept;
+    other files of the user's there stay allowed
+    (`test_identify_keeps_the_users_figure_and_drops_its_own_stale_ones`)."""
+    def never(*args, **kwargs):
+        raise AssertionError("the work started")
+
+    monkeypatch.setattr("jaxship.cli.identify.identify", never)
+    monkeypatch.setattr("jaxship.cli._identification.discovery.identify", never)
+    monkeypatch.setattr("jaxship.cli.autopilot.autopilot_study.evaluate", never)
+    record = tmp_path / "zz.csv"
+    t = np.arange(200) * 0.5
+    js.write_trial_csv(record, js.Experiment(t, np.full_like(t, 0.1), name="zz",
+                                             r=0.01 * (1 - np.exp(-t / 20))))
+    result = tmp_path / "fit" / "result.json"
+    result.parent.mkdir()
+    result.write_text(json.dumps({"model": "nomoto1", "model_class": "Nomoto1", "frozen": {},
+                                  "parameters": {"K": {"value": 0.1}, "T": {"value": 20.0}}}))
+    cases = {"identify": [str(record), "--model", "nomoto1"],
+             "discover": [str(record), "--model", "nomoto1"],
+             "autopilot": ["--model", str(result), "--vessel", "thesis", "--rpm", "300"]}
+    names = {"identify": ("fit_train_00_zz.png", "correlation.png"),
+             "discover": ("residuals_00.png",), "autopilot": ("heading_300rpm.png",)}
+    for command, args in cases.items():
+        for name in names[command]:
+            out = tmp_path / command / name
+            (out / "figures").mkdir(parents=True)
+            (out / "figures" / name).write_text("mine")
+            assert main([command, *args, "--out", str(out)]) == 2
+            err = capsys.readouterr().err
+            assert f"figures/{name} exists and jaxship did not write it" in err, err
+            assert len(err.strip().splitlines()) == 1, err
+            assert files(out) == {f"figures/{name}": "mine"}
 
 
 RACING_RUN = """
