@@ -911,3 +911,26 @@ def test_sigterm_during_the_commit_ends_with_143_and_the_earlier_results_visible
     assert process.returncode == 143, (process.returncode, err)
     assert err.rstrip().endswith("jaxship: terminated.") and "Traceback" not in err, err
     assert {p.name: p.read_text() for p in tmp_path.iterdir() if p.name != MANIFEST} == earlier
+
+
+def test_numpy_warnings_reach_stderr_as_one_line(record, tmp_path, capsys, monkeypatch):
+    """Issue 57: a `discover` mixing a Mariner held-out record with a thesis-vessel
+    training record printed ten raw NumPy overflow warnings with source paths. Whatever
+    the numerical libraries warn of during a command is now one line, without paths,
+    saying what it likely means; the command's own outcome is unchanged."""
+    import warnings
+
+    def overflowing(*args, **kwargs):
+        for _ in range(10):
+            np.exp(np.full(3, 1000.0))  # "overflow encountered in exp", as the audit saw
+        raise ValueError("the fit stopped")
+
+    monkeypatch.setattr("jaxship.cli.identify.identify", overflowing)
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")  # Python's filters outside pytest: each warning once
+        code = main(["identify", record, "--model", "nomoto1", "--out", str(tmp_path / "o")])
+    assert code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and err[1] == "jaxship: error: the fit stopped", err
+    assert err[0].startswith("jaxship: warning: overflow encountered in exp (from the "), err
+    assert "floating-point range" in err[0] and ".py" not in err[0]

@@ -10,6 +10,7 @@ import signal
 import sys
 import threading
 import time
+import warnings
 
 import jax
 import matplotlib
@@ -87,7 +88,11 @@ def main(argv=None) -> int:
     jax.config.update("jax_enable_x64", True)
     enable_compilation_cache()  # second runs skip compilation ($JAXSHIP_CACHE_DIR moves it)
     try:
-        return args.run(args)
+        with warnings.catch_warnings(record=True) as caught:  # the filters as they are
+            try:
+                return args.run(args)
+            finally:
+                _tell(caught)
     except FitDivergedError as error:
         print(f"jaxship: error: {one_line(error)}", file=sys.stderr)
         return 3
@@ -101,6 +106,18 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         _say(_SIGNAL[0])
         return 128 + _SIGNAL[0]
+
+
+def _tell(caught):
+    """One line on stderr for the warnings of the numerical libraries (NumPy's overflow,
+    ...) that the run met, in place of their text with source paths."""
+    messages = dict.fromkeys(one_line(w.message) for w in caught)
+    numbers = any(issubclass(w.category, RuntimeWarning) for w in caught)
+    if messages:
+        print(f"jaxship: warning: {'; '.join(messages)} (from the numerical libraries)"
+              + (": values beyond the floating-point range, often from a record "
+                              "unlike the others (another vessel, other units)."
+                              if numbers else "."), file=sys.stderr)
 
 
 def run() -> None:
