@@ -83,18 +83,14 @@ def locked(out: pathlib.Path):
         handle = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
         try:
             fcntl.flock(handle, fcntl.LOCK_EX)
-            if os.path.samestat(os.fstat(handle), os.stat(path)):
-                break  # else its holder removed it as we waited: lock the new one
-        except FileNotFoundError:
-            pass
-        except OSError as error:
-            if error.errno not in (errno.ENOLCK, errno.EOPNOTSUPP):
-                os.close(handle)
-                raise
-            break
-        except BaseException:
+        except BaseException as error:  # Ctrl-C while waiting, or no locks here
+            if isinstance(error, OSError) and error.errno in (errno.ENOLCK, errno.EOPNOTSUPP):
+                break
             os.close(handle)
             raise
+        with contextlib.suppress(FileNotFoundError):
+            if os.path.samestat(os.fstat(handle), os.stat(path)):
+                break  # else its holder removed it as we waited: lock the new one
         os.close(handle)
     try:
         yield

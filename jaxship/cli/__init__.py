@@ -113,17 +113,17 @@ def _tell(caught):
     ...) that the run met, in place of their text with source paths."""
     messages = dict.fromkeys(one_line(w.message) for w in caught)
     numbers = any(issubclass(w.category, RuntimeWarning) for w in caught)
+    meaning = (": values beyond the floating-point range, often from a record unlike the "
+               "others (another vessel, other units)." if numbers else ".")
     if messages:
         print(f"jaxship: warning: {'; '.join(messages)} (from the numerical libraries)"
-              + (": values beyond the floating-point range, often from a record "
-                              "unlike the others (another vessel, other units)."
-                              if numbers else "."), file=sys.stderr)
+              f"{meaning}", file=sys.stderr)
 
 
 def run() -> None:
-    """The console entry point: `main`, then exit with its status. After Ctrl-C (or
-    SIGTERM, handled alike) the process ends with status 130 (143) without the
-    interpreter's teardown, which crashed
+    """The console entry point (`_jaxship_cli.run` calls it after the imports): `main`,
+    then exit with its status. After Ctrl-C (or SIGTERM, handled alike) the process
+    ends with status 130 (143) without the interpreter's teardown, which crashed
     (SIGSEGV) while XLA's threads were still running; and since an interrupt raised
     inside a garbage-collection callback is swallowed, a watchdog ends the process
     `GRACE` seconds after the signal whatever the main thread is doing. Results are
