@@ -58,6 +58,7 @@ def test_autopilot_writes_gains_runs_report_and_figures(written):
         assert all(math.isfinite(gains[k]) and gains[k] > 0 for k in ("kp", "ki", "kd"))
     assert result["gains"]["pid+ff"]["feedforward"] == "Nomoto1"
     assert result["gains"]["pid"]["feedforward"] is None
+    assert result["model"]["fit_code"] == "successful"
     runs = result["runs"]
     assert [(r["controller"], r["rpm"]) for r in runs] == [
         ("pid+ff", 300.0), ("pid+ff", 500.0), ("pid", 300.0), ("pid", 500.0)]
@@ -201,6 +202,26 @@ def test_a_closed_loop_that_blew_up_exits_3_and_says_so(identified, tmp_path, ca
     title, blank, first = (out / "report.md").read_text().splitlines()[:3]
     assert title.startswith("#") and blank == "" and first.startswith("**The closed loop blew")
     assert json.loads((out / "autopilot.json").read_text())["runs"]
+
+
+def test_a_model_whose_fit_did_not_succeed_is_flagged_and_exits_3(identified, tmp_path, capsys):
+    """Issue 57, case 3: a result whose code is `poorly_determined` (K and T at their start
+    values) gave an autopilot, exit 0, and neither report nor JSON named the fit's code.
+    Now the code is read: a fit that did not succeed is said first in
+    the report and on stderr, is in autopilot.json, and the exit status is 3. (A model
+    written by hand, with no fit, is taken as it is: `test_the_mariner_at_the_defaults`.)"""
+    report = json.loads(pathlib.Path(identified).read_text())
+    report["fit"] |= {"code": "poorly_determined", "success": False}
+    model = tmp_path / "result.json"
+    model.write_text(json.dumps(report))
+    out = tmp_path / "run"
+    assert main(["autopilot", "--model", str(model), "--vessel", "thesis", "--rpm", "300",
+                 "--out", str(out), "--quiet"]) == 3
+    code = "poorly_determined"
+    assert f"not a converged estimate (code {code} in {model})" in capsys.readouterr().err
+    title, blank, first = (out / "report.md").read_text().splitlines()[:3]
+    assert first.startswith("**The model's fit is not a converged estimate")
+    assert json.loads((out / "autopilot.json").read_text())["model"]["fit_code"] == code
 
 
 @pytest.mark.skipif(not os.path.isdir("/proc") or os.name != "posix", reason="needs /proc")

@@ -12,7 +12,7 @@ from helpers import per_sample
 
 import jaxship as js
 import jaxship.cli as cli
-from jaxship._foundation._files import MANIFEST
+from jaxship._foundation._files import MANIFEST, staged_folder
 from jaxship._foundation._params import parameter_fields, resolve_free
 from jaxship.cli import main
 from jaxship.cli._identification.workflow import FitDivergedError
@@ -152,6 +152,11 @@ def _error_line(capsys):
     (["--manoeuvre", "prbs:-5"], "the amplitude must be positive"),
     (["--manoeuvre", "heading-steps:-5"], "heading amplitude must be positive"),
     (["--manoeuvre", "pullout:20", "--duration", "5"], "a pullout needs more than"),
+    # issue 57: 1e9 failed without naming the option; 1e-6 ran 45 s and wrote 600,000 rows
+    # with r = 12,000 deg/s, which jaxship's own reader refused
+    (["--manoeuvre", "turn:35", "--length", "1e9"], "--length 1e+09 m: give a ship or model "
+     "length between 1 and 1000 m (mariner is 160.9 m)"),
+    (["--manoeuvre", "turn:35", "--length", "1e-6"], "--length 1e-06 m: give a ship or model"),
 ])
 def test_simulate_rejects_nonsense_before_simulating(tmp_path, capsys, args, message):
     out = tmp_path / "a" / "b"
@@ -258,6 +263,65 @@ def test_out_that_is_a_file_is_refused_first(command, record, fitted, tmp_path, 
     line = _error_line(capsys)
     assert f"--out {tmp_path / 'new'}: cannot write in {tmp_path} (Permission denied)" in line
     assert not (tmp_path / "new").exists()
+
+
+def _no_work(monkeypatch):
+    def no_work(*args, **kwargs):
+        raise AssertionError("long work started before --out was checked")
+
+    for name in ("simulate.simulate_to_folder", "identify.identify",
+                 "identify.read_experiments", "discover.run_discovery",
+                 "reproduce.reproduce", "autopilot.autopilot_study.evaluate"):
+        monkeypatch.setattr(f"jaxship.cli.{name}", no_work)
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_out_that_is_a_dangling_or_looping_symlink_is_refused_first(command, record, fitted,
+                                                                    tmp_path, capsys,
+                                                                    monkeypatch):
+    """Issue 57, case 7: an --out that is a symbolic link to nothing, or a loop, ran the
+    whole fit and then ended with exit 1, "File exists". Now it is one line, exit 2,
+    before the work, naming the link; a link to a folder is written through."""
+    _no_work(monkeypatch)
+    dangling, loop = tmp_path / "dangling", tmp_path / "loop"
+    dangling.symlink_to(tmp_path / "nowhere")
+    loop.symlink_to(loop)
+    for out, link in ((dangling, dangling), (loop, loop), (dangling / "sub", dangling),
+                      (loop / "sub", loop)):
+        assert main(_command(command, record, fitted, out)) == 2
+        line = _error_line(capsys)
+        assert f"--out {out}: {link} is a symbolic link to" in line, line
+        assert "missing or loops" in line
+    assert not (tmp_path / "nowhere").exists() and dangling.is_symlink() and loop.is_symlink()
+
+
+def test_an_input_that_the_run_would_replace_is_refused_first(record, fitted, tmp_path,
+                                                              capsys, monkeypatch):
+    """Issue 57, case 5: `simulate --out o/same`, then `identify o/same/trial.csv --out
+    o/same` read the record and then removed it with the rest of the earlier run (the
+    folder ended with only result.json). An input that is, or holds, a file of
+    jaxship's earlier run in --out is now refused before the work: exit 2, one line
+    naming it and what to do, and the folder as it was."""
+    _no_work(monkeypatch)
+    same = tmp_path / "o" / "same"
+    with staged_folder(same) as stage:  # as `jaxship simulate --out o/same` left it
+        (stage / "trial.csv").write_text(pathlib.Path(record).read_text())
+        (stage / "indices.json").write_text("{}\n")
+    before = {p.name: p.read_bytes() for p in same.iterdir()}
+    trial = same / "trial.csv"
+    for args, given in (
+            (["identify", str(trial), "--model", "nomoto1"], trial),
+            (["identify", str(same.parent), "--model", "nomoto1"], same.parent),
+            (["identify", record, "--validate", str(trial), "--model", "nomoto1"], trial),
+            (["discover", record, "--holdout", str(trial), "--model", "nomoto1"], trial),
+            (["autopilot", "--model", fitted, "--vessel", "thesis", "--rpm", "300"],
+             pathlib.Path(fitted))):
+        out = pathlib.Path(fitted).parent if args[0] == "autopilot" else same
+        assert main([*args, "--out", str(out)]) == 2
+        line = _error_line(capsys)
+        assert (f"{given} is an input of this run and holds results of jaxship's earlier "
+                f"run in --out {out}") in line and "choose another --out" in line, line
+    assert {p.name: p.read_bytes() for p in same.iterdir()} == before
 
 
 def test_identify_checks_out_before_reading_records(tmp_path, capsys):
@@ -774,3 +838,99 @@ def test_ctrl_c_while_a_worker_starts_leaves_no_worker_and_no_traceback(tmp_path
     time.sleep(0.5)
     stat = pathlib.Path(f"/proc/{child}/stat")
     assert not stat.exists() or stat.read_text().rsplit(")", 1)[1].split()[0] == "Z", child
+
+
+@pytest.mark.parametrize("signum, status, line", [(2, 130, "jaxship: interrupted."),
+                                                  (15, 143, "jaxship: terminated.")])
+def test_a_signal_during_the_imports_ends_with_its_line_and_status(signum, status, line):
+    """Issue 57, case 8: Ctrl-C in the first second, while Python imports the package
+    (jax's import takes seconds), printed a KeyboardInterrupt traceback, and SIGTERM had
+    no handler at all (exit 143, no line). The console entry (`_jaxship_cli`, outside the
+    package) handles both before those imports."""
+    import subprocess
+    import sys
+    import time
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    process = subprocess.Popen([sys.executable, "-m", "_jaxship_cli", "vessels"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               env=env, cwd=pathlib.Path(cli.__file__).parents[2])
+    time.sleep(0.3)  # the interpreter up, the package's imports under way
+    process.send_signal(signum)
+    out, err = process.communicate(timeout=60)
+    assert process.returncode == status, (process.returncode, err)
+    assert err.strip() == line and out == "", err
+
+
+TERMINATED_COMMIT = """
+import os, pathlib, sys, time
+from jaxship import cli
+from jaxship._foundation import _files
+from jaxship.cli import simulate
+
+def slow(source, target):  # each rename of the commit takes a while
+    print("rename", flush=True)
+    time.sleep(0.2)
+    os.rename(source, target)
+
+def run(args):
+    with _files.staged_folder(args.out) as stage:
+        (stage / "trial.csv").write_text("new")
+        (stage / "indices.json").write_text("new")
+        _files.os.replace = slow
+    return 0
+
+simulate.run = run
+sys.argv[1:] = ["simulate", "--vessel", "mariner", "--manoeuvre", "turn:35", "--out",
+                sys.argv[1]]
+cli.run()
+"""
+
+
+def test_sigterm_during_the_commit_ends_with_143_and_the_earlier_results_visible(tmp_path):
+    """Issue 57, case 8: SIGTERM had no handler: the process died mid-commit with exit
+    143 and no line, and the earlier results sat hidden in `.jaxship.PID.old.*` until
+    the next run recovered them. SIGTERM now ends the command as Ctrl-C does: the commit
+    undone, "jaxship: terminated.", exit 143, the earlier results where they were."""
+    import signal
+    import subprocess
+    import sys
+
+    earlier = {"trial.csv": "old", "indices.json": "old", "trial.png": "old"}
+    with staged_folder(tmp_path) as stage:
+        for name, text in earlier.items():
+            (stage / name).write_text(text)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path), JAXSHIP_CACHE_DIR="off")
+    process = subprocess.Popen([sys.executable, "-c", TERMINATED_COMMIT, str(tmp_path)],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               env=env)
+    for _ in range(3):  # the journal written, two of the earlier files moved aside
+        assert process.stdout.readline().strip() == "rename"
+    process.send_signal(signal.SIGTERM)
+    err = process.communicate(timeout=60)[1]
+    assert process.returncode == 143, (process.returncode, err)
+    assert err.rstrip().endswith("jaxship: terminated.") and "Traceback" not in err, err
+    assert {p.name: p.read_text() for p in tmp_path.iterdir() if p.name != MANIFEST} == earlier
+
+
+def test_numpy_warnings_reach_stderr_as_one_line(record, tmp_path, capsys, monkeypatch):
+    """Issue 57: a `discover` mixing a Mariner held-out record with a thesis-vessel
+    training record printed ten raw NumPy overflow warnings with source paths. Whatever
+    the numerical libraries warn of during a command is now one line, without paths,
+    saying what it likely means; the command's own outcome is unchanged."""
+    import warnings
+
+    def overflowing(*args, **kwargs):
+        for _ in range(10):
+            np.exp(np.full(3, 1000.0))  # "overflow encountered in exp", as the audit saw
+        raise ValueError("the fit stopped")
+
+    monkeypatch.setattr("jaxship.cli.identify.identify", overflowing)
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")  # Python's filters outside pytest: each warning once
+        code = main(["identify", record, "--model", "nomoto1", "--out", str(tmp_path / "o")])
+    assert code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and err[1] == "jaxship: error: the fit stopped", err
+    assert err[0].startswith("jaxship: warning: overflow encountered in exp (from the "), err
+    assert "floating-point range" in err[0] and ".py" not in err[0]

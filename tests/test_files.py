@@ -7,9 +7,12 @@ import os
 import signal
 import subprocess
 import sys
+import time
 
+import numpy as np
 import pytest
 
+import jaxship as js
 from jaxship._foundation import _files
 from jaxship._foundation._files import MANIFEST, read_manifest, staged_folder
 from jaxship.cli import main
@@ -204,3 +207,107 @@ def test_a_file_of_the_users_in_the_way_is_refused_before_the_work(tmp_path, cap
     write(tmp_path / "ours", {"report.md": "old"})
     with pytest.raises(AssertionError, match="the work started"):
         main(["discover", "any.csv", "--model", "nomoto1", "--out", str(tmp_path / "ours")])
+
+
+def test_a_file_of_the_users_among_the_figures_is_refused_before_the_work(tmp_path, capsys,
+                                                                          monkeypatch):
+    """Issue 57: a file of the user's in `figures/` under a name jaxship draws was refused
+    only at the commit, after the whole fit or discovery. Now: exit 2, one line, after
+    the records are read (the names follow them) and before the fit, the file kept;
+    other files of the user's there stay allowed
+    (`test_identify_keeps_the_users_figure_and_drops_its_own_stale_ones`)."""
+    def never(*args, **kwargs):
+        raise AssertionError("the work started")
+
+    monkeypatch.setattr("jaxship.cli.identify.identify", never)
+    monkeypatch.setattr("jaxship.cli._identification.discovery.identify", never)
+    monkeypatch.setattr("jaxship.cli.autopilot.autopilot_study.evaluate", never)
+    record = tmp_path / "zz.csv"
+    t = np.arange(200) * 0.5
+    js.write_trial_csv(record, js.Experiment(t, np.full_like(t, 0.1), name="zz",
+                                             r=0.01 * (1 - np.exp(-t / 20))))
+    result = tmp_path / "fit" / "result.json"
+    result.parent.mkdir()
+    result.write_text(json.dumps({"model": "nomoto1", "model_class": "Nomoto1", "frozen": {},
+                                  "parameters": {"K": {"value": 0.1}, "T": {"value": 20.0}}}))
+    cases = {"identify": [str(record), "--model", "nomoto1"],
+             "discover": [str(record), "--model", "nomoto1"],
+             "autopilot": ["--model", str(result), "--vessel", "thesis", "--rpm", "300"]}
+    names = {"identify": ("fit_train_00_zz.png", "correlation.png"),
+             "discover": ("residuals_00.png",), "autopilot": ("heading_300rpm.png",)}
+    for command, args in cases.items():
+        for name in names[command]:
+            out = tmp_path / command / name
+            (out / "figures").mkdir(parents=True)
+            (out / "figures" / name).write_text("mine")
+            assert main([command, *args, "--out", str(out)]) == 2
+            err = capsys.readouterr().err
+            assert f"figures/{name} exists and jaxship did not write it" in err, err
+            assert len(err.strip().splitlines()) == 1, err
+            assert files(out) == {f"figures/{name}": "mine"}
+
+
+RACING_RUN = """
+import importlib.util, os, pathlib, sys, time
+spec = importlib.util.spec_from_file_location("files", sys.argv[1])
+files = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(files)
+out, tag = pathlib.Path(sys.argv[2]), sys.argv[3]
+replace = os.replace
+
+def slow(source, target):  # a slow or network file system
+    time.sleep(0.1)
+    replace(source, target)
+
+files.os.replace = slow
+if tag == "holder":  # takes the lock and waits to be killed
+    with files.locked(out):
+        print("locked", flush=True)
+        time.sleep(60)
+with files.staged_folder(out) as stage:
+    for name in ("trial.csv", "indices.json", "trial.png", "figures/a.png"):
+        (stage / name).parent.mkdir(parents=True, exist_ok=True)
+        (stage / name).write_text(tag)
+    while not (out / "go").exists():  # both commit at once
+        time.sleep(0.01)
+"""
+
+
+def _racing(out, tag):
+    return subprocess.Popen([sys.executable, "-c", RACING_RUN, _files.__file__, str(out), tag],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def test_concurrent_runs_on_one_folder_take_turns_and_never_mix(tmp_path):
+    """Issue 57, case 6: two runs on one --out, each rename slowed (a network file
+    system), left the trial.csv of one beside the figure of the other under one
+    manifest. The commits now take turns under the folder's lock: the folder holds the
+    whole set of one run (the later), its manifest lists exactly those files, and
+    nothing of the staging is left."""
+    write(tmp_path, OLD)
+    runs = [_racing(tmp_path, tag) for tag in ("first", "second")]
+    deadline = time.monotonic() + 60
+    while len(list(tmp_path.glob(".jaxship.*.*"))) < 2 and time.monotonic() < deadline:
+        time.sleep(0.01)  # both staged
+    (tmp_path / "go").write_text("go")
+    for run in runs:
+        err = run.communicate(timeout=60)[1]
+        assert run.returncode == 0, err
+    (tmp_path / "go").unlink()
+    written = files(tmp_path)
+    assert len(set(written.values())) == 1, written
+    assert sorted(written) == sorted(read_manifest(tmp_path)) == sorted(
+        ["trial.csv", "indices.json", "trial.png", "figures/a.png"])
+    assert not list(tmp_path.glob(".jaxship.*"))
+
+
+def test_a_killed_holder_of_the_lock_leaves_it_free(tmp_path):
+    """The lock is the kernel's (`flock`): a run killed while it holds it (SIGKILL, no
+    handler runs) leaves no lock behind, and the next run commits at once."""
+    holder = _racing(tmp_path, "holder")
+    assert holder.stdout.readline().strip() == "locked"
+    holder.kill()
+    holder.communicate(timeout=60)
+    write(tmp_path, NEW)  # would wait for ever on a lock left behind
+    assert files(tmp_path) == NEW
+    assert not list(tmp_path.glob(".jaxship.*"))

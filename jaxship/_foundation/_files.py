@@ -3,9 +3,12 @@ folder of results through a temporary folder whose files are renamed in at the e
 so that an error or an interrupt never leaves half a result (POSIX `rename` is atomic
 within a file system; a journal lets the next run finish or undo the commit of a
 process killed in it), and a manifest of the files jaxship wrote into a results
-folder, so that a later run replaces those and nothing else."""
+folder, so that a later run replaces those and nothing else. Runs on one folder take
+turns at its commit (a lock that the kernel releases when its holder dies)."""
 
 import contextlib
+import errno
+import fcntl
 import json
 import os
 import pathlib
@@ -16,6 +19,7 @@ import tempfile
 
 MANIFEST = ".jaxship-manifest.json"  # the files of the last run in a results folder
 JOURNAL = ".jaxship-commit.json"  # a commit under way: its moves, to finish or undo
+LOCK = ".jaxship.lock"  # held while a run prepares its stage or commits, removed after
 _STAGE = ".jaxship."  # staging folders and temporary files: .jaxship.<pid>.<...>
 _OPEN = set()  # this process' staging folders being written
 
@@ -46,23 +50,53 @@ def staged_folder(out: pathlib.Path):
     is a `ValueError`. After an error nothing is moved, the temporary folder is removed,
     and so is `out` if it was made here and is empty. First a commit that a killed run
     left half done is finished or undone (`recover`), and staging folders of runs that
-    died (their process is gone) are removed."""
+    died (their process is gone) are removed. Both under `out`'s lock (`locked`), so
+    that the commits of concurrent runs never mix: the one that commits last wins
+    whole."""
     made = [folder for folder in (out, *out.parents) if not folder.exists()]
     out.mkdir(parents=True, exist_ok=True)
-    recover(out)
-    _remove_stale(out)
-    stage = pathlib.Path(tempfile.mkdtemp(dir=out, prefix=f"{_STAGE}{os.getpid()}."))
+    with locked(out):
+        recover(out)
+        _remove_stale(out)
+        stage = pathlib.Path(tempfile.mkdtemp(dir=out, prefix=f"{_STAGE}{os.getpid()}."))
     _OPEN.add(stage)
     try:
         yield stage
         _OPEN.discard(stage)
-        commit(stage, out)
+        with locked(out):
+            commit(stage, out)
     finally:
         _OPEN.discard(stage)
         shutil.rmtree(stage, ignore_errors=True)
         for folder in made:  # innermost first; each only while empty
             with contextlib.suppress(OSError):
                 folder.rmdir()
+
+
+@contextlib.contextmanager
+def locked(out: pathlib.Path):
+    """Hold the lock of the folder `out` (an exclusive `flock` on its `LOCK` file, waiting
+    for another process holding it); the file is removed on release. A killed holder
+    releases it with its file descriptors; a file system without locks goes unlocked."""
+    path = out / LOCK
+    while True:
+        handle = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX)
+        except BaseException as error:  # Ctrl-C while waiting, or no locks here
+            if isinstance(error, OSError) and error.errno in (errno.ENOLCK, errno.EOPNOTSUPP):
+                break
+            os.close(handle)
+            raise
+        with contextlib.suppress(FileNotFoundError):
+            if os.path.samestat(os.fstat(handle), os.stat(path)):
+                break  # else its holder removed it as we waited: lock the new one
+        os.close(handle)
+    try:
+        yield
+    finally:
+        path.unlink(missing_ok=True)  # while held: a waiter then locks a new file
+        os.close(handle)
 
 
 def discard_open_stages():
@@ -83,7 +117,7 @@ def commit(stage: pathlib.Path, out: pathlib.Path):
     (the user's) is a `ValueError` before anything moves."""
     new = sorted(p.relative_to(stage).as_posix() for p in stage.rglob("*") if p.is_file())
     old = [p for p in read_manifest(out) if (out / p).is_file()]
-    theirs = [p for p in new if (out / p).exists() and p not in old]
+    theirs = [p for p in new if os.path.lexists(out / p) and p not in old]
     if theirs:
         raise ValueError(f"{out / theirs[0]} exists and jaxship did not write it; move it or "
                          "choose another --out (jaxship replaces only its own files).")

@@ -10,6 +10,7 @@ import signal
 import sys
 import threading
 import time
+import warnings
 
 import jax
 import matplotlib
@@ -31,12 +32,15 @@ EXIT_STATUS = """exit status: 0 done; 2 bad input (arguments, records, an --out 
 written: one line on stderr, nothing written); 1 a file-system failure while writing;
 3 the fit did not converge, blew up, never moved, ended on a parameter bound, or a closed
 loop blew up (results written, the reason on stderr) or diverged (nothing written); 130
-interrupted. JAXSHIP_CACHE_DIR: where compiled programs are kept for later runs (default
+interrupted (Ctrl-C), 143 terminated (SIGTERM): earlier results left as they were.
+JAXSHIP_CACHE_DIR: where compiled programs are kept for later runs (default
 ~/.cache/jaxship/jax; "off" disables)."""
 
 COMMANDS = (vessels, simulate, reproduce, identify, autopilot, discover)
-GRACE = 5.0  # [s] after Ctrl-C, the longest the process takes to end
-_INTERRUPTED = threading.Event()  # Ctrl-C was pressed
+GRACE = 5.0  # [s] after Ctrl-C or SIGTERM, the longest the process takes to end
+ENDINGS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}  # exit 128 + signal
+_INTERRUPTED = threading.Event()  # Ctrl-C was pressed (or SIGTERM came)
+_SIGNAL = [signal.SIGINT]  # the first of them
 _RAISED = threading.Event()  # and raised as KeyboardInterrupt in the main thread
 _RETURNED = threading.Event()  # `main` has returned: the process is ending
 
@@ -84,7 +88,11 @@ def main(argv=None) -> int:
     jax.config.update("jax_enable_x64", True)
     enable_compilation_cache()  # second runs skip compilation ($JAXSHIP_CACHE_DIR moves it)
     try:
-        return args.run(args)
+        with warnings.catch_warnings(record=True) as caught:  # the filters as they are
+            try:
+                return args.run(args)
+            finally:
+                _tell(caught)
     except FitDivergedError as error:
         print(f"jaxship: error: {one_line(error)}", file=sys.stderr)
         return 3
@@ -96,38 +104,57 @@ def main(argv=None) -> int:
         print(f"jaxship: error: {where}{error.strerror or error}.", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print("jaxship: interrupted.", file=sys.stderr)
-        return 130
+        _say(_SIGNAL[0])
+        return 128 + _SIGNAL[0]
+
+
+def _tell(caught):
+    """One line on stderr for the warnings of the numerical libraries (NumPy's overflow,
+    ...) that the run met, in place of their text with source paths."""
+    messages = dict.fromkeys(one_line(w.message) for w in caught)
+    numbers = any(issubclass(w.category, RuntimeWarning) for w in caught)
+    meaning = (": values beyond the floating-point range, often from a record unlike the "
+               "others (another vessel, other units)." if numbers else ".")
+    if messages:
+        print(f"jaxship: warning: {'; '.join(messages)} (from the numerical libraries)"
+              f"{meaning}", file=sys.stderr)
 
 
 def run() -> None:
-    """The console entry point: `main`, then exit with its status. After Ctrl-C the
-    process ends with status 130 without the interpreter's teardown, which crashed
+    """The console entry point (`_jaxship_cli.run` calls it after the imports): `main`,
+    then exit with its status. After Ctrl-C (or SIGTERM, handled alike) the process
+    ends with status 130 (143) without the interpreter's teardown, which crashed
     (SIGSEGV) while XLA's threads were still running; and since an interrupt raised
     inside a garbage-collection callback is swallowed, a watchdog ends the process
     `GRACE` seconds after the signal whatever the main thread is doing. Results are
     committed whole or not at all (`staged_folder`), so ending there loses nothing."""
     _listen_for_interrupts()
-    signal.signal(signal.SIGINT, _interrupt)
+    for signum in ENDINGS:
+        signal.signal(signum, _interrupt)
     status = main()
     _RETURNED.set()
     if _INTERRUPTED.is_set():
-        _end(130)
+        _end(128 + _SIGNAL[0])
     sys.exit(status)
+
+
+def _say(signum):
+    print(f"jaxship: {ENDINGS[signum]}.", file=sys.stderr)
 
 
 def _listen_for_interrupts():
     """Start the watchdog from the byte the C-level signal handler writes (the wakeup
-    fd) as soon as SIGINT arrives: Python's own handler runs only when the main thread
-    is back in Python, which a long XLA computation can delay by many seconds."""
+    fd) as soon as SIGINT or SIGTERM arrives: Python's own handler runs only when the
+    main thread is back in Python, which a long XLA computation can delay by many
+    seconds."""
     read, write = os.pipe()
     os.set_blocking(write, False)
     signal.set_wakeup_fd(write, warn_on_full_buffer=False)
 
     def listen():
-        while signal.SIGINT not in os.read(read, 64):
+        while not (got := [s for s in os.read(read, 64) if s in ENDINGS]):
             pass
-        _watchdog()
+        _watchdog(got[0])
 
     threading.Thread(target=listen, daemon=True).start()
 
@@ -135,12 +162,14 @@ def _listen_for_interrupts():
 def _interrupt(signum, frame):
     if _RAISED.is_set():
         return  # a second Ctrl-C: the watchdog is already on its way
+    if not _INTERRUPTED.is_set():
+        _SIGNAL[0] = signum
     _INTERRUPTED.set()
     if _RETURNED.is_set():  # in the interpreter's teardown, where raising would kill
-        print("jaxship: interrupted.", file=sys.stderr)  # the process by the signal
-        _end(130)
+        _say(_SIGNAL[0])  # the process by the signal
+        _end(128 + _SIGNAL[0])
     if _swallowed(frame):  # raise it again once the main thread is out of there
-        threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGINT)).start()
+        threading.Timer(0.05, os.kill, (os.getpid(), signum)).start()
         return
     _RAISED.set()
     raise KeyboardInterrupt
@@ -158,10 +187,10 @@ def _swallowed(frame) -> bool:
     return False
 
 
-def _watchdog():
+def _watchdog(signum):
     time.sleep(GRACE)
-    print("jaxship: interrupted.", file=sys.stderr)
-    _end(130)
+    _say(signum)
+    _end(128 + signum)
 
 
 def _end(status: int):

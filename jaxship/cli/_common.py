@@ -2,6 +2,7 @@
 progress bar of a fit and notes on stderr."""
 
 import math
+import os
 import pathlib
 import sys
 import tempfile
@@ -76,12 +77,20 @@ def numbers(option, texts) -> list[float]:
     return values
 
 
-def check_out(out: pathlib.Path, writes: tuple[str, ...] = ()):
-    """`ValueError` unless `out` is (or can be made) a folder we can write into, and
-    none of the results the command always `writes` there (file names; a folder as
-    `"name/"`) is in the way as a file of the user's (not in jaxship's manifest), so
-    that the clash is told before the work, not at the commit; writes nothing that
+def check_out(out: pathlib.Path, writes: tuple[str, ...] = (), inputs=()):
+    """`ValueError` unless `out` is (or can be made) a folder we can write into (not under
+    a symbolic link that leads nowhere), none of the results the command always `writes`
+    there is in the way (`check_writes`), and none of its `inputs` (paths) is, or is
+    a folder holding, a file of jaxship's earlier run in `out`, which the commit
+    replaces or removes: told before the work, not at the commit; writes nothing that
     stays."""
+    for folder in (out, *out.parents):
+        if folder.is_symlink() and not folder.exists():
+            raise ValueError(f"--out {out}: {folder} is a symbolic link to "
+                             f"{os.readlink(folder)}, which is missing or loops; give a "
+                             "folder, or make the link's target first.")
+        if folder.exists():
+            break
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out {out} is a file, not a folder; give a folder (it is made if "
                          "need be).")
@@ -96,6 +105,20 @@ def check_out(out: pathlib.Path, writes: tuple[str, ...] = ()):
     except OSError as error:
         raise ValueError(f"--out {out}: cannot write in {parent} "
                          f"({error.strerror or error}).") from None
+    check_writes(out, writes)
+    ours = [os.path.realpath(out / p) for p in read_manifest(out)] if out.is_dir() else []
+    for path in inputs:
+        real = os.path.realpath(path)
+        if any(p == real or p.startswith(real.rstrip(os.sep) + os.sep) for p in ours):
+            raise ValueError(f"{path} is an input of this run and holds results of "
+                             f"jaxship's earlier run in --out {out}, which this run replaces; "
+                             "copy it out of that folder first or choose another --out.")
+
+
+def check_writes(out: pathlib.Path, writes: tuple[str, ...]):
+    """`ValueError` if a result the command writes into `out` (a path relative to `out`;
+    a folder as `"name/"`) is in the way as a file of the user's (not in jaxship's
+    manifest)."""
     ours = set(read_manifest(out)) if out.is_dir() else set()
     for name in writes:
         target = out / name.rstrip("/")
@@ -103,7 +126,7 @@ def check_out(out: pathlib.Path, writes: tuple[str, ...] = ()):
                                    and not target.is_dir()):
             raise ValueError(f"{target} is a file of yours where jaxship writes its {name} "
                              "folder; move it or choose another --out.")
-        if not name.endswith("/") and target.exists() and name not in ours:
+        if not name.endswith("/") and os.path.lexists(target) and name not in ours:
             raise ValueError(f"{target} exists and jaxship did not write it; move it or "
                              "choose another --out (jaxship replaces only its own files).")
 

@@ -49,8 +49,9 @@ def register(sub) -> None:
     auto.set_defaults(run=run, small_programs=lambda args: not args.tune)
 
 
-def _point_name(row, by_rpm) -> str:
-    return f"{row['rpm']:g}rpm" if by_rpm else f"{row['speed']:g}mps"
+def _figure_name(value, by_rpm) -> str:
+    """The figure of the runs at `value` rpm (`by_rpm`) or m/s."""
+    return f"heading_{value:g}{'rpm' if by_rpm else 'mps'}.png"
 
 
 def run(args) -> int:
@@ -71,7 +72,14 @@ def run(args) -> int:
     check_operating_point(vessel, args.vessel, [] if by_rpm else values,
                           values if by_rpm else [])
     model, report = read_result(args.model)
-    check_out(args.out, writes=("autopilot.json", "report.md", "figures/"))
+    fit = report.get("fit")  # none: parameters written by hand
+    code = fit.get("code") if isinstance(fit, dict) else None
+    unfit = "" if fit is None or code == "successful" else (
+        f"The model's fit is not a converged estimate (code {code} in {args.model}): the "
+        "gains and the feed-forward rest on parameters the records did not determine; "
+        "identify the model again on records that excite it (e.g. a zig-zag).")
+    check_out(args.out, inputs=[args.model], writes=("autopilot.json", "report.md", "figures/",
+              *(f"figures/{_figure_name(v, by_rpm)}" for v in values)))
     basis = ""
     if auto:  # from the model's yaw time constant at the mean operating point of the runs
         u0, n0 = autopilot_study.operating_point(
@@ -118,13 +126,13 @@ def run(args) -> int:
                 window=(design.step_time - 10.0, design.duration),
                 title=f"{report['model']} autopilot on {args.vessel} at {row['rpm']:.0f} rpm, "
                 f"{row['speed']:.3g} m/s")
-            name = f"figures/heading_{_point_name(row, by_rpm)}.png"
+            name = f"figures/{_figure_name(values[j], by_rpm)}"
             fig.savefig(stage / name, dpi=100, format="png")
             plt.close(fig)
             figures.append(name)
         result = {
             "model": {"file": str(args.model), "name": report["model"],
-                      "class": type(model).__name__,
+                      "class": type(model).__name__, "fit_code": code,
                       "parameters": {k: float(e["value"] if isinstance(e, dict) else e)
                                      for k, e in report["parameters"].items()}},
             "vessel": args.vessel,
@@ -138,7 +146,7 @@ def run(args) -> int:
             evaluation, title=f"Heading autopilot: {report['model']} on {args.vessel}",
             model_text=f"Model: {report['model']} ({type(model).__name__}) from "
             f"`{args.model}`: {parameters}.", figures=figures)
-        for sentence in (saturation, failure):  # first, under the title
+        for sentence in (saturation, failure, unfit):  # first, under the title
             if sentence:
                 title, _, rest = page.partition("\n")
                 page = f"{title}\n\n**{sentence}**\n{rest}"
@@ -149,10 +157,10 @@ def run(args) -> int:
           f"({len(figures)} figures)")
     if saturation:
         print(f"jaxship: warning: {saturation}", file=sys.stderr)
-    if failure:
-        print(f"jaxship: {failure}", file=sys.stderr)
-        return 3
-    return 0
+    for sentence in (failure, unfit):
+        if sentence:
+            print(f"jaxship: {sentence}", file=sys.stderr)
+    return 3 if failure or unfit else 0
 
 
 def gains_table(gains: dict) -> str:

@@ -34,7 +34,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    check_out(args.out, writes=("discovery.json", "report.md", "figures/"))
+    check_out(args.out, writes=("discovery.json", "report.md", "figures/"),
+              inputs=[*args.train, *(args.holdout or [])])
     say = (lambda message: None) if args.quiet else (
         lambda message: tqdm.write(f"jaxship: {message} ...", file=sys.stderr))
     report = run_discovery(args.train, args.holdout, model=args.model, out=args.out,

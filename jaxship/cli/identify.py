@@ -9,12 +9,14 @@ import sys
 from .._foundation._files import staged_folder
 from .._models._vessel.catalogue import VESSELS
 from ..plotting import save_identification_figures
+from ..plotting._fits import identification_figure_names
 from ._common import (
     VELOCITIES,
     ProgressBar,
     add_sample_interval,
     add_velocities,
     check_out,
+    check_writes,
     note,
     one_line,
 )
@@ -79,13 +81,18 @@ def run(args) -> int:
     if args.max_steps < 1:
         raise ValueError(f"--max-steps {args.max_steps}: give a positive number of optimiser "
                          "steps (default 256).")
-    check_out(args.out, writes=("result.json",) + (() if args.no_figures else ("figures/",)))
+    check_out(args.out, writes=("result.json",) + (() if args.no_figures else ("figures/",)),
+              inputs=[*args.train, *(args.validate or [])])
     over_ground = VELOCITIES.get(args.velocities)
     train = read_experiments(args.train, role="training", note=note,
                              sample_interval=args.sample_interval, over_ground=over_ground)
     held_out = None if args.validate is None else read_experiments(
         args.validate, role="validation", note=note, sample_interval=args.sample_interval,
         over_ground=over_ground)
+    if not args.no_figures:  # their names follow the records'
+        names = identification_figure_names(
+            [e.name for e in train], None if held_out is None else [e.name for e in held_out])
+        check_writes(args.out, tuple(f"figures/{name}" for name in names))
     bar = ProgressBar(not args.quiet)
     result = identify(train, model=args.model, horizon=horizon, validate=held_out,
                       rudder=args.rudder, channels=args.channels, initial=args.initial,

@@ -14,6 +14,7 @@ from ._trials import TrialSpec, simulate_to_folder
 
 # the most samples `simulate` integrates (10 million samples hold gigabytes)
 MAX_SAMPLES = 5_000_000
+LENGTHS = (1.0, 1000.0)  # [m] the lengths --length takes: a basin model to the longest ship
 
 
 def register(sub) -> None:
@@ -34,6 +35,10 @@ def run(args) -> int:
     # every check before the simulation; the files appear in --out only when all are written
     vessel = get_vessel(args.vessel)
     if positive("--length", args.length):
+        if not LENGTHS[0] <= args.length <= LENGTHS[1]:
+            raise ValueError(f"--length {args.length:g} m: give a ship or model length between "
+                             f"{LENGTHS[0]:g} and {LENGTHS[1]:g} m ({args.vessel} is "
+                             f"{float(vessel.length):.4g} m).")
         vessel = froude_scale(vessel, args.length / float(vessel.length))
     spec = TrialSpec.parse(args.manoeuvre)
     speed, rpm = positive("--speed", args.speed), positive("--rpm", args.rpm)

@@ -168,6 +168,20 @@ def _file_part(name: str) -> str:
     return keep.strip("._")[:60] or "record"
 
 
+def identification_figure_names(train_names, validation_names=None) -> list[str]:
+    """The file names `save_identification_figures` writes for training (and held-out)
+    records of these names."""
+    blocks = [("train", train_names)] + (
+        [] if validation_names is None else [("validation", validation_names)])
+    return ([_fit_figure_name(label, i, name) for label, names in blocks
+             for i, name in enumerate(names)]
+            + [f"residuals_{label}.png" for label, _ in blocks] + ["correlation.png"])
+
+
+def _fit_figure_name(label: str, i: int, name: str) -> str:
+    return f"fit_{label}_{i:02d}_{_file_part(name)}.png"
+
+
 def save_identification_figures(result, folder, *, dpi: int = 100) -> list:
     """Write the figures of a result of the `identify` command into `folder`
     and return their paths:
@@ -197,7 +211,7 @@ def save_identification_figures(result, folder, *, dpi: int = 100) -> list:
         for i, name in enumerate(block.names):
             save(plot_comparison(block, i, title=f"{model} on {label} record {name} "
                                                  "(simulation from the measured start)"),
-                 f"fit_{label}_{i:02d}_{_file_part(name)}.png")
+                 _fit_figure_name(label, i, name))
     horizon = result.train.horizon
     what = "simulation" if horizon is None else f"{horizon:g} s prediction"
     save(plot_residuals(result.train, title=f"{model}: {what} errors on the training records"),

@@ -11,6 +11,7 @@ import numpy as np
 import jaxship as js
 
 from ..._foundation._files import staged_folder
+from .._common import check_writes
 from .data import check_froude, preset_length, read_experiments
 from .registry import get_model_entry, model_key
 from .workflow import identify, logs_wind
@@ -40,6 +41,8 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
                                taken=[e.name for e in train],
                                sample_interval=sample_interval,
                                over_ground=over_ground) if holdout_paths else None
+    check_writes(pathlib.Path(out), tuple(f"figures/{_figure_name(i)}"
+                                          for i in range(len(holdout or train))))
     name, length = model_key(model), preset_length(model_key(model))
     if holdout and length is not None:  # identify checks the training records
         check_froude(holdout, length, "held-out", name)
@@ -55,6 +58,10 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
         (stage / "discovery.json").write_text(json.dumps(report.to_dict(), indent=2) + "\n")
         (stage / "report.md").write_text(text + "\n")
     return report
+
+
+def _figure_name(i: int) -> str:
+    return f"residuals_{i:02d}.png"
 
 
 def save_discovery_figures(report, train, holdout, folder: pathlib.Path) -> list[pathlib.Path]:
@@ -93,7 +100,7 @@ def save_discovery_figures(report, train, holdout, folder: pathlib.Path) -> list
         axes[0, 0].set_title(f"{name}: measured minus simulated, before and after adding "
                              f"{added}", fontsize=9)
         fig.tight_layout()
-        path = folder / f"residuals_{i:02d}.png"
+        path = folder / _figure_name(i)
         fig.savefig(path, dpi=110)
         plt.close(fig)
         paths.append(path)

@@ -1,0 +1,26 @@
+"""The `jaxship` command's entry point, outside the package so that it runs before the
+package's imports (seconds: jax's among them): Ctrl-C or SIGTERM in that time ends the
+command with its line and status (130, 143), as `jaxship.cli.run` does later, not with
+a traceback. Nothing is written before those imports end."""
+
+import os
+import signal
+import sys
+
+
+def _end(signum, frame):
+    print("jaxship: interrupted." if signum == signal.SIGINT else "jaxship: terminated.",
+          file=sys.stderr, flush=True)
+    os._exit(128 + signum)
+
+
+def run() -> None:
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, _end)
+    from jaxship.cli import run as command  # `command` installs its own handlers
+
+    command()
+
+
+if __name__ == "__main__":
+    run()
