@@ -714,6 +714,7 @@ from jaxship import cli
 def main(argv=None):  # one XLA computation of tens of seconds: Python's handler waits
     loop = jax.jit(lambda x: jax.lax.fori_loop(0, 2_000_000_000,
                                                lambda i, x: jnp.sin(x) + 1e-9, x))
+    loop = loop.lower(jnp.float32(0.0)).compile()  # compiled before "started"
     print("started", flush=True)
     loop(jnp.float32(0.0)).block_until_ready()
     return 0
@@ -739,7 +740,7 @@ def test_ctrl_c_during_a_long_xla_computation_ends_the_command_within_grace():
     process = subprocess.Popen([sys.executable, "-c", LONG_XLA_CALL], stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, env=env)
     assert process.stdout.readline().strip() == "started"
-    time.sleep(1.0)  # compiled and running
+    time.sleep(1.0)  # running
     sent = time.monotonic()
     process.send_signal(signal.SIGINT)
     err = process.communicate(timeout=60)[1]
