@@ -12,6 +12,7 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings, strategies as st
 
 import jaxship as js
+from jaxship._simulation._data import _cumulative_trapezoid
 from jaxship._simulation._readers import _PLAUSIBLE, _UNITS, _from_si, _to_si
 
 
@@ -30,7 +31,10 @@ def experiments(draw, limit=1e12, both=False):
     """An `Experiment` with strictly increasing time and arbitrary finite values in a
     random subset of the channels (psi or r among them; both with `both`, so that none is
     derived: a derivative of values near the float limit overflows); values up to `limit`,
-    and up to what any ship logs in the channels the reader checks (`_PLAUSIBLE`)."""
+    and up to what any ship logs in the channels the reader checks (`_PLAUSIBLE`). The
+    channels agree with each other as the reader checks (`_consistency`): psi turns by
+    less than half a circle a sample, by the integral of r where r is logged, and x, y run
+    the distance of u, v."""
     num = draw(st.integers(2, 25))
     t0 = draw(finite(1e6))
     steps = draw(st.lists(st.floats(1e-3, 1e3), min_size=num - 1, max_size=num - 1))
@@ -41,6 +45,19 @@ def experiments(draw, limit=1e12, both=False):
     column = lambda key: st.lists(finite(min(limit, _PLAUSIBLE.get(key, (limit,))[0])),
                                   min_size=num, max_size=num).map(np.array)
     values = {key: draw(column(key)) for key in ("delta", *sorted(chosen))}
+    if "psi" in chosen:  # from its first value, by the integral of r or by turns below pi
+        if "r" in chosen:  # r scaled down where it would turn by more than 3 rad a sample
+            most = np.max(np.abs(np.diff(_cumulative_trapezoid(values["r"], t))))
+            values["r"] = values["r"] * min(1.0, 3.0 / most) if most > 0 else values["r"]
+        turns = (_cumulative_trapezoid(values["r"], t) if "r" in chosen else
+                 np.concatenate([[0.0], np.cumsum(draw(column("turn")) % 6.0 - 3.0)[:-1]]))
+        values["psi"] = values["psi"][0] + turns
+    if {"x", "y", "u"} <= chosen:  # a straight track from the first position
+        speed = np.hypot(values["u"], values.get("v", 0.0))
+        heading = draw(st.floats(-math.pi, math.pi))
+        run = _cumulative_trapezoid(speed, t)
+        values["x"] = values["x"][0] + run * math.cos(heading)
+        values["y"] = values["y"][0] + run * math.sin(heading)
     return js.Experiment(t, name="prop", **values)
 
 

@@ -12,7 +12,7 @@ import numpy as np
 
 import jaxship as js
 from jaxship._models._vessel.mmg import GRAVITY
-from jaxship._simulation._data import OVER_GROUND
+from jaxship._simulation._data import OVER_GROUND, check_uniform
 from jaxship._simulation._measured import header_names
 from jaxship._simulation._readers import UTF16_MARKS
 
@@ -111,6 +111,13 @@ def read_experiments(paths, *, role: str = "training", note=None, taken=(),
     if isinstance(paths, (str, Path)):
         paths = [paths]
     experiments = []
+
+    def read(item):  # with the reader's note (a heading unwrapped) said
+        e = _with_velocities(js.read_measured(item), over_ground)
+        if note is not None and "note" in e.meta:
+            note(f"{item}: {e.meta['note']}")
+        return e
+
     for path in paths:
         path = Path(path)
         if path.is_dir():
@@ -129,12 +136,11 @@ def read_experiments(paths, *, role: str = "training", note=None, taken=(),
             if not found:
                 raise ValueError(f"{path}: the {role} folder holds no measurement file "
                                  "(trial CSV, Esso Osaka CSV, HSVA or MARIN .dat).")
-            experiments.extend(_with_velocities(js.read_measured(item), over_ground)
-                               for item in found)
+            experiments.extend(read(item) for item in found)
         elif not path.exists():
             raise ValueError(f"{path}: no such {role} file or folder.")
         else:
-            experiments.append(_with_velocities(js.read_measured(path), over_ground))
+            experiments.append(read(path))
     if not experiments:
         raise ValueError(f"no {role} files given.")
     names = [e.name for e in experiments] + list(taken)
@@ -232,10 +238,6 @@ def check_experiments(experiments, rudder: str, role: str, model: str = "",
                 "them or a Nomoto model.")
         if e.num_samples < 3:
             raise ValueError(f"{where}: needs at least 3 samples, has {e.num_samples}.")
-        if not e.is_uniform():
-            steps = np.diff(e.t)
-            k = int(np.argmax(np.abs(steps - e.dt))) + 1
-            raise ValueError(
-                f"{where}: column 't': sampling is not uniform (t[{k}] - t[{k - 1}] = "
-                f"{steps[k - 1]!r} s, mean interval {e.dt!r} s); resample the record first."
-            )
+        check_uniform(e.t, where, "interpolate the record onto a uniform time grid first "
+                      "(--sample-interval keeps every k-th sample: it does not make the "
+                      "intervals equal).")
