@@ -40,6 +40,19 @@ HEADING_SPAN = math.radians(5.0)  # judged when psi or the integrated r spans th
 MIN_SPEED = 0.1  # m/s: below it GNSS noise swamps the speed from the positions
 
 
+def _along_track(t, si, scale) -> float:
+    """The mean cosine, weighted by length, between the track's steps and the steps of
+    the velocity u, v turned by the heading `scale * psi` (trapezoidal): 1 when they
+    agree (0.84-1 on the measured sets: a current, GNSS noise), about 0 when the
+    heading is off by a unit."""
+    psi, u, v = scale * si["psi"], si["u"], si.get("v", 0.0)
+    step = lambda a: 0.5 * (a[1:] + a[:-1]) * np.diff(t)
+    ex, ey = step(u * np.cos(psi) - v * np.sin(psi)), step(u * np.sin(psi) + v * np.cos(psi))
+    dx, dy = np.diff(si["x"]), np.diff(si["y"])
+    weight = np.sum(np.hypot(ex, ey) * np.hypot(dx, dy))
+    return float(np.sum(ex * dx + ey * dy) / weight) if weight > 0 else 1.0
+
+
 def _resolved(values, change) -> bool:
     """Whether floats as large as `values` resolve a `change` to a thousandth."""
     return bool(change > 1e3 * np.spacing(np.max(np.abs(values))))
@@ -65,6 +78,8 @@ def check_consistency(where: str, t, si: dict, headers: dict, units: dict) -> No
       $R(t) = \\int_{t_0}^t r\\,dt$, $s$ by least squares, must give $s \\approx 1$
       (0.5-2) where the fit explains the heading (residual below half its spread) and
       the heading or $R$ spans `HEADING_SPAN`; $s < 0$ is an opposite sign convention;
+    - the heading against the track: the steps of u, v turned by psi point along the
+      track's steps (`_along_track` above 0.5);
     - positions against velocities: the track's length $\\sum|\\Delta(x, y)|$ over the
       distance run $\\int\\sqrt{u^2 + v^2}\\,dt$ within 0.1-10 (a current and GNSS
       noise change it by a fifth, a unit a thousandfold), judged from a mean speed of
@@ -73,10 +88,10 @@ def check_consistency(where: str, t, si: dict, headers: dict, units: dict) -> No
     t = np.asarray(t, dtype=np.float64)
     if t.shape[0] < 3:
         return
-    if "psi" in si and "r" in si:
+    if "psi" in si and "r" in si and _resolved(si["psi"], math.pi):
         r_int = _cumulative_trapezoid(si["r"], t)
         a, b = r_int - r_int.mean(), si["psi"] - si["psi"].mean()
-        spans = max(np.ptp(a), np.ptp(b)) >= HEADING_SPAN and _resolved(si["psi"], np.ptp(a))
+        spans = max(np.ptp(a), np.ptp(b)) >= HEADING_SPAN
         scale = float(a @ b / (a @ a)) if a @ a > 0 else math.nan
         residual = np.linalg.norm(b - scale * a) / max(np.linalg.norm(b), 1e-300)
         if spans and residual < 0.5 and not 0.5 <= scale <= 2.0:
@@ -98,6 +113,17 @@ def check_consistency(where: str, t, si: dict, headers: dict, units: dict) -> No
         judged = run >= MIN_SPEED * (t[-1] - t[0]) and _resolved(np.hypot(si["x"], si["y"]),
                                                                   run)
         ratio = path / run if judged else 1.0
+        if judged and "psi" in si and _resolved(si["psi"], math.pi):  # against the track
+            agree = {k: _along_track(t, si, k) for k in (1.0, _DEG, 1 / _DEG)}
+            best = max(agree, key=agree.get)
+            if agree[1.0] < 0.5:
+                hint = (_likely(1 / best, ("psi",), headers, units, 1.3) if agree[best] >= 0.8
+                        else "check the units of these columns.")
+                raise ValueError(
+                    f"{where}: column '{headers['psi']}' heads the velocities of columns "
+                    f"'{headers['u']}', '{headers.get('v', 'v')}' along the track of columns "
+                    f"'{headers['x']}', '{headers['y']}' only to a mean cosine of "
+                    f"{agree[1.0]:.2f} (near 1 when they agree): {hint}")
         if not 0.1 <= ratio <= 10.0:
             hint = _likely(ratio, ("t", "x", "y", "u", "v"), headers, units, 3.0)
             moved = ", ".join(f"'{headers[k]}'" for k in ("u", "v") if k in headers)
