@@ -162,11 +162,31 @@ def _resampled(experiments, interval: float, role: str, note) -> list[js.Experim
         raise ValueError(f"the sample interval must be a positive number of seconds, got "
                          f"{interval!r}.")
     factors = [max(1, round(interval / e.dt)) for e in experiments]
+    for e, k in zip(experiments, factors):
+        kept = -(-e.num_samples // k)
+        if kept < 3:
+            raise ValueError(f"--sample-interval {interval:g}: keeps {kept} sample(s) of the "
+                             f"{role} record {source(e)} ({e.duration:.4g} s sampled every "
+                             f"{e.dt:.3g} s); a fit needs at least 3: choose an interval of "
+                             f"at most {e.duration / 2:.3g} s.")
     if note is not None and any(k > 1 for k in factors):
         changes = sorted({f"{e.dt:.3g} s -> {k * e.dt:.3g} s" for e, k in
                           zip(experiments, factors) if k > 1})
         note(f"{role} records resampled to every k-th sample ({', '.join(changes)}).")
     return [e.decimate(k) if k > 1 else e for e, k in zip(experiments, factors)]
+
+
+def check_held_out(train, held_out) -> None:
+    """A `ValueError` where a validation record is a training record (the same samples):
+    its fit % would be reported as a held-out check."""
+    for e in held_out:
+        for f in train:
+            if e.channels == f.channels and e.num_samples == f.num_samples and all(
+                    np.array_equal(getattr(e, k), getattr(f, k)) for k in ("t", *e.channels)):
+                raise ValueError(f"--validate: the validation record {source(e)} holds the "
+                                 f"samples of the training record {source(f)}, so it is no "
+                                 "held-out check; validate on records not used in the fit, or "
+                                 "drop --validate.")
 
 
 def as_experiments(data, role: str) -> list[js.Experiment]:
