@@ -176,17 +176,15 @@ def _resampled(experiments, interval: float, role: str, note) -> list[js.Experim
     return [e.decimate(k) if k > 1 else e for e, k in zip(experiments, factors)]
 
 
-def check_held_out(train, held_out) -> None:
-    """A `ValueError` where a validation record is a training record (the same samples):
-    its fit % would be reported as a held-out check."""
-    for e in held_out:
-        for f in train:
-            if e.channels == f.channels and e.num_samples == f.num_samples and all(
-                    np.array_equal(getattr(e, k), getattr(f, k)) for k in ("t", *e.channels)):
-                raise ValueError(f"--validate: the validation record {source(e)} holds the "
-                                 f"samples of the training record {source(f)}, so it is no "
-                                 "held-out check; validate on records not used in the fit, or "
-                                 "drop --validate.")
+def same_records(train, held_out) -> list[str]:
+    """A sentence for each validation record that is a training record (the same
+    samples): its fit % is no held-out check."""
+    return [f"the validation record {source(e)} holds the samples of the training record "
+            f"{source(f)}: its fit % is no held-out check (--validate records not used in "
+            "the fit for one)."
+            for e in held_out for f in train
+            if e.channels == f.channels and e.num_samples == f.num_samples
+            and all(np.array_equal(getattr(e, k), getattr(f, k)) for k in ("t", *e.channels))]
 
 
 def as_experiments(data, role: str) -> list[js.Experiment]:

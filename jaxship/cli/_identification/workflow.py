@@ -30,8 +30,8 @@ from .data import (
     as_experiments,
     check_experiments,
     check_froude,
-    check_held_out,
     preset_length,
+    same_records,
     valid_samples,
 )
 from .registry import MODELS, model_key
@@ -161,14 +161,13 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     if validate is not None:
         held_out = as_experiments(validate, "validation")
         check_experiments(held_out, rudder, "validation", name, entry.requires)
-        check_held_out(train_exps, held_out)
     length = preset_length(name)
     if length is not None:
         check_froude(train_exps, length, "training", name)
         check_froude(held_out or [], length, "validation", name)
     train_ds = js.Dataset.from_experiments(train_exps)
     valid_ds = None if held_out is None else js.Dataset.from_experiments(held_out)
-    notes, caught = [], []
+    notes, caught = same_records(train_exps, held_out or []), []
     longest = max(e.duration for e in train_exps)
     if horizon is not None and horizon >= longest:
         notes.append(f"the horizon (--horizon {horizon:g} s) is not shorter than any training "
