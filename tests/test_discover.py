@@ -195,6 +195,34 @@ def test_a_held_out_prediction_that_blows_up_rejects_that_candidate(monkeypatch)
     assert not offset & set(report.named)
 
 
+def test_a_base_model_that_blows_up_on_the_held_out_records_exits_3(tmp_path, capsys,
+                                                                    monkeypatch):
+    """The base model fitted to the training records, predicting the held-out records,
+    blew up (the README's KVLCC2 discover trained on its two smallest zig-zags): that ended
+    as "bad input", exit 2, naming a channel. It is a fit that does not hold: exit 3, the
+    reason in one line, nothing written (issue 57)."""
+    from jaxship._analysis._discover import _workflow
+    from jaxship._foundation._validate import NonFiniteError
+
+    def blowing_up(*args, **kwargs):
+        raise NonFiniteError("channel 'psi': non-finite values at 277 valid samples.")
+
+    assert main(["simulate", "--vessel", "mariner", "--manoeuvre", "zigzag:20/20",
+                 "--duration", "200", "--dt", "1", "--out", str(tmp_path / "zz")]) == 0
+    monkeypatch.setattr(_workflow, "holdout_check", blowing_up)
+    capsys.readouterr()
+    record = str(tmp_path / "zz" / "trial.csv")
+    assert main(["discover", record, "--holdout", record, "--model", "nomoto1", "--out",
+                 str(tmp_path / "d"), "--quiet"]) == 3
+    err = capsys.readouterr().err
+    assert "blows up on the held-out records" in err and "non-finite values" in err, err
+    assert len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "d").exists()
+    with pytest.raises(js.FitError, match="train on records that cover them"):
+        js.discover(js.Nomoto1(K=0.05, T=20.0), js.read_trial_csv(record),
+                    js.read_trial_csv(record))
+
+
 def test_the_held_out_rise_and_its_standard_error_over_stretches():
     rng = np.random.default_rng(0)
     t = np.tile(np.arange(0.0, 150.0, 0.5), (2, 1))

@@ -15,11 +15,10 @@ import warnings
 import jax
 import matplotlib
 
-from .. import __version__
-
 
 matplotlib.use("Agg")  # the command writes files; it never opens a window
 
+from .. import FitError, __version__  # noqa: E402
 from .._foundation._cache import enable_compilation_cache  # noqa: E402
 from .._foundation._files import discard_open_stages  # noqa: E402
 from . import autopilot, discover, identify, reproduce, simulate, vessels  # noqa: E402
@@ -93,7 +92,7 @@ def main(argv=None) -> int:
                 return args.run(args)
             finally:
                 _tell(caught)
-    except FitDivergedError as error:
+    except (FitDivergedError, FitError) as error:
         print(f"jaxship: error: {one_line(error)}", file=sys.stderr)
         return 3
     except ValueError as error:

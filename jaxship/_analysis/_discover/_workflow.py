@@ -44,6 +44,7 @@ import scipy  # scipy.stats loads on first use (an import-time saving)
 from ..._estimate._fit import PredictionError, fit
 from ..._estimate._initial import EstimatedStarts, MeasuredStates
 from ..._estimate._lm import RESULTS, LevenbergMarquardt
+from ..._estimate._result import FitError
 from ..._estimate._sensitivity import sensitivities
 from ..._estimate._windows import as_dataset
 from ..._foundation._contract import AbstractComposite
@@ -239,7 +240,13 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
     rank = {c.id: i for i, c in enumerate(catalogue)} | {e.id: -1 for e in _split(model)[1]}
     ordered = lambda effects: tuple(sorted(effects, key=lambda e: rank[e.id]))
     effect_names = {}  # {id: its fitted parameters} of the effects added
-    before = held = check(base_fit.model) if holdout else None
+    try:
+        before = held = check(base_fit.model) if holdout else None
+    except NonFiniteError as error:  # no bad input: the training records do not hold
+        raise FitError(
+            f"the base model fitted to the training records (fit: {base_fit.message}) blows "
+            f"up on the held-out records ({error}): they do not determine it for those "
+            "manoeuvres; train on records that cover them.") from None
     accepted, rejected, first_scores = [], [], None
     for iteration in range(max_effects):
         if len(accepted) >= max_effects:
