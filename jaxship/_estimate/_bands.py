@@ -246,7 +246,8 @@ def normal_draws(values, std, correlation, num_samples: int, rng) -> np.ndarray:
     values, std = np.asarray(values, np.float64), np.asarray(std, np.float64)
     corr = np.eye(values.size) if correlation is None else np.asarray(correlation, np.float64)
     cov = corr * np.outer(std, std)
-    return rng.multivariate_normal(values, cov, size=num_samples, method="eigh")
+    return rng.multivariate_normal(values, cov, size=num_samples, method="eigh",
+                                   check_valid="ignore")  # rounding: slightly negative
 
 
 def prediction_bands(result, dataset, *, level: float = 0.9,

@@ -26,6 +26,7 @@ from ._trials import (
 DRAWS = 64  # parameter draws of the band
 LEVEL = 0.9  # the band: the central 90 % of the draws' values
 SEED = 0
+SIMULATOR = js.Simulator(substeps=2)  # as `run_spec`'s
 
 
 def imo_specs(vessel) -> tuple[TrialSpec, ...]:
@@ -133,12 +134,18 @@ def _drawn_criteria(vessel, names, draws, runs, *, speed, rpm):
     """`({criterion: (values, met or not)}, how many)` of the draws that ran every trial:
     each trial of `runs` simulated at once for every parameter draw (`simulate_batch`)."""
     vessels = [rebuild(vessel, names, row) for row in draws]
-    x0 = js.stack([initial_state(v, speed=speed, rpm=rpm) for v in vessels])
-    batch = js.stack(vessels)
-    found, ran = {}, np.ones(len(vessels), bool)
+    nominal = initial_state(vessel, speed=speed, rpm=rpm)
+    starts, ran = [], np.ones(len(vessels), bool)
+    for k, v in enumerate(vessels):  # a draw with no straight run is left out
+        try:
+            starts.append(initial_state(v, speed=speed, rpm=rpm))
+        except ValueError:
+            starts.append(nominal)
+            ran[k] = False
+    x0, batch, found = js.stack(starts), js.stack(vessels), {}
     for spec, (manoeuvre, _, _) in runs.items():
         trajs = jax.tree.map(np.asarray, js.simulate_batch(
-            batch, manoeuvre, x0, in_axes=(0, None, 0, None)))
+            batch, manoeuvre, x0, in_axes=(0, None, 0, None), simulator=SIMULATOR))
         for k, v in enumerate(vessels):
             traj = jax.tree.map(lambda a, k=k: a[k], trajs)
             marks = _trial_marks(spec, manoeuvre, traj) if traj.success else None

@@ -283,7 +283,7 @@ def run_spec(vessel, spec, *, speed=None, rpm=None, duration=None, dt=None, subs
     spec = TrialSpec.parse(spec) if isinstance(spec, str) else spec
     x0 = initial_state(vessel, speed=speed, rpm=rpm)
     manoeuvre = build_manoeuvre(spec, vessel, x0, duration=duration, dt=dt)
-    simulator = Simulator(substeps=substeps)
+    simulator = Simulator(substeps=substeps)  # `_imo.SIMULATOR` too
     traj = simulate(vessel, manoeuvre, x0, simulator=simulator)
     if spec.kind == "stop" and duration is None and bool(traj.success):
         traj = _cut_at_stop(traj)

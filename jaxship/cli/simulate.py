@@ -123,6 +123,10 @@ def run_imo(args, chosen, vessel, *, speed, rpm) -> int:
     print(check.table())
     print(f"band: {check.draws['from']} ({check.draws['used']} of {check.draws['draws']} "
           "draws ran)")
+    if check.draws["draws"] and not check.draws["used"]:
+        note("no parameter draw ran every trial: the standard errors reach values where the "
+             "model has no straight run or blows up (see the result's identifiability flags); "
+             "no band.")
     print(f"wrote {args.out}/criteria.md, {args.out}/indices.json, {args.out}/imo_criteria.png, "
           + ", ".join(f"{args.out}/{f}" for f in figures))
     return 0
