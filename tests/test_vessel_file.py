@@ -158,3 +158,43 @@ def test_imo_band_from_the_standard_errors_of_a_result(tmp_path, capsys):
         low, high = row["band"]  # n_r moves the turn; the stop hardly
         assert low <= row["value"] * 1.01 and high >= row["value"] * 0.99
         assert low < high or row["criterion"].startswith("stopping")
+
+
+def test_a_result_of_ones_own_vessel_rebuilds_it_with_effects():
+    """`result.json` keeps the vessel (`vessel`) and its effects (`effects`): a vessel of
+    a file comes back with its fitted values, effect parameters included."""
+    from jaxship._models._vessel.file import vessel_to_dict
+    from jaxship._foundation._validate import _to_plain
+    from jaxship.cli._identification import model_from_report
+
+    vessel = js.vessel("kvlcc2")
+    report = {"model": "vessel", "parameters": {
+        "n_r": {"value": 0.01, "std": 0.001}, "rudder_offset.offset": {"value": 0.02}},
+        "vessel": _to_plain(vessel_to_dict(vessel)), "effects": ["RudderOffset"]}
+    model = model_from_report(report)
+    assert isinstance(model, js.AugmentedVessel)
+    assert model.base.n_r == 0.01 and model.effects[0].offset == 0.02
+    assert model.base.shaft.max_rate == math.inf
+
+
+def test_identify_starts_from_a_result_and_autopilot_needs_a_vessel(tmp_path, capsys):
+    model = js.Nomoto1(K=0.05, T=10.0)
+    zigzag = js.simulate(model, js.ZigZag(math.radians(10), math.radians(10),
+                                          duration=200.0, dt=1.0))
+    record = tmp_path / "zigzag.csv"
+    js.write_trial_csv(record, js.Experiment.from_trajectory(zigzag))
+    fit = ["identify", str(record), "--no-figures", "--quiet"]
+    assert main([*fit, "--model", "nomoto1", "--out", str(tmp_path / "a")]) == 0
+    assert main([*fit, "--vessel", str(tmp_path / "a" / "result.json"),
+                 "--out", str(tmp_path / "b")]) == 0
+    again = json.loads((tmp_path / "b" / "result.json").read_text())
+    assert again["model"] == "nomoto1" and "--vessel" in again["start"]["method"]
+    assert again["parameters"]["K"]["value"] == pytest.approx(0.05, rel=1e-3)
+    capsys.readouterr()
+    assert main([*fit, "--model", "nomoto1", "--vessel", "thesis", "--out",
+                 str(tmp_path / "c")]) == 2
+    assert "one of them" in capsys.readouterr().err
+    assert main(["autopilot", "--model", str(tmp_path / "a" / "result.json"), "--vessel",
+                 str(tmp_path / "a" / "result.json"), "--rpm", "300", "--out",
+                 str(tmp_path / "d")]) == 2
+    assert "this needs a vessel" in capsys.readouterr().err
