@@ -9,8 +9,10 @@ import numpy as np
 import pytest
 
 import jaxship as js
+from jaxship._foundation._validate import _to_plain
+from jaxship._models._vessel.file import vessel_text, vessel_to_dict
 from jaxship.cli import main
-from jaxship.cli._identification import read_result
+from jaxship.cli._identification import model_from_report, read_result
 
 
 @pytest.mark.parametrize("name", list(js.VESSELS))
@@ -67,7 +69,7 @@ BAD = [
 
 @pytest.mark.parametrize("old, new, message", BAD, ids=[b[2] for b in BAD])
 def test_a_bad_vessel_file_is_one_line_and_exit_2(old, new, message, tmp_path, capsys):
-    text = js._models._vessel.file.vessel_text(js.vessel("esso_osaka"))
+    text = vessel_text(js.vessel("esso_osaka"))
     assert old in text
     path = tmp_path / "bad.toml"
     path.write_text(text.replace(old, new, 1))
@@ -81,7 +83,7 @@ def test_a_bad_vessel_file_is_one_line_and_exit_2(old, new, message, tmp_path, c
 
 
 def test_degrees_and_rpm_are_read_in_a_file(tmp_path):
-    text = js._models._vessel.file.vessel_text(js.vessel("esso_osaka"))
+    text = vessel_text(js.vessel("esso_osaka"))
     text = text.replace('max_angle = { value = 0.6108652381980153, unit = "rad" }',
                         'max_angle = { value = 35, unit = "deg" }')
     text = text.replace('nominal_n = { value = 10.0, unit = "rev/s" }',
@@ -163,17 +165,13 @@ def test_imo_band_from_the_standard_errors_of_a_result(tmp_path, capsys):
 def test_a_result_of_ones_own_vessel_rebuilds_it_with_effects():
     """`result.json` keeps the vessel (`vessel`) and its effects (`effects`): a vessel of
     a file comes back with its fitted values, effect parameters included."""
-    from jaxship._models._vessel.file import vessel_to_dict
-    from jaxship._foundation._validate import _to_plain
-    from jaxship.cli._identification import model_from_report
-
     vessel = js.vessel("kvlcc2")
     report = {"model": "vessel", "parameters": {
-        "n_r": {"value": 0.01, "std": 0.001}, "rudder_offset.offset": {"value": 0.02}},
+        "n_r": {"value": 0.01, "std": 0.001}, "rudder_offset.delta0": {"value": 0.02}},
         "vessel": _to_plain(vessel_to_dict(vessel)), "effects": ["RudderOffset"]}
     model = model_from_report(report)
     assert isinstance(model, js.AugmentedVessel)
-    assert model.base.n_r == 0.01 and model.effects[0].offset == 0.02
+    assert model.base.n_r == 0.01 and model.effects[0].delta0 == 0.02
     assert model.base.shaft.max_rate == math.inf
 
 
@@ -189,7 +187,7 @@ def test_identify_starts_from_a_result_and_autopilot_needs_a_vessel(tmp_path, ca
                  "--out", str(tmp_path / "b")]) == 0
     again = json.loads((tmp_path / "b" / "result.json").read_text())
     assert again["model"] == "nomoto1" and "--vessel" in again["start"]["method"]
-    assert again["parameters"]["K"]["value"] == pytest.approx(0.05, rel=1e-3)
+    assert again["parameters"]["K"]["value"] == pytest.approx(0.05, rel=2e-2)
     capsys.readouterr()
     assert main([*fit, "--model", "nomoto1", "--vessel", "thesis", "--out",
                  str(tmp_path / "c")]) == 2
