@@ -3,6 +3,7 @@ bad input on every command is one line and a non-zero exit before any long work,
 are written whole or not at all, fits that do not converge say so and exit with 3."""
 
 import json
+import math
 import os
 import pathlib
 
@@ -716,6 +717,7 @@ from jaxship import cli
 def main(argv=None):  # one XLA computation of tens of seconds: Python's handler waits
     loop = jax.jit(lambda x: jax.lax.fori_loop(0, 2_000_000_000,
                                                lambda i, x: jnp.sin(x) + 1e-9, x))
+    loop = loop.lower(jnp.float32(0.0)).compile()  # compiled before "started"
     print("started", flush=True)
     loop(jnp.float32(0.0)).block_until_ready()
     return 0
@@ -741,7 +743,7 @@ def test_ctrl_c_during_a_long_xla_computation_ends_the_command_within_grace():
     process = subprocess.Popen([sys.executable, "-c", LONG_XLA_CALL], stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, env=env)
     assert process.stdout.readline().strip() == "started"
-    time.sleep(1.0)  # compiled and running
+    time.sleep(1.0)  # running
     sent = time.monotonic()
     process.send_signal(signal.SIGINT)
     err = process.communicate(timeout=60)[1]
@@ -936,3 +938,137 @@ def test_numpy_warnings_reach_stderr_as_one_line(record, tmp_path, capsys, monke
     assert len(err) == 2 and err[1] == "jaxship: error: the fit stopped", err
     assert err[0].startswith("jaxship: warning: overflow encountered in exp (from the "), err
     assert "floating-point range" in err[0] and ".py" not in err[0]
+
+
+# -- issue 57 (part A): records checked against themselves, float types, messages that say
+# which option or column and what to do
+
+
+def _rewritten(source, path, change, drop=()):
+    """The trial CSV `source` written to `path` with `change({header: values})` applied
+    and the columns `drop` left out."""
+    headers = pathlib.Path(source).read_text().splitlines()[0].split(",")
+    columns = dict(zip(headers, np.loadtxt(source, delimiter=",", skiprows=1).T))
+    for header in drop:
+        del columns[header]
+    change(columns)
+    rows = "".join(",".join(repr(float(v)) for v in row) + "\n" for row in zip(*columns.values()))
+    pathlib.Path(path).write_text(",".join(columns) + "\n" + rows)
+    return str(path)
+
+
+def _scaled(header, factor):
+    return lambda columns: columns.__setitem__(header, columns[header] * factor)
+
+
+@pytest.mark.parametrize("header, factor, likely", [
+    ("psi [deg]", math.pi / 180, "in rad rather than deg"),  # radians labelled deg
+    ("r [deg/s]", math.pi / 180, "in rad/s rather than deg/s"),  # rad/s labelled deg/s
+    ("t [s]", 1000.0, "in ms rather than s"),
+])
+def test_a_column_in_another_unit_is_refused_naming_it(record, tmp_path, capsys, header,
+                                                       factor, likely):
+    """A heading in radians labelled deg (before: psi fit 1.8 %, exit 0), time stamps in
+    ms labelled s (before: T = 1820 s, exit 0): refused in one line naming the column and
+    the unit it likely holds, nothing written."""
+    bad = _rewritten(record, tmp_path / "bad.csv", _scaled(header, factor))
+    assert main(["identify", bad, "--model", "nomoto1", "--out", str(tmp_path / "out")]) == 2
+    line = _error_line(capsys)
+    assert f"column '{header}'" in line and likely in line, line
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_wrapped_heading_is_unwrapped_with_a_note(record, tmp_path, capsys):
+    """A heading wrapped at +-180 deg without an r column: before, K came out many times
+    too small (r differenced across the 360 deg jumps); now unwrapped, said in a note,
+    and K as from the unwrapped record (Nomoto1 K = 0.06)."""
+    def wrap(columns):
+        columns["psi [deg]"] = (columns["psi [deg]"] + 170.0 + 180.0) % 360.0 - 180.0
+    bad = _rewritten(record, tmp_path / "wrapped.csv", wrap, drop=("r [deg/s]",))
+    assert np.any(np.abs(np.diff(np.loadtxt(bad, delimiter=",", skiprows=1)[:, 2])) > 300)
+    out = tmp_path / "out"
+    assert main(["identify", bad, "--model", "nomoto1", "--no-figures", "--quiet", "--out",
+                 str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "column 'psi [deg]' wraps around" in err and "unwrapped" in err, err
+    K = json.loads((out / "result.json").read_text())["parameters"]["K"]["value"]
+    assert K == pytest.approx(0.06, rel=0.05)
+
+
+def test_a_record_too_short_to_determine_the_model_ends_with_its_code(record, tmp_path,
+                                                                       capsys):
+    """Three rows: before, exit 0 "successful" with correlation(K, T) = +1; now the code
+    poorly_determined (exit 3) and a flag saying the record is too short."""
+    short = tmp_path / "short.csv"
+    short.write_text("".join(pathlib.Path(record).read_text().splitlines(True)[:4]))
+    out = tmp_path / "out"
+    assert main(["identify", str(short), "--model", "nomoto1", "--no-figures", "--quiet",
+                 "--out", str(out)]) == 3
+    err = capsys.readouterr().err
+    assert "too few to determine the parameters" in err and "longer record" in err, err
+    assert json.loads((out / "result.json").read_text())["fit"]["code"] == "poorly_determined"
+
+
+def test_uniform_epoch_time_stamps_are_uniform(record, tmp_path, capsys):
+    """10 Hz stamps of 1.7e9 s (Unix time): before, refused as "not uniform" (a relative
+    tolerance below the float spacing); now fitted."""
+    def at_10_hz(columns):  # the record five times faster, sampled every 0.1 s
+        columns["t [s]"] = 1.7e9 + columns["t [s]"] / 5
+        columns["r [deg/s]"] = columns["r [deg/s]"] * 5
+
+    epoch = _rewritten(record, tmp_path / "epoch.csv", at_10_hz)
+    assert main(["identify", epoch, "--model", "nomoto1", "--no-figures", "--quiet", "--out",
+                 str(tmp_path / "out")]) == 0
+
+
+def test_jittered_time_stamps_say_what_to_do(record, tmp_path, capsys):
+    """Before: `np.float64(0.1039...)` and "resample the record first", which
+    --sample-interval cannot do; now plain numbers and what to do instead."""
+    jitter = np.random.default_rng(1).uniform(-0.05, 0.05, 400)
+    bad = _rewritten(record, tmp_path / "jitter.csv", lambda c: c.__setitem__(
+        "t [s]", c["t [s]"] + jitter))
+    assert main(["identify", bad, "--model", "nomoto1", "--out", str(tmp_path / "out")]) == 2
+    line = _error_line(capsys)
+    assert "sampling is not uniform" in line and "np.float64" not in line, line
+    assert "interpolate the record onto a uniform time grid" in line, line
+    assert "--sample-interval keeps every k-th sample" in line, line
+
+
+def test_armax_on_a_straight_run_names_the_rudder(record, tmp_path, capsys):
+    """Before: "the input `u` is constant", `u` being the surge-speed column."""
+    straight = _rewritten(record, tmp_path / "straight.csv", lambda c: [
+        c.__setitem__(k, c[k] * 0) for k in ("delta [deg]", "psi [deg]", "r [deg/s]")])
+    main(["identify", straight, "--model", "armax", "--no-figures", "--quiet", "--out",
+          str(tmp_path / "out")])
+    captured = capsys.readouterr()
+    text = captured.out + captured.err
+    assert "rudder input is constant" in text and "`u`" not in text, text
+
+
+def test_a_sample_interval_beyond_the_record_names_the_option(record, tmp_path, capsys):
+    """Before: an error that did not name --sample-interval."""
+    assert main(["identify", record, "--model", "nomoto1", "--sample-interval", "1000",
+                 "--out", str(tmp_path / "out")]) == 2
+    line = _error_line(capsys)
+    assert "--sample-interval 1000" in line and "choose an interval of at most" in line, line
+
+
+def test_a_horizon_beyond_the_records_is_said(record, tmp_path, capsys):
+    """Before: --horizon 10000 on a 200 s record accepted with no note."""
+    assert main(["identify", record, "--model", "nomoto1", "--horizon", "10000", "--no-figures",
+                 "--quiet", "--out", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert "--horizon 10000 s) is not shorter than any training record" in out, out
+    assert "output error" in out
+
+
+def test_validating_on_the_training_record_is_said(record, tmp_path, capsys):
+    """Before: reported as a held-out check, with nothing said."""
+    copy = tmp_path / "copy.csv"
+    copy.write_text(pathlib.Path(record).read_text())
+    out = tmp_path / "out"
+    assert main(["identify", record, "--model", "nomoto1", "--validate", str(copy),
+                 "--no-figures", "--quiet", "--out", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert f"the validation record {copy} holds the samples of the training record" in said
+    assert "no held-out check" in json.loads((out / "result.json").read_text())["notes"][0]

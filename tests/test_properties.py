@@ -12,6 +12,7 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings, strategies as st
 
 import jaxship as js
+from jaxship._simulation._data import _cumulative_trapezoid
 from jaxship._simulation._readers import _PLAUSIBLE, _UNITS, _from_si, _to_si
 
 
@@ -30,7 +31,10 @@ def experiments(draw, limit=1e12, both=False):
     """An `Experiment` with strictly increasing time and arbitrary finite values in a
     random subset of the channels (psi or r among them; both with `both`, so that none is
     derived: a derivative of values near the float limit overflows); values up to `limit`,
-    and up to what any ship logs in the channels the reader checks (`_PLAUSIBLE`)."""
+    and up to what any ship logs in the channels the reader checks (`_PLAUSIBLE`). The
+    channels agree with each other as the reader checks (`_consistency`): psi turns by
+    at most 1 rad a sample, by the integral of r where r is logged, and x, y run the
+    track of u, v (u ahead, |v| below u/5) turned by psi (or along a line)."""
     num = draw(st.integers(2, 25))
     t0 = draw(finite(1e6))
     steps = draw(st.lists(st.floats(1e-3, 1e3), min_size=num - 1, max_size=num - 1))
@@ -41,6 +45,21 @@ def experiments(draw, limit=1e12, both=False):
     column = lambda key: st.lists(finite(min(limit, _PLAUSIBLE.get(key, (limit,))[0])),
                                   min_size=num, max_size=num).map(np.array)
     values = {key: draw(column(key)) for key in ("delta", *sorted(chosen))}
+    if "psi" in chosen:  # from its first value, by the integral of r or by turns of 1 rad
+        if "r" in chosen:  # r scaled down where it would turn by more than 1 rad a sample
+            most = np.max(np.abs(np.diff(_cumulative_trapezoid(values["r"], t))))
+            values["r"] = values["r"] * min(1.0, 1.0 / most) if most > 0 else values["r"]
+        turns = (_cumulative_trapezoid(values["r"], t) if "r" in chosen else
+                 np.concatenate([[0.0], np.cumsum(draw(column("turn")) % 2.0 - 1.0)[:-1]]))
+        values["psi"] = values["psi"][0] + turns
+    if {"x", "y", "u"} <= chosen:  # the track of u, v turned by psi, from the first position
+        values["u"] = np.abs(values["u"])
+        if "v" in chosen:
+            values["v"] = 0.2 * values["u"] * np.sin(values["v"])
+        psi = values.get("psi", draw(st.floats(-math.pi, math.pi)))
+        u, v = values["u"], values.get("v", 0.0)
+        values["x"] = values["x"][0] + _cumulative_trapezoid(u * np.cos(psi) - v * np.sin(psi), t)
+        values["y"] = values["y"][0] + _cumulative_trapezoid(u * np.sin(psi) + v * np.cos(psi), t)
     return js.Experiment(t, name="prop", **values)
 
 
@@ -251,3 +270,107 @@ def test_any_bytes_give_a_record_or_one_line_error(tmp_path_factory, case):
         assert "\n" not in str(error) and str(path) in str(error), str(error)
     else:
         assert experiment.num_samples >= 1 and np.all(np.isfinite(experiment.t))
+
+
+@st.composite
+def ship_records(draw):
+    """A trial a ship could log (issue 57): a heading turned by a yaw rate of a few
+    sinusoids (spanning at least 10 deg), u, v of 0.5-10 m/s and the track they run;
+    r, and x, y with u, v, each logged or not (at least one of them)."""
+    num = draw(st.integers(30, 300))
+    dt = draw(st.sampled_from([0.05, 0.1, 0.2, 0.5, 1.0]))
+    t = draw(st.floats(0.0, 1e4)) + dt * np.arange(num)
+    s = t - t[0]
+    amplitude = math.radians(draw(st.floats(0.5, 5.0)))  # deg/s
+    period = draw(st.floats(10.0, 200.0))
+    r = amplitude * np.sin(2 * math.pi * s / period + draw(st.floats(0, 6)))
+    r += math.radians(10.0) / s[-1] * draw(st.sampled_from([-1.0, 1.0]))  # a turn of 10 deg
+    psi = draw(st.floats(-10.0, 10.0)) + _cumulative_trapezoid(r, t)
+    u = draw(st.floats(0.5, 10.0)) * (1 + 0.1 * np.cos(2 * math.pi * s / period))
+    v = -0.05 * u * np.sin(2 * math.pi * s / period)
+    x = _cumulative_trapezoid(u * np.cos(psi) - v * np.sin(psi), t)
+    y = _cumulative_trapezoid(u * np.sin(psi) + v * np.cos(psi), t)
+    values = dict(psi=psi, u=u, v=v)
+    logged = draw(st.sampled_from([("r",), ("x", "y"), ("r", "x", "y")]))
+    values.update({k: {"r": r, "x": x, "y": y}[k] for k in logged})
+    delta = np.deg2rad(10.0) * np.sign(np.sin(2 * math.pi * s / period))
+    return js.Experiment(t, delta, name="ship", **values)
+
+
+def rewritten(path, change):
+    """The trial CSV at `path` with `change(columns)` applied to its {header: values}."""
+    lines = path.read_text().splitlines()
+    headers = lines[0].split(",")
+    columns = dict(zip(headers, np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2).T))
+    change(columns)
+    rows = zip(*columns.values())
+    path.write_text(",".join(columns) + "\n"
+                    + "".join(",".join(repr(float(v)) for v in row) + "\n" for row in rows))
+
+
+def relabel(columns, old, new, factor=1.0):
+    columns[new] = columns.pop(old) * factor
+
+
+# a column written in another unit than its label: (units written, the change, the label
+# of the column named, the unit it likely holds); r in deg/s labelled rad/s is left to
+# the yaw-rate bound (`_PLAUSIBLE`) when beyond it
+CORRUPTIONS = {
+    "psi in deg labelled rad": ("si", lambda c: relabel(c, "psi [rad]", "psi [rad]",
+                                                        180 / math.pi), "psi [rad]", "deg"),
+    "psi in rad labelled deg": ("display", lambda c: relabel(c, "psi [deg]", "psi [deg]",
+                                                             math.pi / 180), "psi [deg]", "rad"),
+    "r in rad/s labelled deg/s": ("display", lambda c: relabel(c, "r [deg/s]", "r [deg/s]",
+                                                               math.pi / 180), "r [deg/s]",
+                                  "rad/s"),
+    "t in ms labelled s": ("display", lambda c: relabel(c, "t [s]", "t [s]", 1000.0), "t [s]",
+                           "ms"),
+}
+
+
+# without r: a heading in rad labelled deg barely turns, which the track cannot tell from
+# a ship that held its course
+NEED_R = ("r in rad/s labelled deg/s", "psi in rad labelled deg")
+
+
+@SETTINGS
+@given(ship_records(), st.sampled_from(sorted(CORRUPTIONS)))
+def test_columns_that_disagree_by_a_unit_are_refused_naming_the_column(tmp_path_factory,
+                                                                       experiment, case):
+    """Cross-channel inconsistencies (issue 57): a record that agrees with itself reads;
+    a heading, yaw rate or time column scaled by a unit error (57.3 or 1000) is refused,
+    naming the column and the unit it likely holds."""
+    units, change, header, likely = CORRUPTIONS[case]
+    path = tmp_path_factory.mktemp("units") / "trial.csv"
+    js.write_trial_csv(path, experiment, units=units)
+    js.read_trial_csv(path)  # the record as logged agrees with itself
+    if case in NEED_R and not experiment.has("r"):
+        return
+    rewritten(path, change)
+    with pytest.raises(ValueError) as error:
+        js.read_trial_csv(path)
+    message = str(error.value)
+    assert "\n" not in message and f"'{header}'" in message, message
+    assert f"in {likely} rather than" in message or "is beyond" in message, message
+
+
+@SETTINGS
+@given(ship_records(), st.sampled_from(["+-180", "0-360"]))
+def test_a_wrapped_heading_is_unwrapped_with_a_note(tmp_path_factory, experiment, wrap):
+    """A heading logged wrapped (at +-180 deg or in 0-360 deg, from any start) reads as
+    the unwrapped heading, to a whole number of turns, with a note naming the column."""
+    path = tmp_path_factory.mktemp("wrap") / "trial.csv"
+    js.write_trial_csv(path, experiment)
+    low = -180.0 if wrap == "+-180" else 0.0
+
+    def wrapped(columns):
+        columns["psi [deg]"] = (columns["psi [deg]"] - low) % 360.0 + low
+
+    rewritten(path, wrapped)
+    back = js.read_trial_csv(path)
+    turns = (back.psi - experiment.psi) / (2 * math.pi)
+    np.testing.assert_allclose(turns, np.round(turns[0]), atol=1e-9)
+    jumps = np.abs(np.diff(np.deg2rad(np.loadtxt(path, delimiter=",", skiprows=1)[:, 2])))
+    assert ("note" in back.meta) == bool(np.any(jumps > math.pi))
+    if "note" in back.meta:
+        assert "'psi [deg]'" in back.meta["note"] and "unwrapped" in back.meta["note"]

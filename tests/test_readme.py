@@ -77,6 +77,23 @@ def test_the_example_runs_as_written(tmp_path):
     assert ": successful," in done.stdout, done.stdout
 
 
+def test_the_example_runs_in_float32(tmp_path):
+    """The example without its `jax_enable_x64` line (JAX's default float32): before,
+    `fit` refused jaxship's own simulation as "sampling is not uniform" (a tolerance below
+    float32's spacing of the time stamps); now it converges (issue 57)."""
+    code = block("python", after="## Example")
+    lines = [line for line in code.splitlines() if "jax_enable_x64" not in line]
+    assert len(lines) == len(code.splitlines()) - 1
+    env = os.environ | {"PYTHONPATH": os.pathsep.join(
+        [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])}
+    env.pop("JAX_ENABLE_X64", None)
+    done = subprocess.run([sys.executable, "-c", "\n".join(lines)], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert "Nomoto1 fitted to 1 experiment(s)" in done.stdout, done.stdout
+    assert ": successful," in done.stdout, done.stdout
+
+
 def test_the_table_has_every_command():
     names = {command for command, _ in table_rows()}  # a command may have more rows
     assert names == {m.__name__.rsplit(".", 1)[1] for m in cli.COMMANDS}

@@ -125,7 +125,8 @@ def _check(y, u, na, nb, nc, nk):
     if y.size < 5 * (na + nb + nc) + n0 + 10:
         raise ValueError(f"{y.size} samples are too few for {na + nb + nc} parameters.")
     if np.ptp(u) == 0:
-        raise ValueError("the input `u` is constant: it does not excite B.")
+        raise ValueError(f"the rudder input is constant ({u[0]:.4g} rad throughout): it does "
+                         "not excite B; use a record whose rudder moves (a zig-zag or PRBS).")
     return y, u, n0
 
 

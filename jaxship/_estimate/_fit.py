@@ -564,6 +564,11 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
     covariance = full[:d, :d]
     null = [v[:d] / np.linalg.norm(v[:d]) for v in null if np.linalg.norm(v[:d]) > 1e-3]
     flags, no_excitation = excitation_flags(ds, estimator.rudder)
+    if rows.size <= columns.shape[0]:  # as many unknowns as residuals: any data fit exactly
+        flags.append(f"the records hold {rows.size} fitted values for {columns.shape[0]} "
+                     "unknowns (parameters and start states): too few to determine the "
+                     "parameters; use a longer record.")
+        no_excitation = True
 
     shape = (ds.num_experiments, ds.num_samples)
     predictions = {}

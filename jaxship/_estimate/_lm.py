@@ -192,8 +192,9 @@ class RESULTS(optx.RESULTS):
     at_bound = ("an estimate ended on a bound of its parameter: the data pull it beyond, "
                 "so the fit is not a proper optimum (see the parameter flags)")
     poorly_determined = ("the data do not determine a combination of the parameters (a "
-                         "singular information matrix, or no excitation): only other "
-                         "combinations are identified (see the parameter flags)")
+                         "singular information matrix, no excitation, or a record too "
+                         "short): only other combinations are identified (see the "
+                         "parameter flags)")
 
 
 def as_code(result) -> RESULTS:

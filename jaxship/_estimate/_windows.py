@@ -18,7 +18,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._models._steering._base import AuxInputs, WindowStart
-from .._simulation._data import Dataset, Experiment
+from .._simulation._data import Dataset, Experiment, check_uniform
 from .._simulation._integrate import Simulator
 
 
@@ -80,16 +80,8 @@ def check_data(ds: Dataset, rudder: str, channels, *, rtol: float = 1e-6) -> Non
                     f"{bad.size - 1} more samples; all values must be finite (cut the record "
                     "with Experiment.segment or repair the file)."
                 )
-        steps = np.diff(t)
-        dt = float(np.asarray(ds.dt)[i])
-        off = np.nonzero(np.abs(steps - dt) > rtol * dt)[0]
-        if off.size:
-            k = int(off[0]) + 1
-            raise ValueError(
-                f"{where}: sampling is not uniform (t[{k}] - t[{k - 1}] = {steps[k - 1]!r} s, "
-                f"mean interval {dt!r} s); the inputs are replayed at a constant interval: "
-                "resample the record first."
-            )
+        check_uniform(t, where, "the inputs are replayed at a constant interval: "
+                      "interpolate the record onto a uniform time grid first.", rtol)
 
 
 # how each replayed signal is interpolated between samples (MATLAB's `InterSample`):

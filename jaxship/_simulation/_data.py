@@ -30,6 +30,43 @@ def _cumulative_trapezoid(y: np.ndarray, t: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(t))])
 
 
+def _spacing(t) -> tuple[float, np.dtype]:
+    """The spacing of JAX's float type (float32 unless x64 is enabled) at the largest
+    |t|, and that type."""
+    dtype = jax.dtypes.canonicalize_dtype(jnp.float64)
+    return float(np.spacing(np.asarray(np.max(np.abs(t)), dtype))), dtype
+
+
+def sampling_tolerance(t, rtol: float = 1e-6) -> float:
+    """The largest $|t_{k+1} - t_k - \\Delta t|$ [s] of uniform sampling:
+    $\\mathrm{rtol}\\,\\Delta t + 8\\,\\epsilon$, $\\epsilon$ the spacing of JAX's float
+    type at the largest |t|, whose rounding of the time stamps (a simulation in float32,
+    epoch time stamps) is no irregularity."""
+    t = np.asarray(t, dtype=np.float64)
+    return rtol * (t[-1] - t[0]) / (t.shape[0] - 1) + 8 * _spacing(t)[0]
+
+
+def check_uniform(t, where: str, advice: str, rtol: float = 1e-6) -> None:
+    """A one-line `ValueError` naming `where` and giving `advice` when the time stamps
+    `t` are not uniform (`sampling_tolerance`), or when JAX's float type cannot resolve
+    the sample interval at their size (then saying how to enable float64)."""
+    t = np.asarray(t, dtype=np.float64)
+    steps = np.diff(t)
+    dt = float((t[-1] - t[0]) / steps.shape[0])
+    spacing, dtype = _spacing(t)
+    if spacing > 0.1 * dt:
+        x64 = ("enable float64 (`jax.config.update('jax_enable_x64', True)` before any "
+               "computation) or " if dtype != np.float64 else "")
+        raise ValueError(f"{where}: column 't': {dtype.name} resolves time stamps of "
+                         f"{np.max(np.abs(t)):.4g} s only to {spacing:.3g} s, too coarse for "
+                         f"the {dt:.4g} s sample interval: {x64}subtract the first time stamp.")
+    off = np.nonzero(np.abs(steps - dt) > sampling_tolerance(t, rtol))[0]
+    if off.size:
+        k = int(off[0]) + 1
+        raise ValueError(f"{where}: column 't': sampling is not uniform (t[{k}] - t[{k - 1}] "
+                         f"= {steps[k - 1]:.6g} s, mean interval {dt:.6g} s); {advice}")
+
+
 OVER_GROUND = ("velocities", "over ground")  # metadata of records whose u, v are over ground
 
 
@@ -164,8 +201,10 @@ class Experiment(eqx.Module):
         return dict(self.metadata)
 
     def is_uniform(self, rtol: float = 1e-6) -> bool:
-        """True when every sample interval equals `dt` to a relative `rtol`."""
-        return bool(np.all(np.abs(np.diff(self.t) - self.dt) <= rtol * self.dt))
+        """True when every sample interval equals `dt` to a relative `rtol` and the
+        rounding of the float type (`sampling_tolerance`)."""
+        return bool(np.all(np.abs(np.diff(self.t) - self.dt)
+                           <= sampling_tolerance(self.t, rtol)))
 
     def has(self, channel: str) -> bool:
         """True when `channel` was measured (not derived or zero-filled); `t` always."""

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._consistency import unwrap_heading
 from ._data import OVER_GROUND, Experiment
 from ._readers import (
     _HEADER,
@@ -75,8 +76,8 @@ def read_esso_osaka(path) -> Experiment:
     (positive delta gives positive r). u, v are over ground (derived from the GNSS
     receiver's track, UPSTREAM_README: the model logs no speed through the water).
     The heading `psi_hat` is wrapped to [-pi, pi] in the files (the README's "not
-    wrapped" is wrong: every turning run jumps by 2 pi); it is unwrapped here with
-    `np.unwrap`. x, y are the pond's
+    wrapped" is wrong: every turning run jumps by 2 pi); it is unwrapped here
+    (`unwrap_heading`). x, y are the pond's
     earth-fixed x0, y0 axes (not north/east; psi is measured from x0).
     `wind_speed`/`wind_dir` are the TRUE wind, the direction it comes from, measured
     from x0 (checked: the logged apparent
@@ -109,7 +110,7 @@ def read_esso_osaka(path) -> Experiment:
     data, lines = _parse_numbers(path, headers, records)
     _check_time(path, headers[columns["t"]], data[:, columns["t"]], lines, False, 0.0)
     values = {_ESSO_COLUMNS[k][0]: data[:, j] for k, j in columns.items()}
-    values["psi"] = np.unwrap(values["psi"])  # wrapped to [-pi, pi] in the files
+    values["psi"] = unwrap_heading(values["psi"])[0]  # wrapped to [-pi, pi] in the files
     extra = {k: values.pop(k) for k in ("wind_speed_relative", "wind_dir_relative") if k in values}
     return Experiment(
         name=path.stem, extra=extra, **values,

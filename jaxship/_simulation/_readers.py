@@ -19,7 +19,10 @@ header `name [unit]`:
 | `wind_dir` | true wind direction the wind comes *from*, from north (x) | deg, rad |
 
 `t`, `delta` and one of `psi`, `r` are required, the rest optional; column order is
-free. Rows are numbered from 1 after the header ("row 3" is the third data row) and
+free. A wrapped heading (jumps of about 360 deg, at +-180 or in 0-360) is unwrapped, with
+a note in the metadata (`"note"`); columns that disagree by a unit (psi against the
+integrated r, the positions against u, v: `_consistency.check_consistency`) are refused.
+Rows are numbered from 1 after the header ("row 3" is the third data row) and
 every error message names the file, the column, the row and its line. Blank lines and
 trailing rows whose cells are all empty (spreadsheet exports) are skipped; an empty or
 non-finite cell anywhere else is an error. Unknown column names are an error unless
@@ -35,7 +38,8 @@ from pathlib import Path
 import numpy as np
 
 from .._foundation._state import Trajectory
-from ._data import CHANNELS, OVER_GROUND, Experiment
+from ._consistency import check_consistency, unwrap_heading
+from ._data import CHANNELS, OVER_GROUND, Experiment, sampling_tolerance
 
 
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
@@ -268,12 +272,12 @@ def _check_time(path, header, t, lines, require_uniform, rtol):
         )
     if require_uniform:
         dt = float(np.median(steps))
-        bad = np.nonzero(np.abs(steps - dt) > rtol * dt)[0]
+        bad = np.nonzero(np.abs(steps - dt) > sampling_tolerance(t, rtol))[0]
         if bad.size:
             k = int(bad[0]) + 1
             raise ValueError(
                 f"{path}: column '{header}', row {k + 1} (line {lines[k]}): sampling interval "
-                f"{float(steps[k - 1])!r} s differs from the typical (median) interval {dt!r} s; "
+                f"{steps[k - 1]:.6g} s differs from the typical (median) interval {dt:.6g} s; "
                 "uniform sampling is required (require_uniform=True)."
             )
 
@@ -353,9 +357,18 @@ def read_trial_csv(path, *, require_uniform: bool = False, allow_unknown: bool =
     for key, (j, unit) in columns.items():
         if key in _PLAUSIBLE:
             _check_plausible(path, headers[j], key, unit, values[key], lines)
+    notes = {}
+    if "psi" in values:
+        values["psi"], wraps = unwrap_heading(values["psi"])
+        if wraps:
+            notes["note"] = (f"column '{headers[columns['psi'][0]]}' wraps around "
+                             f"{wraps} time(s) (jumps of about 360 deg): unwrapped.")
+    check_consistency(str(path), values["t"], values,
+                      {k: headers[j] for k, (j, _) in columns.items()},
+                      {k: unit for k, (_, unit) in columns.items()})
     return Experiment(
         name=path.stem if name is None else name,
-        metadata={"file": str(path), "format": "trial csv",
+        metadata={"file": str(path), "format": "trial csv", **notes,
                   **dict([OVER_GROUND] if over_ground else [])},
         extra={k: data[:, j] for k, j in extra_columns.items()},
         **values,

@@ -12,7 +12,7 @@ import numpy as np
 
 import jaxship as js
 from jaxship._models._vessel.mmg import GRAVITY
-from jaxship._simulation._data import OVER_GROUND
+from jaxship._simulation._data import OVER_GROUND, check_uniform
 from jaxship._simulation._measured import header_names
 from jaxship._simulation._readers import UTF16_MARKS
 
@@ -111,6 +111,13 @@ def read_experiments(paths, *, role: str = "training", note=None, taken=(),
     if isinstance(paths, (str, Path)):
         paths = [paths]
     experiments = []
+
+    def read(item):  # with the reader's note (a heading unwrapped) said
+        e = _with_velocities(js.read_measured(item), over_ground)
+        if note is not None and "note" in e.meta:
+            note(f"{item}: {e.meta['note']}")
+        return e
+
     for path in paths:
         path = Path(path)
         if path.is_dir():
@@ -129,12 +136,11 @@ def read_experiments(paths, *, role: str = "training", note=None, taken=(),
             if not found:
                 raise ValueError(f"{path}: the {role} folder holds no measurement file "
                                  "(trial CSV, Esso Osaka CSV, HSVA or MARIN .dat).")
-            experiments.extend(_with_velocities(js.read_measured(item), over_ground)
-                               for item in found)
+            experiments.extend(read(item) for item in found)
         elif not path.exists():
             raise ValueError(f"{path}: no such {role} file or folder.")
         else:
-            experiments.append(_with_velocities(js.read_measured(path), over_ground))
+            experiments.append(read(path))
     if not experiments:
         raise ValueError(f"no {role} files given.")
     names = [e.name for e in experiments] + list(taken)
@@ -156,11 +162,29 @@ def _resampled(experiments, interval: float, role: str, note) -> list[js.Experim
         raise ValueError(f"the sample interval must be a positive number of seconds, got "
                          f"{interval!r}.")
     factors = [max(1, round(interval / e.dt)) for e in experiments]
+    for e, k in zip(experiments, factors):
+        kept = -(-e.num_samples // k)
+        if kept < 3:
+            raise ValueError(f"--sample-interval {interval:g}: keeps {kept} sample(s) of the "
+                             f"{role} record {source(e)} ({e.duration:.4g} s sampled every "
+                             f"{e.dt:.3g} s); a fit needs at least 3: choose an interval of "
+                             f"at most {e.duration / 2:.3g} s.")
     if note is not None and any(k > 1 for k in factors):
         changes = sorted({f"{e.dt:.3g} s -> {k * e.dt:.3g} s" for e, k in
                           zip(experiments, factors) if k > 1})
         note(f"{role} records resampled to every k-th sample ({', '.join(changes)}).")
     return [e.decimate(k) if k > 1 else e for e, k in zip(experiments, factors)]
+
+
+def same_records(train, held_out) -> list[str]:
+    """A sentence for each validation record that is a training record (the same
+    samples): its fit % is no held-out check."""
+    return [f"the validation record {source(e)} holds the samples of the training record "
+            f"{source(f)}: its fit % is no held-out check (--validate records not used in "
+            "the fit for one)."
+            for e in held_out for f in train
+            if e.channels == f.channels and e.num_samples == f.num_samples
+            and all(np.array_equal(getattr(e, k), getattr(f, k)) for k in ("t", *e.channels))]
 
 
 def as_experiments(data, role: str) -> list[js.Experiment]:
@@ -232,10 +256,6 @@ def check_experiments(experiments, rudder: str, role: str, model: str = "",
                 "them or a Nomoto model.")
         if e.num_samples < 3:
             raise ValueError(f"{where}: needs at least 3 samples, has {e.num_samples}.")
-        if not e.is_uniform():
-            steps = np.diff(e.t)
-            k = int(np.argmax(np.abs(steps - e.dt))) + 1
-            raise ValueError(
-                f"{where}: column 't': sampling is not uniform (t[{k}] - t[{k - 1}] = "
-                f"{steps[k - 1]!r} s, mean interval {e.dt!r} s); resample the record first."
-            )
+        check_uniform(e.t, where, "interpolate the record onto a uniform time grid first "
+                      "(--sample-interval keeps every k-th sample: it does not make the "
+                      "intervals equal).")

@@ -26,7 +26,14 @@ import jaxship as js
 from ..._foundation._params import parameter_fields
 from ..._foundation._progress import Progress
 from .assessment import assess
-from .data import as_experiments, check_experiments, check_froude, preset_length, valid_samples
+from .data import (
+    as_experiments,
+    check_experiments,
+    check_froude,
+    preset_length,
+    same_records,
+    valid_samples,
+)
 from .registry import MODELS, model_key, start_entry
 from .result import IdentificationResult
 from .simulation import simulate_records
@@ -165,7 +172,12 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
         check_froude(held_out or [], length, "validation", name)
     train_ds = js.Dataset.from_experiments(train_exps)
     valid_ds = None if held_out is None else js.Dataset.from_experiments(held_out)
-    notes, caught = [], []
+    notes, caught = same_records(train_exps, held_out or []), []
+    longest = max(e.duration for e in train_exps)
+    if horizon is not None and horizon >= longest:
+        notes.append(f"the horizon (--horizon {horizon:g} s) is not shorter than any training "
+                     f"record (the longest: {longest:.4g} s): each record is one window, so the "
+                     "fit is output error (--horizon none).")
     if default_channels:  # a default u or v that never varies (e.g. no surge dynamics)
         constant = [c for c in channels
                     if c in ("u", "v") and np.ptp(valid_samples(train_ds, c)) == 0]
