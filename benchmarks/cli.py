@@ -31,7 +31,8 @@ the command then leaves as they are), and prints the ratio default / own.
 Run: `python benchmarks/cli.py [--repeats N] [--table | --flags] [--only TEXT]` (the median
 of N runs of each, default 1; `--only`: the table's rows whose name contains TEXT, e.g.
 `--only discover` after a change to `discover` alone; the `autopilot` rows read the
-`identify (nomoto1)` row's result).
+`identify (nomoto1)` row's result, the `simulate imo` row the `identify (esso_osaka 3-DOF)`
+row's: `--only esso` times both).
 """
 
 import argparse
@@ -94,6 +95,9 @@ def table_commands(out: Path) -> dict:
         "identify (nomoto1)": identify + ["--model", "nomoto1", "--out", str(out / "fit")],
         "identify (esso_osaka 3-DOF)": identify + ["--model", "esso_osaka", "--out",
                                                    str(out / "esso")],
+        "simulate imo (the esso_osaka fit)": ["jaxship", "simulate", "--vessel",
+                                              str(out / "esso" / "result.json"),
+                                              "--manoeuvre", "imo", "--out", str(out / "imo")],
         "autopilot": autopilot + ["--out", str(out / "ap")],
         "autopilot --tune": autopilot + ["--tune", "--out", str(out / "ap-tune")],
         "discover (kvlcc2)": ["jaxship", "discover", *map(str, (p for p in hsva

@@ -186,6 +186,7 @@ from ._models._vessel._base import (
 )
 from ._models._vessel.catalogue import VESSELS as VESSELS, get_vessel as get_vessel
 from ._models._vessel.esso_osaka import LowSpeedMMGVessel as LowSpeedMMGVessel
+from ._models._vessel.file import load_vessel as load_vessel, save_vessel as save_vessel
 from ._models._vessel.mariner import Mariner as Mariner
 from ._models._vessel.mmg import MMGVessel as MMGVessel
 from ._models._vessel.nomoto import NomotoVessel as NomotoVessel

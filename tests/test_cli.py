@@ -663,7 +663,9 @@ def test_help_shows_defaults_and_which_options_are_required(capsys):
             main([command, "--help"])
         assert stop.value.code == 0
         seen[command] = " ".join(capsys.readouterr().out.split())
-    assert "--vessel VESSEL preset name (see `jaxship vessels`) (required)" in seen["simulate"]
+    assert "--vessel VESSEL a preset (see `jaxship vessels`), a vessel file (TOML; " \
+        "`jaxship vessels --show NAME` writes one to start from) or the result.json of " \
+        "`jaxship identify` (its fitted model) (required)" in seen["simulate"]
     assert "--out OUT output folder (required)" in seen["identify"]
     assert "--max-steps MAX_STEPS optimiser step limit (default: 256)" in seen["identify"]
     assert "most effects added (default: 3)" in seen["discover"]

@@ -95,8 +95,8 @@ def test_the_example_runs_in_float32(tmp_path):
 
 
 def test_the_table_has_every_command():
-    names = [command for command, _ in table_rows()]
-    assert sorted(names) == sorted(m.__name__.rsplit(".", 1)[1] for m in cli.COMMANDS)
+    names = {command for command, _ in table_rows()}  # a command may have more rows
+    assert names == {m.__name__.rsplit(".", 1)[1] for m in cli.COMMANDS}
     assert all(example.split()[1] == command for command, example in table_rows())
 
 
@@ -111,9 +111,9 @@ def test_every_table_example_parses(argv, monkeypatch):
     assert main(argv) == 0
     (args,) = seen
     assert args.command == argv[0]
-    if getattr(args, "vessel", None):
+    if getattr(args, "vessel", None) and not args.vessel.endswith(("result.json", ".toml")):
         get_vessel(args.vessel)
-    if getattr(args, "manoeuvre", None):
+    if getattr(args, "manoeuvre", None) and args.manoeuvre != "imo":
         TrialSpec.parse(args.manoeuvre)
     if args.command in ("identify", "discover"):
         assert args.model in MODELS, args.model
@@ -129,7 +129,7 @@ def test_the_manoeuvres_the_readme_names_parse():
 
 def test_the_cheap_examples_run(tmp_path, capsys):
     assert main(["vessels"]) == 0
-    (argv,) = argv_of(dict(table_rows())["simulate"])
+    (argv,) = argv_of(next(e for c, e in table_rows() if c == "simulate"))
     argv[argv.index("--out") + 1] = str(tmp_path / "zz")
     assert main(argv) == 0
     assert {"trial.csv", "indices.json", "trial.png"} <= {p.name for p in

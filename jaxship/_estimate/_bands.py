@@ -231,13 +231,23 @@ def _parameter_draws(result, covariance, num_samples, rng) -> tuple[tuple, np.nd
             raise ValueError(f"the fit does not determine {', '.join(bad)} (infinite standard "
                              "error): no band from its covariance; fix them or pass "
                              "`covariance=None`.")
-        cov = np.asarray(report.correlation) * np.outer(std, std)
+        return report.names, normal_draws(values, std, report.correlation, num_samples, rng)
     else:
         cov = np.asarray(covariance, dtype=np.float64)
         if cov.shape != (values.size, values.size):
             raise ValueError(f"`covariance` must be ({values.size}, {values.size}) for the "
                              f"free parameters {report.names}, got {cov.shape}.")
     return report.names, rng.multivariate_normal(values, cov, size=num_samples, method="eigh")
+
+
+def normal_draws(values, std, correlation, num_samples: int, rng) -> np.ndarray:
+    """`(num_samples, d)` draws from $N(\\hat\\theta, D C D)$: the estimates `values`,
+    standard errors `std` ($D$) and `correlation` ($C$; None: independent draws)."""
+    values, std = np.asarray(values, np.float64), np.asarray(std, np.float64)
+    corr = np.eye(values.size) if correlation is None else np.asarray(correlation, np.float64)
+    cov = corr * np.outer(std, std)
+    return rng.multivariate_normal(values, cov, size=num_samples, method="eigh",
+                                   check_valid="ignore")  # rounding: slightly negative
 
 
 def prediction_bands(result, dataset, *, level: float = 0.9,

@@ -283,7 +283,7 @@ def run_spec(vessel, spec, *, speed=None, rpm=None, duration=None, dt=None, subs
     spec = TrialSpec.parse(spec) if isinstance(spec, str) else spec
     x0 = initial_state(vessel, speed=speed, rpm=rpm)
     manoeuvre = build_manoeuvre(spec, vessel, x0, duration=duration, dt=dt)
-    simulator = Simulator(substeps=substeps)
+    simulator = Simulator(substeps=substeps)  # `_imo.SIMULATOR` too
     traj = simulate(vessel, manoeuvre, x0, simulator=simulator)
     if spec.kind == "stop" and duration is None and bool(traj.success):
         traj = _cut_at_stop(traj)
@@ -438,6 +438,41 @@ def simulate_to_folder(
         fig.savefig(out / "imo_criteria.png", dpi=110)
         plt.close(fig)
     return indices
+
+
+def simulate_steering_to_folder(model, spec, out, *, dt, duration, title="") -> dict:
+    """Run `spec` on the steering `model` from rest (`jaxship.simulate`'s closed loop on
+    its heading and yaw rate), its time scale `duration / 35` (a zig-zag's 35 L/U),
+    and write `trial.csv` (t, delta, r, psi), `indices.json` and `trial.png` to `out`."""
+    tau = duration / 35
+    vessel = _TimeScale(length=tau, nominal_speed=1.0)
+    manoeuvre = build_manoeuvre(spec, vessel, straight_state(0.0, 0.0), duration=duration,
+                                dt=dt)
+    traj = simulate(model, manoeuvre, simulator=Simulator(substeps=2))
+    if not bool(traj.success):
+        raise ValueError(f"the simulation of {_spec_text(spec)} failed (non-finite state); "
+                         "try a smaller --dt.")
+    record = Experiment.from_trajectory(traj)
+    record = Experiment(record.t, record.delta, name=record.name, r=record.r, psi=record.psi)
+    write_trial_csv(pathlib.Path(out) / "trial.csv", record)
+    indices = {k: (None if isinstance(v, float) and not np.isfinite(v) else v)
+               for k, v in trial_indices(spec, manoeuvre, traj).items()
+               if k != "min_speed_m_s" and k != "max_speed_m_s"}
+    (pathlib.Path(out) / "indices.json").write_text(json.dumps(indices, indent=2) + "\n")
+    name = title or _spec_text(spec)
+    fig = plot_trajectory(traj, title=name, labels=[name],
+                          indices=_trial_marks(spec, manoeuvre, traj))
+    fig.savefig(pathlib.Path(out) / "trial.png", dpi=110)
+    plt.close(fig)
+    return indices
+
+
+@dataclasses.dataclass(frozen=True)
+class _TimeScale:
+    """What `build_manoeuvre` reads of a vessel, for a steering model: L/U = `length`."""
+
+    length: float
+    nominal_speed: float
 
 
 def _spec_text(spec) -> str:

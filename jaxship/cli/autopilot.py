@@ -9,12 +9,12 @@ import matplotlib.pyplot as plt
 from tqdm.auto import tqdm
 
 from .._foundation._files import staged_folder
-from .._models._vessel.catalogue import get_vessel
 from ..plotting import plot_autopilot
 from ._common import check_operating_point, check_out, numbers
 from ._identification import read_result
 from ._studies import autopilot as autopilot_study
 from ._studies.autopilot import cell
+from ._vessel import VESSEL_HELP, read_vessel_option
 
 
 def register(sub) -> None:
@@ -27,8 +27,7 @@ def register(sub) -> None:
         "autopilot.json, report.md and figures/ into --out.")
     auto.add_argument("--model", required=True, type=pathlib.Path,
                       help="result.json written by `jaxship identify`")
-    auto.add_argument("--vessel", required=True, help="the vessel steered (see `jaxship "
-                      "vessels`)")
+    auto.add_argument("--vessel", required=True, help="the vessel steered: " + VESSEL_HELP)
     auto.add_argument("--rpm", nargs="+", default=None, help="propeller rates of the runs")
     auto.add_argument("--speed", nargs="+", default=None, help="approach speeds [m/s]")
     auto.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
@@ -68,7 +67,7 @@ def run(args) -> int:
         raise ValueError("--step, --natural-frequency (or auto) and --damping take "
                          "numbers.") from None
     autopilot_study.Design.scaled(omega, step=step, damping=damping).check()
-    vessel = get_vessel(args.vessel)
+    vessel = read_vessel_option(args.vessel, vessel_only=True).model
     check_operating_point(vessel, args.vessel, [] if by_rpm else values,
                           values if by_rpm else [])
     model, report = read_result(args.model)

@@ -7,6 +7,8 @@ from tqdm.auto import tqdm
 
 from ._common import VELOCITIES, add_sample_interval, add_velocities, check_out, note
 from ._identification.discovery import run_discovery
+from ._vessel import VESSEL_HELP
+from .identify import start_model
 
 
 def register(sub) -> None:
@@ -20,8 +22,10 @@ def register(sub) -> None:
                       help="training records: trial CSV or measurement files, or folders")
     disc.add_argument("--holdout", nargs="+", type=pathlib.Path, default=None, metavar="TEST",
                       help="held-out records (other manoeuvres) the effects must improve")
-    disc.add_argument("--model", required=True, help="a registered model (see `jaxship "
-                      "identify --help`)")
+    disc.add_argument("--model", default=None, help="a registered model (see `jaxship "
+                      "identify --help`; this or --vessel)")
+    disc.add_argument("--vessel", default=None,
+                      help="the model to start from, in place of --model: " + VESSEL_HELP)
     disc.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
     disc.add_argument("--max-effects", type=int, default=3, help="most effects added")
     disc.add_argument("--alpha", type=float, default=0.01,
@@ -34,11 +38,12 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    name, start = start_model(args.model, args.vessel)
     check_out(args.out, writes=("discovery.json", "report.md", "figures/"),
               inputs=[*args.train, *(args.holdout or [])])
     say = (lambda message: None) if args.quiet else (
         lambda message: tqdm.write(f"jaxship: {message} ...", file=sys.stderr))
-    report = run_discovery(args.train, args.holdout, model=args.model, out=args.out,
+    report = run_discovery(args.train, args.holdout, model=name, start=start, out=args.out,
                            max_effects=args.max_effects, alpha=args.alpha,
                            sample_interval=args.sample_interval,
                            over_ground=VELOCITIES.get(args.velocities), progress=say,

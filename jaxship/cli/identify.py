@@ -21,6 +21,7 @@ from ._common import (
     one_line,
 )
 from ._identification import MODELS, get_model_entry, identify, read_experiments
+from ._vessel import VESSEL_HELP, read_vessel_option
 
 
 def register(sub) -> None:
@@ -35,9 +36,11 @@ def register(sub) -> None:
     )
     ident.add_argument("train", nargs="+", type=pathlib.Path,
                        help="training records: trial CSV or measurement files, or folders")
-    ident.add_argument("--model", required=True,
+    ident.add_argument("--model", default=None,
                        help="a registered model (listed below): a steering model, armax or a "
-                       "vessel preset name")
+                       "vessel preset name (this or --vessel)")
+    ident.add_argument("--vessel", default=None,
+                       help="the model to start from, in place of --model: " + VESSEL_HELP)
     ident.add_argument("--horizon", default=None,
                        help="prediction horizon [s]; none: output error, "
                        "0: equation error")
@@ -58,7 +61,8 @@ def register(sub) -> None:
     ident.add_argument("--no-figures", action="store_true", help="write result.json only")
     ident.add_argument("--quiet", action="store_true", help="no progress bar")
     # a vessel's fit runs long programs, which XLA's defaults compile to run faster
-    ident.set_defaults(run=run, small_programs=lambda args: args.model not in VESSELS)
+    ident.set_defaults(run=run, small_programs=lambda args: args.vessel is None
+                       and args.model not in VESSELS)
 
 
 def _horizon(text):
@@ -74,9 +78,21 @@ def _horizon(text):
     return value
 
 
+def start_model(model, vessel):
+    """`(name, start model or None)` of `--model` or `--vessel` (one of them)."""
+    if (model is None) == (vessel is None):
+        raise ValueError("give --model (a registered model) or --vessel (a preset, a vessel "
+                         "file or a result.json to start from), one of them.")
+    if vessel is None:
+        get_model_entry(model)
+        return model, None
+    chosen = read_vessel_option(vessel)
+    return chosen.name, chosen.model
+
+
 def run(args) -> int:
     # every check before the fit; the files appear in --out only when all are written
-    get_model_entry(args.model)  # unknown models fail before reading any file
+    name, start = start_model(args.model, args.vessel)  # unknown ones fail before any file
     horizon = _horizon(args.horizon)
     if args.max_steps < 1:
         raise ValueError(f"--max-steps {args.max_steps}: give a positive number of optimiser "
@@ -94,7 +110,7 @@ def run(args) -> int:
             [e.name for e in train], None if held_out is None else [e.name for e in held_out])
         check_writes(args.out, tuple(f"figures/{name}" for name in names))
     bar = ProgressBar(not args.quiet)
-    result = identify(train, model=args.model, horizon=horizon, validate=held_out,
+    result = identify(train, model=name, start=start, horizon=horizon, validate=held_out,
                       rudder=args.rudder, channels=args.channels, initial=args.initial,
                       max_steps=args.max_steps, progress=bar)
     written = ["result.json"]

@@ -1,15 +1,20 @@
-"""`jaxship simulate`: a standard trial of a vessel preset, its indices, records and
-figure."""
+"""`jaxship simulate`: a standard trial (or the IMO set, `--manoeuvre imo`) of a vessel
+preset, a vessel file or an identified model, its indices, records and figures."""
 
 import json
 import math
 import pathlib
 
+import matplotlib.pyplot as plt
+
 from .._foundation._files import staged_folder
-from .._models._vessel.catalogue import get_vessel
+from .._models._vessel._base import AbstractVessel
 from .._simulation._froude import froude_scale
-from ._common import check_operating_point, check_out, positive
-from ._trials import TrialSpec, simulate_to_folder
+from ..plotting import plot_imo_criteria, plot_trajectory
+from ._common import check_operating_point, check_out, note, positive
+from ._imo import check_imo, imo_specs
+from ._trials import TrialSpec, simulate_steering_to_folder, simulate_to_folder
+from ._vessel import VESSEL_HELP, read_vessel_option
 
 
 # the most samples `simulate` integrates (10 million samples hold gigabytes)
@@ -19,8 +24,10 @@ LENGTHS = (1.0, 1000.0)  # [m] the lengths --length takes: a basin model to the 
 
 def register(sub) -> None:
     sim = sub.add_parser("simulate", help="simulate a standard trial")
-    sim.add_argument("--vessel", required=True, help="preset name (see `jaxship vessels`)")
-    sim.add_argument("--manoeuvre", required=True, help="e.g. turn:35, zigzag:-10/10, thesis")
+    sim.add_argument("--vessel", required=True, help=VESSEL_HELP)
+    sim.add_argument("--manoeuvre", required=True, help="e.g. turn:35, zigzag:-10/10, thesis; "
+                     "imo: the IMO MSC.137(76) trials and criteria, with the band the "
+                     "standard errors of an identified model give")
     sim.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
     sim.add_argument("--speed", type=float, help="approach speed [m/s]")
     sim.add_argument("--rpm", type=float, help="propeller rate [rpm]")
@@ -33,18 +40,25 @@ def register(sub) -> None:
 
 def run(args) -> int:
     # every check before the simulation; the files appear in --out only when all are written
-    vessel = get_vessel(args.vessel)
+    chosen = read_vessel_option(args.vessel)
+    if not isinstance(chosen.model, AbstractVessel):
+        return run_steering(args, chosen)
+    vessel, imo = chosen.model, args.manoeuvre.strip().lower() == "imo"
     if positive("--length", args.length):
         if not LENGTHS[0] <= args.length <= LENGTHS[1]:
             raise ValueError(f"--length {args.length:g} m: give a ship or model length between "
                              f"{LENGTHS[0]:g} and {LENGTHS[1]:g} m ({args.vessel} is "
                              f"{float(vessel.length):.4g} m).")
         vessel = froude_scale(vessel, args.length / float(vessel.length))
-    spec = TrialSpec.parse(args.manoeuvre)
+    spec = TrialSpec.parse("zigzag:20/20" if imo else args.manoeuvre)
     speed, rpm = positive("--speed", args.speed), positive("--rpm", args.rpm)
+    if chosen.report is not None and speed is None and rpm is None and vessel.nominal_n:
+        rpm = 60.0 * float(vessel.nominal_n)  # fitted: the speed its coefficients give
+        note(f"the approach at the service propeller rate of {args.vessel}, {rpm:.4g} rpm "
+             "(the fitted coefficients set the speed); give --speed or --rpm to choose.")
     duration, dt = positive("--duration", args.duration), positive("--dt", args.dt)
     limit = math.degrees(float(vessel.rudder.max_angle))
-    for angle in spec.rudder_angles:
+    for angle in [a for s in (imo_specs(vessel) if imo else [spec]) for a in s.rudder_angles]:
         if abs(angle) > limit * (1 + 1e-12):
             raise ValueError(f"--manoeuvre {args.manoeuvre}: the rudder angle {angle:g} deg is "
                              f"beyond the rudder limit of {args.vessel} ({limit:g} deg); give "
@@ -68,6 +82,8 @@ def run(args) -> int:
         raise ValueError(f"--duration/--dt: {samples:.3g} samples ({duration or 100 * tau:.4g} s "
                          f"at {dt or tau / 20:.3g} s), more than {MAX_SAMPLES:.0e}; give a "
                          "larger --dt or a shorter --duration.")
+    if imo:
+        return run_imo(args, chosen, vessel, speed=speed, rpm=rpm)
     check_out(args.out, writes=("trial.csv", "indices.json"))
     with staged_folder(args.out) as stage:
         indices = simulate_to_folder(vessel, spec, stage, speed=speed, rpm=rpm,
@@ -76,4 +92,76 @@ def run(args) -> int:
         written = sorted(p.name for p in stage.iterdir())
     print(json.dumps(indices, indent=2))
     print(f"wrote {args.out}/" + f", {args.out}/".join(written))
+    return 0
+
+
+def run_imo(args, chosen, vessel, *, speed, rpm) -> int:
+    """`--manoeuvre imo`: the trials of `imo_specs`, the criteria with margins and bands;
+    writes `criteria.md`, `indices.json`, `imo_criteria.png` and one figure a trial."""
+    if args.duration is not None or args.dt is not None:
+        raise ValueError("--manoeuvre imo runs each trial for its own duration and sample "
+                         "interval; leave out --duration and --dt.")
+    figures = [f"{spec.kind}{''.join(f'{v:g}' for v in spec.values[:1])}.png"
+               for spec in imo_specs(vessel)]
+    check_out(args.out, writes=("criteria.md", "indices.json", "imo_criteria.png", *figures))
+    check = check_imo(vessel, report=chosen.report, speed=speed, rpm=rpm)
+    with staged_folder(args.out) as stage:
+        (stage / "criteria.md").write_text(
+            f"# IMO MSC.137(76) criteria: {chosen.label}\n\n{check.table()}\nBand: the "
+            f"central {check.draws['level']:.0%} of {check.draws['used']} of "
+            f"{check.draws['draws']} parameter draws from {check.draws['from']}.\n")
+        (stage / "indices.json").write_text(json.dumps(check.to_dict(), indent=2) + "\n")
+        fig = plot_imo_criteria(check.rows, bands=check.bands,
+                                title=f"{chosen.label}: IMO MSC.137(76) criteria")
+        fig.savefig(stage / "imo_criteria.png", dpi=110)
+        plt.close(fig)
+        for name, (text, (_, traj, marks)) in zip(figures, check.runs.items()):
+            fig = plot_trajectory(traj, length=float(vessel.length), indices=marks,
+                                  title=f"{chosen.label} {text}", labels=[text])
+            fig.savefig(stage / name, dpi=110)
+            plt.close(fig)
+    print(check.table())
+    print(f"band: {check.draws['from']} ({check.draws['used']} of {check.draws['draws']} "
+          "draws ran)")
+    if check.draws["draws"] and not check.draws["used"]:
+        note("no parameter draw ran every trial: the standard errors reach values where the "
+             "model has no straight run or blows up (see the result's identifiability flags); "
+             "no band.")
+    print(f"wrote {args.out}/criteria.md, {args.out}/indices.json, {args.out}/imo_criteria.png, "
+          + ", ".join(f"{args.out}/{f}" for f in figures))
+    return 0
+
+
+STEERING_KINDS = ("zigzag", "prbs", "3211", "heading-steps", "thesis")
+
+
+def run_steering(args, chosen) -> int:
+    """A steering model of an identify result through a closed-loop trial: its heading
+    and yaw rate (no track, no speed); `--dt` and `--duration` default to its first
+    training record's."""
+    spec = TrialSpec.parse(args.manoeuvre) if args.manoeuvre.strip().lower() != "imo" \
+        else None
+    if spec is None or spec.kind not in STEERING_KINDS:
+        raise ValueError(f"--vessel {args.vessel}: a {type(chosen.model).__name__} steering "
+                         "model has no track, speed or propeller, so it has no "
+                         f"{args.manoeuvre} trial; give one of {', '.join(STEERING_KINDS)} "
+                         "(the IMO check needs a vessel: identify a vessel preset).")
+    for option in ("length", "speed", "rpm"):
+        if getattr(args, option) is not None:
+            raise ValueError(f"--{option}: a steering model has no length, speed or "
+                             "propeller; leave it out.")
+    records = (chosen.report.get("data") or {}).get("train") or [{}]
+    dt = positive("--dt", args.dt) or positive("dt_s of the result", records[0].get("dt_s"))
+    duration = positive("--duration", args.duration) or positive(
+        "duration_s of the result", records[0].get("duration_s"))
+    if dt is None or duration is None or duration < 2 * dt:
+        raise ValueError("give --dt and --duration (longer than two samples): the result "
+                         "names no training record to take them from.")
+    check_out(args.out, writes=("trial.csv", "indices.json", "trial.png"))
+    with staged_folder(args.out) as stage:
+        indices = simulate_steering_to_folder(chosen.model, spec, stage, dt=dt,
+                                              duration=duration,
+                                              title=f"{chosen.label} {args.manoeuvre}")
+    print(json.dumps(indices, indent=2))
+    print(f"wrote {args.out}/trial.csv, {args.out}/indices.json, {args.out}/trial.png")
     return 0

@@ -1,14 +1,26 @@
-"""`jaxship vessels`: the vessel presets with their size, speed, rpm and source."""
+"""`jaxship vessels`: the vessel presets with their size, speed, rpm and source; with
+`--show NAME`, a preset as a vessel file (TOML) to start one's own ship from."""
 
 from .._models._vessel.catalogue import VESSELS, get_vessel
+from .._models._vessel.file import vessel_text
 
 
 def register(sub) -> None:
     vessels = sub.add_parser("vessels", help="list the vessel presets and their sources")
+    vessels.add_argument("--show", metavar="NAME", default=None,
+                         help="print the preset NAME as a vessel file (TOML: the model class "
+                         "and every coefficient with its unit), e.g. `jaxship vessels --show "
+                         "esso_osaka > my_ship.toml`, then `--vessel my_ship.toml`")
     vessels.set_defaults(run=run, small_programs=lambda args: False)
 
 
 def run(args) -> int:
+    if args.show is not None:
+        vessel = get_vessel(args.show)
+        key = args.show.strip().lower().replace("-", "_")
+        print(vessel_text(vessel, source=f"the preset {key}: {VESSELS[key].description}"),
+              end="")
+        return 0
     width = max(map(len, VESSELS))
     print(f"{'name':<{width}}  {'L [m]':>7}  {'U [m/s]':>7}  {'n [rpm]':>7}  source")
     for name, entry in VESSELS.items():

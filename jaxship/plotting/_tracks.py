@@ -425,24 +425,35 @@ def plot_spiral(curve, *, reverse=None, ordered=None, reference=None,
     return fig
 
 
-def plot_imo_criteria(rows, *, title="IMO MSC.137(76) manoeuvrability criteria"):
-    """The `imo_criteria` rows as a table figure: criterion, value, limit and the
-    verdict (green pass, red fail). **Returns:** the matplotlib `Figure`."""
+def plot_imo_criteria(rows, *, title="IMO MSC.137(76) manoeuvrability criteria", bands=None):
+    """The `imo_criteria` rows as a table figure: criterion, value, limit, the margin
+    (limit - value) and the verdict (green pass, red fail); with `bands` (`{criterion:
+    (low, high)}`, e.g. from parameter draws) a column of them. **Returns:** the
+    matplotlib `Figure`."""
     rows = list(rows)
-    fig, ax = plt.subplots(figsize=(10, 0.45 * len(rows) + 1.3), layout="constrained")
+    bands = bands or {}
+    fig, ax = plt.subplots(figsize=(11 if bands else 10, 0.45 * len(rows) + 1.3),
+                           layout="constrained")
     ax.axis("off")
-    cells = [[row.criterion, f"{row.value:.2f} {row.unit}", f"<= {row.limit:.2f} {row.unit}",
-              "pass" if row.passed else "FAIL"] for row in rows]
-    table = ax.table(cellText=cells or [["(no criteria)", "", "", ""]],
-                     colLabels=["criterion", "value", "limit", "result"],
-                     colWidths=[0.58, 0.14, 0.16, 0.1], loc="center", cellLoc="left")
+    labels = ["criterion", "value", "limit", "margin"] + (["band"] if bands else []) + \
+        ["result"]
+    cells = []
+    for row in rows:
+        band = bands.get(row.criterion)
+        cells.append([row.criterion, f"{row.value:.2f} {row.unit}",
+                      f"<= {row.limit:.2f} {row.unit}", f"{row.limit - row.value:+.2f}"]
+                     + ([f"{band[0]:.2f} to {band[1]:.2f}" if band else "-"] if bands else [])
+                     + ["pass" if row.passed else "FAIL"])
+    widths = [0.46, 0.12, 0.14, 0.1] + ([0.16] if bands else []) + [0.08]
+    table = ax.table(cellText=cells or [["(no criteria)"] + [""] * (len(labels) - 1)],
+                     colLabels=labels, colWidths=widths, loc="center", cellLoc="left")
     table.auto_set_font_size(False)
     table.set_fontsize(9)
     table.scale(1.0, 1.4)
     for (i, j), cell in table.get_celld().items():
         if i == 0:
             cell.set_text_props(weight="bold")
-        elif j == 3 and rows:
+        elif j == len(labels) - 1 and rows:
             cell.set_facecolor("#c9f2c9" if rows[i - 1].passed else "#f6c4c4")
     _title(fig, title, size=12.0)
     return fig

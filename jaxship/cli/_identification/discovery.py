@@ -13,23 +13,24 @@ import jaxship as js
 from ..._foundation._files import staged_folder
 from .._common import check_writes
 from .data import check_froude, preset_length, read_experiments
-from .registry import get_model_entry, model_key
+from .registry import model_key, start_entry
 from .workflow import identify, logs_wind
 
 
 def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
                   max_effects: int = 3, alpha: float = 0.01, sample_interval=None,
-                  over_ground=None, progress=None, note=None):
+                  over_ground=None, progress=None, note=None, start=None):
     """Read the records (resampled to `sample_interval` [s] if given, the trial CSVs' u, v
     over ground if `over_ground`: `read_experiments`),
     fit `model` (as `jaxship identify` does, for start values), run discovery and write
     `out/discovery.json`, `out/report.md` and `out/figures/`. Returns the
     `DiscoveryReport`. `progress` takes the stage messages, `note` (default `progress`)
     what was done to the records (files skipped, resampling): the command prints notes
-    even when quiet."""
+    even when quiet. `start`: a model to start from (`--vessel`), fitted as `model`
+    (`start_entry`)."""
     say = progress or (lambda message: None)
     note = note or say
-    get_model_entry(model)  # an unknown model fails before any file is read
+    name = start_entry(model, start)[0] if start is not None else model_key(model)
     if max_effects < 1:
         raise ValueError(f"--max-effects must be at least 1, got {max_effects}.")
     if not 0 < alpha < 1:
@@ -43,11 +44,12 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
                                over_ground=over_ground) if holdout_paths else None
     check_writes(pathlib.Path(out), tuple(f"figures/{_figure_name(i)}"
                                           for i in range(len(holdout or train))))
-    name, length = model_key(model), preset_length(model_key(model))
+    length = float(start.length) if isinstance(start, js.AbstractVessel) else \
+        preset_length(name)
     if holdout and length is not None:  # identify checks the training records
         check_froude(holdout, length, "held-out", name)
-    say(f"start values: identify {model} on {len(train)} training records")
-    start = identify(train, model=model).fit.model
+    say(f"start values: identify {name} on {len(train)} training records")
+    start = identify(train, model=name, start=start).fit.model
     report = js.discover(start, train, holdout, max_effects=max_effects, alpha=alpha,
                          progress=say)
     with staged_folder(pathlib.Path(out)) as stage:  # all or nothing

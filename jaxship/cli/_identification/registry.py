@@ -54,14 +54,17 @@ class ModelEntry:
     fit: Callable | None = None
 
 
-def _vessel_entry(name: str) -> ModelEntry:
+def _vessel_entry(name: str, vessel=None, description: str = "") -> ModelEntry:
+    """The entry of the vessel preset `name`, or of the `vessel` given (`--vessel`)."""
     def start(train, context):
-        return js.vessel(name)
+        return js.vessel(name) if vessel is None else vessel
 
     return ModelEntry(
-        "vessel preset (3-DOF, default_free estimated): " + js.VESSELS[name].description,
+        "vessel preset (3-DOF, default_free estimated): " + js.VESSELS[name].description
+        if vessel is None else description,
         start, start,
-        start_method=f"the preset's coefficients (get_vessel({name!r}))",
+        start_method=f"the preset's coefficients (get_vessel({name!r}))" if vessel is None
+        else "the given vessel's coefficients (--vessel)",
         channels=("psi", "r", "u", "v"), default_channels=("psi", "r", "u", "v"),
         requires=("u", "v"), initial=("measured",),
     )
@@ -129,6 +132,25 @@ def model_key(name: str) -> str:
         if candidate in MODELS:
             return candidate
     raise ValueError(f"unknown model {name!r}; choose from {', '.join(MODELS)}.")
+
+
+OWN_VESSEL = "vessel"  # the registry name of a vessel of one's own (a vessel file)
+
+
+def start_entry(name: str | None, start) -> tuple[str, ModelEntry]:
+    """`(name, entry)` of a fit that starts from the model `start` (`--vessel`: a preset,
+    a vessel file, an earlier result): a vessel is fitted as the presets are (its
+    `default_free` coefficients; named by its preset `name`, else `OWN_VESSEL`), a
+    steering model as the registry's `name`; the start values are `start`'s own."""
+    if isinstance(start, js.AbstractVessel):
+        key = name if name in js.VESSELS else OWN_VESSEL
+        base = start.base if isinstance(start, js.AugmentedVessel) else start
+        description = f"vessel {type(base).__name__} (3-DOF, default_free estimated)"
+        return key, _vessel_entry(key, start, description)
+    key = model_key(name)
+    given = lambda train, context: start
+    return key, dataclasses.replace(MODELS[key], start=given, fallback=given,
+                                    start_method="the given model's values (--vessel)")
 
 
 def get_model_entry(name: str) -> ModelEntry:

@@ -10,14 +10,15 @@ import math
 import pathlib
 import re
 
-import equinox as eqx
 import jax
 import numpy as np
 
 import jaxship as js
 
-from ..._foundation._params import parameter_fields
+from ..._foundation._contract import AbstractComposite
+from ..._foundation._params import get_path, parameter_fields, rebuild
 from ..._foundation._validate import _to_plain
+from ..._models._vessel.file import vessel_from_dict, vessel_to_dict
 from .assessment import Assessment
 from .registry import model_key
 
@@ -82,7 +83,7 @@ class IdentificationResult:
         """JSON-ready report (schema in the `identify` docstring)."""
         fitted = self.fit.to_dict()
         report = self.fit.parameters
-        start = {n: _to_plain(float(getattr(self.start, n))) for n in report.names}
+        start = {n: _to_plain(float(get_path(self.start, n))) for n in report.names}
         parameters = {}
         for name, entry in fitted["parameters"].items():
             rel = report.relative_std[report.names.index(name)]
@@ -112,6 +113,7 @@ class IdentificationResult:
             "parameters": parameters,
             "frozen": fitted["frozen"],
             "constants": _constants(self.model),
+            **_structure(self.model),
             "fit": {k: fitted[k] for k in ("success", "code", "result", "num_steps", "cost",
                                           "window_samples", "weights")},
             "train": self.train.to_dict(),
@@ -150,6 +152,34 @@ def _constants(model) -> dict:
     return out
 
 
+def _structure(model) -> dict:
+    """What rebuilds the model beside its values: `effects`, the class names of its
+    effects in order (a model with effects), and `vessel`, the fitted vessel in the
+    vessel file's form (`vessel_to_dict`), so that a vessel of one's own file comes back."""
+    base = model.base if isinstance(model, AbstractComposite) else model
+    out = {}
+    if isinstance(model, AbstractComposite):
+        out["effects"] = [type(effect).__name__ for effect in model.effects]
+    if isinstance(base, js.AbstractVessel):
+        out["vessel"] = _to_plain(vessel_to_dict(base))
+    return out
+
+
+def _with_effects(model, names):
+    """`model` with the effects of the class names `names` (default values) added."""
+    effects = []
+    for name in names:
+        cls = getattr(js, str(name), None)
+        if not (isinstance(cls, type) and issubclass(cls, js.AbstractEffect)):
+            raise ValueError(f"unknown effect {name!r} in the identify result.")
+        try:
+            effects.append(cls())
+        except TypeError:
+            raise ValueError(f"the effect {name} needs more than its parameters (a record); "
+                             "it cannot be rebuilt from result.json.") from None
+    return js.augment(model, *effects) if effects else model
+
+
 # "RossAutopilot reference scales (frozen): L = 1.2 m, U0 = 1.1 m/s, n0 = 6.1 rev/s" (start_ross)
 _ROSS_SCALES = re.compile(r"L = (\S+) m, U0 = (\S+) m/s, n0 = (\S+) rev/s")
 
@@ -167,21 +197,27 @@ def _number(name, value) -> float:
 def model_from_report(report: dict):
     """The fitted model of an `identify` report (`IdentificationResult.to_dict()`, i.e.
     the parsed `result.json` of `jaxship identify`): a steering model rebuilt from its
-    class name, `parameters` (values), `frozen` and `constants`, or a vessel preset
-    with its estimated and frozen coefficients. Reports written before `constants`
-    existed rebuild `RossAutopilot` from the reference-scale note of its start.
+    class name, `parameters` (values), `frozen` and `constants`, or a vessel from its
+    `vessel` (the vessel file's form; older reports: the preset `model`) with its
+    estimated and frozen coefficients; either with the effects of `effects` (class
+    names) and their fitted parameters. Reports written before `constants` existed
+    rebuild `RossAutopilot` from the reference-scale note of its start.
 
     **Raises** `ValueError` (one line) for a report without `model` and `parameters`,
-    non-numeric values, an ARMAX model (discrete, no yaw equation to design on) or a
-    model with effects."""
+    non-numeric values, an ARMAX model (discrete, no yaw equation to design on) or an
+    effect that needs more than its parameters (a recorded disturbance)."""
     if not isinstance(report, dict) or not isinstance(report.get("parameters"), dict) or \
             "model" not in report:
         raise ValueError("not an identify result: no 'model' and 'parameters' (write one "
                          "with `jaxship identify`).")
+    own_vessel = isinstance(report.get("vessel"), dict)
     try:
         name = model_key(report["model"])
     except ValueError:
-        raise ValueError(f"unknown model {report['model']!r} in the identify result.") from None
+        if not own_vessel:
+            raise ValueError(f"unknown model {report['model']!r} in the identify result.") \
+                from None
+        name = str(report["model"])
     for key, kind in (("frozen", dict), ("constants", dict), ("notes", list)):
         if report.get(key) is not None and not isinstance(report[key], kind):
             raise ValueError(f"'{key}' in the identify result is a {type(report[key]).__name__}, "
@@ -191,21 +227,16 @@ def model_from_report(report: dict):
         values[key] = _number(key, entry.get("value") if isinstance(entry, dict) else entry)
     for key, value in (report.get("frozen") or {}).items():
         values[key] = _number(key, value)
-    if any("." in key for key in values):
-        raise ValueError(f"the {name} result has effect parameters "
-                         f"({', '.join(k for k in values if '.' in k)}); models with effects "
-                         "cannot be rebuilt from result.json.")
     if name == "armax":
         raise ValueError("armax is a discrete model of the yaw rate: it has no yaw equation "
                          "to design an autopilot on; identify a steering model.")
-    if name in js.VESSELS:
-        model = js.vessel(name)
-        known = parameter_fields(model)
-        unknown = [k for k in values if k not in known]
-        if unknown:
-            raise ValueError(f"the {name} preset has no coefficient {unknown[0]!r}.")
-        return eqx.tree_at(lambda m: tuple(getattr(m, k) for k in values), model,
-                           tuple(values.values()))
+    effects = report.get("effects") or []
+    if any("." in key for key in values) and not effects:
+        raise ValueError(f"the {name} result has effect parameters "
+                         f"({', '.join(k for k in values if '.' in k)}) but no 'effects'.")
+    if own_vessel or name in js.VESSELS:
+        base = vessel_from_dict(_finite(report["vessel"])) if own_vessel else js.vessel(name)
+        return _set_values(_with_effects(base, effects), values, name)
     cls = getattr(js, str(report.get("model_class", "")), None)
     if not (isinstance(cls, type) and issubclass(cls, js.AbstractSteeringModel)):
         raise ValueError(f"unknown model class {report.get('model_class')!r} in the identify "
@@ -219,11 +250,31 @@ def model_from_report(report: dict):
                              "re-run `jaxship identify` to write them.")
         constants = dict(zip(("length", "speed", "rate"), found[0].groups()))
     constants = {k: _number(k, v) for k, v in (constants or {}).items()}
+    own = {k: v for k, v in values.items() if "." not in k}
     try:
-        return cls(**constants, **values)
+        model = cls(**constants, **own)
     except TypeError as error:
         raise ValueError(f"cannot rebuild {cls.__name__} from the identify result: "
                          f"{error}.") from None
+    return _set_values(_with_effects(model, effects), values, name)
+
+
+def _set_values(model, values: dict, name: str):
+    """`model` with the parameters `values` (`{name or "<effect id>.<field>": value}`)."""
+    known = parameter_fields(model)
+    unknown = [k for k in values if k not in known]
+    if unknown:
+        raise ValueError(f"the {name} model has no coefficient {unknown[0]!r}.")
+    return rebuild(model, tuple(values), tuple(values.values())) if values else model
+
+
+def _finite(data):
+    """The vessel dict of a result with the "inf" strings of JSON as floats again."""
+    if isinstance(data, dict):
+        return {k: _finite(v) for k, v in data.items()}
+    if isinstance(data, list):
+        return [_finite(v) for v in data]
+    return float(data) if data in ("inf", "-inf") else data
 
 
 def read_result(path) -> tuple[object, dict]:

@@ -34,7 +34,7 @@ from .data import (
     same_records,
     valid_samples,
 )
-from .registry import MODELS, model_key
+from .registry import MODELS, model_key, start_entry
 from .result import IdentificationResult
 from .simulation import simulate_records
 from .starts import StartContext
@@ -69,7 +69,8 @@ def _parse_channels(channels, allowed) -> tuple[str, ...]:
 def identify(train, *, model: str, horizon: float | None = None, validate=None,
              rudder: str = "delta", channels=None, initial: str = "auto",
              max_steps: int = 256, substeps: int = 1,
-             progress: Callable[[Progress], None] | None = None) -> IdentificationResult:
+             progress: Callable[[Progress], None] | None = None,
+             start=None) -> IdentificationResult:
     """Estimate a registered steering model from training records and validate it.
 
     **Arguments:**
@@ -100,6 +101,9 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
       simulations always start from the measured state.
     - `max_steps`: optimiser step limit; `substeps`: RK4 steps per sample interval.
     - `progress`: a callable receiving `Progress` reports, or None (quiet).
+    - `start`: a model to start from (`--vessel`: a vessel of a preset or a vessel
+      file, the model of an earlier result), fitted as `model` is (`start_entry`); a
+      vessel's `model` is its preset name, or None for a vessel of one's own.
 
     Start values: the entry's `start` (linear least squares by `initial_estimate`,
     or a nested fit); if it fails (e.g. no excitation) the entry's neutral
@@ -132,8 +136,8 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     from r, r differenced from psi); a note says so, and with the default `channels`
     such a channel is not fitted when every training record lacks it.
     """
-    name = model_key(model)
-    entry = MODELS[name]
+    name, entry = start_entry(model, start) if start is not None else \
+        (model_key(model), MODELS[model_key(model)])
     if rudder not in ("delta", "delta_c"):
         raise ValueError(f"unknown rudder channel {rudder!r}; choose 'delta' (measured angle) "
                          "or 'delta_c' (command).")
@@ -161,7 +165,8 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     if validate is not None:
         held_out = as_experiments(validate, "validation")
         check_experiments(held_out, rudder, "validation", name, entry.requires)
-    length = preset_length(name)
+    length = float(start.length) if isinstance(start, js.AbstractVessel) else \
+        preset_length(name)
     if length is not None:
         check_froude(train_exps, length, "training", name)
         check_froude(held_out or [], length, "validation", name)

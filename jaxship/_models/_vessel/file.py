@@ -1,0 +1,226 @@
+"""The vessel file: a vessel's class and every coefficient in a TOML file, with units.
+
+One coefficient a line, `name = { value = 3.0, unit = "m" }` where it is dimensional
+and a bare number where it is not (units as in the class's `param` fields: SI, radians,
+rev/s; degrees, deg/s and rpm are read too); the rudder servo and the shaft are the
+tables `[rudder]` and `[shaft]`. Floats are written with `repr`, so that a vessel
+reads back bit for bit. `vessel_to_dict` / `vessel_from_dict` are the same content as
+a dict (what `jaxship identify` stores in its result).
+"""
+
+import dataclasses
+import inspect
+import math
+import pathlib
+import re
+import tomllib
+
+from ..._foundation._params import parameter_fields
+from .._actuators import RudderServo, Shaft
+from ._base import AbstractVessel
+from .esso_osaka import LowSpeedMMGVessel
+from .mariner import Mariner
+from .mmg import MMGVessel
+from .nomoto import NomotoVessel
+from .ross import RossVessel
+from .sway_yaw import SwayYawVessel
+
+
+CLASSES = {c.__name__: c for c in (RossVessel, Mariner, MMGVessel, LowSpeedMMGVessel,
+                                   SwayYawVessel, NomotoVessel)}
+# the actuators' fields and units (RudderServo, Shaft)
+ACTUATORS = {"rudder": (RudderServo, {"max_angle": "rad", "max_rate": "rad/s",
+                                      "time_constant": "s"}),
+             "shaft": (Shaft, {"max_rate": "rev/s", "time_constant": "s"})}
+# other units read for a field's own, and the factor to it
+OTHER_UNITS = {"rad": {"deg": math.pi / 180}, "rad/s": {"deg/s": math.pi / 180},
+               "rev/s": {"rpm": 1 / 60}}
+# physical ranges beyond the fields' bounds: sizes, masses and densities are positive
+POSITIVE = {"length", "draft", "draught", "volume", "rho", "mass", "m", "mass_nd", "iz",
+            "i_zz_j_zz", "propeller_diameter", "prop_diameter", "rudder_area", "rudder_span",
+            "radius_of_gyration", "rudder_aspect_ratio", "nominal_speed",
+            "rudder.max_rate", "rudder.time_constant", "shaft.max_rate", "shaft.time_constant"}
+NON_NEGATIVE = {"nominal_n", "frontal_wind_area", "lateral_wind_area"}
+UNBOUNDED_OK = {"shaft.max_rate"}  # no limit on the shaft's rate
+
+
+def _unit(info) -> str:
+    return "" if info.unit in ("", "-") else info.unit
+
+
+def vessel_to_dict(vessel: AbstractVessel) -> dict:
+    """`{"model": class name, field: value or {"value", "unit"}, "rudder": {...},
+    "shaft": {...}}`: every field of `vessel`, floats as they are (SI)."""
+    if type(vessel).__name__ not in CLASSES:
+        raise ValueError(f"{type(vessel).__name__} has no vessel file form; the vessel "
+                         f"classes are {', '.join(CLASSES)}.")
+    params = parameter_fields(vessel)
+    out = {"model": type(vessel).__name__}
+    for field in dataclasses.fields(vessel):
+        value = getattr(vessel, field.name)
+        if field.name in ACTUATORS:
+            units = ACTUATORS[field.name][1]
+            out[field.name] = {k: {"value": float(getattr(value, k)), "unit": u}
+                               for k, u in units.items()}
+        elif isinstance(value, tuple):
+            out[field.name] = [float(v) for v in value]
+        else:
+            unit = _unit(params[field.name])
+            out[field.name] = {"value": float(value), "unit": unit} if unit else float(value)
+    return out
+
+
+def _number(text, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"{text} is {value!r}, not a number.")
+    return float(value)
+
+
+def _value(name, entry, unit, bounds=(-math.inf, math.inf)) -> float:
+    """The SI value of the field `name` from its `entry` (a number, or `{value, unit}`),
+    checked against its `unit` and physical range."""
+    if isinstance(entry, dict):
+        extra = set(entry) - {"value", "unit"}
+        if extra or "value" not in entry or "unit" not in entry:
+            raise ValueError(f"field '{name}': write {{ value = ..., unit = \"{unit or '-'}\" }}"
+                             f" (got the keys {', '.join(sorted(entry))}).")
+        given, value = entry["unit"], _number(f"field '{name}'", entry["value"])
+    else:
+        given, value = unit or "-", _number(f"field '{name}'", entry)
+        if unit:
+            raise ValueError(f"field '{name}': give its unit, {{ value = {value!r}, unit = "
+                             f"\"{unit}\" }}.")
+    if given in OTHER_UNITS.get(unit, {}):
+        value *= OTHER_UNITS[unit][given]
+    elif given != (unit or "-"):
+        known = [unit or "-", *OTHER_UNITS.get(unit, {})]
+        raise ValueError(f"field '{name}': unit {given!r} is wrong; give it in "
+                         f"{' or '.join(repr(u) for u in known)}.")
+    lower, upper = bounds
+    if name in POSITIVE:
+        lower = max(lower, 0.0)
+    if not (math.isfinite(value) or name in UNBOUNDED_OK and value == math.inf):
+        raise ValueError(f"field '{name}' is {value!r}: give a finite number.")
+    if (name in POSITIVE and not value > 0) or (name in NON_NEGATIVE and value < 0) \
+            or not lower <= value <= upper or name == "rudder.max_angle" and \
+            not 0 < value <= math.pi / 2:
+        what = ("between 0 and 90 deg" if name == "rudder.max_angle" else "positive"
+                if name in POSITIVE else "not negative" if name in NON_NEGATIVE
+                else f"between {lower:g} and {upper:g}")
+        shown = f"{value!r} {unit}".strip()
+        raise ValueError(f"field '{name}' = {shown} is out of its physical range: it must be "
+                         f"{what}.")
+    return value
+
+
+def _fields(cls, data: dict, expected: dict, where: str = "") -> dict:
+    """`data`'s keys checked against `expected` (names to anything): unknown, missing."""
+    for key in data:
+        if key not in expected:
+            raise ValueError(f"unknown field '{where}{key}' for {cls.__name__}; its fields "
+                             f"are {', '.join(expected)}.")
+    for key in expected:
+        if key not in data:
+            raise ValueError(f"missing field '{where}{key}' of {cls.__name__}.")
+    return data
+
+
+def vessel_from_dict(data: dict) -> AbstractVessel:
+    """The vessel of `vessel_to_dict`'s form. **Raises** `ValueError` (one line naming
+    the field) for an unknown model class, an unknown or missing field, a wrong unit or
+    a value outside its physical range."""
+    if not isinstance(data, dict) or "model" not in data:
+        raise ValueError(f"missing field 'model' (the vessel class: {', '.join(CLASSES)}).")
+    cls = CLASSES.get(data["model"])
+    if cls is None:
+        raise ValueError(f"field 'model': unknown vessel class {data['model']!r}; choose "
+                         f"one of {', '.join(CLASSES)}.")
+    params = {f.name: f.metadata.get("jaxship_parameter") for f in dataclasses.fields(cls)}
+    values = _fields(cls, {k: v for k, v in data.items() if k != "model"}, params)
+    kwargs = {}
+    for name, info in params.items():
+        entry = values[name]
+        if name in ACTUATORS:
+            actuator, units = ACTUATORS[name]
+            if not isinstance(entry, dict):
+                raise ValueError(f"field '{name}' must be a table [{name}] of "
+                                 f"{', '.join(units)}.")
+            _fields(actuator, entry, units, f"{name}.")
+            kwargs[name] = actuator(**{k: _value(f"{name}.{k}", entry[k], u)
+                                       for k, u in units.items()})
+        elif info is None:  # a tuple of dimensionless coefficients
+            if not isinstance(entry, list):
+                raise ValueError(f"field '{name}' must be a list of numbers.")
+            kwargs[name] = tuple(_number(f"field '{name}'", v) for v in entry)
+        else:
+            kwargs[name] = _value(name, entry, _unit(info), (info.lower, info.upper))
+    return cls(**kwargs)
+
+
+def _comments(cls) -> dict:
+    """The trailing comments of the class's field lines (symbol and source), by name."""
+    try:
+        source = inspect.getsource(cls)
+    except (OSError, TypeError):
+        return {}
+    above = dict((k, v) for v, k in re.findall(r"^    #\s*(.*)\n    (\w+): ", source, flags=re.M))
+    return above | dict(re.findall(r"^    (\w+): [^#\n]*#\s*(.*)$", source, flags=re.M))
+
+
+def _toml_value(entry) -> str:
+    if isinstance(entry, dict):
+        return f"{{ value = {_float(entry['value'])}, unit = \"{entry['unit']}\" }}"
+    if isinstance(entry, list):
+        return "[" + ", ".join(map(_float, entry)) + "]"
+    return _float(entry)
+
+
+def _float(value: float) -> str:
+    return repr(float(value))  # exact; TOML spells inf, -inf and nan as Python does
+
+
+def vessel_text(vessel: AbstractVessel, *, source: str = "") -> str:
+    """The vessel file's text (TOML) of `vessel`, with `source` (a line: where its
+    coefficients come from) in the header."""
+    data = vessel_to_dict(vessel)
+    comments = _comments(type(vessel))
+    lines = ["# jaxship vessel file: `--vessel FILE` on the command line, "
+             "jaxship.load_vessel in Python.",
+             "# A dimensional coefficient is { value = ..., unit = \"...\" } in SI units "
+             "(deg, deg/s, rpm read too);",
+             "# a bare number is dimensionless. Every field is required.",
+             *([f"# {source}"] if source else []),
+             f"model = \"{data.pop('model')}\""]
+    tables = {k: data.pop(k) for k in ACTUATORS}
+    for name, entry in data.items():
+        note = comments.get(name, "")
+        lines.append(f"{name} = {_toml_value(entry)}" + (f"  # {note}" if note else ""))
+    for name, table in tables.items():
+        lines += ["", f"[{name}]"] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
+    return "\n".join(lines) + "\n"
+
+
+def save_vessel(vessel: AbstractVessel, path, *, source: str = "") -> pathlib.Path:
+    """Write `vessel` as a vessel file (TOML, `vessel_text`) at `path`; returns the path."""
+    path = pathlib.Path(path)
+    path.write_text(vessel_text(vessel, source=source), encoding="utf-8")
+    return path
+
+
+def load_vessel(path) -> AbstractVessel:
+    """The vessel of the vessel file at `path` (see `save_vessel`). **Raises**
+    `ValueError`, one line naming the file and the field: not TOML, an unknown or
+    missing field, a wrong unit, a value out of its physical range."""
+    path = pathlib.Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as error:
+        raise ValueError(f"cannot read {path}: {error.strerror or error}.") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"{path} is not a text file; give a vessel file (TOML).") from None
+    except tomllib.TOMLDecodeError as error:
+        raise ValueError(f"{path} is not a vessel file (TOML): {error}.") from None
+    try:
+        return vessel_from_dict(data)
+    except ValueError as error:
+        raise ValueError(f"{path}: {error}") from None

@@ -1,0 +1,198 @@
+"""Vessel files (`save_vessel`, `load_vessel`, `jaxship vessels --show`) and `--vessel`
+taking a preset, a vessel file or an identify result (issue 62)."""
+
+import json
+import math
+
+import jax
+import numpy as np
+import pytest
+
+import jaxship as js
+from jaxship._foundation._validate import _to_plain
+from jaxship._models._vessel.file import vessel_text, vessel_to_dict
+from jaxship.cli import main
+from jaxship.cli._identification import model_from_report, read_result
+
+
+@pytest.mark.parametrize("name", list(js.VESSELS))
+def test_every_preset_round_trips_bit_for_bit(name, tmp_path):
+    """Written and read back, each preset has the same class and leaves, bit for bit,
+    and simulates to the same trajectory."""
+    vessel = js.vessel(name)
+    back = js.load_vessel(js.save_vessel(vessel, tmp_path / f"{name}.toml"))
+    assert type(back) is type(vessel)
+    leaves, tree = jax.tree.flatten(vessel)
+    again, tree_back = jax.tree.flatten(back)
+    assert tree == tree_back
+    assert all(np.float64(a).tobytes() == np.float64(b).tobytes()
+               for a, b in zip(leaves, again))
+    manoeuvre = js.ZigZag(math.radians(10), math.radians(10), duration=20.0, dt=0.5)
+    x0 = js.straight_state(float(vessel.nominal_speed), float(vessel.nominal_n))
+    first, second = js.simulate(vessel, manoeuvre, x0), js.simulate(back, manoeuvre, x0)
+    for a, b in zip(jax.tree.leaves(first), jax.tree.leaves(second)):
+        assert np.array_equal(np.asarray(a), np.asarray(b))
+
+
+def test_vessels_show_writes_a_file_that_simulate_reads(tmp_path, capsys):
+    assert main(["vessels", "--show", "kvlcc2"]) == 0
+    text = capsys.readouterr().out
+    assert 'model = "MMGVessel"' in text and 'length = { value = 7.0, unit = "m" }' in text
+    path = tmp_path / "ship.toml"
+    path.write_text(text)
+    assert main(["simulate", "--vessel", str(path), "--manoeuvre", "zigzag:10/10",
+                 "--out", str(tmp_path / "own")]) == 0
+    assert main(["simulate", "--vessel", "kvlcc2", "--manoeuvre", "zigzag:10/10",
+                 "--out", str(tmp_path / "preset")]) == 0
+    capsys.readouterr()
+    own, preset = (json.loads((tmp_path / d / "indices.json").read_text())
+                   for d in ("own", "preset"))
+    assert own == preset
+
+
+BAD = [
+    ('length = { value = 3.0, unit = "m" }', 'lenght = { value = 3.0, unit = "m" }',
+     "unknown field 'lenght'"),
+    ('x_0f = -0.02139  # X_0F\', resistance coefficient ahead\n', "", "missing field 'x_0f'"),
+    ('length = { value = 3.0, unit = "m" }', 'length = { value = 3.0, unit = "ft" }',
+     "field 'length': unit 'ft' is wrong"),
+    ('length = { value = 3.0, unit = "m" }', 'length = { value = -3.0, unit = "m" }',
+     "field 'length' = -3.0 m is out of its physical range"),
+    ('max_angle = { value = 0.6108652381980153, unit = "rad" }',
+     'max_angle = { value = 135, unit = "deg" }',
+     "field 'rudder.max_angle' = 2.356194490192345 rad is out of its physical range"),
+    ('model = "LowSpeedMMGVessel"', 'model = "Tugboat"', "unknown vessel class 'Tugboat'"),
+    ('length = { value = 3.0, unit = "m" }', "length = 3.0", "field 'length': give its unit"),
+    ('model = "LowSpeedMMGVessel"', 'model = "LowSpeedMMGVessel', "is not a vessel file (TOML)"),
+]
+
+
+@pytest.mark.parametrize("old, new, message", BAD, ids=[b[2] for b in BAD])
+def test_a_bad_vessel_file_is_one_line_and_exit_2(old, new, message, tmp_path, capsys):
+    text = vessel_text(js.vessel("esso_osaka"))
+    assert old in text
+    path = tmp_path / "bad.toml"
+    path.write_text(text.replace(old, new, 1))
+    out = tmp_path / "out"
+    code = main(["simulate", "--vessel", str(path), "--manoeuvre", "turn:35", "--out",
+                 str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert message in err and str(path) in err, err
+    assert not out.exists()
+
+
+def test_degrees_and_rpm_are_read_in_a_file(tmp_path):
+    text = vessel_text(js.vessel("esso_osaka"))
+    text = text.replace('max_angle = { value = 0.6108652381980153, unit = "rad" }',
+                        'max_angle = { value = 35, unit = "deg" }')
+    text = text.replace('nominal_n = { value = 10.0, unit = "rev/s" }',
+                        'nominal_n = { value = 600, unit = "rpm" }')
+    path = tmp_path / "deg.toml"
+    path.write_text(text)
+    vessel = js.load_vessel(path)
+    assert vessel.rudder.max_angle == pytest.approx(math.radians(35), abs=1e-15)
+    assert vessel.nominal_n == 10.0
+
+
+def test_identify_then_simulate_reproduces_the_fitted_model(tmp_path, capsys):
+    """A Nomoto 1 fitted to a thesis-vessel zig-zag: `simulate --vessel result.json`
+    runs the fitted model (the same trajectory as the fit's model in Python), and the
+    rebuilt model replays its training record to the fit % of the result."""
+    trial = tmp_path / "trial"
+    assert main(["simulate", "--vessel", "thesis", "--manoeuvre", "zigzag:20/20",
+                 "--out", str(trial)]) == 0
+    fit = tmp_path / "fit"
+    assert main(["identify", str(trial / "trial.csv"), "--model", "nomoto1", "--quiet",
+                 "--no-figures", "--out", str(fit)]) == 0
+    assert main(["simulate", "--vessel", str(fit / "result.json"), "--manoeuvre",
+                 "zigzag:20/20", "--out", str(tmp_path / "sim")]) == 0
+    capsys.readouterr()
+    report = json.loads((fit / "result.json").read_text())
+    fitted = js.Nomoto1(**{k: e["value"] for k, e in report["parameters"].items()},
+                        **report["frozen"])
+    record = js.read_trial_csv(trial / "trial.csv")
+    dt = float(record.t[1] - record.t[0])
+    ours = js.simulate(fitted, js.ZigZag(math.radians(20), math.radians(20),
+                                         duration=float(record.t[-1]), dt=dt),
+                       simulator=js.Simulator(substeps=2))
+    simulated = js.read_trial_csv(tmp_path / "sim" / "trial.csv")
+    assert simulated.t.size == ours.t.size
+    np.testing.assert_allclose(simulated.psi, np.asarray(ours.state.psi), atol=1e-9)
+    model, _ = read_result(fit / "result.json")
+    assert model == fitted
+    predicted = js.predict(model, record, estimator=js.PredictionError(horizon=None))
+    assert predicted.metrics["psi"].fit_percent == pytest.approx(
+        report["train_simulation"]["channels"]["psi"]["fit_percent"], abs=0.5)
+
+
+def test_imo_check_of_a_preset_and_a_steering_model_refused(tmp_path, capsys):
+    out = tmp_path / "imo"
+    assert main(["simulate", "--vessel", "kvlcc2", "--manoeuvre", "imo", "--out",
+                 str(out)]) == 0
+    printed = capsys.readouterr().out
+    indices = json.loads((out / "indices.json").read_text())
+    rows = {r["criterion"]: r for r in indices["imo_criteria"]}
+    assert len(rows) == 6 and "stopping: track reach, full astern" in rows
+    for row in rows.values():
+        assert row["margin"] == pytest.approx(row["limit"] - row["value"])
+        assert row["passed"] == (row["margin"] >= 0) and row["band"] is None
+    assert indices["uncertainty"]["from"].startswith("none")
+    assert {"criteria.md", "imo_criteria.png", "turn35.png", "stop.png"} <= {
+        p.name for p in out.iterdir()}
+    assert "| criterion | value | limit | margin" in printed
+
+
+def test_imo_band_from_the_standard_errors_of_a_result(tmp_path, capsys):
+    """Independent normal draws from std where the result stores no correlation."""
+    vessel = js.vessel("kvlcc2")
+    result = tmp_path / "result.json"
+    result.write_text(json.dumps({"model": "kvlcc2", "parameters": {
+        "n_r": {"value": float(vessel.n_r), "std": 0.002 * abs(float(vessel.n_r))}}}))
+    out = tmp_path / "imo"
+    assert main(["simulate", "--vessel", str(result), "--manoeuvre", "imo", "--out",
+                 str(out)]) == 0
+    capsys.readouterr()
+    indices = json.loads((out / "indices.json").read_text())
+    assert indices["uncertainty"]["from"].startswith("independent normal draws from std")
+    assert indices["uncertainty"]["used"] == indices["uncertainty"]["draws"] > 0
+    for row in indices["imo_criteria"]:
+        low, high = row["band"]  # n_r moves the turn; the stop hardly
+        assert low <= row["value"] * 1.01 and high >= row["value"] * 0.99
+        assert low < high or row["criterion"].startswith("stopping")
+
+
+def test_a_result_of_ones_own_vessel_rebuilds_it_with_effects():
+    """`result.json` keeps the vessel (`vessel`) and its effects (`effects`): a vessel of
+    a file comes back with its fitted values, effect parameters included."""
+    vessel = js.vessel("kvlcc2")
+    report = {"model": "vessel", "parameters": {
+        "n_r": {"value": 0.01, "std": 0.001}, "rudder_offset.delta0": {"value": 0.02}},
+        "vessel": _to_plain(vessel_to_dict(vessel)), "effects": ["RudderOffset"]}
+    model = model_from_report(report)
+    assert isinstance(model, js.AugmentedVessel)
+    assert model.base.n_r == 0.01 and model.effects[0].delta0 == 0.02
+    assert model.base.shaft.max_rate == math.inf
+
+
+def test_identify_starts_from_a_result_and_autopilot_needs_a_vessel(tmp_path, capsys):
+    model = js.Nomoto1(K=0.05, T=10.0)
+    zigzag = js.simulate(model, js.ZigZag(math.radians(10), math.radians(10),
+                                          duration=200.0, dt=1.0))
+    record = tmp_path / "zigzag.csv"
+    js.write_trial_csv(record, js.Experiment.from_trajectory(zigzag))
+    fit = ["identify", str(record), "--no-figures", "--quiet"]
+    assert main([*fit, "--model", "nomoto1", "--out", str(tmp_path / "a")]) == 0
+    assert main([*fit, "--vessel", str(tmp_path / "a" / "result.json"),
+                 "--out", str(tmp_path / "b")]) == 0
+    again = json.loads((tmp_path / "b" / "result.json").read_text())
+    assert again["model"] == "nomoto1" and "--vessel" in again["start"]["method"]
+    assert again["parameters"]["K"]["value"] == pytest.approx(0.05, rel=2e-2)
+    capsys.readouterr()
+    assert main([*fit, "--model", "nomoto1", "--vessel", "thesis", "--out",
+                 str(tmp_path / "c")]) == 2
+    assert "one of them" in capsys.readouterr().err
+    assert main(["autopilot", "--model", str(tmp_path / "a" / "result.json"), "--vessel",
+                 str(tmp_path / "a" / "result.json"), "--rpm", "300", "--out",
+                 str(tmp_path / "d")]) == 2
+    assert "this needs a vessel" in capsys.readouterr().err
