@@ -708,3 +708,17 @@ def test_a_report_says_first_when_the_base_model_does_not_describe_the_records(m
     assert report.to_markdown().splitlines()[:3] == ["# Discovery report", "", first[0]]
     fine = dataclasses.replace(report, holdout_fit_percent_before={"psi": 5.0, "r": 12.0})
     assert fine._base_does_not_describe() == []
+
+
+@pytest.mark.parametrize("duration", [0.2, 1.0])
+def test_a_record_too_short_to_judge_is_refused_not_nothing_missing(duration):
+    """Issue 57 case 4: `discover` on one record of 0.2 s or 1 s said "nothing missing";
+    its base fit leaves K and T undetermined (only K/T shows in so short a turn), so no
+    missing effect can be judged: a `FitError` saying so (the command's exit 3)."""
+    truth = js.Nomoto1(K=0.06, T=25.0)
+    delta = np.full(int(round(duration / 0.1)) + 1, 10 * DEG)
+    tr = js.simulate(truth, js.Replay(delta, dt=0.1))
+    short = js.Experiment(np.asarray(tr.t), delta, psi=np.asarray(tr.state.psi),
+                          r=np.asarray(tr.state.r), name="short")
+    with pytest.raises(js.FitError, match="cannot tell whether an effect is missing"):
+        js.discover(js.Nomoto1(K=0.05, T=20.0), [short])

@@ -197,6 +197,10 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
     - `progress`: a callable taking a message string (the CLI's progress bar).
 
     **Returns:** a `DiscoveryReport`.
+
+    **Raises:** `jaxship.FitError` where the base model's fit leaves its parameters
+    undetermined or never moves (records too short or too poor to judge a missing
+    effect), or where its prediction of the held-out records blows up.
     """
     say = progress or (lambda message: None)
     free = tuple(default_free(model) if free is None else free)
@@ -232,6 +236,11 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
 
     say("fitting the base model")
     base_fit = fit(model, train, estimator=loss(model), free=free)
+    if base_fit.code in (RESULTS.poorly_determined, RESULTS.did_not_move):
+        raise FitError(  # records too short or too poor: no effect can be judged missing
+            f"the base model's fit to the training records is {base_fit.code_name} "
+            f"({base_fit.message}): these records cannot tell whether an effect is missing; "
+            "give longer records that excite the model (e.g. zig-zags).")
     channels = tuple(base_fit.metrics)
     current, cost = base_fit, base_fit.cost
     # effects join in one order, the start model's first, then the catalogue's: each
