@@ -196,3 +196,19 @@ def test_identify_starts_from_a_result_and_autopilot_needs_a_vessel(tmp_path, ca
                  str(tmp_path / "a" / "result.json"), "--rpm", "300", "--out",
                  str(tmp_path / "d")]) == 2
     assert "this needs a vessel" in capsys.readouterr().err
+
+
+def test_simulate_reads_the_fit_code_of_its_result(tmp_path, capsys):
+    """Issue 57's "every command reads the code of what it consumes": a result whose fit
+    did not converge simulates, says so first on stderr and exits 3 (the README's exit
+    status for a fit that did not converge); the files are written."""
+    vessel = js.vessel("kvlcc2")
+    result = tmp_path / "result.json"
+    result.write_text(json.dumps({"model": "kvlcc2", "fit": {"code": "max_steps_reached"},
+                                  "parameters": {"n_r": {"value": float(vessel.n_r)}}}))
+    out = tmp_path / "tc"
+    assert main(["simulate", "--vessel", str(result), "--manoeuvre", "turn:35", "--duration",
+                 "100", "--out", str(out)]) == 3
+    err = capsys.readouterr().err
+    assert f"not a converged estimate (code max_steps_reached in {result})" in err, err
+    assert (out / "trial.csv").is_file()

@@ -11,7 +11,7 @@ from tqdm.auto import tqdm
 from .._foundation._files import staged_folder
 from ..plotting import plot_autopilot
 from ._common import check_operating_point, check_out, numbers
-from ._identification import read_result
+from ._identification import read_result, unconverged_fit
 from ._studies import autopilot as autopilot_study
 from ._studies.autopilot import cell
 from ._vessel import VESSEL_HELP, read_vessel_option
@@ -73,10 +73,7 @@ def run(args) -> int:
     model, report = read_result(args.model)
     fit = report.get("fit")  # none: parameters written by hand
     code = fit.get("code") if isinstance(fit, dict) else None
-    unfit = "" if fit is None or code == "successful" else (
-        f"The model's fit is not a converged estimate (code {code} in {args.model}): the "
-        "gains and the feed-forward rest on parameters the records did not determine; "
-        "identify the model again on records that excite it (e.g. a zig-zag).")
+    unfit = unconverged_fit(report, args.model)
     check_out(args.out, inputs=[args.model], writes=("autopilot.json", "report.md", "figures/",
               *(f"figures/{_figure_name(v, by_rpm)}" for v in values)))
     basis = ""

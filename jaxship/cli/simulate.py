@@ -4,6 +4,7 @@ preset, a vessel file or an identified model, its indices, records and figures."
 import json
 import math
 import pathlib
+import sys
 
 import matplotlib.pyplot as plt
 
@@ -12,6 +13,7 @@ from .._models._vessel._base import AbstractVessel
 from .._simulation._froude import froude_scale
 from ..plotting import plot_imo_criteria, plot_trajectory
 from ._common import check_operating_point, check_out, note, positive
+from ._identification import unconverged_fit
 from ._imo import check_imo, imo_specs
 from ._trials import TrialSpec, simulate_steering_to_folder, simulate_to_folder
 from ._vessel import VESSEL_HELP, read_vessel_option
@@ -39,10 +41,19 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    # every check before the simulation; the files appear in --out only when all are written
+    """A vessel's trial (`run_vessel`) or a steering model's (`run_steering`); exit 3,
+    the reason said first, where `--vessel` is a result whose fit did not converge."""
     chosen = read_vessel_option(args.vessel)
-    if not isinstance(chosen.model, AbstractVessel):
-        return run_steering(args, chosen)
+    unfit = unconverged_fit(chosen.report, args.vessel) if chosen.report else ""
+    if unfit:
+        print(f"jaxship: {unfit}", file=sys.stderr)
+    trial = run_vessel if isinstance(chosen.model, AbstractVessel) else run_steering
+    status = trial(args, chosen)
+    return 3 if unfit else status
+
+
+def run_vessel(args, chosen) -> int:
+    # every check before the simulation; the files appear in --out only when all are written
     vessel, imo = chosen.model, args.manoeuvre.strip().lower() == "imo"
     if positive("--length", args.length):
         if not LENGTHS[0] <= args.length <= LENGTHS[1]:

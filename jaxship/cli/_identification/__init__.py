@@ -17,6 +17,7 @@ from .result import (
     IdentificationResult as IdentificationResult,
     model_from_report as model_from_report,
     read_result as read_result,
+    unconverged_fit as unconverged_fit,
 )
 from .simulation import (
     simulate_armax_records as simulate_armax_records,

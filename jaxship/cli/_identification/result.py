@@ -277,6 +277,18 @@ def _finite(data):
     return float(data) if data in ("inf", "-inf") else data
 
 
+def unconverged_fit(report: dict, source) -> str:
+    """The sentence that the fit behind `report` (a result.json, read from `source`) is
+    no converged estimate, or "" when it is (or when the file has no `fit`: parameters
+    written by hand). Every command that takes a result says it and exits 3."""
+    fit = report.get("fit")
+    code = fit.get("code") if isinstance(fit, dict) else "successful"
+    return "" if code == "successful" else (
+        f"The model's fit is not a converged estimate (code {code} in {source}): what this "
+        "command computes from it rests on parameters the records did not determine; "
+        "identify the model again on records that excite it (e.g. a zig-zag).")
+
+
 def read_result(path) -> tuple[object, dict]:
     """`(model, report)` from the `result.json` of `jaxship identify` at `path`
     (see `model_from_report`). **Raises** `ValueError` (one line) when the file is
