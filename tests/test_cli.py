@@ -241,13 +241,7 @@ def test_out_that_is_a_file_is_refused_first(command, record, fitted, tmp_path, 
                                              monkeypatch):
     """An --out that is a file, lies under a file or cannot be written is one line, exit
     2, before any record is read or anything simulated or fitted."""
-    def no_work(*args, **kwargs):
-        raise AssertionError("long work started before --out was checked")
-
-    for name in ("simulate.simulate_to_folder", "identify.identify",
-                 "identify.read_experiments", "discover.run_discovery",
-                 "reproduce.reproduce", "autopilot.autopilot_study.evaluate"):
-        monkeypatch.setattr(f"jaxship.cli.{name}", no_work)
+    _no_work(monkeypatch)
     target = tmp_path / "taken"
     target.write_text("a file\n")
     assert main(_command(command, record, fitted, target)) == 2
@@ -267,6 +261,7 @@ def test_out_that_is_a_file_is_refused_first(command, record, fitted, tmp_path, 
 
 
 def _no_work(monkeypatch):
+    """Any long work fails the test: it must not start before --out is checked."""
     def no_work(*args, **kwargs):
         raise AssertionError("long work started before --out was checked")
 
