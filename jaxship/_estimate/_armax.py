@@ -29,7 +29,8 @@ from .._foundation._covariance import parameter_report
 from .._foundation._params import parameter_fields
 from .._models._armax_model import ARMAX_NAMES, ARMAX_ORDERS, ARMAXModel
 from ._discrete import continuous_parameters
-from ._fit import AbstractEstimator, excitation_flags
+from ._excitation import excitation_flags
+from ._fit import AbstractEstimator
 from ._result import FitResult, Prediction, assemble_result
 from ._windows import as_dataset, check_data
 

@@ -33,6 +33,7 @@ from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
 from .._foundation._progress import ProgressCallback, reporting_steps, step_hook
 from .._foundation._sharding import sharded_vmap
 from .._simulation._integrate import Simulator, integrate, replay_policy
+from ._excitation import excitation_flags
 from ._initial import EstimatedStarts, MeasuredStates
 from ._kalman import SmoothedStates
 from ._linear import LinearStart
@@ -254,25 +255,6 @@ def _offset_scales(ds) -> np.ndarray:
         spread = math.sqrt(np.sum(np.where(mask, (y - mean) ** 2, 0.0)) / mask.sum())
         out.append(0.01 * spread if spread > 0 else 1e-3)
     return np.array(out)
-
-
-def excitation_flags(ds, rudder) -> tuple[list[str], bool]:
-    """Flags of experiments whose rudder never moves, and whether that is all of them."""
-    flags, constant = [], []
-    for i, name in enumerate(ds.names):
-        d = np.asarray(getattr(ds, rudder))[i, : ds.lengths[i]]
-        if np.ptp(d) == 0.0:
-            constant.append(name)
-    if constant and len(constant) == ds.num_experiments:
-        flags.append(
-            f"the rudder input is constant in every experiment ({', '.join(constant)}): the "
-            "data contain no excitation, so the steering parameters cannot be identified; "
-            "use a zig-zag, PRBS or turning record."
-        )
-    elif constant:
-        flags.append(f"the rudder input is constant in experiment(s) {', '.join(constant)}: "
-                     "they add no excitation.")
-    return flags, bool(constant) and len(constant) == ds.num_experiments
 
 
 def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), free=None,
@@ -563,12 +545,7 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
     full, null = (nan, []) if blown else least_squares_covariance(jrows, rows, groups)
     covariance = full[:d, :d]
     null = [v[:d] / np.linalg.norm(v[:d]) for v in null if np.linalg.norm(v[:d]) > 1e-3]
-    flags, no_excitation = excitation_flags(ds, estimator.rudder)
-    if rows.size <= columns.shape[0]:  # as many unknowns as residuals: any data fit exactly
-        flags.append(f"the records hold {rows.size} fitted values for {columns.shape[0]} "
-                     "unknowns (parameters and start states): too few to determine the "
-                     "parameters; use a longer record.")
-        no_excitation = True
+    flags, no_excitation = excitation_flags(ds, estimator.rudder, rows.size, columns.shape[0])
 
     shape = (ds.num_experiments, ds.num_samples)
     predictions = {}
