@@ -175,7 +175,7 @@ def test_a_result_of_ones_own_vessel_rebuilds_it_with_effects():
     assert model.base.shaft.max_rate == math.inf
 
 
-def test_identify_starts_from_a_result_and_autopilot_needs_a_vessel(tmp_path, capsys):
+def test_identify_and_discover_start_from_a_result_and_autopilot_needs_a_vessel(tmp_path, capsys):
     model = js.Nomoto1(K=0.05, T=10.0)
     zigzag = js.simulate(model, js.ZigZag(math.radians(10), math.radians(10),
                                           duration=200.0, dt=1.0))
@@ -196,6 +196,11 @@ def test_identify_starts_from_a_result_and_autopilot_needs_a_vessel(tmp_path, ca
                  str(tmp_path / "a" / "result.json"), "--rpm", "300", "--out",
                  str(tmp_path / "d")]) == 2
     assert "this needs a vessel" in capsys.readouterr().err
+    # discover starts from the fitted model too: nothing is missing from these records
+    assert main(["discover", str(record), "--vessel", str(tmp_path / "a" / "result.json"),
+                 "--out", str(tmp_path / "e"), "--quiet"]) == 0
+    report = json.loads((tmp_path / "e" / "discovery.json").read_text())
+    assert report["verdict"] == "nothing_missing", report["effects"]
 
 
 def test_simulate_reads_the_fit_code_of_its_result(tmp_path, capsys):
