@@ -255,7 +255,9 @@ def test_imo_criteria_table():
     table = fig.axes[0].tables[0]
     cells = table.get_celld()
     assert cells[(1, 0)].get_text().get_text() == "stopping: track reach, full astern"
-    assert cells[(1, 3)].get_text().get_text() == "FAIL"  # 19.4 L > 15 L
+    assert cells[(0, 3)].get_text().get_text() == "margin"
+    assert cells[(1, 3)].get_text().get_text() == "-4.38"  # 15 L - 19.4 L: missed
+    assert cells[(1, 4)].get_text().get_text() == "FAIL"  # 19.4 L > 15 L
 
 
 # --------------------------------------------------------------------------- identification

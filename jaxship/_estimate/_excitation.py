@@ -4,6 +4,9 @@ more fitted values than unknowns."""
 import numpy as np
 
 
+# how the flags of records that determine nothing begin (`excitation_flags`)
+TOO_POOR = ("the rudder input is constant in every experiment", "the records hold")
+
 def excitation_flags(ds, rudder, values=None, unknowns=None) -> tuple[list[str], bool]:
     """Flags of experiments whose rudder never moves, and of records holding no more
     fitted `values` (residuals) than `unknowns` (parameters and start states: any data

@@ -41,6 +41,7 @@ import equinox as eqx
 import numpy as np
 import scipy  # scipy.stats loads on first use (an import-time saving)
 
+from ..._estimate._excitation import TOO_POOR
 from ..._estimate._fit import PredictionError, fit
 from ..._estimate._initial import EstimatedStarts, MeasuredStates
 from ..._estimate._lm import RESULTS, LevenbergMarquardt
@@ -198,9 +199,10 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
 
     **Returns:** a `DiscoveryReport`.
 
-    **Raises:** `jaxship.FitError` where the base model's fit leaves its parameters
-    undetermined or never moves (records too short or too poor to judge a missing
-    effect), or where its prediction of the held-out records blows up.
+    **Raises:** `jaxship.FitError` where the records cannot determine the base model
+    (no rudder moves, or no more fitted values than unknowns: too short or too poor to
+    judge a missing effect) or its fit never moves, or where its prediction of the
+    held-out records blows up.
     """
     say = progress or (lambda message: None)
     free = tuple(default_free(model) if free is None else free)
@@ -236,11 +238,12 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
 
     say("fitting the base model")
     base_fit = fit(model, train, estimator=loss(model), free=free)
-    if base_fit.code in (RESULTS.poorly_determined, RESULTS.did_not_move):
-        raise FitError(  # records too short or too poor: no effect can be judged missing
+    too_poor = [f for f in base_fit.parameters.undetermined if f.startswith(TOO_POOR)]
+    if too_poor or base_fit.code == RESULTS.did_not_move:
+        raise FitError(  # no excitation or too few values: no effect can be judged missing
             f"the base model's fit to the training records is {base_fit.code_name} "
-            f"({base_fit.message}): these records cannot tell whether an effect is missing; "
-            "give longer records that excite the model (e.g. zig-zags).")
+            f"({'; '.join(too_poor) or base_fit.message}): these records cannot tell whether "
+            "an effect is missing; give longer records that excite the model (e.g. zig-zags).")
     channels = tuple(base_fit.metrics)
     current, cost = base_fit, base_fit.cost
     # effects join in one order, the start model's first, then the catalogue's: each
