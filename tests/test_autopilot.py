@@ -309,3 +309,30 @@ def test_an_autopilot_prints_its_gains():
     """`print(pilot)` showed `kp=f64[]`: it shows the values."""
     pilot = js.HeadingAutopilot(kp=jnp.asarray(2.5), ki=jnp.asarray(0.125), kd=jnp.asarray(5.0))
     assert "kp=Array(2.5," in repr(pilot) and "ki=Array(0.125," in repr(pilot)
+
+
+FLOAT32_LOOP = """
+import jaxship as js
+ap = js.design_autopilot(js.Nomoto1(K=0.5, T=2.0), bandwidth=0.3)
+run = js.closed_loop(js.vessel("thesis"), [ap], rpm=[400.0], duration=60.0)
+metrics = js.closed_loop_metrics(run)
+print(run.psi.dtype, float(metrics.residual_sum[0, 0]) >= 0.0)
+"""
+
+
+def test_a_closed_loop_and_its_metrics_run_in_float32():
+    """JAX's default float32 (issue 57): `closed_loop_metrics` refused its own run, the
+    1 s sampling "not a multiple" of an output interval of 0.10000000149 s (a tolerance
+    below float32's spacing); now the tolerance is the float type's."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    env = os.environ | {"PYTHONPATH": os.pathsep.join(
+        [str(Path(__file__).parent.parent), *filter(None, [os.environ.get("PYTHONPATH")])])}
+    env.pop("JAX_ENABLE_X64", None)
+    done = subprocess.run([sys.executable, "-c", FLOAT32_LOOP], env=env, capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == ["float32", "True"], done.stdout

@@ -15,6 +15,7 @@ from .._models._environment import Environment
 from .._models._steering._base import AbstractSteeringModel
 from .._models._vessel._base import AbstractVessel, straight_run
 from .._simulation._batch import stack, straight_run_batch
+from .._simulation._data import sampling_tolerance
 from .._simulation._integrate import Held, Simulator, integrate
 from .._simulation._simulate import _as_arrays, initial_vector, vessel_field
 from .._simulation._simulate_steering import steering_field
@@ -235,7 +236,8 @@ def closed_loop_metrics(run: ClosedLoop, sample_interval: float = 1.0,
     t = np.asarray(run.t)
     dt = float(t[1] - t[0])
     every = int(round(sample_interval / dt))
-    if every < 1 or abs(every * dt - sample_interval) > 1e-9 * max(1.0, sample_interval):
+    # to the rounding of JAX's float type (float32 holds 0.1 s as 0.10000000149 s)
+    if every < 1 or abs(every * dt - sample_interval) > every * sampling_tolerance(t, 1e-9):
         raise ValueError(f"`sample_interval` ({sample_interval} s) must be a multiple of the "
                          f"run's output interval ({dt} s).")
     start, end = (t[0], t[-1]) if window is None else window
