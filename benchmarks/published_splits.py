@@ -1,127 +1,371 @@
-"""Esso Osaka on the data owners' published splits: the lab's own MMG coefficients
-against the same model structure identified by jaxship on each training set.
+"""Esso Osaka on the data owners' published splits, by a protocol that makes every choice
+on training runs only: the lab's simulator against `jaxship identify --model esso_osaka`.
 
-Run: python benchmarks/published_splits.py [--paper "Miyauchi 2022"] [--horizon 60]
+Run: python benchmarks/published_splits.py [--select-only] [--sets Train-R ...]
+     python benchmarks/published_splits.py --tables   (the tables of the results file)
 
-For each paper's training sets (`benchmarks/studies/published_splits.py`) the
-`esso_osaka` preset's default free coefficients, and those with the yaw inertia and the
-race factor (`FREE_SETS`), are fitted by prediction error (windows of `--horizon` seconds,
-logged true wind replayed, records decimated to 2 Hz); every model,
-and the preset unfitted (the lab's coefficients, `reference/MMG_params_EssoOsaka3m.csv`),
-is then scored on each test run by a free simulation from its first measured state at
-10 Hz (`free_run_score`). Printed: per test run the RMSE of r [deg/s] and psi [deg], the
-mean position error [m] and the r fit %, and the cut of the r RMSE against the lab's
-coefficients, with the goal of issue 32 (at least 40 % on every non-berthing run) stated
-as met or not. Berthing runs are scored as measured: their bow and stern thrusters are
-not logged, so no model fed these logs can follow them.
+1. **Selection** (`select`). Each candidate setting of the fit (free set, prediction
+   horizon, sample interval, wind-load model: `FACTORS`) is scored by leave-one-run-out
+   cross-validation on Miyauchi's Train-R, the training set the preset's defaults come
+   from: `jaxship identify` on three of its four runs, a free simulation of the fourth
+   (`free_run_score`, 10 Hz), the r RMSE divided by the lab simulator's on that run,
+   averaged over the four folds. A coordinate search starts from the command's settings
+   and tries each factor's values in turn, keeping the best. Every candidate's score is
+   printed; the run reader refuses every test run's name while this runs (`Reader`).
+2. **Headline** (`headline`). `jaxship identify --model esso_osaka` with no option (its
+   defaults are the selection: `jaxship.VESSELS["esso_osaka"].fit_settings`, checked
+   against the results file by `tests/test_published_splits.py`) on each training set of
+   both papers; every model and both lab columns are scored on the test runs:
+   - `lab (Fujiwara wind)`: the lab's simulator as published (its coefficients and
+     Fujiwara et al.'s wind loads);
+   - `lab (jaxship wind)`: the lab's coefficients with jaxship's generic wind loads.
+   Goals are judged against the stronger of the two on each run (`GOALS`).
+3. **One source.** Everything lands in `benchmarks/results/published_splits.json`;
+   `--tables` prints the Markdown tables that README.md, docs/results.md and
+   benchmarks/README.md carry (a test checks they match the file).
 
-`--discover` adds `jaxship discover`'s final model: from the preset with the second free
-set, trained on Miyauchi's Train-R, the two `turn_cut` runs of Train-TR held out for its
-checks (`DISCOVER_HOLDOUT`: training runs of Miyauchi's other sets, in no test set), 2 Hz.
-Train-R shares no run with either paper's test set, so this column is scored on both.
+Berthing runs are scored as measured: their bow and stern thrusters are not logged, so
+no model fed these logs can follow them.
 """
 
 import argparse
-import math
+import contextlib
+import dataclasses
+import json
 import pathlib
 import sys
+import tempfile
 import time
 
 import jax
 import numpy as np
-import optimistix as optx
 
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))  # benchmarks.studies
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # benchmarks.studies
 
 import jaxship as js  # noqa: E402
-from benchmarks.studies.published_splits import SPLITS, free_run_score, read_runs  # noqa: E402
-from benchmarks.studies.real_data import ESSO_FREE  # noqa: E402
+import jaxship.cli  # noqa: E402
+from benchmarks.studies.published_splits import SPLITS, free_run_score  # noqa: E402
 
 
-GOAL = 0.40  # issue 32: r RMSE cut by at least 40 % on every non-berthing test run
-# the free sets: the preset's default, and with the yaw inertia (added mass included) and
-# the propeller-race factor of the rudder inflow, chosen among 20 sets on Miyauchi's
-# Train-R by their test-run scores (a selection on the test runs: the Wakita split, other
-# training runs and two other test runs, is the check)
-FREE_SETS = {"": ESSO_FREE, " + I_zz, k_x": ESSO_FREE + ("i_zz_j_zz", "k_x")}
-DISCOVER_HOLDOUT = ("turn_cut_14-Sep-2020_15_58_08", "turn_cut_14-Sep-2020_16_09_02")
+RESULTS = ROOT / "benchmarks" / "results" / "published_splits.json"
+SELECTION_SET = ("Miyauchi 2022", "Train-R")
+GOAL_CUT = 0.40  # issue 58: r RMSE cut by at least 40 % on each non-berthing test run
+EXTRA_FREE = ("i_zz_j_zz", "k_x")  # the yaw inertia and the race factor of the rudder inflow
+
+# the command's settings before any choice (`jaxship identify`'s own defaults, but at the
+# interval and horizon the fits of the published-splits work used): the search's start
+START = {"free": "default", "horizon": 60.0, "sample_interval": 0.5, "wind": "jaxship"}
+# the values tried for each factor, in the order the coordinate search visits them
+FACTORS = {
+    "free": ("default", "default + i_zz_j_zz, k_x"),
+    "horizon": (30.0, 60.0, 120.0),
+    "sample_interval": (0.5, 1.0),
+    "wind": ("jaxship", "fujiwara", "none"),
+}
 
 
-def identified(train_names, horizon, free):
-    """The `free` coefficients of the preset fitted on `train_names` (2 Hz)."""
-    train = [r.decimate(5) for r in read_runs(train_names)]
-    estimator = js.PredictionError(horizon=horizon, wind=True, max_steps=100,
-                                   simulator=js.Simulator(max_step=math.inf, substeps=2),
-                                   solver=optx.LevenbergMarquardt(rtol=1e-6, atol=1e-6))
-    return js.fit(js.vessel("esso_osaka"), train, estimator=estimator, free=free)
+def test_names() -> set:
+    """Every test run of both papers."""
+    return {n for split in SPLITS.values() for n in split["Test"]}
 
 
-def discovered(free):
-    """`discover` from the preset with `free` on Miyauchi's Train-R (2 Hz), the
-    `DISCOVER_HOLDOUT` runs held out."""
-    train, held = ([r.decimate(5) for r in read_runs(names)]
-                   for names in (SPLITS["Miyauchi 2022"]["Train-R"], DISCOVER_HOLDOUT))
-    start = time.perf_counter()
-    say = lambda message: print(f"discover, {time.perf_counter() - start:4.0f} s: {message}",
-                                file=sys.stderr)
-    return js.discover(js.vessel("esso_osaka"), train, held, free=free, progress=say)
+class Reader:
+    """The Esso Osaka runs by name (file paths and `Experiment`s); inside `training_only()`
+    a test run's name raises, so a selection cannot open one."""
+
+    def __init__(self, root=None):
+        base = js.shared_data_dir() if root is None else pathlib.Path(root)
+        self.folder = None if base is None else base / "esso_osaka_frt"
+        self.forbidden = frozenset()
+
+    @contextlib.contextmanager
+    def training_only(self):
+        self.forbidden = frozenset(test_names())
+        try:
+            yield self
+        finally:
+            self.forbidden = frozenset()
+
+    def path(self, name: str) -> pathlib.Path:
+        if name in self.forbidden:
+            raise PermissionError(f"{name} is a test run: the selection reads training runs "
+                                  "only.")
+        if self.folder is None or not self.folder.is_dir():
+            raise FileNotFoundError("the Esso Osaka data (esso_osaka_frt) is not found; set "
+                                    "$JAXSHIP_DATA.")
+        found = sorted(self.folder.glob(f"*/{name}.csv"))
+        if not found:
+            raise FileNotFoundError(f"run {name}.csv not found under {self.folder}.")
+        return found[0]
+
+    def runs(self, names) -> list:
+        return [js.read_esso_osaka(self.path(n)) for n in names]
+
+
+def lab(wind: str):
+    """The lab's coefficients (the `esso_osaka` preset) with the wind-load model `wind`:
+    `"jaxship"` (generic), `"fujiwara"` (Fujiwara et al. 1998, the lab's simulator) or
+    `"none"` (no wind areas: the logged wind is not replayed)."""
+    vessel = js.get_vessel("esso_osaka")
+    if wind == "jaxship":
+        return vessel
+    if wind == "none":
+        return dataclasses.replace(vessel, frontal_wind_area=0.0, lateral_wind_area=0.0)
+    if wind == "fujiwara":
+        return js.esso_osaka_lab()
+    raise ValueError(f"unknown wind model {wind!r}")
+
+
+def identify(reader, names, setting=None, *, workdir) -> object:
+    """The vessel `jaxship identify` fits on the runs `names`: with no option (the preset's
+    defaults) when `setting` is None, else with every option of `setting` given."""
+    out = pathlib.Path(tempfile.mkdtemp(dir=workdir))
+    argv = ["identify", *map(str, (reader.path(n) for n in names)), "--out", str(out),
+            "--no-figures", "--quiet"]
+    if setting is None:
+        argv += ["--model", "esso_osaka"]
+    else:
+        start = out / "start.toml"
+        js.save_vessel(lab(setting["wind"]), start, source="the lab's coefficients")
+        free = ",".join(js.default_free(js.get_vessel("esso_osaka"))
+                        + (EXTRA_FREE if setting["free"] != "default" else ()))
+        argv += ["--vessel", str(start), "--horizon", f"{setting['horizon']:g}",
+                 "--sample-interval", f"{setting['sample_interval']:g}", "--free", free]
+        out = out / "fit"
+        argv[argv.index("--out") + 1] = str(out)
+    code = jaxship.cli.main(argv)
+    if code not in (0, 3):
+        raise RuntimeError(f"jaxship {' '.join(argv)} exited {code}")
+    return js.load_vessel(out / "vessel.toml"), code
+
+
+def cv_score(reader, names, setting, *, workdir, say) -> dict:
+    """Leave-one-run-out score of `setting` on the runs `names`: per fold the held run's r
+    RMSE [rad/s] and its ratio to that of the lab's coefficients with jaxship's wind (a
+    fixed scale per run, so that each fold weighs alike)."""
+    folds = []
+    for held in names:
+        t0 = time.perf_counter()
+        model, code = identify(reader, [n for n in names if n != held], setting,
+                               workdir=workdir)
+        run, = reader.runs([held])
+        r = free_run_score(model, [run])[0].rmse["r"]
+        lab_r = free_run_score(lab("jaxship"), [run])[0].rmse["r"]  # a fixed scale per run
+        folds.append({"held": held, "r_rmse": r, "ratio": r / lab_r, "exit": code})
+        say(f"  fold {held}: r RMSE {np.degrees(r):.3f} deg/s, {r / lab_r:.3f} of the lab's "
+            f"(exit {code}, {time.perf_counter() - t0:.0f} s)")
+    return {"folds": folds, "score": float(np.mean([f["ratio"] for f in folds]))}
+
+
+def key(setting) -> str:
+    return ", ".join(f"{k} {v}" for k, v in setting.items())
+
+
+def select(reader, names, *, workdir, say, known=None, evaluate=cv_score) -> dict:
+    """The coordinate search (module docstring) on the training runs `names`, inside
+    `reader.training_only()`: `{"chosen": setting, "candidates": [...]}`. `known` maps a
+    candidate's `key` to a score already measured (a rerun measures only new ones);
+    `evaluate` scores a candidate (`cv_score`)."""
+    known = dict(known or {})
+    tried = []
+    with reader.training_only():
+        best = dict(START)
+
+        def score(setting):
+            k = key(setting)
+            if k not in known:
+                say(f"candidate {k}:")
+                known[k] = evaluate(reader, names, setting, workdir=workdir, say=say)
+            say(f"candidate {k}: cross-validation score {known[k]['score']:.3f}")
+            if k not in (c["setting_key"] for c in tried):
+                tried.append({"setting": dict(setting), "setting_key": k, **known[k]})
+            return known[k]["score"]
+
+        best_score = score(best)
+        for factor, values in FACTORS.items():
+            for value in values:
+                candidate = {**best, factor: value}
+                s = score(candidate)
+                if s < best_score:
+                    best, best_score = candidate, s
+    return {"training_set": list(SELECTION_SET), "runs": list(names), "chosen": best,
+            "score": best_score, "candidates": tried}
+
+
+LABS = {"lab (Fujiwara wind)": "fujiwara", "lab (jaxship wind)": "jaxship"}
+
+
+def scores(model, runs) -> list[dict]:
+    """`free_run_score` of `model` on `runs`, as plain numbers (SI)."""
+    return [{"run": s.run, "r": s.rmse["r"], "psi": s.rmse["psi"], "position_mean":
+             s.position_mean, "position_final": s.position_final, "r_fit": s.fit_percent["r"]}
+            for s in free_run_score(model, runs)]
+
+
+def headline(reader, *, workdir, say) -> dict:
+    """`jaxship identify --model esso_osaka` (its defaults) on each training set of both
+    papers, and both lab columns, scored on each paper's test runs, with the goals."""
+    out = {}
+    for paper, split in SPLITS.items():
+        test = reader.runs(split["Test"])
+        columns = {name: scores(lab(wind), test) for name, wind in LABS.items()}
+        fits = {}
+        for name in (k for k in split if k != "Test"):
+            t0 = time.perf_counter()
+            model, code = identify(reader, split[name], None, workdir=workdir)
+            fits[name] = {"exit": code, "seconds": round(time.perf_counter() - t0)}
+            say(f"{paper} {name}: exit {code}, {fits[name]['seconds']} s")
+            columns[name] = scores(model, test)
+        out[paper] = {"test": list(split["Test"]), "columns": columns, "fits": fits,
+                      "goals": {k: goals(columns, k) for k in fits}}
+    return out
+
+
+def goals(columns, name) -> dict:
+    """Issue 58's goals for the column `name` on the non-berthing test runs, each against
+    the stronger of the two lab columns on that run and measure."""
+    rows = [i for i, s in enumerate(columns[name]) if not s["run"].startswith("berthing")]
+    best = lambda i, m: min(columns[lab_][i][m] for lab_ in LABS)
+    cut = [1 - columns[name][i]["r"] / best(i, "r") for i in rows]
+    worse = {m: [columns[name][i]["run"] for i in rows if columns[name][i][m] > best(i, m)]
+             for m in ("psi", "position_mean")}
+    return {"r_cut": cut, "r_cut_met": min(cut) >= GOAL_CUT, "worse_than_lab": worse,
+            "position_and_heading_met": not any(worse.values())}
+
+
+def discovered(reader, *, say) -> tuple[dict, object]:
+    """Point 5: `jaxship.discover` from the preset with its chosen free set on three of
+    Train-R's runs, the fourth held out for its checks, inside `training_only()`:
+    `(record, model)`, the record naming what it found and the held-out cost it buys."""
+    names = SPLITS[SELECTION_SET[0]][SELECTION_SET[1]]
+    settings = js.VESSELS["esso_osaka"].fit_settings
+    step = round(settings.sample_interval / 0.1)
+    with reader.training_only():
+        train, held = ([r.decimate(step) for r in reader.runs(part)]
+                       for part in (names[:-1], names[-1:]))
+        t0 = time.perf_counter()
+        report = js.discover(js.get_vessel("esso_osaka"), train, held, free=settings.free,
+                             progress=lambda text: say(f"discover: {text}"))
+    named = [e.id for e in report.effects]
+    record = {"train": list(names[:-1]), "held_out": list(names[-1:]),
+              "verdict": str(report.verdict), "named": named,
+              "holdout_cost_before": float(report.holdout_cost_before),
+              "holdout_cost_after": float(report.holdout_cost_after),
+              "seconds": round(time.perf_counter() - t0)}
+    return record, report.model_after
+
+
+def tables(results) -> str:
+    """The Markdown tables of the results file (module docstring)."""
+    sel = results["selection"]
+    lines = [f"### Selection: leave-one-run-out on {' '.join(sel['training_set'])}", "",
+             "| candidate | score (r RMSE / lab's, mean of folds) | per fold |",
+             "|---|---:|---|"]
+    for c in sel["candidates"]:
+        mark = " **(chosen)**" if c["setting"] == sel["chosen"] else ""
+        lines.append(f"| {c['setting_key']}{mark} | {c['score']:.3f} | "
+                     + ", ".join(f"{f['ratio']:.2f}" for f in c["folds"]) + " |")
+    for paper, block in results.get("headline", {}).items():
+        lines += ["", f"### {paper}: free simulation of each test run", "",
+                  "| test run | model | r RMSE [deg/s] | r cut vs stronger lab | psi RMSE [deg] "
+                  "| mean position error [m] | final [m] | r fit % |",
+                  "|---|---|---:|---:|---:|---:|---:|---:|"]
+        cols = block["columns"]
+        for i, run in enumerate(block["test"]):
+            best = min(cols[k][i]["r"] for k in LABS)
+            for name, col in cols.items():
+                s = col[i]
+                cut = "" if name in LABS else f"{100 * (1 - s['r'] / best):.0f} %"
+                lines.append(f"| {run} | {name} | {np.degrees(s['r']):.3f} | {cut} | "
+                             f"{np.degrees(s['psi']):.1f} | {s['position_mean']:.1f} | "
+                             f"{s['position_final']:.1f} | {s['r_fit']:.1f} |")
+        if paper == SELECTION_SET[0] and "discover" in results:
+            d = results["discover"]
+            lines.append(f"\n`discover` on {', '.join(d['train'])}, {d['held_out'][0]} held "
+                         f"out: {d['verdict']}; named {', '.join(d['named']) or 'nothing'}; "
+                         f"held-out cost {d['holdout_cost_before']:.4g} -> "
+                         f"{d['holdout_cost_after']:.4g}.")
+        for name, g in block["goals"].items():
+            worse = "; ".join(f"{m} worse than the lab on {', '.join(runs)}"
+                              for m, runs in g["worse_than_lab"].items() if runs) or "none worse"
+            lines.append(f"\n{paper} {name}: r RMSE cut on the non-berthing runs "
+                         + ", ".join(f"{100 * c:.0f} %" for c in g["r_cut"])
+                         + f" (goal >= {100 * GOAL_CUT:.0f} % on each: "
+                         + ("met" if g["r_cut_met"] else "not met") + "); psi and position: "
+                         + worse + ".")
+    lines += bands_table(results.get("bands", {}))
+    return "\n".join(lines)
+
+
+def bands_table(bands) -> list[str]:
+    """The prediction bands' rows (`benchmarks/prediction_bands.py`) and the goal's count."""
+    if not bands:
+        return []
+    lines = ["", "### Prediction bands: coverage of each held-out run, and the yardstick", "",
+             "| case | held-out run | r inside the 90 % band (a correct model: 90 % range) "
+             "| psi inside (range) | inside the yardstick |", "|---|---|---|---|---|"]
+    for case in bands.values():
+        for row in case["runs"]:
+            text = lambda c: (f"{100 * row[c]:.0f} % ({100 * row[c + '_range'][0]:.0f}-"
+                              f"{100 * row[c + '_range'][1]:.0f} %)")
+            verdict = ("yes" if row["inside"] else "no") if row["scored"] else "(berthing)"
+            lines.append(f"| {case['title']} | {row['run']} | {text('r')} | {text('psi')} | "
+                         f"{verdict} |")
+    scored = [r for case in bands.values() for r in case["runs"] if r["scored"]]
+    passed = sum(r["inside"] for r in scored)
+    lines.append(f"\nInside the yardstick's range, both channels: {passed} of {len(scored)} "
+                 f"non-berthing held-out runs (goal: at least 10 of 12): "
+                 + ("met." if passed >= 10 and len(scored) == 12 else "not met."))
+    return lines
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--paper", choices=sorted(SPLITS), action="append",
-                        help="a paper's splits (default: both)")
-    parser.add_argument("--horizon", type=float, default=60.0,
-                        help="prediction horizon of the fits [s] (60)")
-    parser.add_argument("--sets", nargs="+", metavar="SET",
-                        help="training sets to fit, e.g. Train-R Train-TZRB (default: all)")
+    parser.add_argument("--select-only", action="store_true", help="the selection only")
+    parser.add_argument("--tables", action="store_true",
+                        help="print the tables of the results file, run nothing")
     parser.add_argument("--discover", action="store_true",
-                        help="add `discover`'s model, trained on Miyauchi's Train-R")
+                        help="add `discover` on Train-R's runs (point 5) as a column")
+    parser.add_argument("--without", nargs="*", default=[], metavar="FACTOR=VALUE",
+                        help="leave a candidate value out of the search (e.g. wind=fujiwara)")
     args = parser.parse_args(argv)
+    if args.tables:
+        print(tables(json.loads(RESULTS.read_text())))
+        return
     jax.config.update("jax_enable_x64", True)
     js.enable_compilation_cache()
-    extra = {}
-    if args.discover:
-        report = discovered(FREE_SETS[" + I_zz, k_x"])
-        named = " + ".join(e.id for e in report.effects) or "nothing"
-        print(f"discover on Miyauchi's Train-R: {report.verdict}, named {named}; held-out "
-              f"cost {report.holdout_cost_before:.4g} -> {report.holdout_cost_after:.4g}",
-              file=sys.stderr)
-        extra[f"Miyauchi Train-R + I_zz, k_x + discover ({named})"] = report.model_after
-    for paper in args.paper or sorted(SPLITS):
-        split = SPLITS[paper]
-        test = read_runs(split["Test"])
-        columns = {"lab": js.vessel("esso_osaka")}
-        for name in (k for k in split if k != "Test" and (not args.sets or k in args.sets)):
-            for suffix, free in FREE_SETS.items():
-                t0 = time.perf_counter()
-                fit = identified(split[name], args.horizon, free)
-                print(f"{paper} {name}{suffix}: {fit.code_name} after {fit.num_steps} steps, "
-                      f"{time.perf_counter() - t0:.0f} s", file=sys.stderr)
-                columns[name + suffix] = fit.model
-        columns.update(extra)
-        scores = {k: free_run_score(m, test) for k, m in columns.items()}
-        print(f"\n## {paper}: free simulation of each test run (horizon of the fits "
-              f"{args.horizon:g} s)\n")
-        print("| test run | model | r RMSE [deg/s] | r cut vs lab | psi RMSE [deg] | "
-              "mean position error [m] | final [m] | r fit % |")
-        print("|---|---|---|---|---|---|---|---|")
-        for i, run in enumerate(test):
-            lab = scores["lab"][i].rmse["r"]
-            for k in columns:
-                s = scores[k][i]
-                cut = "" if k == "lab" else f"{100 * (1 - s.rmse['r'] / lab):.0f} %"
-                print(f"| {run.name} | {k} | {np.degrees(s.rmse['r']):.3f} | {cut} | "
-                      f"{np.degrees(s.rmse['psi']):.1f} | {s.position_mean:.1f} | "
-                      f"{s.position_final:.1f} | {s.fit_percent['r']:.1f} |")
-        manoeuvres = [i for i, run in enumerate(test) if not run.name.startswith("berthing")]
-        for k in (k for k in columns if k != "lab"):
-            cuts = [1 - scores[k][i].rmse["r"] / scores["lab"][i].rmse["r"] for i in manoeuvres]
-            verdict = "met" if min(cuts) >= GOAL else "not met"
-            print(f"\n{k}: r RMSE cut on the non-berthing runs "
-                  + ", ".join(f"{100 * c:.0f} %" for c in cuts)
-                  + f"; goal (>= {100 * GOAL:.0f} % on each) {verdict}.")
+    for item in args.without:
+        factor, value = item.split("=")
+        FACTORS[factor] = tuple(v for v in FACTORS[factor] if str(v) != value)
+    results = json.loads(RESULTS.read_text()) if RESULTS.is_file() else {}
+    known = {c["setting_key"]: c for c in results.get("selection", {}).get("candidates", [])}
+    say = lambda text: print(text, file=sys.stderr, flush=True)
+    reader = Reader()
+    names = SPLITS[SELECTION_SET[0]][SELECTION_SET[1]]
+    with tempfile.TemporaryDirectory() as workdir:
+        results["selection"] = select(reader, names, workdir=workdir, say=say, known=known)
+        write(results)
+        say(f"chosen on {' '.join(SELECTION_SET)}: {key(results['selection']['chosen'])}")
+        if args.select_only:
+            return
+        results["headline"] = headline(reader, workdir=workdir, say=say)
+        if args.discover:
+            results["discover"], model = discovered(reader, say=say)
+            label = "Train-R + discover (" + (" + ".join(results["discover"]["named"])
+                                              or "nothing") + ")"
+            block = results["headline"][SELECTION_SET[0]]
+            test = reader.runs(block["test"])
+            block["columns"][label] = scores(model, test)
+            block["goals"][label] = goals(block["columns"], label)
+    write(results)
+    print(tables(results))
+
+
+def write(results) -> None:
+    RESULTS.parent.mkdir(exist_ok=True)
+    RESULTS.write_text(json.dumps(results, indent=1) + "\n")
 
 
 if __name__ == "__main__":

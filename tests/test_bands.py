@@ -65,6 +65,29 @@ def test_the_bands_of_the_true_model_cover_the_nominal_share_of_samples():
     assert all(share < 0.6 for share in pooled(narrow, records).values())
 
 
+def test_the_draws_give_the_spread_of_a_correct_models_per_record_coverage():
+    """The yardstick of issue 58: with the true model and noise model, each independent
+    record's coverage falls inside the central 90 % range of its draws' coverage
+    (`coverage_range`) for about 90 % of 200 records (binomial sd 2 points); without the
+    disturbance the model is wrong, and far fewer do. The ranges have a real width (runs
+    of 100 s scatter) and the draws' coverage is about the level on average."""
+    records = records_of(range(200))
+    bands = js.prediction_bands(TRUTH, records, disturbance=DISTURBANCE,
+                                measurement_std=NOISE, num_samples=300)
+    covered, ranges = bands.coverage(records), bands.coverage_range(0.9)
+    for c in ("r", "psi"):
+        low, high = ranges[c][:, 0], ranges[c][:, 1]
+        inside = np.mean((covered[c] >= low) & (covered[c] <= high))
+        assert abs(inside - 0.9) < 0.07, (c, inside)
+        assert np.median(high - low) > 0.1, c
+        assert abs(np.mean(bands.draw_coverage[c]) - 0.9) < 0.02, c
+    wrong = js.prediction_bands(TRUTH, records, measurement_std=NOISE, num_samples=300)
+    covered, ranges = wrong.coverage(records), wrong.coverage_range(0.9)
+    inside = np.mean((covered["psi"] >= ranges["psi"][:, 0])
+                     & (covered["psi"] <= ranges["psi"][:, 1]))
+    assert inside < 0.3, inside
+
+
 def test_a_disturbance_calibrated_on_training_records_holds_on_new_ones():
     """Fitted on 6 records, the disturbance calibrated on them (with the fit's robust
     parameter covariance) comes within a factor 2 of the truth, and its bands cover

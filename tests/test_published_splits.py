@@ -1,11 +1,14 @@
 """The Esso Osaka data owners' published splits and the free-simulation score
 (issue 32; the data are needed only for the split check)."""
 
+import json
+
 import jax
 import numpy as np
 import pytest
 
 import jaxship as js
+from benchmarks import published_splits as protocol
 from benchmarks.studies.published_splits import (
     MIYAUCHI_2022,
     WAKITA_2022,
@@ -80,3 +83,57 @@ def test_the_free_run_score_is_the_hand_computed_one():
         assert score.fit_percent[c] == pytest.approx(by_hand, abs=0.2), c
     assert score.position_mean == pytest.approx(0.5, rel=2e-3)
     assert score.position_final == pytest.approx(0.5, rel=2e-3)
+
+
+@needs_esso
+def test_the_selection_never_opens_a_test_run(tmp_path):
+    """Issue 58, point 1: while the selection runs, the reader refuses every test run of
+    both papers (a real read of a test run raises), the candidates are scored only on the
+    training runs of the set being fitted, and every factor's values are tried."""
+    reader = protocol.Reader()
+    train = protocol.SPLITS["Miyauchi 2022"]["Train-R"]
+    seen, tried = [], []
+
+    def evaluate(reader, names, setting, **_):
+        with pytest.raises(PermissionError):
+            reader.path(protocol.SPLITS["Miyauchi 2022"]["Test"][0])
+        seen.extend(run.name for run in reader.runs(names[:1]))
+        tried.append(setting)
+        # any deterministic score: prefer a longer horizon and the larger free set
+        return {"folds": [], "score": 1.0 / setting["horizon"]
+                + (0.0 if setting["free"] == "default" else -0.001)}
+
+    chosen = protocol.select(reader, train, workdir=tmp_path, say=lambda text: None,
+                             evaluate=evaluate)
+    assert set(seen) <= set(train) and not set(seen) & protocol.test_names()
+    for factor, values in protocol.FACTORS.items():
+        assert set(values) <= {t[factor] for t in tried}, factor
+    assert chosen["chosen"]["horizon"] == max(protocol.FACTORS["horizon"])
+    assert chosen["chosen"]["free"] != "default"
+    reader.path(protocol.SPLITS["Miyauchi 2022"]["Test"][0])  # allowed again afterwards
+
+
+def test_the_presets_defaults_are_the_recorded_selection():
+    """Issue 58, point 2: what `jaxship identify --model esso_osaka` does by default is
+    what the protocol chose (benchmarks/results/published_splits.json)."""
+    results = json.loads(protocol.RESULTS.read_text())
+    chosen = results["selection"]["chosen"]
+    settings = js.VESSELS["esso_osaka"].fit_settings
+    assert settings.horizon == chosen["horizon"]
+    assert settings.sample_interval == chosen["sample_interval"]
+    extra = () if chosen["free"] == "default" else protocol.EXTRA_FREE
+    assert settings.free == js.default_free(js.get_vessel("esso_osaka")) + extra
+    assert protocol.WIND_OF_PRESET == chosen["wind"]
+    assert results["selection"]["training_set"] == ["Miyauchi 2022", "Train-R"]
+
+
+def test_the_documents_carry_the_results_files_tables():
+    """Issue 58, point 6: the tables in docs/results.md and benchmarks/README.md are the
+    ones the results file gives, character for character."""
+    text = protocol.tables(json.loads(protocol.RESULTS.read_text()))
+    root = protocol.ROOT
+    for doc in ("docs/results.md", "benchmarks/README.md"):
+        body = (root / doc).read_text(encoding="utf-8")
+        start = body.index("<!-- published_splits.json: begin -->")
+        end = body.index("<!-- published_splits.json: end -->")
+        assert body[start:end].split("-->", 1)[1].strip() == text.strip(), doc

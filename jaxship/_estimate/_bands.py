@@ -63,8 +63,12 @@ class PredictionBands:
     """The bands of `prediction_bands` on a dataset's records (E) and samples (N):
     `nominal` (the fitted model's prediction), `lower`, `upper` `{channel: (E, N)}`,
     `t` (E, N), `predicted` (E, N) (the samples predicted: not the start values, not
-    the padding), `level` (nominal coverage), `disturbance`, `num_samples` and
-    `num_dropped` (runs whose simulation was not finite, left out of the bands)."""
+    the padding), `level` (nominal coverage), `disturbance`, `num_samples`,
+    `num_dropped` (runs whose simulation was not finite, left out of the bands) and
+    `draw_coverage` `{channel: (E, S)}`: the coverage of each record by the band that
+    each of the S draws gets. A draw is a record the model and its noise model would
+    produce if they were right, so this is the per-record yardstick for `coverage`
+    (each draw is one of the S that make the band: a 1/S part of it)."""
 
     names: tuple[str, ...]
     t: np.ndarray
@@ -76,6 +80,13 @@ class PredictionBands:
     disturbance: Disturbance
     num_samples: int
     num_dropped: int
+    draw_coverage: dict
+
+    def coverage_range(self, probability: float = 0.9) -> dict[str, np.ndarray]:
+        """`{channel: (E, 2)}` the central `probability` range of `draw_coverage`: where a
+        correct model's coverage of each record falls with that probability."""
+        q = ((1 - probability) / 2, (1 + probability) / 2)
+        return {c: np.quantile(v, q, axis=1).T for c, v in self.draw_coverage.items()}
 
     def coverage(self, dataset) -> dict[str, np.ndarray]:
         """`{channel: (E,)}` the fraction of each record's predicted samples whose
@@ -195,17 +206,21 @@ class _Runs:
         b, integral = self.unit[disturbance.tau]
         added = {"r": disturbance.std * b, "psi": disturbance.std * integral}
         shape = (self.ds.num_experiments, self.ds.num_samples)
-        nominal, lower, upper = {}, {}, {}
+        nominal, lower, upper, draws = {}, {}, {}, {}
         for c, name in enumerate(self.channels):
-            lo, hi = _central_interval(self.runs[c] + added.get(name, 0.0), level)
+            runs = self.runs[c] + added.get(name, 0.0)
+            lo, hi = _central_interval(runs, level)
             nominal[name], hit = to_timeline(self.nominal[c], self.layout, shape)
             lower[name], _ = to_timeline(lo, self.layout, shape)
             upper[name], _ = to_timeline(hi, self.layout, shape)
+            inside, _ = to_timeline((runs >= lo[..., None]) & (runs <= hi[..., None]),
+                                    self.layout, shape)
+            draws[name] = inside.sum(axis=1) / np.maximum(hit.sum(axis=1), 1)[:, None]
         return PredictionBands(
             names=tuple(self.ds.names), t=np.asarray(self.ds.t), predicted=np.asarray(hit),
             nominal=nominal, lower=lower, upper=upper, level=float(level),
             disturbance=disturbance, num_samples=self.num_samples,
-            num_dropped=self.num_dropped)
+            num_dropped=self.num_dropped, draw_coverage=draws)
 
 
 def _parameter_draws(result, covariance, num_samples, rng) -> tuple[tuple, np.ndarray]:

@@ -286,10 +286,10 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
 
 
 def to_timeline(values, layout, shape) -> tuple[np.ndarray, np.ndarray]:
-    """Scatter window values (E, W, L) onto the samples (E, N); returns
+    """Scatter window values (E, W, L, ...) onto the samples (E, N, ...); returns
     `(timeline, predicted_mask)` (samples never predicted, e.g. sample 0, are False)."""
     values = np.asarray(values)
-    out = np.zeros(shape)
+    out = np.zeros(tuple(shape) + values.shape[3:])
     hit = np.zeros(shape, dtype=bool)
     mask = layout["mask"]
     e_idx = np.broadcast_to(np.arange(shape[0])[:, None, None], mask.shape)

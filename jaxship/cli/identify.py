@@ -6,6 +6,8 @@ import math
 import pathlib
 import sys
 
+import jaxship as js
+
 from .._foundation._files import staged_folder
 from .._models._vessel.catalogue import VESSELS
 from ..plotting import save_identification_figures
@@ -43,7 +45,11 @@ def register(sub) -> None:
                        help="the model to start from, in place of --model: " + VESSEL_HELP)
     ident.add_argument("--horizon", default=None,
                        help="prediction horizon [s]; none: output error, "
-                       "0: equation error")
+                       "0: equation error (default: none; a preset's own where it has one)")
+    ident.add_argument("--free", default=None, metavar="NAMES",
+                       help="the estimated coefficients, comma separated; a leading + adds "
+                       "them to the default set (default: the model's default free set; a "
+                       "preset's own where it has one)")
     ident.add_argument("--validate", nargs="+", type=pathlib.Path, default=None,
                        metavar="TEST", help="held-out records to validate on")
     ident.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
@@ -78,6 +84,42 @@ def _horizon(text):
     return value
 
 
+def _free(text, default):
+    """`--free`: None (the model's default), or the names given (after a `+`: added to
+    `default`, the preset's set or None for the model's own)."""
+    if text is None:
+        return default
+    add = text.strip().startswith("+")
+    names = tuple(n.strip() for n in text.strip().lstrip("+").split(",") if n.strip())
+    if not names:
+        raise ValueError(f"--free {text!r}: give coefficient names, comma separated.")
+    if not add:
+        return names
+    return None if default is None else tuple(dict.fromkeys(default + names))
+
+
+def preset_settings(name, args):
+    """`(horizon, sample_interval, free, note)`: the options given, else the preset's
+    `fit_settings` (a protocol's choice) where `name` is a preset that has them."""
+    settings = VESSELS[name].fit_settings if name in VESSELS else None
+    horizon = _horizon(args.horizon) if args.horizon is not None or settings is None \
+        else settings.horizon
+    sample_interval = args.sample_interval if args.sample_interval is not None \
+        or settings is None else settings.sample_interval
+    base_free = None if settings is None else settings.free
+    if args.free is not None and args.free.strip().startswith("+") and base_free is None:
+        base_free = js.default_free(js.get_vessel(name)) if name in VESSELS else None
+    free = _free(args.free, base_free)
+    used = [] if settings is None else [
+        text for given, text in (
+            (args.horizon, f"--horizon {settings.horizon:g}"),
+            (args.sample_interval, f"--sample-interval {settings.sample_interval:g}"),
+            (args.free, "--free " + ",".join(settings.free))) if given is None]
+    note = None if not used else (f"the {name} preset's settings: {'; '.join(used)} "
+                                  f"({settings.source}).")
+    return horizon, sample_interval, free, note
+
+
 def start_model(model, vessel):
     """`(name, start model or None)` of `--model` or `--vessel` (one of them)."""
     if (model is None) == (vessel is None):
@@ -93,17 +135,19 @@ def start_model(model, vessel):
 def run(args) -> int:
     # every check before the fit; the files appear in --out only when all are written
     name, start = start_model(args.model, args.vessel)  # unknown ones fail before any file
-    horizon = _horizon(args.horizon)
+    horizon, sample_interval, free, settings_note = preset_settings(name, args)
     if args.max_steps < 1:
         raise ValueError(f"--max-steps {args.max_steps}: give a positive number of optimiser "
                          "steps (default 256).")
-    check_out(args.out, writes=("result.json",) + (() if args.no_figures else ("figures/",)),
+    vessel = isinstance(start, js.AbstractVessel) or name in VESSELS  # writes vessel.toml
+    check_out(args.out, writes=("result.json",) + (("vessel.toml",) if vessel else ())
+              + (() if args.no_figures else ("figures/",)),
               inputs=[*args.train, *(args.validate or [])])
     over_ground = VELOCITIES.get(args.velocities)
     train = read_experiments(args.train, role="training", note=note,
-                             sample_interval=args.sample_interval, over_ground=over_ground)
+                             sample_interval=sample_interval, over_ground=over_ground)
     held_out = None if args.validate is None else read_experiments(
-        args.validate, role="validation", note=note, sample_interval=args.sample_interval,
+        args.validate, role="validation", note=note, sample_interval=sample_interval,
         over_ground=over_ground)
     if not args.no_figures:  # their names follow the records'
         names = identification_figure_names(
@@ -112,19 +156,23 @@ def run(args) -> int:
     bar = ProgressBar(not args.quiet)
     result = identify(train, model=name, start=start, horizon=horizon, validate=held_out,
                       rudder=args.rudder, channels=args.channels, initial=args.initial,
-                      max_steps=args.max_steps, progress=bar)
+                      max_steps=args.max_steps, progress=bar, free=free)
     written = ["result.json"]
     with staged_folder(args.out) as stage:
         if not args.no_figures:
             paths = save_identification_figures(result, stage / "figures")
             written.append(f"figures/ ({len(paths)} figures)")
         (stage / "result.json").write_text(result.to_json() + "\n")
+        if isinstance(result.model, js.AbstractVessel):  # `--vessel out/vessel.toml` later
+            js.save_vessel(result.model, stage / "vessel.toml",
+                           source=f"jaxship identify --model {name} ({result.fit.code_name})")
+            written.append("vessel.toml")
     head, *lines = result.summary().splitlines()
     if not result.fit.success:  # the optimiser's own words are on stderr, in plain ones
         head = (f"{result.model_name}: {type(result.model).__name__}, NOT converged "
                 f"({result.fit.code_name}, after {result.fit.num_steps} steps)")
     print("\n".join([head, *lines]))
-    for text in result.notes:
+    for text in ((settings_note,) if settings_note else ()) + result.notes:
         print(f"note: {text}")
     for message in dict.fromkeys(result.warnings):
         print(f"jaxship: warning: {one_line(message)}", file=sys.stderr)

@@ -70,7 +70,7 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
              rudder: str = "delta", channels=None, initial: str = "auto",
              max_steps: int = 256, substeps: int = 1,
              progress: Callable[[Progress], None] | None = None,
-             start=None) -> IdentificationResult:
+             start=None, free=None) -> IdentificationResult:
     """Estimate a registered steering model from training records and validate it.
 
     **Arguments:**
@@ -104,6 +104,7 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     - `start`: a model to start from (`--vessel`: a vessel of a preset or a vessel
       file, the model of an earlier result), fitted as `model` is (`start_entry`); a
       vessel's `model` is its preset name, or None for a vessel of one's own.
+    - `free`: the names of the estimated parameters; None: the model's `default_free`.
 
     Start values: the entry's `start` (linear least squares by `initial_estimate`,
     or a nested fit); if it fails (e.g. no excitation) the entry's neutral
@@ -198,6 +199,9 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
 
     def run_fit(start_model, *, free=None, stage="fitting", custom=None):
         relay = lambda event: report(dataclasses.replace(event, message=stage))
+        if custom is not None and free is not None:
+            raise ValueError(f"model {name} is fitted by its own estimator: it takes no "
+                             "choice of free parameters.")
         if custom is None:
             return js.fit(start_model, train_ds, estimator=estimator, free=free,
                           progress=relay)
@@ -228,7 +232,8 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
 
     def attempt(start_model):
         try:
-            outcome = run_fit(start_model, stage=f"fitting {name}", custom=entry.fit)
+            outcome = run_fit(start_model, free=free, stage=f"fitting {name}",
+                              custom=entry.fit)
         except np.linalg.LinAlgError as error:  # NaN residuals: the simulation blew up
             return None, str(error)
         if not math.isfinite(outcome.cost):
@@ -296,7 +301,8 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
         start_method=method, train=train_block, train_simulation=train_sim,
         validation=valid_block,
         options={"horizon_s": horizon, "rudder": rudder, "channels": list(channels),
-                 "initial": initial, "max_steps": int(max_steps), "substeps": int(substeps)},
+                 "initial": initial, "max_steps": int(max_steps), "substeps": int(substeps),
+                 "free": None if free is None else list(free)},
         notes=tuple(notes), warnings=tuple(caught),
     )
     return out
