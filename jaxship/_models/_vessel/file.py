@@ -224,7 +224,8 @@ def vessel_text(vessel: AbstractVessel, *, source: str = "") -> str:
              "jaxship.load_vessel in Python.",
              "# A dimensional coefficient is { value = ..., unit = \"...\" } in SI units "
              "(deg, deg/s, rpm read too);",
-             "# a bare number is dimensionless. Every field is required.",
+             "# a bare number is dimensionless. Every field is required; a [wind_model] "
+             "table only for wind loads other than FossenWindLoads.",
              *([f"# {source}"] if source else []),
              f"model = \"{data.pop('model')}\""]
     tables = {k: data.pop(k) for k in (*ACTUATORS, WIND) if k in data}
