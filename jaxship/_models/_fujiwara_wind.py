@@ -11,11 +11,13 @@ from the angle $\\alpha$ off the bow and $q = \\tfrac12\\rho_a U_A^2$,
   (about midship),
 
 each of $X_0 \\dots N_3$ a constant plus coefficients times geometric ratios
-(`TERMS`; the ship has a superstructure, "ss" = 1). The paper's $\\alpha$ runs from
-port: a wind from starboard at $\\alpha > 0$ would give $C_Y > 0$, a force to starboard,
-so $\\alpha = -\\gamma$ with jaxship's $\\gamma$ (+ from starboard), as in the Esso Osaka
-lab's simulator (GitHub NAOE-5thLab/mmg-1p1r-simulator, `angle_of_attack = 2 pi -
-gamma_a`) and the public `wind_EO` function (`alpha = atan2(-v_rel, u_rel)`).
+(`TERMS`; the ship has a superstructure, "ss" = 1). The angle is read as
+$\\alpha = -\\gamma$, jaxship's $\\gamma$ being + from starboard, as the Esso Osaka
+lab's simulator (GitHub NAOE-5thLab/mmg-1p1r-simulator: angle of attack = 2 pi minus
+the clockwise apparent-wind angle) and the public `wind_EO` function
+($\\alpha$ = atan2(-v_rel, u_rel)) read it: with $Y_1 > 0$ a beam wind from starboard
+then pushes to port, and a head wind on a ship moving ahead holds it back
+(`tests/test_wind_loads.py`).
 """
 
 import jax.numpy as jnp
@@ -26,7 +28,8 @@ from ._environment import AbstractWindLoads, _apparent
 
 
 # {term: (constant, ((coefficient, ratio), ...))}: Fujiwara et al. (1998), the
-# regression table (as in `shared/reference/fujiwara_wind.md`); ratio names below
+# regression table (as in `shared/reference/fujiwara_wind.md` and `wind_EO`; the lab's
+# Python code has x_AL z_AL/A_L for Y5's last ratio, 0.004 deg/s on its free runs)
 TERMS = {
     "X0": (-0.330, ((0.293, "B H_BR/A_T"), (0.0193, "x_AL/z_AL"), (0.682, "A_OD/L^2"))),
     "X1": (-1.353, ((1.700, "A_L/(L B)"), (2.870, "L z_AL/A_L"), (-0.463, "L H_BR/A_L"),
@@ -91,7 +94,7 @@ class FujiwaraWindLoads(AbstractWindLoads):
                 for name, (constant, terms) in TERMS.items()}
 
     def load_coefficients(self, alpha, frontal_area, lateral_area):
-        """$(C_X, C_Y, C_N)$ [-] at the paper's wind angle `alpha` [rad] (+ from port)."""
+        """$(C_X, C_Y, C_N)$ [-] at the paper's wind angle `alpha` [rad] ($-\\gamma$)."""
         c = self.coefficients(frontal_area, lateral_area)
         return (
             c["X0"] + c["X1"] * jnp.cos(alpha) + c["X3"] * jnp.cos(3 * alpha)
