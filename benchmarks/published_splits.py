@@ -46,7 +46,11 @@ sys.path.insert(0, str(ROOT))  # benchmarks.studies
 
 import jaxship as js  # noqa: E402
 import jaxship.cli  # noqa: E402
-from benchmarks.studies.published_splits import SPLITS, free_run_score  # noqa: E402
+from benchmarks.studies.published_splits import (  # noqa: E402
+    SPLITS,
+    free_run_score,
+    lab_as_published,
+)
 
 
 RESULTS = ROOT / "benchmarks" / "results" / "published_splits.json"
@@ -114,7 +118,7 @@ def lab(wind: str):
     if wind == "none":
         return dataclasses.replace(vessel, frontal_wind_area=0.0, lateral_wind_area=0.0)
     if wind == "fujiwara":
-        return js.esso_osaka_lab()
+        return lab_as_published()
     raise ValueError(f"unknown wind model {wind!r}")
 
 

@@ -136,7 +136,13 @@ from ._models._effects import (
     augment as augment,
     nonlinear_nomoto2 as nonlinear_nomoto2,
 )
-from ._models._environment import Current as Current, Environment as Environment, Wind as Wind
+from ._models._environment import (
+    Current as Current,
+    Environment as Environment,
+    FossenWindLoads as FossenWindLoads,
+    Wind as Wind,
+)
+from ._models._fujiwara_wind import FujiwaraWindLoads as FujiwaraWindLoads
 from ._models._hydro_effects import (
     AddedMassError as AddedMassError,
     ApparentWind as ApparentWind,

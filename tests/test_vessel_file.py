@@ -3,7 +3,9 @@ taking a preset, a vessel file or an identify result (issue 62)."""
 
 import json
 import math
+import re
 
+import equinox as eqx
 import jax
 import numpy as np
 import pytest
@@ -217,3 +219,27 @@ def test_simulate_reads_the_fit_code_of_its_result(tmp_path, capsys):
     err = capsys.readouterr().err
     assert f"not a converged estimate (code max_steps_reached in {result})" in err, err
     assert (out / "trial.csv").is_file()
+
+
+def test_a_wind_model_round_trips_in_its_table(tmp_path):
+    """The Esso Osaka preset with Fujiwara's wind loads (issue 58): written with a
+    `[wind_model]` table, read back bit for bit; the default writes no table, and a
+    table without a known model or with a field missing is one line naming it."""
+    lab = eqx.tree_at(lambda v: v.wind_model, js.vessel("esso_osaka"),
+                      js.FujiwaraWindLoads.esso_osaka())
+    text = vessel_text(lab)
+    assert '[wind_model]\nmodel = "FujiwaraWindLoads"' in text
+    assert "\n[wind_model]\n" not in vessel_text(js.vessel("esso_osaka"))
+    back = js.load_vessel(js.save_vessel(lab, tmp_path / "lab.toml"))
+    assert back.wind_model == lab.wind_model
+    assert jax.tree.structure(back) == jax.tree.structure(lab)
+    for old, new, message in [
+            ('model = "FujiwaraWindLoads"', 'model = "Isherwood"', "table [wind_model] must name"),
+            ('bridge_height = { value = 0.294, unit = "m" }\n', "",
+             "missing field 'wind_model.bridge_height'"),
+            ('breadth = { value = 0.48925, unit = "m" }', 'breadth = { value = -0.5, unit = "m" }',
+             "field 'wind_model.breadth' = -0.5 m is out of its physical range")]:
+        path = tmp_path / "bad.toml"
+        path.write_text(text.replace(old, new, 1))
+        with pytest.raises(ValueError, match=re.escape(message)):
+            js.load_vessel(path)

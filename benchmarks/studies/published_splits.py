@@ -14,12 +14,14 @@ Each is `{set name: run names}` (file stems), the test set under `"Test"`;
 (`free_run_score`) is that of a free simulation of each test run from its first
 measured state, replaying the logged rudder angle, propeller rate and true wind: RMSE
 of u, v, r and psi, mean and final distance between the simulated and measured
-positions, and fit % per channel.
+positions, and fit % per channel. `lab_as_published` is the lab's simulator: the
+`esso_osaka` preset (the lab's coefficients) with the lab's wind loads.
 """
 
 import dataclasses
 from pathlib import Path
 
+import equinox as eqx
 import numpy as np
 
 import jaxship as js
@@ -74,6 +76,15 @@ WAKITA_2022 = {
 
 SPLITS = {"Miyauchi 2022": MIYAUCHI_2022, "Wakita 2022": WAKITA_2022}
 SCORED = ("u", "v", "r", "psi")
+
+
+def lab_as_published() -> js.LowSpeedMMGVessel:
+    """The lab's simulator as published (GitHub NAOE-5thLab/mmg-1p1r-simulator): the
+    `esso_osaka` preset, the lab's coefficients, with its wind loads, Fujiwara et al.'s
+    (1998) regression for the lab's geometry (`jaxship.FujiwaraWindLoads.esso_osaka()`)
+    instead of jaxship's generic `FossenWindLoads`."""
+    return eqx.tree_at(lambda v: v.wind_model, js.vessel("esso_osaka"),
+                       js.FujiwaraWindLoads.esso_osaka())
 
 
 def read_runs(names, root=None) -> list[js.Experiment]:

@@ -446,6 +446,10 @@ class AugmentedVessel(_Augmented, AbstractVessel):
         return self._wind_areas()[0]
 
     @property
+    def wind_model(self):
+        return self.base.wind_model
+
+    @property
     def lateral_wind_area(self):
         return self._wind_areas()[1]
 

@@ -6,8 +6,9 @@ quantity of dimension $\\mathrm{kg}^a\\,\\mathrm{m}^b\\,\\mathrm{s}^c$ scales by
 $\\lambda^{3a + b + c/2}$: lengths by $\\lambda$, times by $\\sqrt\\lambda$, speeds by
 $\\sqrt\\lambda$, rates (yaw rate, propeller rate) by $1/\\sqrt\\lambda$, masses and
 forces by $\\lambda^3$, moments by $\\lambda^4$; angles and non-dimensional coefficients
-stay. A vessel's factors come from the units of its `param` fields; its rudder servo and
-shaft scale as the rates and time constants they are. Reynolds-number effects (friction)
+stay. A vessel's factors come from the units of its `param` fields and of its wind
+model's (`FujiwaraWindLoads`' geometry); its rudder servo and shaft scale as the rates
+and time constants they are. Reynolds-number effects (friction)
 do not scale this way: jaxship's models have none, so a scaled model is exactly similar.
 """
 
@@ -67,10 +68,11 @@ def _scale_vessel(vessel, scale):
     factor = lambda unit: scale ** froude_exponent(family_unit(unit, base))
     root = math.sqrt(scale)
     scaled = _scaled_fields(base, factor)
-    scaled = eqx.tree_at(lambda v: (v.rudder, v.shaft), scaled, (
+    scaled = eqx.tree_at(lambda v: (v.rudder, v.shaft, v.wind_model), scaled, (
         RudderServo(base.rudder.max_angle, base.rudder.max_rate / root,
                     base.rudder.time_constant * root),
-        Shaft(base.shaft.max_rate / root, base.shaft.time_constant * root)))
+        Shaft(base.shaft.max_rate / root, base.shaft.time_constant * root),
+        _scaled_fields(base.wind_model, factor)))
     if not isinstance(vessel, AbstractComposite):
         return scaled
     effects = tuple(_scaled_fields(e, factor) for e in vessel.effects)

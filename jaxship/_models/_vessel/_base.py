@@ -18,7 +18,7 @@ from ..._foundation._state import (
     to_vector,
 )
 from .._actuators import RudderServo, Shaft
-from .._environment import Environment, Wind
+from .._environment import AbstractWindLoads, Environment, Wind
 
 
 class AbstractVessel(AbstractModel):
@@ -41,6 +41,9 @@ class AbstractVessel(AbstractModel):
     nominal_n: eqx.AbstractVar[float]  # propeller rate at U_0 in straight run [rev/s]
     frontal_wind_area: eqx.AbstractVar[float]  # A_F [m^2], 0 for no windage
     lateral_wind_area: eqx.AbstractVar[float]  # A_L [m^2]
+    # how the wind on those areas makes loads (`jaxship.FossenWindLoads()` in every
+    # class unless given another)
+    wind_model: eqx.AbstractVar[AbstractWindLoads]
 
     # the model contract (`AbstractModel`): fitted outputs by default, channels every
     # window starts from, wind loads, a rudder servo; its coefficients are `param` fields
@@ -108,7 +111,8 @@ class AbstractVessel(AbstractModel):
         propeller rate replayed (`inputs["delta"]`, `inputs["n"]`; their states do not
         move) or, with `servo`, the rudder command `inputs["delta"]` through the
         vessel's servo; with `inputs["wind_speed"]` and `["wind_dir"]` the wind loads
-        of `jaxship.Wind`. The same `state_derivative` as `jaxship.simulate`."""
+        of `jaxship.Wind` by the vessel's `wind_model`. The same `state_derivative` as
+        `jaxship.simulate`."""
         mass_inverse = inverse3(self.mass_matrix())  # once per evaluation
 
         def field(t, y, inputs):
@@ -158,7 +162,8 @@ def _state_derivative(
         cn, ce = environment.current.velocity()
         ug, vg = _ground_body_velocity(state, cn, ce)
         loads = environment.wind.loads(
-            ug, vg, state.psi, vessel.frontal_wind_area, vessel.lateral_wind_area, vessel.length
+            ug, vg, state.psi, vessel.frontal_wind_area, vessel.lateral_wind_area, vessel.length,
+            vessel.wind_model,
         )
         tau = tau + jnp.stack(jnp.broadcast_arrays(*loads))
     # written out: a 3x3 `dot` is a library call per evaluation on CPU, this fuses

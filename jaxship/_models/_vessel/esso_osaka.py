@@ -19,6 +19,7 @@ from jaxtyping import Array
 
 from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
+from .._environment import AbstractWindLoads, FossenWindLoads
 from ._base import AbstractVessel
 from .mmg import GRAVITY, SPEED_FLOOR, SWITCH_WIDTH, safe_atan2, safe_sqrt, side_value, smooth_abs
 
@@ -87,8 +88,9 @@ class LowSpeedMMGVessel(AbstractVessel):
     itself is discontinuous where the $u_R$ branches and propeller quadrants meet
     ($n = 0$ or $u = 0$); this implementation keeps those switches (finite forces, but
     derivatives there are one-sided). The upstream bow/stern thrusters are left out
-    (no thruster signal is logged in the data set); its Fujiwara wind-load regression
-    is left out too (wind loads come from `Environment`; the projected areas are given).
+    (no thruster signal is logged in the data set). Its wind loads are Fujiwara et al.'s
+    (1998) regression, `jaxship.FujiwaraWindLoads.esso_osaka()` as the `wind_model`;
+    the preset keeps every vessel's default, `FossenWindLoads` on the given areas.
     """
 
     length: float = param(free=False, unit="m")  # L_pp
@@ -148,6 +150,7 @@ class LowSpeedMMGVessel(AbstractVessel):
     gamma_n: float = param(free=True, unit="-")  # gamma_N, flow straightening for v + x_R r < 0
     gamma_p: float = param(free=True, unit="-")  # gamma_P, for v + x_R r >= 0
     rho: float = param(998.0, free=False, unit="kg/m^3")  # fresh water
+    wind_model: AbstractWindLoads = FossenWindLoads()  # wind loads on A_F, A_L
 
     def _scales(self):
         L, d = self.length, self.draft

@@ -3,7 +3,9 @@
 One coefficient a line, `name = { value = 3.0, unit = "m" }` where it is dimensional
 and a bare number where it is not (units as in the class's `param` fields: SI, radians,
 rev/s; degrees, deg/s and rpm are read too); the rudder servo and the shaft are the
-tables `[rudder]` and `[shaft]`. Floats are written with `repr`, so that a vessel
+tables `[rudder]` and `[shaft]`, and a wind-load model other than the default
+(`FossenWindLoads`) the table `[wind_model]` (`model = "FujiwaraWindLoads"` and its
+geometry). Floats are written with `repr`, so that a vessel
 reads back bit for bit. `vessel_to_dict` / `vessel_from_dict` are the same content as
 a dict (what `jaxship identify` stores in its result).
 """
@@ -17,6 +19,8 @@ import tomllib
 
 from ..._foundation._params import parameter_fields
 from .._actuators import RudderServo, Shaft
+from .._environment import FossenWindLoads
+from .._fujiwara_wind import FujiwaraWindLoads
 from ._base import AbstractVessel
 from .esso_osaka import LowSpeedMMGVessel
 from .mariner import Mariner
@@ -41,6 +45,11 @@ POSITIVE = {"length", "draft", "draught", "volume", "rho", "mass", "m", "mass_nd
             "radius_of_gyration", "rudder_aspect_ratio", "nominal_speed",
             "rudder.max_rate", "rudder.time_constant", "shaft.max_rate", "shaft.time_constant"}
 NON_NEGATIVE = {"nominal_n", "frontal_wind_area", "lateral_wind_area"}
+# the wind-load models of the table [wind_model] (none: the default, FossenWindLoads)
+WIND_MODELS = {c.__name__: c for c in (FujiwaraWindLoads,)}
+WIND = "wind_model"
+POSITIVE |= {f"{WIND}.{k}" for k in ("length_overall", "breadth", "superstructure_area",
+                                     "area_centre_height", "bridge_height")}
 UNBOUNDED_OK = {"shaft.max_rate"}  # no limit on the shaft's rate
 
 
@@ -50,7 +59,9 @@ def _unit(info) -> str:
 
 def vessel_to_dict(vessel: AbstractVessel) -> dict:
     """`{"model": class name, field: value or {"value", "unit"}, "rudder": {...},
-    "shaft": {...}}`: every field of `vessel`, floats as they are (SI)."""
+    "shaft": {...}}`: every field of `vessel`, floats as they are (SI); its
+    `wind_model` as `"wind_model": {"model": class name, field: ...}` unless it is the
+    default `FossenWindLoads`."""
     if type(vessel).__name__ not in CLASSES:
         raise ValueError(f"{type(vessel).__name__} has no vessel file form; the vessel "
                          f"classes are {', '.join(CLASSES)}.")
@@ -58,7 +69,10 @@ def vessel_to_dict(vessel: AbstractVessel) -> dict:
     out = {"model": type(vessel).__name__}
     for field in dataclasses.fields(vessel):
         value = getattr(vessel, field.name)
-        if field.name in ACTUATORS:
+        if field.name == WIND:
+            if not isinstance(value, FossenWindLoads):
+                out[WIND] = _wind_to_dict(value)
+        elif field.name in ACTUATORS:
             units = ACTUATORS[field.name][1]
             out[field.name] = {k: {"value": float(getattr(value, k)), "unit": u}
                                for k, u in units.items()}
@@ -68,6 +82,27 @@ def vessel_to_dict(vessel: AbstractVessel) -> dict:
             unit = _unit(params[field.name])
             out[field.name] = {"value": float(value), "unit": unit} if unit else float(value)
     return out
+
+
+def _wind_to_dict(model) -> dict:
+    """`{"model": class name, field: {"value", "unit"}}` of a wind-load model."""
+    if type(model).__name__ not in WIND_MODELS:
+        raise ValueError(f"the wind model {type(model).__name__} has no vessel file form; "
+                         f"the wind models are FossenWindLoads, {', '.join(WIND_MODELS)}.")
+    return {"model": type(model).__name__,
+            **{k: {"value": float(getattr(model, k)), "unit": info.unit}
+               for k, info in parameter_fields(model).items()}}
+
+
+def _wind_from_dict(entry):
+    """The wind-load model of the table [wind_model] (`_wind_to_dict`'s form)."""
+    if not isinstance(entry, dict) or entry.get("model") not in WIND_MODELS:
+        raise ValueError(f"table [{WIND}] must name its model = one of "
+                         f"{', '.join(WIND_MODELS)} (without it: FossenWindLoads).")
+    cls = WIND_MODELS[entry["model"]]
+    fields = parameter_fields(cls)
+    _fields(cls, {k: v for k, v in entry.items() if k != "model"}, fields, f"{WIND}.")
+    return cls(**{k: _value(f"{WIND}.{k}", entry[k], info.unit) for k, info in fields.items()})
 
 
 def _number(text, value) -> float:
@@ -135,9 +170,10 @@ def vessel_from_dict(data: dict) -> AbstractVessel:
     if cls is None:
         raise ValueError(f"field 'model': unknown vessel class {data['model']!r}; choose "
                          f"one of {', '.join(CLASSES)}.")
-    params = {f.name: f.metadata.get("jaxship_parameter") for f in dataclasses.fields(cls)}
-    values = _fields(cls, {k: v for k, v in data.items() if k != "model"}, params)
-    kwargs = {}
+    params = {f.name: f.metadata.get("jaxship_parameter") for f in dataclasses.fields(cls)
+              if f.name != WIND}
+    kwargs = {} if WIND not in data else {WIND: _wind_from_dict(data[WIND])}
+    values = _fields(cls, {k: v for k, v in data.items() if k not in ("model", WIND)}, params)
     for name, info in params.items():
         entry = values[name]
         if name in ACTUATORS:
@@ -188,15 +224,17 @@ def vessel_text(vessel: AbstractVessel, *, source: str = "") -> str:
              "jaxship.load_vessel in Python.",
              "# A dimensional coefficient is { value = ..., unit = \"...\" } in SI units "
              "(deg, deg/s, rpm read too);",
-             "# a bare number is dimensionless. Every field is required.",
+             "# a bare number is dimensionless. Every field is required; a [wind_model] "
+             "table only for wind loads other than FossenWindLoads.",
              *([f"# {source}"] if source else []),
              f"model = \"{data.pop('model')}\""]
-    tables = {k: data.pop(k) for k in ACTUATORS}
+    tables = {k: data.pop(k) for k in (*ACTUATORS, WIND) if k in data}
     for name, entry in data.items():
         note = comments.get(name, "")
         lines.append(f"{name} = {_toml_value(entry)}" + (f"  # {note}" if note else ""))
     for name, table in tables.items():
-        lines += ["", f"[{name}]"] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
+        lines += ["", f"[{name}]"] + [f"{k} = " + (f'"{v}"' if k == "model" else _toml_value(v))
+                                      for k, v in table.items()]
     return "\n".join(lines) + "\n"
 
 

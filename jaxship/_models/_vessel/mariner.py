@@ -12,6 +12,7 @@ from jaxtyping import Array
 
 from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
+from .._environment import AbstractWindLoads, FossenWindLoads
 from ._base import AbstractVessel
 
 
@@ -114,6 +115,7 @@ class Mariner(AbstractVessel):
     n_0: float = param(3e-5, free=False, unit="-")  # N'_0
     n_0u: float = param(6e-5, free=False, unit="-")  # N'_0u
     n_0uu: float = param(3e-5, free=False, unit="-")  # N'_0uu
+    wind_model: AbstractWindLoads = FossenWindLoads()  # wind loads on A_F, A_L
 
     def mass_matrix(self) -> Array:
         L = self.length

@@ -14,6 +14,7 @@ from jaxtyping import Array
 
 from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
+from .._environment import AbstractWindLoads, FossenWindLoads
 from ._base import AbstractVessel
 
 
@@ -143,6 +144,7 @@ class MMGVessel(AbstractVessel):
     gamma_r_plus: float = param(free=False, unit="-")  # gamma_R for beta_R > 0 (flow straightening)
     gamma_r_minus: float = param(free=False, unit="-")  # gamma_R for beta_R < 0
     rho: float = param(1025.0, free=False, unit="kg/m^3")  # water density
+    wind_model: AbstractWindLoads = FossenWindLoads()  # wind loads on A_F, A_L
 
     def mass(self) -> Array:
         """Displacement mass $m = \\rho\\nabla$ [kg]."""

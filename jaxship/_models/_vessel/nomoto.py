@@ -6,6 +6,7 @@ from jaxtyping import Array
 
 from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
+from .._environment import AbstractWindLoads, FossenWindLoads
 from ._base import AbstractVessel
 
 
@@ -38,6 +39,7 @@ class NomotoVessel(AbstractVessel):
     nominal_n: float = param(0.0, free=False, unit="rev/s")
     frontal_wind_area: float = param(0.0, free=False, unit="m^2")  # A_F, no windage
     lateral_wind_area: float = param(0.0, free=False, unit="m^2")  # A_L
+    wind_model: AbstractWindLoads = FossenWindLoads()  # wind loads on A_F, A_L
 
     def mass_matrix(self) -> Array:
         return jnp.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, self.time_constant]])

@@ -15,6 +15,7 @@ from jaxtyping import Array
 
 from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
+from .._environment import AbstractWindLoads, FossenWindLoads
 from ._base import AbstractVessel
 
 
@@ -132,6 +133,7 @@ class RossVessel(AbstractVessel):
     flow_straightening: float = param(free=False, unit="-")  # gamma_R
     race_kappa: float = param(free=False, unit="-")  # kappa, MMG propeller-race factor
     race_epsilon: float = param(free=False, unit="-")  # epsilon, (1 - w_R) / (1 - w_P)
+    wind_model: AbstractWindLoads = FossenWindLoads()  # wind loads on A_F, A_L
 
     def mass_matrix(self) -> Array:
         m, xg = self.mass, self.xg

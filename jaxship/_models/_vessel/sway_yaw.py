@@ -14,6 +14,7 @@ from jaxtyping import Array
 
 from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
+from .._environment import AbstractWindLoads, FossenWindLoads
 from ._base import AbstractVessel
 
 
@@ -86,6 +87,7 @@ class SwayYawVessel(AbstractVessel):
     frontal_wind_area: float = param(0.0, free=False, unit="m^2")  # A_F
     lateral_wind_area: float = param(0.0, free=False, unit="m^2")  # A_L
     rho: float = param(1025.0, free=False, unit="kg/m^3")  # water density
+    wind_model: AbstractWindLoads = FossenWindLoads()  # wind loads on A_F, A_L
 
     def mass_matrix(self) -> Array:
         L = self.length
