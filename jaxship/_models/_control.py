@@ -173,10 +173,14 @@ class Feedforward(eqx.Module):
     `RossAutopilot` thesis eq. 5.6 (the hull moment along the reference, divided by
     the rudder's moment per angle). Where the rudder has no effect (zero speed) it
     returns 0.
+
+    `gain` $g$ scales the inverse, $g\\,\\delta_{ff}$ (1: the model as identified; tuned
+    on the vessel by `tune_autopilot`).
     """
 
     model: AbstractVessel | AbstractSteeringModel
     newton_steps: int = eqx.field(static=True, default=2)
+    gain: ArrayLike = 1.0  # g [-]
 
     def __call__(self, r_d: ArrayLike, r_dot_d: ArrayLike, state: ShipState,
                  limit: ArrayLike = np.pi / 2) -> Array:
@@ -191,7 +195,7 @@ class Feedforward(eqx.Module):
             usable = jnp.abs(slope) > 1e-300
             delta = delta - jnp.where(usable, value / jnp.where(usable, slope, 1.0), 0.0)
             delta = jnp.clip(delta, -limit, limit)
-        return delta
+        return self.gain * delta
 
 
 class AutopilotMemory(eqx.Module):

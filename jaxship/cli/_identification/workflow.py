@@ -228,7 +228,8 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
 
     def attempt(start_model):
         try:
-            outcome = run_fit(start_model, stage=f"fitting {name}", custom=entry.fit)
+            outcome = run_fit(start_model, free=entry.free, stage=f"fitting {name}",
+                              custom=entry.fit)
         except np.linalg.LinAlgError as error:  # NaN residuals: the simulation blew up
             return None, str(error)
         if not math.isfinite(outcome.cost):
