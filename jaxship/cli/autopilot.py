@@ -34,7 +34,8 @@ def register(sub) -> None:
     auto.add_argument("--step", default="45", help="heading step [deg], at 50 / omega_n "
                       "s (100 s for 0.5 rad/s)")
     auto.add_argument("--tune", action="store_true",
-                      help="also tune the gains on the vessel at the given rpm/speeds")
+                      help="also tune the gains on the vessel at the given rpm/speeds: the "
+                      "PID's and the feed-forward's (its acceleration and steady-turn parts)")
     auto.add_argument("--natural-frequency", default="auto",
                       help="the controller's omega_n [rad/s]; auto: 1.25 / T from "
                       "the model's yaw time constant T, at most half the rudder servo's "
