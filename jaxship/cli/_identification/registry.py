@@ -94,7 +94,8 @@ MODELS: dict[str, ModelEntry] = {
         "course stability: T held at the linear Nomoto1's (the scale), K [1/s], n1 [-] (either "
         "sign: n1 < 0 course unstable, a spiral loop) and n3 [s^2/rad^2] estimated",
         starts.start_norrbin_either, starts.fallback_nonlinear, free=("K", "n1", "n3"),
-        start_method="the linear Nomoto1 least-squares K, T with n1 = 1, n3 = 0",
+        start_method="linear least squares with n1 = +1 or -1 (initial_estimate), as "
+        "nomoto1-nonlinear",
     ),
     "ross-autopilot": ModelEntry(
         "Ross (2008) autopilot model without roll, driven by the measured u, v (thesis eq. "

@@ -116,12 +116,12 @@ def start_nonlinear(train: js.Dataset, context: StartContext) -> js.NonlinearNom
 
 
 def start_norrbin_either(train: js.Dataset, context: StartContext) -> js.NonlinearNomoto:
-    """The linear Nomoto1 least-squares K, T with $n_1 = 1$, $n_3 = 0$: the start of
-    `nomoto1-norrbin`, which holds T (the equation's scale, Norrbin's model being
-    unchanged when K, T and all $n_i$ are multiplied by one number) and estimates K,
-    $n_1$ of either sign and $n_3$ (Astrom & Kallstrom 1979, sec. 2; thesis eq. 3.4)."""
-    first = initial_estimate(js.Nomoto1(K=1.0, T=1.0), train, rudder=context.rudder)
-    return js.NonlinearNomoto(K=first.K, T=first.T, n3=0.0, n1=1.0)
+    """The start of `nomoto1-norrbin`: `start_nonlinear`'s regression (n1 = +1 or -1, or
+    the linear Nomoto1 K, T with n3 = 0). The fit then holds T (the equation's scale:
+    Norrbin's model is unchanged when K, T and all $n_i$ are multiplied by one number)
+    and estimates K, $n_1$ of either sign and $n_3$ (Astrom & Kallstrom 1979, sec. 2;
+    thesis eq. 3.4)."""
+    return start_nonlinear(train, context)
 
 
 def fallback_nonlinear(train: js.Dataset, context: StartContext) -> js.NonlinearNomoto:
