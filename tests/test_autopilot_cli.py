@@ -6,6 +6,7 @@ chapter-5 study and the `--tune` option."""
 import json
 import math
 import os
+import re
 import pathlib
 
 import jax
@@ -58,6 +59,17 @@ def test_autopilot_writes_gains_runs_report_and_figures(written):
         assert all(math.isfinite(gains[k]) and gains[k] > 0 for k in ("kp", "ki", "kd"))
     assert result["gains"]["pid+ff"]["feedforward"] == "Nomoto1"
     assert result["gains"]["pid"]["feedforward"] is None
+    # issue 61: the feed-forward's gains, and in the report the model it inverts and its
+    # steady-turn gain where the step steers against the linear one (equal for Nomoto1)
+    ff = result["gains"]["pid+ff"]
+    assert (ff["ff_gain"], ff["ff_steady_gain"]) == (1.0, 1.0)
+    report = (written / "report.md").read_text()
+    said = re.search(r"inverts the Nomoto1 model\. .* a gain r/delta = (\S+) 1/s where the "
+                     r"autopilot steers, against the identified model's linear gain 1/d = "
+                     r"(\S+) 1/s", report)
+    assert said, report[:2000]
+    assert float(said[1]) == pytest.approx(float(said[2]), rel=1e-3)
+    assert float(said[2]) == pytest.approx(result["model"]["parameters"]["K"], rel=1e-3)
     assert result["model"]["fit_code"] == "successful"
     runs = result["runs"]
     assert [(r["controller"], r["rpm"]) for r in runs] == [

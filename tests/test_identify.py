@@ -36,8 +36,9 @@ DEG = np.pi / 180
 DT = 0.5
 NUM = 600
 TRUTH = Nomoto1(K=0.06, T=25.0)  # K [1/s], T [s]
-STEERING_MODELS = ("nomoto1", "nomoto2", "nomoto1-nonlinear", "ross-autopilot",
-                   "linear-sway-yaw", "norrbin-crossflow", "low-speed-sway-yaw", "armax")
+STEERING_MODELS = ("nomoto1", "nomoto2", "nomoto1-nonlinear", "nomoto1-norrbin",
+                   "ross-autopilot", "linear-sway-yaw", "norrbin-crossflow",
+                   "low-speed-sway-yaw", "armax")
 
 
 def rudder_sequence(seed, amplitudes=(10.0,), hold=(16, 48)):
@@ -220,6 +221,21 @@ def test_every_registered_model_recovers_quietly(name, truth, capsys):
         assert steps == sorted(steps) and steps[-1] >= 1
     assert all(isinstance(e, Progress) for e in events) and events[-1].done
     assert json.loads(res.to_json())["model"] == name
+
+
+@pytest.mark.slow
+def test_norrbin_of_either_stability_recovers_a_course_unstable_truth():
+    """Issue 61: `nomoto1-norrbin` holds T at the linear start (the equation's scale) and
+    estimates K, n1 of either sign and n3: on a course-unstable truth (n1 = -1) it
+    recovers the truth scaled by T_start / T_truth, n1 < 0 included."""
+    truth = NonlinearNomoto(K=0.06, T=25.0, n3=300.0, n1=-1.0)
+    train = record(truth, rudder_sequence(5, amplitudes=(5.0, 15.0, 30.0)), name="a")
+    res = identify(train, model="nomoto1-norrbin")
+    assert res.fit.success and res.fit.names == ("K", "n3", "n1")
+    scale = float(res.model.T) / truth.T
+    np.testing.assert_allclose(res.fit.values, [scale * truth.K, scale * truth.n3,
+                                                scale * truth.n1], rtol=1e-5)
+    assert res.fit.values[2] < 0
 
 
 def _csv_with(tmp_path, name, edit):

@@ -124,9 +124,17 @@ class TunedAutopilot(eqx.Module):
     success: Array
 
 
+def _tuned_values(autopilot):
+    """Getter of the values `tune_autopilot` tunes: the PID gains and, with a
+    feed-forward, its acceleration and steady-turn gains (`Feedforward`)."""
+    if autopilot.feedforward is None:
+        return lambda a: (a.kp, a.ki, a.kd)
+    return lambda a: (a.kp, a.ki, a.kd, a.feedforward.gain, a.feedforward.steady_gain)
+
+
 def _with_gains(autopilot, log_gains):
     gains = tuple(jnp.exp(log_gains))
-    return eqx.tree_at(lambda a: (a.kp, a.ki, a.kd), autopilot, gains)
+    return eqx.tree_at(_tuned_values(autopilot), autopilot, gains)
 
 
 def tune_autopilot(plant, autopilot: HeadingAutopilot, *, speeds=None, rpm=None,
@@ -134,21 +142,24 @@ def tune_autopilot(plant, autopilot: HeadingAutopilot, *, speeds=None, rpm=None,
                    disturbance: YawDisturbance | None = None, max_steps: int = 30,
                    rtol: float = 1e-4, atol: float = 1e-8,
                    simulator: Simulator = Simulator()) -> TunedAutopilot:
-    """Tune `kp`, `ki`, `kd` of `autopilot` on `plant` by minimising
-    `tracking_objective` (mean squared heading error plus `rudder_weight` times the
-    mean squared rudder command) over the closed-loop runs at all `speeds` (or `rpm`)
-    at once, sampled every `dt` [s] for `duration` [s].
+    """Tune `kp`, `ki`, `kd` of `autopilot` on `plant` and, with a feed-forward, its
+    `gain` and `steady_gain` (`Feedforward`: the model's inverse split into its
+    acceleration and steady-turn parts), by minimising `tracking_objective` (mean
+    squared heading error plus `rudder_weight` times the mean squared rudder command)
+    over the closed-loop runs at all `speeds` (or `rpm`) at once, sampled every `dt`
+    [s] for `duration` [s].
 
     Levenberg-Marquardt (optimistix) on the residuals $\\tilde\\psi_k/\\sqrt N$,
     $\\sqrt w\\,\\delta_{c,k}/\\sqrt N$, whose sum of squares is the objective, with the
     gains in log space (they stay positive; the start must be positive) and the
     Jacobian by forward mode through the simulation. One gain set for all speeds (no
-    gain schedule). The reference model, feed-forward and limits stay as they are.
+    gain schedule). The reference model, the feed-forward's model and the limits stay
+    as they are.
     """
-    gains = np.array([np.asarray(autopilot.kp), np.asarray(autopilot.ki),
-                      np.asarray(autopilot.kd)], dtype=float)
-    if gains.shape != (3,) or not np.all(gains > 0):
-        raise ValueError(f"tune one autopilot with positive kp, ki, kd, got {gains}.")
+    gains = np.array([np.asarray(g) for g in _tuned_values(autopilot)(autopilot)],
+                     dtype=float)
+    if gains.ndim != 1 or not np.all(gains > 0):
+        raise ValueError(f"tune one autopilot with positive gains, got {gains}.")
     plant, x0, dt_, num, simulator, steps = _setup(plant, speeds, rpm, duration, dt,
                                                    disturbance, simulator)
     autopilot = _as_arrays(autopilot)

@@ -173,15 +173,31 @@ class Feedforward(eqx.Module):
     `RossAutopilot` thesis eq. 5.6 (the hull moment along the reference, divided by
     the rudder's moment per angle). Where the rudder has no effect (zero speed) it
     returns 0.
+
+    **Gains.** The inverse splits into the steady-turn rudder $\\delta_s = \\delta_{ff}(r_d,
+    0)$ (the manoeuvring characteristic, Norrbin's $H(r_d)/K$ for `NonlinearNomoto`;
+    Astrom & Kallstrom 1979, sec. 2) and the acceleration part $\\delta_{ff}(r_d,
+    \\dot r_d) - \\delta_s$ ($T\\dot r_d/K$ for Nomoto models), weighted by `gain` $g_a$
+    and `steady_gain` $g_s$:
+
+    $$\\delta = g_a\\,[\\delta_{ff}(r_d, \\dot r_d) - \\delta_s] + g_s\\,\\delta_s.$$
+
+    Both 1 (default): the model's inverse itself. The acceleration part rests on the
+    yaw inertia per rudder angle $T/K$, which zig-zags determine well; the steady part
+    on the characteristic at the small yaw rates of an autopilot's turn, which they
+    barely excite (a course-unstable ship's spiral loop lies inside it), so
+    `tune_autopilot` tunes both on the vessel.
     """
 
     model: AbstractVessel | AbstractSteeringModel
     newton_steps: int = eqx.field(static=True, default=2)
+    gain: ArrayLike = 1.0  # g_a [-] on the acceleration part
+    steady_gain: ArrayLike = 1.0  # g_s [-] on the steady-turn part
 
-    def __call__(self, r_d: ArrayLike, r_dot_d: ArrayLike, state: ShipState,
-                 limit: ArrayLike = np.pi / 2) -> Array:
-        """$\\delta_{ff}$ [rad] for the desired yaw rate `r_d` and acceleration `r_dot_d`
-        at the measured `state`, within $\\pm$`limit`."""
+    def inverse(self, r_d: ArrayLike, r_dot_d: ArrayLike, state: ShipState,
+                limit: ArrayLike = np.pi / 2) -> Array:
+        """The model's rudder $\\delta_{ff}$ [rad] with $\\dot r(r_d, \\delta_{ff}) =
+        \\dot r_d$ at the measured `state`, within $\\pm$`limit` (Newton, class text)."""
         def residual(delta):
             return yaw_acceleration(self.model, r_d, delta, state) - r_dot_d
 
@@ -192,6 +208,15 @@ class Feedforward(eqx.Module):
             delta = delta - jnp.where(usable, value / jnp.where(usable, slope, 1.0), 0.0)
             delta = jnp.clip(delta, -limit, limit)
         return delta
+
+    def __call__(self, r_d: ArrayLike, r_dot_d: ArrayLike, state: ShipState,
+                 limit: ArrayLike = np.pi / 2) -> Array:
+        """$\\delta$ [rad] of the class text for the desired yaw rate `r_d` and
+        acceleration `r_dot_d` at the measured `state`."""
+        full = self.inverse(r_d, r_dot_d, state, limit)
+        steady = self.inverse(r_d, jnp.zeros_like(jnp.asarray(r_dot_d, dtype=float)), state,
+                              limit)
+        return self.gain * (full - steady) + self.steady_gain * steady
 
 
 class AutopilotMemory(eqx.Module):

@@ -34,7 +34,8 @@ def register(sub) -> None:
     auto.add_argument("--step", default="45", help="heading step [deg], at 50 / omega_n "
                       "s (100 s for 0.5 rad/s)")
     auto.add_argument("--tune", action="store_true",
-                      help="also tune the gains on the vessel at the given rpm/speeds")
+                      help="also tune the gains on the vessel at the given rpm/speeds: the "
+                      "PID's and the feed-forward's (its acceleration and steady-turn parts)")
     auto.add_argument("--natural-frequency", default="auto",
                       help="the controller's omega_n [rad/s]; auto: 1.25 / T from "
                       "the model's yaw time constant T, at most half the rudder servo's "
@@ -83,6 +84,10 @@ def run(args) -> int:
         omega, basis = autopilot_study.natural_frequency_for(model, vessel, speed=u0, n=n0,
                                                              step=step)
     design = autopilot_study.Design.scaled(omega, step=step, damping=damping, basis=basis)
+    u_mean, n_mean = autopilot_study.operating_point(
+        vessel, **{"rpm" if by_rpm else "speed": sum(values) / len(values)})
+    inverse = autopilot_study.feedforward_gain_text(model, vessel, design, speed=u_mean,
+                                                    n=n_mean)
 
     bar = tqdm(total=2 + 2 * int(args.tune), desc="autopilot", unit="stage", leave=False,
                file=sys.stderr, disable=args.quiet)
@@ -141,7 +146,7 @@ def run(args) -> int:
         page = evaluation_report(
             evaluation, title=f"Heading autopilot: {report['model']} on {args.vessel}",
             model_text=f"Model: {report['model']} ({type(model).__name__}) from "
-            f"`{args.model}`: {parameters}.", figures=figures)
+            f"`{args.model}`: {parameters}. {inverse}", figures=figures)
         for sentence in (saturation, failure, unfit):  # first, under the title
             if sentence:
                 title, _, rest = page.partition("\n")
@@ -149,6 +154,7 @@ def run(args) -> int:
         (stage / "report.md").write_text(page)
     print(gains_table(evaluation.gains()))
     print(runs_table(evaluation.rows))
+    print(inverse)
     print(f"wrote {args.out}/autopilot.json, {args.out}/report.md, {args.out}/figures/ "
           f"({len(figures)} figures)")
     if saturation:
@@ -161,11 +167,13 @@ def run(args) -> int:
 
 def gains_table(gains: dict) -> str:
     """Markdown table of `Evaluation.gains()`."""
-    lines = ["| controller | K_p [-] | K_i [1/s] | K_d [s] | feed-forward |",
-             "|---|---|---|---|---|"]
+    lines = ["| controller | K_p [-] | K_i [1/s] | K_d [s] | feed-forward | its gains "
+             "(acceleration, steady turn) |", "|---|---|---|---|---|---|"]
     for name, g in gains.items():
+        ff = g["feedforward"]
+        weights = "-" if ff is None else f"{g['ff_gain']:.3g}, {g['ff_steady_gain']:.3g}"
         lines.append(f"| {name} | {g['kp']:.4g} | {g['ki']:.4g} | {g['kd']:.4g} | "
-                     f"{g['feedforward'] or 'none'} |")
+                     f"{ff or 'none'} | {weights} |")
     return "\n".join(lines) + "\n"
 
 

@@ -40,6 +40,7 @@ class ModelEntry:
     - `fit(start, train, context) -> FitResult`: replaces the prediction-error fit
       (`jaxship.fit` with `context.estimator`) for models it does not serve, e.g.
       the discrete ARMAX model; None: `jaxship.fit`.
+    - `free`: the parameters estimated, where not the start model's `param` defaults.
     """
 
     description: str
@@ -52,6 +53,7 @@ class ModelEntry:
     requires: tuple[str, ...] = ()
     initial: tuple[str, ...] = ("measured", "estimate")
     fit: Callable | None = None
+    free: tuple[str, ...] | None = None
 
 
 def _vessel_entry(name: str, vessel=None, description: str = "") -> ModelEntry:
@@ -86,6 +88,14 @@ MODELS: dict[str, ModelEntry] = {
         "nonlinear first-order Nomoto model T r' + n3 r^3 + n1 r = K delta (Norrbin): K [1/s], "
         "T [s], n3 [s^2/rad^2]",
         starts.start_nonlinear, starts.fallback_nonlinear,
+    ),
+    "nomoto1-norrbin": ModelEntry(
+        "nonlinear first-order Nomoto model T r' + n3 r^3 + n1 r = K delta (Norrbin) of either "
+        "course stability: T held at the linear Nomoto1's (the scale), K [1/s], n1 [-] (either "
+        "sign: n1 < 0 course unstable, a spiral loop) and n3 [s^2/rad^2] estimated",
+        starts.start_norrbin_either, starts.fallback_nonlinear, free=("K", "n1", "n3"),
+        start_method="linear least squares with n1 = +1 or -1 (initial_estimate), as "
+        "nomoto1-nonlinear",
     ),
     "ross-autopilot": ModelEntry(
         "Ross (2008) autopilot model without roll, driven by the measured u, v (thesis eq. "

@@ -115,6 +115,15 @@ def start_nonlinear(train: js.Dataset, context: StartContext) -> js.NonlinearNom
     return start
 
 
+def start_norrbin_either(train: js.Dataset, context: StartContext) -> js.NonlinearNomoto:
+    """The start of `nomoto1-norrbin`: `start_nonlinear`'s regression (n1 = +1 or -1, or
+    the linear Nomoto1 K, T with n3 = 0). The fit then holds T (the equation's scale:
+    Norrbin's model is unchanged when K, T and all $n_i$ are multiplied by one number)
+    and estimates K, $n_1$ of either sign and $n_3$ (Astrom & Kallstrom 1979, sec. 2;
+    thesis eq. 3.4)."""
+    return start_nonlinear(train, context)
+
+
 def fallback_nonlinear(train: js.Dataset, context: StartContext) -> js.NonlinearNomoto:
     first = neutral_nomoto1(train, context.rudder)
     return js.NonlinearNomoto(K=first.K, T=first.T)

@@ -232,7 +232,8 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
 
     def attempt(start_model):
         try:
-            outcome = run_fit(start_model, free=free, stage=f"fitting {name}",
+            outcome = run_fit(start_model, free=entry.free if free is None else free,
+                              stage=f"fitting {name}",
                               custom=entry.fit)
         except np.linalg.LinAlgError as error:  # NaN residuals: the simulation blew up
             return None, str(error)

@@ -149,13 +149,17 @@ class Evaluation:
     tuning: dict | None = None
 
     def gains(self) -> dict:
-        """{controller: {kp, ki, kd, feedforward}}: kp [rad/rad], ki [1/s], kd [s] and
-        the class of the inverted model (None: feedback only)."""
+        """{controller: {kp, ki, kd, feedforward[, ff_gain, ff_steady_gain]}}: kp
+        [rad/rad], ki [1/s], kd [s], the class of the inverted model (None: feedback
+        only) and the feed-forward's gains."""
         out = {}
         for name, a in self.controllers.items():
             ff = a.feedforward
             out[name] = {"kp": float(a.kp), "ki": float(a.ki), "kd": float(a.kd),
                          "feedforward": None if ff is None else type(ff.model).__name__}
+            if ff is not None:  # its acceleration and steady-turn gains (`Feedforward`)
+                out[name] |= {"ff_gain": float(ff.gain),
+                              "ff_steady_gain": float(ff.steady_gain)}
         if self.tuning is not None and "tuned" in out:
             out["tuned"] |= self.tuning
         return out
@@ -254,6 +258,25 @@ def natural_frequency_for(model, plant, *, speed: float, n: float,
                f"{speed:.3g} m/s ({limited}; at most 0.5 / T_servo = {0.5 / servo:.3g} "
                f"rad/s and {rudder:.3g} rad/s for the rudder), the reference and timing in "
                "the thesis' proportions")
+
+
+def feedforward_gain_text(model, plant, design: Design, *, speed: float, n: float) -> str:
+    """Which model the feed-forward inverts and its steady-turn gain where the step steers:
+    at the reference's peak yaw rate $r_p = A\\omega\\,2e^{-2}$ (the peak of
+    $\\dot\\psi_d$ of eq. 5.7 at damping 1 for a step $A$) the model's steady-turn
+    rudder $\\delta_s$ (`Feedforward.inverse` with $\\dot r_d = 0$) and its gain
+    $r_p/\\delta_s$, against the linear gain $1/d$ of `yaw_inertia` about the straight
+    run (K for Nomoto models), in one sentence."""
+    state = js.straight_run(plant, speed=speed)  # the measured u, v, n the inverse uses
+    r_peak = abs(design.step) * DEG * design.reference_frequency * 2 * math.exp(-2)
+    steady = float(js.Feedforward(model).inverse(r_peak, 0.0, state))
+    linear = 1.0 / float(js.yaw_inertia(model, speed=speed, n=n)[1])
+    gain = r_peak / steady if steady != 0 else math.inf
+    return (f"The feed-forward inverts the {type(model).__name__} model. At the step's peak "
+            f"desired yaw rate {math.degrees(r_peak):.3g} deg/s its steady-turn rudder is "
+            f"{math.degrees(steady):.3g} deg: a gain r/delta = {gain:.4g} 1/s where the "
+            f"autopilot steers, against the identified model's linear gain 1/d = "
+            f"{linear:.4g} 1/s at r = 0.")
 
 
 def design_controllers(model, plant, design: Design = Design(), *, speed: float,

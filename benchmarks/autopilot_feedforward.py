@@ -1,0 +1,111 @@
+"""Does the autopilot's reference feed-forward help on vessels jaxship did not fit? (issue 61)
+
+Run as a new user would, through the command line: each vessel's steering model from
+`jaxship identify` on that vessel's zig-zags, then `jaxship autopilot` with its defaults
+(45 deg step) on a vessel preset, PID with feed-forward (pid+ff) against the same PID
+without it (pid). Printed per run: the summed heading error (thesis eq. 3.19, deg at 1 s
+over the window after the step), the overshoot [deg], and the ratio pid+ff / pid.
+
+- Mariner at 7.7 m/s: zig-zags 10/10 and 20/20 of jaxship's `mariner` preset, which
+  is also the plant;
+- KVLCC2 7 m model at 600 and 711 rpm: HSVA's measured zig-zags 10/5, 20/5, 10/10 P and
+  20/10 P (SIMMAN 2008, /work/shared/data or $JAXSHIP_DATA); the plant is the `kvlcc2`
+  preset (an MMG model jaxship did not fit to these records);
+- the thesis vessel at 300 and 400 rpm: zig-zags 10/10 and 20/20 of the `thesis`
+  preset at each rate, merged.
+
+    python benchmarks/autopilot_feedforward.py [--models nomoto1 nomoto1-norrbin]
+"""
+
+import argparse
+import json
+import pathlib
+import subprocess
+import sys
+import tempfile
+
+import jaxship as js
+
+HSVA = ("HSVA_CPMC_KVLCC2_Z_10_05", "HSVA_CPMC_KVLCC2_Z_20_05",
+        "HSVA_CPMC_KVLCC2_Z_10_10_P", "HSVA_CPMC_KVLCC2_Z_20_10_P")
+
+
+def jaxship(*args) -> subprocess.CompletedProcess:
+    """One `jaxship` command; exit code 3 (a fit not converged) is reported, not fatal."""
+    quiet = ["--quiet"] if args[0] != "simulate" else []
+    done = subprocess.run([sys.executable, "-m", "jaxship.cli", *map(str, args), *quiet],
+                          capture_output=True, text=True)
+    if done.returncode not in (0, 3):
+        raise RuntimeError(f"jaxship {' '.join(map(str, args))} failed:\n{done.stderr}")
+    return done
+
+
+def zigzags(vessel: str, folder: pathlib.Path, **point) -> list:
+    """10/10 and 20/20 zig-zags of a preset at each given --speed or --rpm."""
+    (key, values), = point.items()
+    paths = []
+    for value in values:
+        for angle in (10, 20):
+            out = folder / f"{vessel}_{angle}_{value:g}"
+            jaxship("simulate", "--vessel", vessel, "--manoeuvre", f"zigzag:{angle}/{angle}",
+                    f"--{key}", value, "--out", out)
+            paths.append(out / "trial.csv")
+    return paths
+
+
+def cases(folder: pathlib.Path) -> list:
+    """(name, training records, plant preset, run option, values) of the five runs."""
+    data = js.shared_data_dir()
+    hsva = [] if data is None else [data / "kvlcc2_simman2008_hsva" / f"{n}.dat" for n in HSVA]
+    out = [("Mariner", zigzags("mariner", folder, speed=[7.7]), "mariner", "--speed", [7.7])]
+    if hsva and all(p.is_file() for p in hsva):
+        out.append(("KVLCC2 (HSVA)", hsva, "kvlcc2", "--rpm", [600, 711]))
+    else:
+        print("KVLCC2: HSVA data not found (set $JAXSHIP_DATA); skipped", file=sys.stderr)
+    out.append(("thesis", zigzags("thesis", folder, rpm=[300, 400]), "thesis", "--rpm",
+                [300, 400]))
+    return out
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--models", nargs="+", default=["nomoto1", "nomoto1-norrbin"])
+    parser.add_argument("--autopilot", nargs="*", default=[],
+                        help="extra options passed to `jaxship autopilot`")
+    args = parser.parse_args(argv)
+    print("| vessel | model | run | pid+ff sum [deg] | pid sum [deg] | ratio | "
+          "pid+ff overshoot [deg] | pid overshoot [deg] | fit |")
+    print("|---|---|---|---:|---:|---:|---:|---:|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = pathlib.Path(tmp)
+        for name, train, plant, option, values in cases(folder):
+            for model in args.models:
+                fit = folder / f"{plant}_{model}"
+                done = jaxship("identify", *train, "--model", model, "--out", fit,
+                               "--no-figures")
+                fitted = "converged" if done.returncode == 0 else "NOT converged"
+                ap = folder / f"{plant}_{model}_ap"
+                try:
+                    jaxship("autopilot", "--model", fit / "result.json", "--vessel", plant,
+                            option, *values, "--out", ap, *args.autopilot)
+                except RuntimeError as error:
+                    print(f"| {name} | {model} | autopilot failed: "
+                          f"{str(error).splitlines()[-1][:80]} | | | | | | {fitted} |")
+                    continue
+                rows = json.loads((ap / "autopilot.json").read_text())["runs"]
+                by = {(r["controller"], r["rpm"], r["speed"]): r for r in rows}
+                for (controller, rpm, speed), ff in by.items():
+                    if controller != "pid+ff":
+                        continue
+                    fb = by[("pid", rpm, speed)]
+                    run = f"{speed:.3g} m/s" if option == "--speed" else f"{rpm:.0f} rpm"
+                    a, b = ff["sum_abs_error_deg"], fb["sum_abs_error_deg"]
+                    ratio = "-" if None in (a, b) else f"{a / b:.2f}"
+                    print(f"| {name} | {model} | {run} | {a:.1f} | {b:.1f} | {ratio} | "
+                          f"{ff['max_overshoot_deg']:.2f} | {fb['max_overshoot_deg']:.2f} | "
+                          f"{fitted} |", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
