@@ -2,7 +2,7 @@
 
 For every scenario (an effect at a size, two effects, the white null and the coloured
 null with a slowly varying yaw moment) it runs discovery on `--seeds` independent data
-sets (`jaxship/cli/_studies/discovery.py`: Nomoto 1 truth integrated finely, rate-limited
+sets (`benchmarks/studies/discovery.py`: Nomoto 1 truth integrated finely, rate-limited
 rudder logged at 2 Hz, 4 training zig-zags, 2 held-out turning circles) and prints:
 
 - detection: the hidden effect (or each of two) named or in a named class, nothing
@@ -23,6 +23,7 @@ import argparse
 import json
 import pathlib
 import subprocess
+import sys
 import tempfile
 import time
 
@@ -30,7 +31,10 @@ import jax
 import numpy as np
 
 import jaxship as js
-from jaxship.cli._studies.discovery import outcome, run_case, vessel_records
+
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))  # benchmarks.studies
+from benchmarks.studies.discovery import outcome, run_case, vessel_records  # noqa: E402
 
 
 DEG = np.pi / 180

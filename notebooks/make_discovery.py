@@ -17,10 +17,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import jaxship as js
-from jaxship.cli._studies.discovery import hidden_effect_records, outcome, vessel_records
 
 
 sys.path.insert(0, str(pathlib.Path.cwd().parent))  # the project root: benchmarks.studies
+from benchmarks.studies.discovery import hidden_effect_records, outcome, vessel_records  # noqa: E402
 from benchmarks.studies.real_data import (  # noqa: E402
     esso_osaka_low_speed_discovery,
     esso_osaka_low_speed_steering,

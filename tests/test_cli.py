@@ -607,7 +607,7 @@ def test_ctrl_c_ends_the_command_with_130_at_once_every_time(tmp_path):
     import time
 
     from jaxship.cli import GRACE
-    from jaxship.cli._studies.discovery import hidden_effect_records
+    from benchmarks.studies.discovery import hidden_effect_records
 
     train, held = hidden_effect_records(js.Nomoto1(K=0.06, T=25.0), 0)
     paths = []

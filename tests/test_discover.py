@@ -22,7 +22,7 @@ from jaxship._estimate._sensitivity import sensitivities
 from jaxship._estimate._windows import as_dataset
 from jaxship._foundation._files import MANIFEST, staged_folder
 from jaxship.cli import main
-from jaxship.cli._studies.discovery import (
+from benchmarks.studies.discovery import (
     condition_records,
     hidden_effect_records,
     outcome,

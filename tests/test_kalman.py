@@ -266,7 +266,7 @@ def test_a_vessels_smoother_recovers_the_unlogged_drift_and_a_fit_needs_no_logge
     missing."""
     import equinox as eqx
 
-    from jaxship.cli._studies.discovery import vessel_records
+    from benchmarks.studies.discovery import vessel_records
 
     mariner = js.vessel("mariner")
     logged, _ = vessel_records(mariner, 0)

@@ -45,7 +45,8 @@ import jaxship as js
 from jaxship._foundation._files import staged_folder
 from jaxship.cli._trials import trial_indices
 
-from . import autopilot_thesis as chapter5, discovery, thesis
+from . import autopilot_thesis as chapter5, thesis
+from .discovery_case import hidden_effect_records
 from .reproduce_report import (
     DISCOVERY_HIDDEN,
     DISCOVERY_SEED,
@@ -271,7 +272,7 @@ def _discovery(quick, out, say=None) -> dict:
     base = js.Nomoto1(K=0.06, T=25.0)  # as `discovery.run_case`
     hidden = js.YawCubicDamping(beta=DISCOVERY_HIDDEN)
     say("simulating the records")
-    train, holdout = discovery.hidden_effect_records(js.augment(base, hidden), DISCOVERY_SEED)
+    train, holdout = hidden_effect_records(js.augment(base, hidden), DISCOVERY_SEED)
     report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout,
                          max_effects=1 if quick else 3, progress=say)
     say("drawing the held-out records")
