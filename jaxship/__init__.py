@@ -51,6 +51,7 @@ from ._estimate._bands import (
     calibrate_disturbance as calibrate_disturbance,
     prediction_bands as prediction_bands,
 )
+from ._estimate._discrete import fit_discrete_response as fit_discrete_response
 from ._estimate._discrete_estimator import (
     DiscreteResponse as DiscreteResponse,
     LeastSquaresRegression as LeastSquaresRegression,

@@ -19,8 +19,7 @@ import equinox as eqx
 import numpy as np
 
 import jaxship as js
-from jaxship._estimate._discrete import fit_discrete_response
-from jaxship.cli._trials import initial_state
+from jaxship import fit_discrete_response
 
 
 DEG = np.pi / 180.0
@@ -95,7 +94,7 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
     `"generalisation"` {(structure, method): {trial: fit % of r}} and the records.
     """
     v = js.vessel(vessel) if isinstance(vessel, str) else vessel
-    x0 = initial_state(v, rpm=rpm)
+    x0 = js.straight_run(v, n=None if rpm is None else rpm / 60.0)  # nominal if None
     tau = float(v.length) / float(x0.u)
     duration = duration_lengths * tau
     rate = float(v.rudder.max_rate)
@@ -161,7 +160,7 @@ def design_study(vessel="thesis", *, rpm=500.0, dt=0.5, noise_r=0.05 * DEG, dura
     **Returns** `{"nominal": {...}, "reports": {(model, manoeuvre): DesignReport}}`.
     """
     v = js.vessel(vessel) if isinstance(vessel, str) else vessel
-    x0 = initial_state(v, rpm=rpm)
+    x0 = js.straight_run(v, n=None if rpm is None else rpm / 60.0)  # nominal if None
     thesis = js.thesis_manoeuvre(dt=dt)
     duration = float(thesis.duration) if duration is None else float(duration)
     rate = float(v.rudder.max_rate)
