@@ -17,7 +17,7 @@ import pytest
 import jaxship as js
 from jaxship.cli import main
 from jaxship.cli._identification import model_from_report, read_result
-from jaxship.cli._studies import autopilot as study
+from jaxship.cli.reproduction import autopilot as study
 from jaxship.plotting import plot_autopilot
 
 

@@ -606,8 +606,8 @@ def test_ctrl_c_ends_the_command_with_130_at_once_every_time(tmp_path):
     import threading
     import time
 
-    from jaxship.cli import GRACE
     from benchmarks.studies.discovery import hidden_effect_records
+    from jaxship.cli import GRACE
 
     train, held = hidden_effect_records(js.Nomoto1(K=0.06, T=25.0), 0)
     paths = []

@@ -14,14 +14,6 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._analysis._discover import _workflow as discover_workflow
-from jaxship._analysis._discover._holdout import cost_rise, record_indices
-from jaxship._analysis._discover._plausible import rudder_equivalent
-from jaxship._analysis._discover._workflow import heldout_rise
-from jaxship._estimate._sensitivity import sensitivities
-from jaxship._estimate._windows import as_dataset
-from jaxship._foundation._files import MANIFEST, staged_folder
-from jaxship.cli import main
 from benchmarks.studies.discovery import (
     condition_records,
     hidden_effect_records,
@@ -32,6 +24,14 @@ from benchmarks.studies.discovery import (
     vessel_records,
     wind_records,
 )
+from jaxship._analysis._discover import _workflow as discover_workflow
+from jaxship._analysis._discover._holdout import cost_rise, record_indices
+from jaxship._analysis._discover._plausible import rudder_equivalent
+from jaxship._analysis._discover._workflow import heldout_rise
+from jaxship._estimate._sensitivity import sensitivities
+from jaxship._estimate._windows import as_dataset
+from jaxship._foundation._files import MANIFEST, staged_folder
+from jaxship.cli import main
 
 
 DEG = np.pi / 180

@@ -23,7 +23,7 @@ from jaxship import (
 from jaxship._estimate._linear import initial_estimate
 from jaxship._foundation._params import parameter_fields
 from jaxship._models._steering.ross import HULL_TERMS
-from jaxship.cli._studies import thesis as ti
+from jaxship.cli.reproduction import thesis as ti
 
 
 DEG = np.pi / 180

@@ -4,15 +4,15 @@ thesis vessel, written up as `report.md` with the thesis' numbers beside ours.
 1. **Trials** (thesis sec. 4.1): turning circles at 5, 10, 20 and 40 deg, zig-zags 5/5
    to 40/40 and the thesis manoeuvre, each at 200 and 500 rpm (`trials/*.csv`,
    `indices.json`), with what the thesis' figs. 4.2-4.7 state about them.
-2. **Identification** (chapter 4, `jaxship.cli._studies.thesis`): Nomoto and Ross models from
+2. **Identification** (chapter 4, `jaxship.cli.reproduction.thesis`): Nomoto and Ross models from
    the single 40 deg / 500 rpm record of each family and from the merged records
    (200 + 500 rpm) of each family; their yaw-rate fit % next to the fit % in the
    legends of the thesis' figs. 4.8-4.30 (`identification.json`).
-3. **Heading autopilot** (chapter 5, `jaxship.cli._studies.autopilot_thesis`): a PID with reference
-   feed-forward from each merged model, run on the vessel at 300 and 400 rpm; our
-   residuals next to the thesis' Tables 5.2-5.7 (`autopilot.json`).
+3. **Heading autopilot** (chapter 5, `jaxship.cli.reproduction.autopilot_thesis`): a PID
+   with reference feed-forward from each merged model, run on the vessel at 300 and 400 rpm;
+   our residuals next to the thesis' Tables 5.2-5.7 (`autopilot.json`).
 4. **Discovery** (`jaxship.discover`): a synthetic Nomoto case with cubic yaw damping
-   hidden, as the discovery tests use it (`jaxship.cli._studies.discovery`;
+   hidden, as the discovery tests use it (`jaxship.cli.reproduction.discovery_case`;
    `discovery.json`).
 
 The trials are those of chapter 4's experiment design (`thesis.simulate_design`), so
