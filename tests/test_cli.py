@@ -13,9 +13,9 @@ from helpers import per_sample
 
 import jaxship as js
 import jaxship.cli as cli
-from jaxship._foundation._files import MANIFEST, staged_folder
 from jaxship._foundation._params import parameter_fields, resolve_free
 from jaxship.cli import main
+from jaxship.cli._files import MANIFEST, staged_folder
 from jaxship.cli._identification.workflow import FitDivergedError
 
 
@@ -864,7 +864,7 @@ def test_a_signal_during_the_imports_ends_with_its_line_and_status(signum, statu
 TERMINATED_COMMIT = """
 import os, pathlib, sys, time
 from jaxship import cli
-from jaxship._foundation import _files
+from jaxship.cli import _files
 from jaxship.cli import simulate
 
 def slow(source, target):  # each rename of the commit takes a while

@@ -30,8 +30,8 @@ from jaxship._analysis._discover._plausible import rudder_equivalent
 from jaxship._analysis._discover._workflow import heldout_rise
 from jaxship._estimate._sensitivity import sensitivities
 from jaxship._estimate._windows import as_dataset
-from jaxship._foundation._files import MANIFEST, staged_folder
 from jaxship.cli import main
+from jaxship.cli._files import MANIFEST, staged_folder
 
 
 DEG = np.pi / 180

@@ -12,7 +12,7 @@ import jaxship as js
 
 from .._estimate._bands import normal_draws
 from .._foundation._params import rebuild
-from .._models._vessel._base import surge_force
+from ._common import surge_force
 from ._trials import (
     TrialSpec,
     _spec_text,

@@ -6,8 +6,7 @@ import math
 import pathlib
 import sys
 
-from .._foundation._files import staged_folder
-from .._models._vessel.catalogue import VESSELS
+from .. import VESSELS
 from ..plotting import save_identification_figures
 from ..plotting._fits import identification_figure_names
 from ._common import (
@@ -20,6 +19,7 @@ from ._common import (
     note,
     one_line,
 )
+from ._files import staged_folder
 from ._identification import MODELS, get_model_entry, identify, read_experiments
 from ._vessel import VESSEL_HELP, read_vessel_option
 

@@ -42,9 +42,9 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import jaxship as js
-from jaxship._foundation._files import staged_folder
 from jaxship.cli._trials import trial_indices
 
+from .._files import staged_folder
 from . import autopilot_thesis as chapter5, thesis
 from .discovery_case import hidden_effect_records
 from .reproduce_report import (
