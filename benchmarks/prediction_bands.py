@@ -62,7 +62,7 @@ def esso_case(paper, train_set):
     estimator = js.PredictionError(horizon=60.0, wind=True, max_steps=100,
                                    simulator=js.Simulator(max_step=math.inf, substeps=2),
                                    solver=optx.LevenbergMarquardt(rtol=1e-6, atol=1e-6))
-    fit = js.fit(js.vessel("esso_osaka"), train, estimator=estimator,
+    fit = js.fit(js.get_vessel("esso_osaka"), train, estimator=estimator,
                  free=FREE_SETS[" + I_zz, k_x"])
     replay = js.PredictionError(horizon=None, wind=True, channels=("psi", "r"))
     return f"Esso Osaka, {paper}, {train_set}", fit, train, test, replay
@@ -72,7 +72,7 @@ def kvlcc2_case():
     train, test = kvlcc2_discovery_split()
     estimator = js.PredictionError(horizon=60.0, max_steps=100,
                                    solver=optx.LevenbergMarquardt(rtol=1e-6, atol=1e-6))
-    fit = js.fit(js.vessel("kvlcc2"), train, estimator=estimator)
+    fit = js.fit(js.get_vessel("kvlcc2"), train, estimator=estimator)
     replay = js.PredictionError(horizon=None, channels=("psi", "r"))
     return "KVLCC2, HSVA zig-zags (10/10 held out, MARIN's four)", fit, train, test, replay
 

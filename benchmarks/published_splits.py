@@ -54,7 +54,7 @@ def identified(train_names, horizon, free):
     estimator = js.PredictionError(horizon=horizon, wind=True, max_steps=100,
                                    simulator=js.Simulator(max_step=math.inf, substeps=2),
                                    solver=optx.LevenbergMarquardt(rtol=1e-6, atol=1e-6))
-    return js.fit(js.vessel("esso_osaka"), train, estimator=estimator, free=free)
+    return js.fit(js.get_vessel("esso_osaka"), train, estimator=estimator, free=free)
 
 
 def discovered(free):
@@ -65,7 +65,7 @@ def discovered(free):
     start = time.perf_counter()
     say = lambda message: print(f"discover, {time.perf_counter() - start:4.0f} s: {message}",
                                 file=sys.stderr)
-    return js.discover(js.vessel("esso_osaka"), train, held, free=free, progress=say)
+    return js.discover(js.get_vessel("esso_osaka"), train, held, free=free, progress=say)
 
 
 def main(argv=None):
@@ -92,7 +92,7 @@ def main(argv=None):
     for paper in args.paper or sorted(SPLITS):
         split = SPLITS[paper]
         test = read_runs(split["Test"])
-        columns = {"lab": js.vessel("esso_osaka")}
+        columns = {"lab": js.get_vessel("esso_osaka")}
         for name in (k for k in split if k != "Test" and (not args.sets or k in args.sets)):
             for suffix, free in FREE_SETS.items():
                 t0 = time.perf_counter()

@@ -35,7 +35,7 @@ frequency 0.2 rad/s). The models are those identified from the **merged** experi
 and 500 rpm (chapter 4, sec. 4.3); the closed loop runs at **300 and 400 rpm**, speeds not
 used for the fits.
 
-Here the same chain runs on `js.vessel("thesis")` (the true vessel steered, rudder 45 deg and
+Here the same chain runs on `js.get_vessel("thesis")` (the true vessel steered, rudder 45 deg and
 15 deg/s through its servo; not the thesis' own coefficients, which are unpublished), with the
 models of `jaxship/cli/reproduction/thesis.py` (the chapter-4 pipeline).
 
@@ -63,7 +63,7 @@ from jaxship.cli.reproduction import autopilot_thesis as ap
 
 
 jax.config.update("jax_enable_x64", True)
-vessel = js.vessel("thesis")
+vessel = js.get_vessel("thesis")
 design = ap.Design()
 print(f"controller: omega_n = {design.natural_frequency} rad/s, zeta = {design.damping}; "
       f"reference: omega = {design.reference_frequency} rad/s, zeta = "

@@ -92,7 +92,7 @@ goal was a cut of at least 40 % on every non-berthing run; the table says where 
     new_code_cell("""if HAVE:
     names = list(dict.fromkeys(SPLITS["Miyauchi 2022"]["Test"] + SPLITS["Wakita 2022"]["Test"]))
     test = read_runs(names)
-    models = {"lab": js.vessel("esso_osaka"), "jaxship, Train-R": fitted.model}
+    models = {"lab": js.get_vessel("esso_osaka"), "jaxship, Train-R": fitted.model}
     sims = {k: [free_run(m, run) for run in test] for k, m in models.items()}
     scores = {k: [run_score(run, sim) for run, sim in zip(test, sims[k])] for k in models}
     rows = ["| test run | in | model | r RMSE [deg/s] | r cut | psi RMSE [deg] | "

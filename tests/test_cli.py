@@ -580,14 +580,14 @@ def test_mmg_coefficients_have_units(preset):
     """The unit column of `identify` for the MMG presets: primed coefficients are "-",
     dimensional ones carry their SI unit; and every preset's coefficients have a unit
     (their `param` metadata), which Froude scaling reads."""
-    fields = parameter_fields(js.vessel(preset))
+    fields = parameter_fields(js.get_vessel(preset))
     assert all(info.unit for info in fields.values()), [k for k, i in fields.items()
                                                         if not i.unit]
     assert fields["y_v"].unit == "-" and fields["length"].unit == "m"
     assert fields["rho"].unit == "kg/m^3"
-    assert {spec.unit for spec in resolve_free(js.vessel(preset))} == {"-"}
+    assert {spec.unit for spec in resolve_free(js.get_vessel(preset))} == {"-"}
     for name in js.VESSELS:
-        fields = parameter_fields(js.vessel(name))
+        fields = parameter_fields(js.get_vessel(name))
         assert all(info.unit for info in fields.values()), (name, [k for k, i in fields.items()
                                                                    if not i.unit])
 

@@ -62,7 +62,7 @@ def test_the_free_run_score_is_the_hand_computed_one():
     every error is minus the offset (RMSE = |offset|, position error = the offsets'
     distance) and the fit % is the textbook formula on those errors."""
     jax.config.update("jax_enable_x64", True)
-    vessel = js.vessel("esso_osaka")
+    vessel = js.get_vessel("esso_osaka")
     x0 = js.straight_run(vessel)  # the nominal straight run
     traj = js.simulate(vessel, js.ZigZag(20 * np.pi / 180, 20 * np.pi / 180, duration=20.0,
                                          dt=0.1), x0, simulator=js.Simulator(substeps=4))

@@ -283,7 +283,7 @@ def test_the_discovery_case_records_are_the_discovery_tests_records():
     from benchmarks.studies.discovery import hidden_effect_records as tests_records
     from jaxship.cli.reproduction.discovery_case import hidden_effect_records
 
-    truth = js.augment(js.Nomoto1(K=0.06, T=25.0), js.YawCubicDamping(beta=300.0))
+    truth = js.augment(js.Nomoto1(K=0.06, T=25.0), js.effects.YawCubicDamping(beta=300.0))
     mine, theirs = hidden_effect_records(truth, 3), tests_records(truth, 3)
     for a, b in zip(mine[0] + mine[1], theirs[0] + theirs[1], strict=True):
         assert a.name == b.name

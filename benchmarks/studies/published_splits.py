@@ -89,7 +89,7 @@ def read_runs(names, root=None) -> list[js.Experiment]:
         found = sorted(folder.glob(f"*/{name}.csv"))
         if not found:
             raise FileNotFoundError(f"run {name}.csv not found under {folder}.")
-        runs.append(js.read_esso_osaka(found[0]))
+        runs.append(js.read_measured(found[0]))
     return runs
 
 

@@ -37,7 +37,8 @@ def _overshoots(t, psi, delta, switch):
     """First and second overshoot [rad]; NaN where the model never completes them
     (e.g. a fitted gain too small to reach the switch heading)."""
     try:
-        zz = js.zigzag_indices(t=np.asarray(t), psi=np.asarray(psi), delta=np.asarray(delta),
+        zz = js.indices.zigzag_indices(t=np.asarray(t), psi=np.asarray(psi),
+                                       delta=np.asarray(delta),
                             heading_switch=switch)
     except ValueError:
         return np.nan, np.nan
@@ -93,7 +94,7 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
     `"consistency"` (the Tables 2-4 quantities per model),
     `"generalisation"` {(structure, method): {trial: fit % of r}} and the records.
     """
-    v = js.vessel(vessel) if isinstance(vessel, str) else vessel
+    v = js.get_vessel(vessel) if isinstance(vessel, str) else vessel
     x0 = js.straight_run(v, n=None if rpm is None else rpm / 60.0)  # nominal if None
     tau = float(v.length) / float(x0.u)
     duration = duration_lengths * tau
@@ -159,7 +160,7 @@ def design_study(vessel="thesis", *, rpm=500.0, dt=0.5, noise_r=0.05 * DEG, dura
 
     **Returns** `{"nominal": {...}, "reports": {(model, manoeuvre): DesignReport}}`.
     """
-    v = js.vessel(vessel) if isinstance(vessel, str) else vessel
+    v = js.get_vessel(vessel) if isinstance(vessel, str) else vessel
     x0 = js.straight_run(v, n=None if rpm is None else rpm / 60.0)  # nominal if None
     thesis = js.thesis_manoeuvre(dt=dt)
     duration = float(thesis.duration) if duration is None else float(duration)

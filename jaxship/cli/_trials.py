@@ -300,7 +300,7 @@ def _cut_at_stop(traj):
     2.2.7): keep the samples up to the stop and a tenth of the time to stop after it
     (the ship lying stopped); the whole run if it did not stop."""
     try:
-        stop = js.stopping_indices(traj)
+        stop = js.indices.stopping_indices(traj)
     except ValueError:
         return traj
     t = np.asarray(traj.t)
@@ -320,12 +320,12 @@ def trial_indices(spec, manoeuvre, traj) -> dict:
         "max_speed_m_s": float(np.max(traj.speed)),
     }
     if spec.kind == "turn" and spec.values[0] != 0:
-        return base | js.turning_indices(traj).to_dict()
+        return base | js.indices.turning_indices(traj).to_dict()
     if spec.kind == "zigzag":
-        return base | js.zigzag_indices(traj, manoeuvre.heading).to_dict()
+        return base | js.indices.zigzag_indices(traj, manoeuvre.heading).to_dict()
     if spec.kind == "spiral":
         hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
-        curve = js.spiral_curve(traj, hold=hold)
+        curve = js.indices.spiral_curve(traj, hold=hold)
         return base | curve.to_dict() | curve.loop.to_dict()
     if spec.kind == "reverse-spiral":
         curve = _reverse_curve(manoeuvre, traj)
@@ -333,20 +333,20 @@ def trial_indices(spec, manoeuvre, traj) -> dict:
         return (base | curve.to_dict() | {"r_ordered_deg_s": np.rad2deg(ordered).tolist()}
                 | curve.loop.to_dict())
     if spec.kind == "pullout":
-        return base | js.pull_out_indices(traj).to_dict()
+        return base | js.indices.pull_out_indices(traj).to_dict()
     if spec.kind == "stop":
-        return base | js.stopping_indices(traj).to_dict()
+        return base | js.indices.stopping_indices(traj).to_dict()
     return base
 
 
 def _reverse_curve(manoeuvre, traj):
-    return js.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
+    return js.indices.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
 
 
 def _spiral_curve(spec, manoeuvre, traj):
     if spec.kind == "spiral":
         hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
-        return js.spiral_curve(traj, hold=hold)
+        return js.indices.spiral_curve(traj, hold=hold)
     return _reverse_curve(manoeuvre, traj)
 
 
@@ -354,11 +354,11 @@ def _trial_marks(spec, manoeuvre, traj):
     """The indices drawn on the trial figure: turning, zig-zag or stopping."""
     try:
         if spec.kind == "turn" and spec.values[0] != 0:
-            return js.turning_indices(traj)
+            return js.indices.turning_indices(traj)
         if spec.kind == "zigzag":
-            return js.zigzag_indices(traj, manoeuvre.heading)
+            return js.indices.zigzag_indices(traj, manoeuvre.heading)
         if spec.kind == "stop":
-            return js.stopping_indices(traj)
+            return js.indices.stopping_indices(traj)
     except ValueError:  # the run is too short for them: the figure goes without
         return None
     return None
@@ -385,7 +385,7 @@ def trial_criteria(spec, vessel, traj, marks) -> list:
     if not kwargs:
         return []
     speed = float(np.hypot(traj.state.u[0], traj.state.v[0]))
-    return js.imo_criteria(float(vessel.length), speed, **kwargs)
+    return js.indices.imo_criteria(float(vessel.length), speed, **kwargs)
 
 
 def simulate_to_folder(

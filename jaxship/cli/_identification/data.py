@@ -215,7 +215,7 @@ MAX_FROUDE = 1.0
 
 def preset_length(model: str) -> float | None:
     """L_pp [m] of the vessel preset `model`; None for other models (no length)."""
-    vessel = js.vessel(model) if model in js.VESSELS else None
+    vessel = js.get_vessel(model) if model in js.VESSELS else None
     return float(vessel.length) if isinstance(vessel, js.AbstractVessel) else None
 
 

@@ -171,12 +171,12 @@ def _sway_yaw_start(model, train: js.Dataset, context: StartContext, preset: str
 
 
 def start_linear_sway_yaw(train: js.Dataset, context: StartContext) -> js.LinearSwayYaw:
-    return _sway_yaw_start(js.LinearSwayYaw.from_vessel(js.vessel("sea_stratus_linear")), train,
+    return _sway_yaw_start(js.LinearSwayYaw.from_vessel(js.get_vessel("sea_stratus_linear")), train,
                            context, "sea_stratus_linear")
 
 
 def start_norrbin(train: js.Dataset, context: StartContext) -> js.NorrbinCrossFlow:
-    return _sway_yaw_start(js.NorrbinCrossFlow.from_vessel(js.vessel("sea_stratus_nonlinear")),
+    return _sway_yaw_start(js.NorrbinCrossFlow.from_vessel(js.get_vessel("sea_stratus_nonlinear")),
                            train, context, "sea_stratus_nonlinear")
 
 

@@ -129,7 +129,7 @@ def _run(out, quick, progress, identification, closed_loop, discover, parallel) 
     load = os.getloadavg()[0] if sys.platform != "win32" else None
     began, cpu0 = time.perf_counter(), time.process_time()
     timings, cpu, results, sections = {}, {}, {}, []
-    vessel = js.vessel("thesis")
+    vessel = js.get_vessel("thesis")
     families = QUICK_FAMILIES if quick else thesis.FAMILIES
 
     def stage_done(name, clock):
@@ -270,7 +270,7 @@ def _discovery(quick, out, say=None) -> dict:
     say = say or (lambda message: None)
     clock, cpu = time.perf_counter(), time.process_time()
     base = js.Nomoto1(K=0.06, T=25.0)  # as `discovery.run_case`
-    hidden = js.YawCubicDamping(beta=DISCOVERY_HIDDEN)
+    hidden = js.effects.YawCubicDamping(beta=DISCOVERY_HIDDEN)
     say("simulating the records")
     train, holdout = hidden_effect_records(js.augment(base, hidden), DISCOVERY_SEED)
     report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout,

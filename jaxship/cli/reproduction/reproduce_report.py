@@ -148,7 +148,7 @@ def header(run, quick, per_rate, stages):
     }
     return (
         "# jaxship reproduce: Odegard (2009) on the built-in thesis vessel\n\n"
-        "On `jaxship.vessel(\"thesis\")` (the 4 m model of the thesis' Table 4.1, with "
+        "On `jaxship.get_vessel(\"thesis\")` (the 4 m model of the thesis' Table 4.1, with "
         "coefficients derived in docs/thesis_vessel.md because the thesis' are not "
         f"published), this run {'; '.join(done[s] for s in stages)}. "
         + ("Quick design (`--quick`): the 40 deg trial of each family (3 per rate), only the "
