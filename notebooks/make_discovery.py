@@ -15,6 +15,7 @@ import time
 import jax
 import matplotlib.pyplot as plt
 import numpy as np
+from IPython.display import Markdown, display
 
 import jaxship as js
 
@@ -82,7 +83,7 @@ nb.cells = [
         "truth = js.augment(js.Nomoto1(K=0.06, T=25.0), js.effects.YawCubicDamping(beta=300.0))\n"
         "train, holdout = hidden_effect_records(truth, seed=4)\n"
         "report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout)\n"
-        "print(report.to_markdown())"),
+        "display(Markdown(report.to_markdown()))"),
     nbf.v4.new_code_cell("residual_plot(report, holdout, 'held-out turning circles')"),
     nbf.v4.new_markdown_cell(
         "## A rudder offset: named with the effect it cannot be told from\n\n"
@@ -144,7 +145,7 @@ nb.cells = [
         "    kvlcc2 = js.discover(js.get_vessel('kvlcc2'), train, holdout)\n"
         "    print(f'{time.perf_counter() - t0:.0f} s')\n"
         "    text = kvlcc2.to_markdown()\n"
-        "    print(text[:text.index('## Where')] + text[text.index('## Rejected'):])\n"
+        "    display(Markdown(text[:text.index('## Where')] + text[text.index('## Rejected'):]))\n"
         "    print('Loads the base model lacks (mean; while turning to starboard, to port):')\n"
         "    for name, v in kvlcc2.disagreement['before']['forces'].items():\n"
         "        print(f\"  {name} [{v['unit']}]: {v['mean']:.3g}; {v['starboard']:.3g}, \"\n"
@@ -258,7 +259,7 @@ nb.cells = [
     nbf.v4.new_code_cell(
         "if HAVE['esso_osaka_frt']:\n"
         "    hand = esso_osaka_low_speed_steering(data)\n"
-        "    print(hand.table())\n"
+        "    display(Markdown(hand.table()))\n"
         "    _, test = esso_osaka_zigzag_split(data)\n"
         "    fig, axes = plt.subplots(1, len(test), figsize=(11, 3))\n"
         "    for i, (ax, e) in enumerate(zip(axes, test)):\n"
@@ -281,7 +282,7 @@ nb.cells = [
     nbf.v4.new_code_cell(
         "if HAVE['esso_osaka_frt']:\n"
         "    sway = esso_osaka_low_speed_sway_yaw(data)\n"
-        "    print(sway.table())\n"
+        "    display(Markdown(sway.table()))\n"
         "    fig, axes = plt.subplots(2, len(test), figsize=(11, 5), sharex='col')\n"
         "    for i, e in enumerate(test):\n"
         "        for row, channel in enumerate(('r', 'v')):\n"

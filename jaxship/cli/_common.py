@@ -7,7 +7,7 @@ import pathlib
 import sys
 import tempfile
 
-from tqdm.auto import tqdm
+from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
 
 from ._files import read_manifest
 

@@ -6,7 +6,7 @@ import pathlib
 import sys
 
 import matplotlib.pyplot as plt
-from tqdm.auto import tqdm
+from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
 
 from ..plotting import plot_autopilot
 from ._common import check_operating_point, check_out, numbers

@@ -39,7 +39,7 @@ from multiprocessing import resource_tracker
 
 import jax
 import numpy as np
-from tqdm.auto import tqdm
+from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
 
 import jaxship as js
 from jaxship.cli._trials import trial_indices
