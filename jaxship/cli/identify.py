@@ -7,8 +7,7 @@ import pathlib
 import sys
 
 from .. import VESSELS
-from ..plotting import save_identification_figures
-from ..plotting._fits import identification_figure_names
+from ..plotting import identification_figure_names, save_identification_figures
 from ._common import (
     VELOCITIES,
     ProgressBar,

@@ -33,7 +33,6 @@ import math
 import numpy as np
 
 import jaxship as js
-from jaxship._estimate._linear import initial_estimate
 from jaxship.cli._trials import initial_state
 
 
@@ -248,7 +247,7 @@ def identify(model_name, records, vessel, *, settings: Settings = Settings(), no
     """
     pe, oe = _estimators(settings)
     if nomoto is None or model_name == "nomoto":
-        nomoto = initial_estimate(js.Nomoto1(K=0.1, T=5.0), records)
+        nomoto = js.LinearStart()(js.Nomoto1(K=0.1, T=5.0), records, None, "delta")
         nomoto = js.fit(nomoto, records, free=("K", "T"), estimator=pe).model
     if model_name == "nomoto":
         if not settings.output_error:
@@ -263,8 +262,8 @@ def identify(model_name, records, vessel, *, settings: Settings = Settings(), no
     else:
         starts = [nomoto_start(nomoto, scales)]
         try:
-            starts.append(initial_estimate(js.RossAutopilot(**scales), records, free=free,
-                                                span=settings.span))
+            starts.append(js.LinearStart(span=settings.span)(js.RossAutopilot(**scales),
+                                                             records, free, "delta"))
         except ValueError:  # singular regression: the Nomoto start only
             pass
     stages = [r for r in (_safe_fit(m, records, free, pe) for m in starts) if r is not None]
