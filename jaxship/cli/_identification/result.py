@@ -169,7 +169,7 @@ def _with_effects(model, names):
     """`model` with the effects of the class names `names` (default values) added."""
     effects = []
     for name in names:
-        cls = getattr(js, str(name), None)
+        cls = getattr(js.effects, str(name), None)
         if not (isinstance(cls, type) and issubclass(cls, js.effects.AbstractEffect)):
             raise ValueError(f"unknown effect {name!r} in the identify result.")
         try:
