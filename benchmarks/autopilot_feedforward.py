@@ -26,6 +26,7 @@ import tempfile
 
 import jaxship as js
 
+
 HSVA = ("HSVA_CPMC_KVLCC2_Z_10_05", "HSVA_CPMC_KVLCC2_Z_20_05",
         "HSVA_CPMC_KVLCC2_Z_10_10_P", "HSVA_CPMC_KVLCC2_Z_20_10_P")
 

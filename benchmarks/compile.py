@@ -95,7 +95,7 @@ def fit_cases():
     """One fit of a response model and one of a vessel, each called three times with new
     data values and new start values."""
     # (a) Nomoto 1 (K, T) on two Mariner zig-zags
-    mariner = js.vessel("mariner")
+    mariner = js.get_vessel("mariner")
 
     def nomoto_data(value):
         rng = np.random.default_rng(value["seed"])
@@ -127,7 +127,7 @@ def fit_cases():
         ", ".join(f"{x:.4g}" for x in np.asarray(r)) for r in results))
 
     # (b) the thesis vessel, 4 coefficients
-    thesis = js.vessel("thesis")
+    thesis = js.get_vessel("thesis")
     free = ("y_uv", "n_uv", "n_ur", "rudder_area")
     truth = np.array([getattr(thesis, k) for k in free])
     n = 500 / 60
@@ -175,7 +175,7 @@ def main(skip_simulate=False):
 
 def simulate_cases():
     for name in ("mariner", "thesis"):
-        base = js.vessel(name)
+        base = js.get_vessel(name)
         coef = "n_r" if name == "mariner" else "n_ur"
 
         def run(value, base=base, coef=coef):
@@ -193,7 +193,7 @@ def simulate_cases():
         ]
         calls(f"simulate, {name}: 600 s a/a zig-zag at 0.1 s", run, values)
 
-    base = js.vessel("mariner")
+    base = js.get_vessel("mariner")
 
     def run_batch(value):
         vessel = eqx.tree_at(lambda v: v.n_r, base, base.n_r * value["f"])

@@ -2,7 +2,7 @@
 
 For every scenario (an effect at a size, two effects, the white null and the coloured
 null with a slowly varying yaw moment) it runs discovery on `--seeds` independent data
-sets (`jaxship/cli/_studies/discovery.py`: Nomoto 1 truth integrated finely, rate-limited
+sets (`benchmarks/studies/discovery.py`: Nomoto 1 truth integrated finely, rate-limited
 rudder logged at 2 Hz, 4 training zig-zags, 2 held-out turning circles) and prints:
 
 - detection: the hidden effect (or each of two) named or in a named class, nothing
@@ -23,6 +23,7 @@ import argparse
 import json
 import pathlib
 import subprocess
+import sys
 import tempfile
 import time
 
@@ -30,7 +31,10 @@ import jax
 import numpy as np
 
 import jaxship as js
-from jaxship.cli._studies.discovery import outcome, run_case, vessel_records
+
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))  # benchmarks.studies
+from benchmarks.studies.discovery import outcome, run_case, vessel_records  # noqa: E402
 
 
 DEG = np.pi / 180
@@ -38,18 +42,20 @@ K = 0.06
 SCENARIOS = {  # name: (hidden effects, coloured-disturbance std [rad], true values)
     "null (white)": ((), 0.0, {}),
     "null (coloured, 1 deg)": ((), 1.0 * DEG, {}),
-    "rudder offset 0.3 deg": ((js.RudderOffset(delta0=0.3 * DEG),), 0.0,
+    "rudder offset 0.3 deg": ((js.effects.RudderOffset(delta0=0.3 * DEG),), 0.0,
                               {"rudder_offset.delta0": 0.3 * DEG,
                                "yaw_moment_bias.n0": K * 0.3 * DEG}),
-    "rudder offset 0.3 deg, coloured": ((js.RudderOffset(delta0=0.3 * DEG),), 1.0 * DEG, {}),
-    "rudder offset 1 deg, coloured": ((js.RudderOffset(delta0=1.0 * DEG),), 1.0 * DEG, {}),
-    "cubic yaw damping 300": ((js.YawCubicDamping(beta=300.0),), 0.0,
+    "rudder offset 0.3 deg, coloured": ((js.effects.RudderOffset(delta0=0.3 * DEG),),
+                                         1.0 * DEG, {}),
+    "rudder offset 1 deg, coloured": ((js.effects.RudderOffset(delta0=1.0 * DEG),), 1.0 * DEG, {}),
+    "cubic yaw damping 300": ((js.effects.YawCubicDamping(beta=300.0),), 0.0,
                               {"yaw_cubic_damping.beta": 300.0}),
-    "rudder lag 1.5 s": ((js.RudderLag(time_constant=1.5),), 0.0,
+    "rudder lag 1.5 s": ((js.effects.RudderLag(time_constant=1.5),), 0.0,
                          {"rudder_lag.time_constant": 1.5}),
-    "gyro bias 0.02 deg/s": ((js.YawRateSensorBias(bias=0.02 * DEG),), 0.0,
+    "gyro bias 0.02 deg/s": ((js.effects.YawRateSensorBias(bias=0.02 * DEG),), 0.0,
                              {"yaw_rate_sensor_bias.bias": 0.02 * DEG}),
-    "offset + cubic": ((js.RudderOffset(delta0=0.3 * DEG), js.YawCubicDamping(beta=300.0)),
+    "offset + cubic": ((js.effects.RudderOffset(delta0=0.3 * DEG),
+                        js.effects.YawCubicDamping(beta=300.0)),
                        0.0, {}),
 }
 
@@ -60,10 +66,10 @@ def time_mariner():
     `jaxship discover` command on the same records written as trial CSVs, in a new
     process (import, compilation, the preset's `identify` start, discovery, report
     and figures), as a user runs it."""
-    truth = js.augment(js.vessel("mariner"), js.RudderOffset(delta0=0.5 * DEG))
+    truth = js.augment(js.get_vessel("mariner"), js.effects.RudderOffset(delta0=0.5 * DEG))
     train, holdout = vessel_records(truth, 0)
     began = time.perf_counter()
-    report = js.discover(js.vessel("mariner"), train, holdout,
+    report = js.discover(js.get_vessel("mariner"), train, holdout,
                          progress=lambda m: print(f"{time.perf_counter() - began:6.1f} s {m}",
                                                   flush=True))
     print(report.to_markdown())

@@ -45,7 +45,7 @@ def with_params(vessel, theta):
 
 
 def main(args):
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     theta0 = jnp.array([getattr(vessel, k) for k in PARAMS])
     man = js.ZigZag(20 * DEG, 20 * DEG, duration=600.0, dt=0.1)
     x0 = js.straight_run(vessel)

@@ -53,7 +53,8 @@ STEADY = (2 * math.pi, 4 * math.pi)  # heading change [rad] over which the turn 
 def turn_indices(t, x, y, psi, u, v, r, execute_time):
     """(advance, tactical diameter [L], steady speed [m/s], steady |yaw rate| [deg/s]),
     and the side of the turn."""
-    ti = js.turning_indices(t=t, x=x, y=y, psi=psi, u=u, v=v, r=r, execute_time=execute_time)
+    ti = js.indices.turning_indices(t=t, x=x, y=y, psi=psi, u=u, v=v, r=r,
+                                    execute_time=execute_time)
     change = np.abs(psi - psi[int(np.searchsorted(t, execute_time))])
     steady = (change >= STEADY[0]) & (change <= STEADY[1])
     mean = lambda a: float(np.mean(a[steady])) if steady.any() else math.nan
@@ -97,7 +98,7 @@ def main():
     named = [e.id for e in report.effects]
     print(f"discover on HSVA ({time.perf_counter() - began:.0f} s): named {named or 'nothing'}",
           file=sys.stderr)
-    columns = {"preset": js.vessel("kvlcc2"), "HSVA-identified": report.model_before,
+    columns = {"preset": js.get_vessel("kvlcc2"), "HSVA-identified": report.model_before,
                "+ discovered": report.model_after,
                "+ discovered, hull": hull_only(report.model_after)}
     rows = []  # (run, quantity, measured, {column: simulated})
@@ -105,14 +106,14 @@ def main():
     labels = ("advance [L]", "tactical diameter [L]", "steady speed [m/s]",
               "steady yaw rate [deg/s]")
     for path in sorted(marin.glob("MARIN_FREE_KVLCC2_tc_*.dat")):
-        exp = js.read_marin_kvlcc2(path, model_scale=True)
+        exp = js.read_measured(path, model_scale=True)
         measured, side, speed, n = marin_turn(exp)
         sims = {k: simulated_turn(m, side, speed, n) for k, m in columns.items()}
         run = f"MARIN turn 35 {'stb' if side > 0 else 'port'}"
         rows += [(run, lab, measured[i], {k: s[i] for k, s in sims.items()})
                  for i, lab in enumerate(labels)]
     for path in sorted(marin.glob("MARIN_FREE_KVLCC2_zz_*.dat")):
-        exp = js.read_marin_kvlcc2(path, model_scale=True)
+        exp = js.read_measured(path, model_scale=True)
         angle = abs(float(path.stem.split("_")[-2]))
         measured, side, speed, n = measured_zigzag(exp, angle)
         sims = {k: simulate_zigzag(m, angle, angle, side, speed, n) for k, m in columns.items()}

@@ -8,7 +8,8 @@ about 10.3 rps at model scale), as in the tests, and (b) at the MMG model's own
 self-propulsion rate for that speed (11.85 rps: the MMG parameter set has a 0.216 m
 propeller, the tests used the 0.204 m INSEAN stock propeller).
 
-Definitions (both sides alike, `jaxship.zigzag_indices` and `jaxship.turning_indices`):
+Definitions (both sides alike, `jaxship.indices.zigzag_indices` and
+`jaxship.indices.turning_indices`):
 overshoot k = largest heading excursion beyond the switch heading after rudder execute
 k + 1, relative to the heading at the first execute; advance, transfer and tactical
 diameter from the midship track rotated into the initial-course frame at the rudder
@@ -62,8 +63,8 @@ def measured_zigzag(exp, switch_deg):
     # no rudder history given: with a neutral-helm offset (MARIN: about 0.8 deg) the
     # rudder still has the approach sign at the execute; the side is then taken from the
     # heading, which first passes the switch angle on the side the rudder turns to
-    z = js.zigzag_indices(t=exp.t, psi=exp.psi, heading_switch=np.deg2rad(switch_deg),
-                       execute_times=[float(exp.t[k])])
+    z = js.indices.zigzag_indices(t=exp.t, psi=exp.psi, heading_switch=np.deg2rad(switch_deg),
+                                  execute_times=[float(exp.t[k])])
     if z.side != side:
         raise ValueError(f"{exp.name}: heading and rudder disagree about the first side")
     return np.rad2deg(z.overshoots), side, float(np.hypot(exp.u[k], exp.v[k])), float(exp.n[k])
@@ -75,7 +76,7 @@ def simulate_zigzag(vessel, angle_deg, switch_deg, side, speed, n, duration=ZIGZ
     manoeuvre = js.ZigZag(side * np.deg2rad(angle_deg), np.deg2rad(switch_deg),
                           duration=duration, dt=DT, n=n)
     traj = js.simulate(vessel, manoeuvre, x0, simulator=js.Simulator(substeps=1))
-    z = js.zigzag_indices(traj, np.deg2rad(switch_deg))
+    z = js.indices.zigzag_indices(traj, np.deg2rad(switch_deg))
     return np.rad2deg(z.overshoots)
 
 
@@ -88,8 +89,8 @@ def measured_turn(exp):
     track 2-4 % smaller than the printed positions during the turn, so they are not
     used.)"""
     k = execute_index(exp.delta)
-    ti = js.turning_indices(t=exp.t, x=exp.x, y=exp.y, psi=exp.psi, u=exp.u, v=exp.v, r=exp.r,
-                         execute_time=float(exp.t[k]))
+    ti = js.indices.turning_indices(t=exp.t, x=exp.x, y=exp.y, psi=exp.psi, u=exp.u, v=exp.v,
+                                    r=exp.r, execute_time=float(exp.t[k]))
     indices = np.array([ti.advance, ti.transfer, ti.tactical_diameter]) / LENGTH
     return indices, ti.side, float(np.hypot(exp.u[k], exp.v[k])), float(exp.n[k])
 
@@ -99,7 +100,7 @@ def simulate_turn(vessel, side, speed, n, angle_deg=35.0, duration=TURN_DURATION
     x0 = js.straight_state(speed, n)
     traj = js.simulate(vessel, js.Turn(side * np.deg2rad(angle_deg), duration=duration, dt=DT, n=n),
                        x0, simulator=js.Simulator(substeps=1))
-    ti = js.turning_indices(traj)
+    ti = js.indices.turning_indices(traj)
     return np.array([ti.advance, ti.transfer, ti.tactical_diameter]) / LENGTH
 
 
@@ -109,7 +110,7 @@ def self_propulsion_n(vessel, speed):
 
 def compare_hsva(path, vessel, *, self_propulsion=True):
     """Rows (run, quantity, measured, simulated at measured n, simulated at self-propulsion n)."""
-    exp = js.read_hsva_kvlcc2(path)
+    exp = js.read_measured(path)
     angle, switch = zigzag_parameters(exp.name)
     measured, side, speed, n = measured_zigzag(exp, switch)
     sim = simulate_zigzag(vessel, angle, switch, side, speed, n)
@@ -124,7 +125,7 @@ def compare_hsva(path, vessel, *, self_propulsion=True):
 
 
 def compare_marin_turn(path, vessel, *, self_propulsion=True):
-    exp = js.read_marin_kvlcc2(path, model_scale=True)
+    exp = js.read_measured(path, model_scale=True)
     measured, side, speed, n = measured_turn(exp)
     sim = simulate_turn(vessel, side, speed, n)
     sim_sp = (simulate_turn(vessel, side, speed, self_propulsion_n(vessel, speed))
@@ -136,7 +137,7 @@ def compare_marin_turn(path, vessel, *, self_propulsion=True):
 
 
 def compare_marin_zigzag(path, vessel, *, self_propulsion=True):
-    exp = js.read_marin_kvlcc2(path, model_scale=True)
+    exp = js.read_measured(path, model_scale=True)
     angle = abs(float(path.stem.split("_")[-2]))
     measured, side, speed, n = measured_zigzag(exp, angle)
     sim = simulate_zigzag(vessel, angle, angle, side, speed, n)
@@ -175,7 +176,7 @@ def main():
     data = args.data or js.shared_data_dir()
     if data is None or not (data / "kvlcc2_simman2008_hsva").is_dir():
         raise SystemExit("measured data not found: give --data DIR (the shared/data folder)")
-    vessel = js.vessel("kvlcc2")
+    vessel = js.get_vessel("kvlcc2")
     rows = []
     for path in sorted((data / "kvlcc2_simman2008_hsva").glob("*.dat")):
         rows += compare_hsva(path, vessel)

@@ -80,7 +80,7 @@ def kvlcc2_case():
     train, test = kvlcc2_discovery_split()
     estimator = js.PredictionError(horizon=60.0, max_steps=100,
                                    solver=optx.LevenbergMarquardt(rtol=1e-6, atol=1e-6))
-    fit = js.fit(js.vessel("kvlcc2"), train, estimator=estimator)
+    fit = js.fit(js.get_vessel("kvlcc2"), train, estimator=estimator)
     replay = js.PredictionError(horizon=None, channels=("psi", "r"))
     return "KVLCC2, HSVA zig-zags (10/10 held out, MARIN's four)", fit, train, test, replay
 

@@ -72,7 +72,7 @@ def main():
           "later calls, rolled | written out | ratio |")
     print("|---|---|---:|---:|---:|---:|---:|---:|")
     for name in VESSELS:
-        vessel = js.vessel(name)
+        vessel = js.get_vessel(name)
         ways = {rolled: cases(vessel, js.Simulator(solver=js.RK4(rolled=rolled)))
                 for rolled in (True, False)}
         for case in ways[True]:

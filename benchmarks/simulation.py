@@ -211,7 +211,7 @@ class Case:
 
     def __init__(self, name, duration):
         self.name = name
-        self.vessel = js.vessel(name)
+        self.vessel = js.get_vessel(name)
         self.duration = duration
         self.num = int(round(duration / DT)) + 1
         if name == "mariner":

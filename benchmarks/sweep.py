@@ -83,7 +83,7 @@ def peak_rss_mb() -> float:
 def build(args, dt):
     """The batched vessel, manoeuvre and initial state of the whole grid."""
     setup = SETUP[args.vessel]
-    vessel = js.vessel(args.vessel)
+    vessel = js.get_vessel(args.vessel)
     angles = np.linspace(10, 35, args.angles) * DEG
     rng = np.random.default_rng(0)
     factors = rng.uniform(0.8, 1.2, (args.perturbations, len(setup["fields"])))
@@ -130,7 +130,7 @@ def main(args):
     def sweep():
         return js.simulate_batch(
             vessel, manoeuvre, x0, simulator=simulator, in_axes=(0, 0, 0, None),
-            output=js.batch_turning_indices, chunk_size=args.chunk_size,
+            output=js.indices.batch_turning_indices, chunk_size=args.chunk_size,
         )
 
     start = time.perf_counter()
@@ -149,7 +149,7 @@ def main(args):
           f"({runs * (manoeuvre.num_samples - 1) * args.substeps / best / 1e6:.2f} M RK4 "
           f"steps/s); peak memory (maxrss): {peak_rss_mb():.0f} MiB")
     print(f"runs that did not reach 180 deg: {missing} of {runs}")
-    length = float(js.vessel(args.vessel).length)
+    length = float(js.get_vessel(args.vessel).length)
     for name in ("advance", "transfer", "tactical_diameter"):
         v = out[name] / length
         print(f"  {name} / L: min {np.nanmin(v):.2f}, median {np.nanmedian(v):.2f}, "
@@ -160,12 +160,12 @@ def main(args):
     pick = np.unique(np.linspace(0, runs - 1, 8).astype(int))
     take = lambda tree: jax.tree.map(lambda a: a[pick] if np.ndim(a) else a, tree)
     coarse = js.simulate_batch(take(vessel), take(manoeuvre), take(x0), simulator=simulator,
-                            in_axes=(0, 0, 0, None), output=js.batch_turning_indices)
+                            in_axes=(0, 0, 0, None), output=js.indices.batch_turning_indices)
     fine_dt = args.dt / 10
     v_f, m_f, x_f, _ = build(args, fine_dt)
     fine = js.simulate_batch(take(v_f), take(m_f), take(x_f),
                           simulator=js.Simulator(substeps=1, max_step=math.inf),
-                          in_axes=(0, 0, 0, None), output=js.batch_turning_indices)
+                          in_axes=(0, 0, 0, None), output=js.indices.batch_turning_indices)
     print(f"\naccuracy on {pick.size} runs of the grid against dt = {fine_dt:g} s "
           f"(one RK4 step per sample), max relative difference:")
     for name in ("advance", "transfer", "tactical_diameter", "time_to_180"):

@@ -1,20 +1,25 @@
-"""jaxship: differentiable ship-manoeuvring simulation and steering-model identification."""
+"""jaxship: differentiable ship-manoeuvring simulation and steering-model identification.
+
+The public API is `__all__` (grouped by layer as in docs/architecture.md; the API pages
+of the documentation list the same names, tests/test_docs.py). The effects of the effect
+seam are one namespace, `jaxship.effects`; the figures another, `jaxship.plotting`.
+"""
 
 __version__ = "0.1.0"  # the one place of the version (pyproject.toml reads it)
 
+# foundation: parameters, state, progress, the compilation cache
+# analysis: manoeuvre indices, autopilot design and closed loops, experiment design,
+# discovery
 from ._analysis._autopilot import (
-    TunedAutopilot as TunedAutopilot,
     design_autopilot as design_autopilot,
     tune_autopilot as tune_autopilot,
     yaw_inertia as yaw_inertia,
 )
 from ._analysis._closed_loop import (
     ClosedLoop as ClosedLoop,
-    ClosedLoopMetrics as ClosedLoopMetrics,
     YawDisturbance as YawDisturbance,
     closed_loop as closed_loop,
     closed_loop_metrics as closed_loop_metrics,
-    tracking_objective as tracking_objective,
 )
 from ._analysis._design import (
     excitation_order as excitation_order,
@@ -24,33 +29,17 @@ from ._analysis._discover._catalogue import (
     DISCOVERY_CATALOGUE as DISCOVERY_CATALOGUE,
     Candidate as Candidate,
 )
-from ._analysis._discover._locate import locate_disagreement as locate_disagreement
-from ._analysis._discover._report import (
-    CandidateOutcome as CandidateOutcome,
-    CandidateScore as CandidateScore,
-    DiscoveryReport as DiscoveryReport,
-    EffectParameter as EffectParameter,
-)
+from ._analysis._discover._report import DiscoveryReport as DiscoveryReport
 from ._analysis._discover._workflow import discover as discover
-from ._analysis._indices import (
-    format_table as format_table,
-    imo_criteria as imo_criteria,
-    initial_turning_indices as initial_turning_indices,
-    loop_width as loop_width,
-    pull_out_indices as pull_out_indices,
-    reverse_spiral_curve as reverse_spiral_curve,
-    spiral_curve as spiral_curve,
-    stopping_indices as stopping_indices,
-    turning_indices as turning_indices,
-    zigzag_indices as zigzag_indices,
-)
+
+# estimate: fit and predict, the estimator strategies, bands, the Kalman filter
 from ._estimate._armax import ARMAX as ARMAX
 from ._estimate._bands import (
     Disturbance as Disturbance,
-    PredictionBands as PredictionBands,
     calibrate_disturbance as calibrate_disturbance,
     prediction_bands as prediction_bands,
 )
+from ._estimate._discrete import fit_discrete_response as fit_discrete_response
 from ._estimate._discrete_estimator import (
     DiscreteResponse as DiscreteResponse,
     LeastSquaresRegression as LeastSquaresRegression,
@@ -65,13 +54,7 @@ from ._estimate._initial import (
     EstimatedStarts as EstimatedStarts,
     MeasuredStates as MeasuredStates,
 )
-from ._estimate._kalman import (
-    KalmanOutput as KalmanOutput,
-    SmoothedStates as SmoothedStates,
-    ekf as ekf,
-    rts_smoother as rts_smoother,
-    smooth_states as smooth_states,
-)
+from ._estimate._kalman import ekf as ekf, smooth_states as smooth_states
 from ._estimate._likelihood import (
     Innovations as Innovations,
     InnovationsLeastSquares as InnovationsLeastSquares,
@@ -80,18 +63,9 @@ from ._estimate._likelihood import (
 from ._estimate._linear import LinearStart as LinearStart
 from ._estimate._lm import RESULTS as RESULTS, LevenbergMarquardt as LevenbergMarquardt
 from ._estimate._predict import predict as predict
-from ._estimate._result import (
-    FitError as FitError,
-    FitResult as FitResult,
-    Prediction as Prediction,
-)
-from ._foundation._cache import (
-    compilation_cache_dir as compilation_cache_dir,
-    enable_compilation_cache as enable_compilation_cache,
-)
+from ._estimate._result import FitError as FitError, FitResult as FitResult
+from ._foundation._cache import enable_compilation_cache as enable_compilation_cache
 from ._foundation._contract import AbstractModel as AbstractModel
-from ._foundation._covariance import parameter_report as parameter_report
-from ._foundation._kinematics import body_to_earth as body_to_earth, ssa as ssa
 from ._foundation._params import Free as Free, default_free as default_free, param as param
 from ._foundation._progress import Progress as Progress
 from ._foundation._state import (
@@ -100,13 +74,11 @@ from ._foundation._state import (
     Trajectory as Trajectory,
     straight_state as straight_state,
 )
-from ._foundation._validate import (
-    ValidationReport as ValidationReport,
-    final_prediction_error as final_prediction_error,
-    fit_percent as fit_percent,
-    validate as validate,
-)
+from ._foundation._validate import fit_percent as fit_percent, validate as validate
+
+# models: vessels, steering models, effects, environment, manoeuvres, controllers
 from ._models._actuators import RudderServo as RudderServo, Shaft as Shaft
+from ._models._armax_model import ARMAXModel as ARMAXModel
 from ._models._control import (
     Feedforward as Feedforward,
     HeadingAutopilot as HeadingAutopilot,
@@ -114,28 +86,7 @@ from ._models._control import (
     ReferenceModel as ReferenceModel,
     YawRateLevels as YawRateLevels,
 )
-from ._models._effects import (
-    AbstractEffect as AbstractEffect,
-    AbstractLoadEffect as AbstractLoadEffect,
-    AbstractRudderEffect as AbstractRudderEffect,
-    AbstractSensorEffect as AbstractSensorEffect,
-    AbstractVesselPropertyEffect as AbstractVesselPropertyEffect,
-    AbstractYawTermEffect as AbstractYawTermEffect,
-    AugmentedSteering as AugmentedSteering,
-    AugmentedVessel as AugmentedVessel,
-    HeadingSensorBias as HeadingSensorBias,
-    RecordedDisturbance as RecordedDisturbance,
-    RudderDelay as RudderDelay,
-    RudderLag as RudderLag,
-    RudderOffset as RudderOffset,
-    RudderRateLimit as RudderRateLimit,
-    SwayForceBias as SwayForceBias,
-    YawCubicDamping as YawCubicDamping,
-    YawMomentBias as YawMomentBias,
-    YawRateSensorBias as YawRateSensorBias,
-    augment as augment,
-    nonlinear_nomoto2 as nonlinear_nomoto2,
-)
+from ._models._effects import augment as augment
 from ._models._environment import (
     Current as Current,
     Environment as Environment,
@@ -143,23 +94,8 @@ from ._models._environment import (
     Wind as Wind,
 )
 from ._models._fujiwara_wind import FujiwaraWindLoads as FujiwaraWindLoads
-from ._models._hydro_effects import (
-    AddedMassError as AddedMassError,
-    ApparentWind as ApparentWind,
-    CrossflowDrag as CrossflowDrag,
-    PropellerAsymmetry as PropellerAsymmetry,
-    PropellerRace as PropellerRace,
-    RudderStall as RudderStall,
-    SpeedDependentDamping as SpeedDependentDamping,
-    SpeedDependentRudder as SpeedDependentRudder,
-    SurgeTurnResistance as SurgeTurnResistance,
-    UniformCurrent as UniformCurrent,
-    Windage as Windage,
-    YawQuadraticDamping as YawQuadraticDamping,
-)
 from ._models._manoeuvres import (
     AbstractController as AbstractController,
-    AbstractManoeuvre as AbstractManoeuvre,
     Controlled as Controlled,
     Replay as Replay,
     ReverseSpiral as ReverseSpiral,
@@ -191,21 +127,20 @@ from ._models._vessel._base import (
     straight_run as straight_run,
 )
 from ._models._vessel.catalogue import VESSELS as VESSELS, get_vessel as get_vessel
-from ._models._vessel.esso_osaka import LowSpeedMMGVessel as LowSpeedMMGVessel
 from ._models._vessel.file import load_vessel as load_vessel, save_vessel as save_vessel
-from ._models._vessel.mariner import Mariner as Mariner
 from ._models._vessel.mmg import MMGVessel as MMGVessel
-from ._models._vessel.nomoto import NomotoVessel as NomotoVessel
 from ._models._vessel.ross import RossVessel as RossVessel
-from ._models._vessel.sway_yaw import SwayYawVessel as SwayYawVessel
-from ._simulation._batch import simulate_batch as simulate_batch, stack as stack
+
+# simulate: the one time loop, batches, records and readers
+from ._simulation._batch import (
+    simulate_batch as simulate_batch,
+    stack as stack,
+    straight_run_batch as straight_run_batch,
+)
 from ._simulation._data import Dataset as Dataset, Experiment as Experiment
 from ._simulation._froude import froude_scale as froude_scale
 from ._simulation._integrate import RK4 as RK4, Simulator as Simulator
 from ._simulation._measured import (
-    read_esso_osaka as read_esso_osaka,
-    read_hsva_kvlcc2 as read_hsva_kvlcc2,
-    read_marin_kvlcc2 as read_marin_kvlcc2,
     read_measured as read_measured,
     shared_data_dir as shared_data_dir,
 )
@@ -217,16 +152,127 @@ from ._simulation._simulate import simulate as simulate
 
 
 # isort: split
-# helpers of the application (jaxship.cli) and the notebooks
-from ._models._armax_model import ARMAXModel as ARMAXModel
-from ._models._steering.ross import (
-    ROSS_FREE as ROSS_FREE,
-    SPEED_RUDDER as SPEED_RUDDER,
-)
-from ._simulation._batch import (
-    batch_turning_indices as batch_turning_indices,
-    straight_run_batch as straight_run_batch,
-)
+# the namespaces: jaxship.effects.RudderOffset, jaxship.indices.turning_indices, ...
+from . import effects as effects, indices as indices
 
 
-vessel = get_vessel  # js.vessel("mariner"): a fresh instance of a preset (VESSELS)
+__all__ = [
+    # foundation
+    "AbstractModel",
+    "Free",
+    "param",
+    "default_free",
+    "Progress",
+    "ShipState",
+    "Command",
+    "Trajectory",
+    "straight_state",
+    "validate",
+    "fit_percent",
+    "enable_compilation_cache",
+    # models: vessels
+    "AbstractVessel",
+    "MMGVessel",
+    "RossVessel",
+    "VESSELS",
+    "get_vessel",
+    "load_vessel",
+    "save_vessel",
+    "straight_run",
+    "state_derivative",
+    "RudderServo",
+    "Shaft",
+    "Environment",
+    "Current",
+    "Wind",
+    "FossenWindLoads",
+    "FujiwaraWindLoads",
+    # models: steering models
+    "AbstractSteeringModel",
+    "AuxInputs",
+    "Nomoto1",
+    "Nomoto2",
+    "NonlinearNomoto",
+    "NorrbinCrossFlow",
+    "RossAutopilot",
+    "LinearSwayYaw",
+    "LowSpeedSwayYaw",
+    "ARMAXModel",
+    # models: effects (the classes in jaxship.effects)
+    "effects",
+    "augment",
+    # models: manoeuvres and controllers
+    "Turn",
+    "ZigZag",
+    "Stop",
+    "pull_out",
+    "spiral",
+    "ReverseSpiral",
+    "Schedule",
+    "prbs",
+    "multi_step_3211",
+    "thesis_manoeuvre",
+    "Replay",
+    "AbstractController",
+    "Controlled",
+    "HeadingAutopilot",
+    "Feedforward",
+    "ReferenceModel",
+    "HeadingSteps",
+    "YawRateLevels",
+    "heading_perturbations",
+    # simulate
+    "simulate",
+    "Simulator",
+    "RK4",
+    "simulate_batch",
+    "stack",
+    "straight_run_batch",
+    "froude_scale",
+    "Experiment",
+    "Dataset",
+    "read_trial_csv",
+    "write_trial_csv",
+    "read_measured",
+    "shared_data_dir",
+    # estimate
+    "fit",
+    "predict",
+    "FitResult",
+    "FitError",
+    "RESULTS",
+    "AbstractEstimator",
+    "PredictionError",
+    "Innovations",
+    "MaximumLikelihood",
+    "InnovationsLeastSquares",
+    "ARMAX",
+    "DiscreteResponse",
+    "LeastSquaresRegression",
+    "SupportVectorRegression",
+    "fit_discrete_response",
+    "LinearStart",
+    "MeasuredStates",
+    "EstimatedStarts",
+    "LevenbergMarquardt",
+    "prediction_bands",
+    "calibrate_disturbance",
+    "Disturbance",
+    "ekf",
+    "smooth_states",
+    # analysis
+    "indices",
+    "design_autopilot",
+    "tune_autopilot",
+    "yaw_inertia",
+    "closed_loop",
+    "ClosedLoop",
+    "closed_loop_metrics",
+    "YawDisturbance",
+    "fisher_information",
+    "excitation_order",
+    "discover",
+    "DiscoveryReport",
+    "Candidate",
+    "DISCOVERY_CATALOGUE",
+]

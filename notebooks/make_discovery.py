@@ -15,12 +15,13 @@ import time
 import jax
 import matplotlib.pyplot as plt
 import numpy as np
+from IPython.display import Markdown, display
 
 import jaxship as js
-from jaxship.cli._studies.discovery import hidden_effect_records, outcome, vessel_records
 
 
 sys.path.insert(0, str(pathlib.Path.cwd().parent))  # the project root: benchmarks.studies
+from benchmarks.studies.discovery import hidden_effect_records, outcome, vessel_records  # noqa: E402
 from benchmarks.studies.real_data import (  # noqa: E402
     esso_osaka_low_speed_discovery,
     esso_osaka_low_speed_steering,
@@ -79,17 +80,17 @@ nb.cells = [
         "## A hidden cubic yaw damping\n\nThe truth is $T\\dot r + r + \\beta r^3 = K\\delta$ "
         "with K = 0.06 1/s, T = 25 s, beta = 300 s^2/rad^2; the base model has no r^3 term."),
     nbf.v4.new_code_cell(
-        "truth = js.augment(js.Nomoto1(K=0.06, T=25.0), js.YawCubicDamping(beta=300.0))\n"
+        "truth = js.augment(js.Nomoto1(K=0.06, T=25.0), js.effects.YawCubicDamping(beta=300.0))\n"
         "train, holdout = hidden_effect_records(truth, seed=4)\n"
         "report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout)\n"
-        "print(report.to_markdown())"),
+        "display(Markdown(report.to_markdown()))"),
     nbf.v4.new_code_cell("residual_plot(report, holdout, 'held-out turning circles')"),
     nbf.v4.new_markdown_cell(
         "## A rudder offset: named with the effect it cannot be told from\n\n"
         "At one speed a rudder offset and a constant yaw moment are the same column of the "
         "Jacobian; the report names the class and the experiment that would separate them."),
     nbf.v4.new_code_cell(
-        "truth = js.augment(js.Nomoto1(K=0.06, T=25.0), js.RudderOffset(delta0=0.5 * DEG))\n"
+        "truth = js.augment(js.Nomoto1(K=0.06, T=25.0), js.effects.RudderOffset(delta0=0.5 * DEG))\n"
         "train, holdout = hidden_effect_records(truth, seed=3)\n"
         "report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout)\n"
         "for e in report.effects:\n"
@@ -115,10 +116,10 @@ nb.cells = [
         "measured position. The Mariner in a 0.3 m/s north, 0.2 m/s west current "
         "(400 s records):"),
     nbf.v4.new_code_cell(
-        "truth = js.augment(js.vessel('mariner'), js.UniformCurrent(north=0.3, east=-0.2))\n"
+        "truth = js.augment(js.get_vessel('mariner'), js.effects.UniformCurrent(north=0.3, east=-0.2))\n"
         "train, holdout = vessel_records(truth, 0, duration=400.0)\n"
         "t0 = time.perf_counter()\n"
-        "report = js.discover(js.vessel('mariner'), train, holdout)\n"
+        "report = js.discover(js.get_vessel('mariner'), train, holdout)\n"
         "print(f'{time.perf_counter() - t0:.0f} s', report.verdict)\n"
         "for e in report.effects:\n"
         "    print(e.id, {k: f\"{v.value:.3f} +- {v.std:.3f} {v.unit}\"\n"
@@ -141,10 +142,10 @@ nb.cells = [
         "if HAVE['kvlcc2_simman2008_hsva'] and HAVE['kvlcc2_simman2008_marin']:\n"
         "    train, holdout = kvlcc2_discovery_split(data)\n"
         "    t0 = time.perf_counter()\n"
-        "    kvlcc2 = js.discover(js.vessel('kvlcc2'), train, holdout)\n"
+        "    kvlcc2 = js.discover(js.get_vessel('kvlcc2'), train, holdout)\n"
         "    print(f'{time.perf_counter() - t0:.0f} s')\n"
         "    text = kvlcc2.to_markdown()\n"
-        "    print(text[:text.index('## Where')] + text[text.index('## Rejected'):])\n"
+        "    display(Markdown(text[:text.index('## Where')] + text[text.index('## Rejected'):]))\n"
         "    print('Loads the base model lacks (mean; while turning to starboard, to port):')\n"
         "    for name, v in kvlcc2.disagreement['before']['forces'].items():\n"
         "        print(f\"  {name} [{v['unit']}]: {v['mean']:.3g}; {v['starboard']:.3g}, \"\n"
@@ -258,7 +259,7 @@ nb.cells = [
     nbf.v4.new_code_cell(
         "if HAVE['esso_osaka_frt']:\n"
         "    hand = esso_osaka_low_speed_steering(data)\n"
-        "    print(hand.table())\n"
+        "    display(Markdown(hand.table()))\n"
         "    _, test = esso_osaka_zigzag_split(data)\n"
         "    fig, axes = plt.subplots(1, len(test), figsize=(11, 3))\n"
         "    for i, (ax, e) in enumerate(zip(axes, test)):\n"
@@ -281,7 +282,7 @@ nb.cells = [
     nbf.v4.new_code_cell(
         "if HAVE['esso_osaka_frt']:\n"
         "    sway = esso_osaka_low_speed_sway_yaw(data)\n"
-        "    print(sway.table())\n"
+        "    display(Markdown(sway.table()))\n"
         "    fig, axes = plt.subplots(2, len(test), figsize=(11, 5), sharex='col')\n"
         "    for i, e in enumerate(test):\n"
         "        for row, channel in enumerate(('r', 'v')):\n"

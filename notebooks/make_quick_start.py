@@ -14,7 +14,7 @@ CELLS = [
     new_markdown_cell("""# Quick start: a turning circle and a zig-zag
 
 `jaxship` simulates a 3-DOF (surge, sway, yaw) vessel as pure JAX functions. Here the Mariner
-class cargo ship (Chislett & Strom-Tejsen 1965, as in Fossen's MSS `mariner.m`; `js.vessel`
+class cargo ship (Chislett & Strom-Tejsen 1965, as in Fossen's MSS `mariner.m`; `js.get_vessel`
 lists the presets) sails the two trials every manoeuvring booklet has, a 35 deg turning
 circle and a 20/20 zig-zag, and the IMO MSC.137(76) criteria are checked on them.
 
@@ -30,7 +30,7 @@ from jaxship.plotting import plot_imo_criteria, plot_trajectory
 
 jax.config.update("jax_enable_x64", True)  # our choice here; jaxship never changes it
 
-ship = js.vessel("mariner")
+ship = js.get_vessel("mariner")
 L, U = float(ship.length), float(ship.nominal_speed)
 print(f"Mariner: L = {L:.1f} m, approach speed U = {U:.2f} m/s ({U / 0.5144:.1f} kn)")"""),
     new_markdown_cell("""## Turning circle, 35 deg to starboard
@@ -38,13 +38,13 @@ print(f"Mariner: L = {L:.1f} m, approach speed U = {U:.2f} m/s ({U / 0.5144:.1f}
 A trial is a manoeuvre (`js.Turn`, `js.ZigZag`, ...): `js.simulate` runs it from the
 straight run at the approach speed, here for 60 ship lengths' time L/U (past the 540 deg of
 heading change ITTC asks for), with an output every second and two RK4 steps per sample, as
-`jaxship simulate --manoeuvre turn:35` does. `js.turning_indices` gives advance, transfer
+`jaxship simulate --manoeuvre turn:35` does. `js.indices.turning_indices` gives advance, transfer
 and tactical diameter."""),
     new_code_cell("""tau = L / U  # the ship's time scale [s]
 x0 = js.straight_run(ship)  # the approach at the nominal speed
 fine = js.Simulator(substeps=2)
 turn = js.simulate(ship, js.Turn(np.deg2rad(35), duration=60 * tau, dt=1.0), x0, simulator=fine)
-turning = js.turning_indices(turn)
+turning = js.indices.turning_indices(turn)
 tactical = turning.tactical_diameter
 print(f"advance {turning.advance:.0f} m = {turning.advance / L:.2f} L, "
       f"transfer {turning.transfer:.0f} m, "
@@ -56,7 +56,7 @@ The rudder goes to 20 deg and is reversed each time the heading has changed by 2
 overshoots are how far the heading swings past that before it turns back."""),
     new_code_cell("""zigzag = js.simulate(ship, js.ZigZag(np.deg2rad(20), np.deg2rad(20), duration=35 * tau, dt=1.0),
                      x0, simulator=fine)
-zz20 = js.zigzag_indices(zigzag, np.deg2rad(20))
+zz20 = js.indices.zigzag_indices(zigzag, np.deg2rad(20))
 print("overshoots [deg]:", np.round(np.rad2deg(zz20.overshoots), 2))
 fig = plot_trajectory(zigzag, length=L, indices=zz20, title="Mariner, 20/20 zig-zag")"""),
     new_markdown_cell("""## IMO criteria
@@ -65,9 +65,9 @@ MSC.137(76) limits the 35 deg turn (advance 4.5 L, tactical diameter 5 L) and th
 overshoots (the 10/10 limits depend on L/V)."""),
     new_code_cell("""zigzag10 = js.simulate(ship, js.ZigZag(np.deg2rad(10), np.deg2rad(10), duration=35 * tau,
                                         dt=1.0), x0, simulator=fine)
-zz10 = js.zigzag_indices(zigzag10, np.deg2rad(10))
-rows = js.imo_criteria(L, U, turning35=turning, zigzag10=zz10, zigzag20=zz20)
-display(Markdown(js.format_table(rows)))
+zz10 = js.indices.zigzag_indices(zigzag10, np.deg2rad(10))
+rows = js.indices.imo_criteria(L, U, turning35=turning, zigzag10=zz10, zigzag20=zz20)
+display(Markdown(js.indices.format_table(rows)))
 fig = plot_imo_criteria(rows)"""),
     new_markdown_cell("""The same from a shell: `jaxship simulate --vessel mariner --manoeuvre turn:35 --out
 out/turn35` writes the trial's CSV, its indices as JSON and these figures. Next:

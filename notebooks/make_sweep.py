@@ -16,14 +16,14 @@ CELLS = [
 How large is the thesis vessel's tactical diameter at every rudder angle and propeller rate,
 and how well do we know it when the vessel's coefficients come from a fit to noisy trials?
 
-1. Simulate "measured" trials of the thesis vessel (`js.vessel("thesis")`, the 4 m DTMB 5415
+1. Simulate "measured" trials of the thesis vessel (`js.get_vessel("thesis")`, the 4 m DTMB 5415
    model of Odegard 2009, Table 4.1) at 400 and 600 rpm with sensor noise.
 2. Fit its 11 default free coefficients (`js.default_free`) from a perturbed start by
    prediction error, with their covariance (Newey-West where the residuals are coloured).
 3. Draw coefficient sets from the fitted Gaussian, $\\theta_k \\sim N(\\hat\\theta,
    \\hat\\Sigma)$, and simulate every turning circle of the grid 6 rudder angles x 5 rates x
    100 draws = 3,000 runs in **one compiled, vmapped call** (`js.simulate_batch`), reduced to
-   their indices inside it (`output=js.batch_turning_indices`).
+   their indices inside it (`output=js.indices.batch_turning_indices`).
 4. Plot the tactical diameter against rudder angle per rate with 5-95 % bands, next to the
    true vessel's."""),
     new_code_cell("""import time
@@ -39,7 +39,7 @@ import jaxship as js
 jax.config.update("jax_enable_x64", True)  # our choice here; jaxship never changes it
 
 DEG = np.pi / 180
-truth = js.vessel("thesis")
+truth = js.get_vessel("thesis")
 L = float(truth.length)
 free = js.default_free(truth)
 print("free coefficients:", ", ".join(free))"""),
@@ -98,7 +98,7 @@ manoeuvre = js.Turn(a, duration=100.0, dt=0.5, n=rpms[k] / 60)
 
 began = time.perf_counter()
 out = js.simulate_batch(vessel, manoeuvre, x0, in_axes=(0, 0, 0, None),
-                        output=js.batch_turning_indices)
+                        output=js.indices.batch_turning_indices)
 tactical = np.asarray(out["tactical_diameter"]).reshape(angles.size, rpms.size, draws)
 print(f"{a.size} turning circles in {time.perf_counter() - began:.1f} s (with compilation); "
       f"{int(np.sum(~np.isfinite(tactical)))} did not reach 180 deg")
@@ -108,7 +108,7 @@ nominal = js.simulate_batch(truth, js.Turn(np.repeat(angles, rpms.size), duratio
                             js.straight_state(np.tile(np.asarray(js.straight_run_batch(
                                 truth, n=rpms / 60).u), angles.size),
                                 np.tile(rpms, angles.size) / 60),
-                            output=js.batch_turning_indices)
+                            output=js.indices.batch_turning_indices)
 true_tactical = np.asarray(nominal["tactical_diameter"]).reshape(angles.size, rpms.size)"""),
     new_markdown_cell("""## 4. Tactical diameter with 5-95 % bands"""),
     new_code_cell("""low, mid, high = np.nanpercentile(tactical / L, [5, 50, 95], axis=2)

@@ -5,7 +5,7 @@ Run: python notebooks/make_thesis_identification.py.
 The notebook reproduces the identification study of the thesis (Odegard 2009, chapter 4)
 on the built-in thesis vessel: Nomoto and Ross' autopilot model identified from single
 and merged experiments, fit % next to the thesis' numbers. The pipeline is
-`jaxship/cli/_studies/thesis.py`.
+`jaxship/cli/reproduction/thesis.py`.
 """
 
 import pathlib
@@ -24,7 +24,7 @@ Nomoto model (eq. 3.2-3.3) and the autopilot model of Ross (eq. 3.6-3.7) by pred
 minimisation, first from single experiments (the 40 deg trial at 500 rpm, sec. 4.2), then from
 the merged experiments of each family at both rates (sec. 4.3).
 
-Here the same design is simulated with `js.vessel("thesis")` (the Ross-type 3-DOF model of
+Here the same design is simulated with `js.get_vessel("thesis")` (the Ross-type 3-DOF model of
 the 4 m DTMB 5415 model, `docs/thesis_vessel.md`; **not** the thesis' own coefficients, which
 are unpublished), measurement noise is added, and three models are identified:
 
@@ -49,10 +49,10 @@ import numpy as np
 import matplotlib.pyplot as plt
 from IPython.display import Markdown, display
 import jaxship as js
-from jaxship.cli._studies import thesis as ti
+from jaxship.cli.reproduction import thesis as ti
 
 DEG = np.pi / 180
-vessel = js.vessel("thesis")
+vessel = js.get_vessel("thesis")
 settings = ti.Settings()
 print("records sampled at", settings.dt, "s; noise (standard deviations):")
 for k, sigma in ti.NOISE.items():

@@ -11,6 +11,7 @@ import scipy.linalg
 from helpers import central_difference
 
 import jaxship as js
+from jaxship._analysis._closed_loop import tracking_objective
 
 
 DEG = np.pi / 180
@@ -183,7 +184,7 @@ def test_feedforward_lowers_the_residual_sum_on_nomoto():
 def test_feedforward_from_the_vessel_lowers_the_residual_sum_on_the_vessel():
     """Thesis sec. 5.4: the thesis vessel at 300 and 400 rpm, feed-forward by inverting
     the vessel's own yaw equation with the measured u, v."""
-    vessel = js.vessel("thesis")
+    vessel = js.get_vessel("thesis")
     kw = dict(natural_frequency=0.5, n=400 / 60)
     aps = [js.design_autopilot(vessel, feedforward=ff, **kw) for ff in (False, True)]
     runs = [js.closed_loop(vessel, a, rpm=[300.0, 400.0], duration=200.0, dt=0.1) for a in aps]
@@ -200,7 +201,7 @@ def test_feedforward_from_zig_zags_beats_feedback_on_the_full_vessel():
     300 and 400 rpm (neither the model nor the speeds of the design): PID with the
     model's feed-forward has less than 0.7 times the summed heading error of the same PID
     without it, and overshoots less than 2 deg."""
-    vessel = js.vessel("thesis")
+    vessel = js.get_vessel("thesis")
     x0 = js.straight_run(vessel, n=350 / 60)
     zigzag = js.ZigZag(angle=20 * DEG, heading=20 * DEG, duration=60.0, dt=0.1)
     record = js.Experiment.from_trajectory(js.simulate(vessel, zigzag, x0))
@@ -266,7 +267,7 @@ def test_vmap_over_gains_equals_a_loop_and_gradient_equals_finite_difference():
 
     def objective(kp):
         run = js.closed_loop(model, eqx.tree_at(lambda x: x.kp, a, kp), **kw)
-        return js.tracking_objective(run, 0.1)
+        return tracking_objective(run, 0.1)
 
     kp = jnp.asarray(float(a.kp))
     grad = jax.grad(objective)(kp)
@@ -275,7 +276,7 @@ def test_vmap_over_gains_equals_a_loop_and_gradient_equals_finite_difference():
 
 
 def test_disturbance_makes_the_rudder_work():
-    vessel = js.vessel("thesis")
+    vessel = js.get_vessel("thesis")
     a = js.design_autopilot(vessel, natural_frequency=0.5, steps=js.HeadingSteps((), ()))
     calm = js.closed_loop(vessel, a, duration=100.0, dt=0.5)
     sea = js.YawDisturbance(rudder_std=3 * DEG, time_constant=10.0, seed=3)
@@ -313,7 +314,7 @@ def test_metrics_of_a_known_record():
 
 @pytest.mark.slow
 def test_gradient_tuning_beats_pole_placement_on_and_off_the_tuning_speeds():
-    vessel = js.vessel("thesis")
+    vessel = js.get_vessel("thesis")
     steps = js.HeadingSteps(times=(10.0,), headings=(45 * DEG,))
     start = js.design_autopilot(vessel, natural_frequency=0.5, feedforward=False, steps=steps,
                                 n=400 / 60)
@@ -322,7 +323,7 @@ def test_gradient_tuning_beats_pole_placement_on_and_off_the_tuning_speeds():
                               max_steps=20, **kw)
     assert tuned.objective_after < 0.5 * tuned.objective_before
     for rpm in (300.0, 400.0, 500.0):  # 400 rpm was not tuned on
-        before, after = (float(js.tracking_objective(
+        before, after = (float(tracking_objective(
             js.closed_loop(vessel, a, rpm=[rpm], **kw), 0.1)) for a in (start, tuned.autopilot))
         assert after < 0.5 * before
 
@@ -331,7 +332,7 @@ def test_a_wave_filter_calms_the_rudder_in_waves():
     """A fast yaw disturbance (3 s correlation): behind a 2 s first-order wave filter the
     PID works the rudder less (measured: travel 121 -> 91 deg over 200 s) for a larger
     heading error (RMS 2.27 -> 2.86 deg): the trade a wave filter makes."""
-    vessel = js.vessel("thesis")
+    vessel = js.get_vessel("thesis")
     sea = js.YawDisturbance(rudder_std=5 * DEG, time_constant=3.0, sample_interval=0.5, seed=1)
     plain = js.design_autopilot(vessel, natural_frequency=0.5, steps=js.HeadingSteps((), ()))
     filtered = js.design_autopilot(vessel, natural_frequency=0.5, wave_filter=2.0,
@@ -353,7 +354,7 @@ def test_an_autopilot_prints_its_gains():
 FLOAT32_LOOP = """
 import jaxship as js
 ap = js.design_autopilot(js.Nomoto1(K=0.5, T=2.0), bandwidth=0.3)
-run = js.closed_loop(js.vessel("thesis"), [ap], rpm=[400.0], duration=60.0)
+run = js.closed_loop(js.get_vessel("thesis"), [ap], rpm=[400.0], duration=60.0)
 metrics = js.closed_loop_metrics(run)
 print(run.psi.dtype, float(metrics.residual_sum[0, 0]) >= 0.0)
 """

@@ -6,8 +6,8 @@ chapter-5 study and the `--tune` option."""
 import json
 import math
 import os
-import re
 import pathlib
+import re
 
 import jax
 import jax.numpy as jnp
@@ -18,7 +18,7 @@ import pytest
 import jaxship as js
 from jaxship.cli import main
 from jaxship.cli._identification import model_from_report, read_result
-from jaxship.cli._studies import autopilot as study
+from jaxship.cli.reproduction import autopilot as study
 from jaxship.plotting import plot_autopilot
 
 
@@ -275,7 +275,7 @@ def test_the_loader_rebuilds_ross_with_its_reference_scales():
 
 
 def test_the_loader_rebuilds_a_vessel_preset_with_its_estimates():
-    vessel = js.vessel("thesis")
+    vessel = js.get_vessel("thesis")
     report = {"model": "thesis", "model_class": "RossVessel",
               "parameters": {"n_ur": {"value": 2 * float(vessel.n_ur)}}, "frozen": {}}
     model = model_from_report(report)
@@ -336,7 +336,7 @@ def test_the_default_design_follows_the_models_time_constant():
     160 m ship's rudder on its limits. `auto` takes omega_n = 1.25 / T from the model's
     yaw time constant, capped at half the servo bandwidth, and scales the reference and
     the timing with it; on the thesis vessel it gives the thesis' own numbers."""
-    mariner, thesis = js.vessel("mariner"), js.vessel("thesis")
+    mariner, thesis = js.get_vessel("mariner"), js.get_vessel("thesis")
     omega, basis = study.natural_frequency_for(js.Nomoto1(K=0.033, T=21.0), mariner,
                                                speed=7.7, n=0.0)
     assert omega == pytest.approx(1.25 / 21.0) and "T = 21 s" in basis
@@ -358,7 +358,7 @@ def test_the_default_design_keeps_the_feedforward_within_the_rudders_limits():
     feed-forward of a 45 deg step for more rudder than half the limits; the design takes
     the frequency at which the reference model (stepped by `ReferenceModel`, not the
     closed form) asks for exactly half of one limit and less of the other, and says so."""
-    kvlcc2 = js.vessel("kvlcc2")
+    kvlcc2 = js.get_vessel("kvlcc2")
     u0, n0 = study.operating_point(kvlcc2, speed=float(kvlcc2.nominal_speed))
     omega, basis = study.natural_frequency_for(kvlcc2, kvlcc2, speed=u0, n=n0, step=45.0)
     m, d = (float(x) for x in js.yaw_inertia(kvlcc2, speed=u0, n=n0))
@@ -427,7 +427,7 @@ def test_the_mariner_at_the_defaults(tmp_path):
     assert (f"pid+ff {ff['sum_abs_error_deg']:.1f} against pid {fb['sum_abs_error_deg']:.1f} "
             "deg") in text and "**The feed-forward makes the tracking worse**" in text
     # the Mariner's own equations as the model: the feed-forward works at the defaults
-    mariner = js.vessel("mariner")
+    mariner = js.get_vessel("mariner")
     u0, n0 = study.operating_point(mariner, speed=7.7)
     omega, basis = study.natural_frequency_for(mariner, mariner, speed=u0, n=n0)
     own = study.evaluate(mariner, mariner, speeds=[7.7], design=study.Design.scaled(omega))

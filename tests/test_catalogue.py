@@ -4,11 +4,12 @@ import numpy as np
 import pytest
 
 import jaxship as js
+from jaxship._models._vessel.mariner import Mariner
 
 
 @pytest.mark.parametrize("name", list(js.VESSELS))
 def test_preset_turns_to_starboard_with_positive_rudder(name):
-    vessel = js.vessel(name)
+    vessel = js.get_vessel(name)
     assert js.VESSELS[name].description, "the factory docstring must name the model and source"
     x0 = js.straight_run(vessel)
     assert np.isfinite(float(x0.u)) and float(x0.u) > 0
@@ -26,10 +27,10 @@ def test_preset_turns_to_starboard_with_positive_rudder(name):
 
 def test_unknown_vessel_names_the_choices():
     with pytest.raises(ValueError, match="mariner"):
-        js.vessel("titanic")
+        js.get_vessel("titanic")
 
 
 def test_vessel_and_get_vessel_give_fresh_equal_presets():
-    a, b = js.vessel("Mariner"), js.get_vessel("mariner")
-    assert a is not b and type(a) is type(b) is js.Mariner
+    a, b = js.get_vessel("Mariner"), js.get_vessel("mariner")
+    assert a is not b and type(a) is type(b) is Mariner
     assert float(a.length) == float(b.length)

@@ -13,9 +13,9 @@ from helpers import per_sample
 
 import jaxship as js
 import jaxship.cli as cli
-from jaxship._foundation._files import MANIFEST, staged_folder
 from jaxship._foundation._params import parameter_fields, resolve_free
 from jaxship.cli import main
+from jaxship.cli._files import MANIFEST, staged_folder
 from jaxship.cli._identification.workflow import FitDivergedError
 
 
@@ -580,14 +580,14 @@ def test_mmg_coefficients_have_units(preset):
     """The unit column of `identify` for the MMG presets: primed coefficients are "-",
     dimensional ones carry their SI unit; and every preset's coefficients have a unit
     (their `param` metadata), which Froude scaling reads."""
-    fields = parameter_fields(js.vessel(preset))
+    fields = parameter_fields(js.get_vessel(preset))
     assert all(info.unit for info in fields.values()), [k for k, i in fields.items()
                                                         if not i.unit]
     assert fields["y_v"].unit == "-" and fields["length"].unit == "m"
     assert fields["rho"].unit == "kg/m^3"
-    assert {spec.unit for spec in resolve_free(js.vessel(preset))} == {"-"}
+    assert {spec.unit for spec in resolve_free(js.get_vessel(preset))} == {"-"}
     for name in js.VESSELS:
-        fields = parameter_fields(js.vessel(name))
+        fields = parameter_fields(js.get_vessel(name))
         assert all(info.unit for info in fields.values()), (name, [k for k, i in fields.items()
                                                                    if not i.unit])
 
@@ -606,8 +606,8 @@ def test_ctrl_c_ends_the_command_with_130_at_once_every_time(tmp_path):
     import threading
     import time
 
+    from benchmarks.studies.discovery import hidden_effect_records
     from jaxship.cli import GRACE
-    from jaxship.cli._studies.discovery import hidden_effect_records
 
     train, held = hidden_effect_records(js.Nomoto1(K=0.06, T=25.0), 0)
     paths = []
@@ -864,7 +864,7 @@ def test_a_signal_during_the_imports_ends_with_its_line_and_status(signum, statu
 TERMINATED_COMMIT = """
 import os, pathlib, sys, time
 from jaxship import cli
-from jaxship._foundation import _files
+from jaxship.cli import _files
 from jaxship.cli import simulate
 
 def slow(source, target):  # each rename of the commit takes a while

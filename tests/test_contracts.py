@@ -22,11 +22,11 @@ STEERING = {
     "nomoto1": js.Nomoto1(K=0.06, T=25.0),
     "nomoto2": js.Nomoto2(K=0.06, T1=25.0, T2=3.0, T3=5.0),
     "nonlinear_nomoto": js.NonlinearNomoto(K=0.06, T=25.0, n3=300.0),
-    "nonlinear_nomoto2": js.nonlinear_nomoto2(K=0.06, T1=25.0, T2=3.0, T3=5.0, beta1=100.0),
+    "nonlinear_nomoto2": js.effects.nonlinear_nomoto2(K=0.06, T1=25.0, T2=3.0, T3=5.0, beta1=100.0),
     "ross_autopilot": js.RossAutopilot(length=4.0, speed=1.5, rate=8.0, n_ur=-4.0,
                                        n_delta=2.5, n_uv=-1.0),
-    "linear_sway_yaw": js.LinearSwayYaw.from_vessel(js.vessel("sea_stratus_linear")),
-    "norrbin_crossflow": js.NorrbinCrossFlow.from_vessel(js.vessel("sea_stratus_nonlinear")),
+    "linear_sway_yaw": js.LinearSwayYaw.from_vessel(js.get_vessel("sea_stratus_linear")),
+    "norrbin_crossflow": js.NorrbinCrossFlow.from_vessel(js.get_vessel("sea_stratus_nonlinear")),
     "low_speed_sway_yaw": js.LowSpeedSwayYaw(),
 }
 
@@ -36,7 +36,7 @@ def test_every_model_meets_the_contract_through_its_base(name):
     """Every vessel preset and steering model is a `jaxship.AbstractModel`: its replay
     state and field give a derivative of the state's shape, its outputs psi and r have
     a place, and its default free parameters resolve and rebuild it."""
-    model = STEERING[name] if name in STEERING else js.vessel(name)
+    model = STEERING[name] if name in STEERING else js.get_vessel(name)
     assert isinstance(model, js.AbstractModel)
     aux = js.AuxInputs(u=1.0, v=0.0, n=1.0)
     start = WindowStart(r=0.01, psi=0.1, delta=0.05, r_first=0.0, psi_first=0.0,
@@ -59,31 +59,32 @@ def test_every_model_meets_the_contract_through_its_base(name):
 # differ -- and the families it acts on
 U0 = 7.7175  # the Mariner's nominal speed [m/s]
 EFFECTS = {
-    "rudder_offset": (js.RudderOffset(), "delta0", 0.02, ("vessel", "steering")),
-    "yaw_moment_bias": (js.YawMomentBias(), "n0", 1e-4, ("steering",)),
-    "sway_force_bias": (js.SwayForceBias(), "y0", 1e4, ("vessel",)),
-    "yaw_rate_sensor_bias": (js.YawRateSensorBias(), "bias", 1e-3, ("vessel", "steering")),
-    "heading_sensor_bias": (js.HeadingSensorBias(), "bias", 0.01, ("vessel", "steering")),
-    "yaw_cubic_damping": (js.YawCubicDamping(), "beta",
+    "rudder_offset": (js.effects.RudderOffset(), "delta0", 0.02, ("vessel", "steering")),
+    "yaw_moment_bias": (js.effects.YawMomentBias(), "n0", 1e-4, ("steering",)),
+    "sway_force_bias": (js.effects.SwayForceBias(), "y0", 1e4, ("vessel",)),
+    "yaw_rate_sensor_bias": (js.effects.YawRateSensorBias(), "bias", 1e-3, ("vessel", "steering")),
+    "heading_sensor_bias": (js.effects.HeadingSensorBias(), "bias", 0.01, ("vessel", "steering")),
+    "yaw_cubic_damping": (js.effects.YawCubicDamping(), "beta",
                           {"vessel": 2e12, "steering": 300.0}, ("vessel", "steering")),
-    "rudder_lag": (js.RudderLag(), "time_constant", 2.0, ("vessel", "steering")),
-    "rudder_delay": (js.RudderDelay(), "delay", 1.5, ("vessel", "steering")),
-    "rudder_rate_limit": (js.RudderRateLimit(), "inverse_rate", 60.0, ("vessel", "steering")),
-    "yaw_quadratic_damping": (js.YawQuadraticDamping(), "beta",
+    "rudder_lag": (js.effects.RudderLag(), "time_constant", 2.0, ("vessel", "steering")),
+    "rudder_delay": (js.effects.RudderDelay(), "delay", 1.5, ("vessel", "steering")),
+    "rudder_rate_limit": (js.effects.RudderRateLimit(), "inverse_rate", 60.0,
+                          ("vessel", "steering")),
+    "yaw_quadratic_damping": (js.effects.YawQuadraticDamping(), "beta",
                               {"vessel": 4e10, "steering": 10.0}, ("vessel", "steering")),
-    "crossflow_drag": (js.CrossflowDrag(), "coefficient", 0.04, ("vessel",)),
-    "speed_dependent_rudder": (js.SpeedDependentRudder(nominal_speed=U0), "kappa", 0.5,
+    "crossflow_drag": (js.effects.CrossflowDrag(), "coefficient", 0.04, ("vessel",)),
+    "speed_dependent_rudder": (js.effects.SpeedDependentRudder(nominal_speed=U0), "kappa", 0.5,
                                ("vessel", "steering")),
-    "speed_dependent_damping": (js.SpeedDependentDamping(nominal_speed=U0), "kappa", 1.0,
+    "speed_dependent_damping": (js.effects.SpeedDependentDamping(nominal_speed=U0), "kappa", 1.0,
                                 ("steering",)),
-    "rudder_stall": (js.RudderStall(), "c", 0.3, ("vessel", "steering")),
-    "propeller_asymmetry": (js.PropellerAsymmetry(), "moment",
+    "rudder_stall": (js.effects.RudderStall(), "c", 0.3, ("vessel", "steering")),
+    "propeller_asymmetry": (js.effects.PropellerAsymmetry(), "moment",
                             {"vessel": 1.4e6, "steering": 2.6e-4}, ("vessel", "steering")),
-    "propeller_race": (js.PropellerRace(), "gain", 2e-4, ("steering",)),
-    "surge_turn_resistance": (js.SurgeTurnResistance(), "x_vr", 0.004, ("vessel",)),
-    "added_mass_error": (js.AddedMassError(), "s_r", 0.2, ("vessel",)),
-    "current": (js.UniformCurrent(), "north", 0.5, ("vessel",)),
-    "wind": (js.Windage(), "lateral_area", 2000.0, ("vessel",)),
+    "propeller_race": (js.effects.PropellerRace(), "gain", 2e-4, ("steering",)),
+    "surge_turn_resistance": (js.effects.SurgeTurnResistance(), "x_vr", 0.004, ("vessel",)),
+    "added_mass_error": (js.effects.AddedMassError(), "s_r", 0.2, ("vessel",)),
+    "current": (js.effects.UniformCurrent(), "north", 0.5, ("vessel",)),
+    "wind": (js.effects.Windage(), "lateral_area", 2000.0, ("vessel",)),
 }
 # what some effects need to show beyond a calm-water zig-zag of the Mariner from its
 # straight run (or Nomoto 1 without auxiliary inputs): wind (replayed as logged wind,
@@ -145,7 +146,7 @@ def check_contract(f, p0, *, eps, rtol, atol):
 
 @pytest.mark.parametrize("name", VESSELS)
 def test_vessel_contract(name):
-    vessel = js.vessel(name)
+    vessel = js.get_vessel(name)
     coefficient = default_free(vessel)[0]
     p0 = float(get_path(vessel, coefficient))
     # a relative step of 1e-7: the zig-zag's rudder reverses at the heading crossing inside
@@ -191,7 +192,7 @@ def test_effect_contract(effect):
     name = f"{effect}.{field}"
     assert zero.id == effect
     if "vessel" in families:
-        vessel = js.vessel("mariner")
+        vessel = js.get_vessel("mariner")
         environment = shown.get("environment", js.Environment())
         man = short_run(vessel)
         x0 = js.straight_state(vessel.nominal_speed, shown["n"]) if "n" in shown else \
@@ -245,7 +246,7 @@ def test_controller_contract(name):
     """The controller's memory is part of the simulated state: its closed loop under vmap
     over the approach speed equals a loop, and the final heading is differentiable
     (forward mode equals finite differences) in a vessel coefficient through it."""
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     man = CONTROLLERS[name]
     speeds = jnp.array([6.0, 7.7175])
     batched = js.simulate_batch(vessel, man, js.straight_state(speeds, 0.0),
@@ -263,7 +264,7 @@ def test_controller_contract(name):
 
 
 def test_controller_gains_are_differentiable_and_vmappable():
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     x0 = js.straight_run(vessel)
 
     def final_error(kp):
@@ -303,7 +304,7 @@ def test_user_controller_runs_at_the_control_step_with_its_memory_in_the_state()
     """A controller outside the library: the heading settles on the target whatever the
     output interval; its integrator travels in the state (the result with dt = 2 s
     equals the dt = 0.5 s run at the common samples); gains vmap and differentiate."""
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     x0 = js.straight_run(vessel)
     pilot = CourseKeeper(target=10 * DEG, kp=2.0, kd=40.0, ki=0.002)
     fine = js.simulate(vessel, js.Controlled(pilot, duration=400.0, dt=0.5), x0)

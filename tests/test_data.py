@@ -9,15 +9,13 @@ import jaxship as js
 from jaxship import (
     Dataset,
     Experiment,
-    read_esso_osaka,
-    read_hsva_kvlcc2,
-    read_marin_kvlcc2,
     read_measured,
     read_trial_csv,
     shared_data_dir,
     write_trial_csv,
 )
 from jaxship._simulation._data import CHANNELS
+from jaxship._simulation._measured import read_esso_osaka, read_hsva_kvlcc2, read_marin_kvlcc2
 from jaxship.cli._identification import read_experiments
 
 

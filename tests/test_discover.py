@@ -14,15 +14,7 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._analysis._discover import _workflow as discover_workflow
-from jaxship._analysis._discover._holdout import cost_rise, record_indices
-from jaxship._analysis._discover._plausible import rudder_equivalent
-from jaxship._analysis._discover._workflow import heldout_rise
-from jaxship._estimate._sensitivity import sensitivities
-from jaxship._estimate._windows import as_dataset
-from jaxship._foundation._files import MANIFEST, staged_folder
-from jaxship.cli import main
-from jaxship.cli._studies.discovery import (
+from benchmarks.studies.discovery import (
     condition_records,
     hidden_effect_records,
     outcome,
@@ -32,6 +24,16 @@ from jaxship.cli._studies.discovery import (
     vessel_records,
     wind_records,
 )
+from jaxship._analysis._discover import _workflow as discover_workflow
+from jaxship._analysis._discover._holdout import cost_rise, record_indices
+from jaxship._analysis._discover._locate import locate_disagreement
+from jaxship._analysis._discover._plausible import rudder_equivalent
+from jaxship._analysis._discover._report import CandidateOutcome
+from jaxship._analysis._discover._workflow import heldout_rise
+from jaxship._estimate._sensitivity import sensitivities
+from jaxship._estimate._windows import as_dataset
+from jaxship.cli import main
+from jaxship.cli._files import MANIFEST, staged_folder
 
 
 DEG = np.pi / 180
@@ -72,7 +74,7 @@ def test_a_held_out_rise_within_the_disturbances_spread_keeps_the_true_effect():
     standard errors over 60 s stretches). A gate asking the cost to fall rejected it and
     named a yaw-rate sensor bias instead (3 of 40 Monte-Carlo seeds); the held-out gate
     now allows the spread the disturbance gives."""
-    report = run(js.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
+    report = run(js.effects.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
     assert outcome(report, ("rudder_offset",)) == "correct", report.to_markdown()
     assert report.holdout_cost_after > report.holdout_cost_before  # the rise it allows
 
@@ -84,7 +86,7 @@ def test_the_held_out_check_vetoes_but_does_not_choose():
     veto): the data do not say which is missing, so nothing is named. The offset and a
     yaw-moment bias are one class on a Nomoto model (their scores tie to rounding), so the
     rejection names the class, whichever member was refitted."""
-    report = run(js.RudderOffset(delta0=0.3 * DEG), seed=1018, disturbance=1.0 * DEG)
+    report = run(js.effects.RudderOffset(delta0=0.3 * DEG), seed=1018, disturbance=1.0 * DEG)
     assert report.verdict == "nothing_missing", report.to_markdown()
     assert any("rudder_offset or yaw_moment_bias explains the training data better" in why
                for r in report.rejected for why in r.why), report.to_markdown()
@@ -107,7 +109,7 @@ def test_a_refit_that_fails_numerically_rejects_that_candidate_not_the_run(monke
         return fit(model, *args, **kwargs)
 
     monkeypatch.setattr(_workflow, "fit", failing)
-    report = run(js.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
+    report = run(js.effects.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
     failed = [r for r in report.rejected if r.id in one_class]
     assert failed and failed[0].why == (
         "the refit failed numerically (LinAlgError: SVD did not converge)",)
@@ -154,7 +156,7 @@ def test_a_candidate_whose_sensitivities_are_not_finite_is_rejected_not_the_run(
         return dataclasses.replace(sens, jacobian=jac)
 
     monkeypatch.setattr(_workflow, "sensitivities", broken)
-    report = run_case((js.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
+    report = run_case((js.effects.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
     assert report.names_or_classes() and "rudder_offset" in report.names_or_classes()[0]
     why = [r.why for r in report.rejected if r.id == "yaw_cubic_damping"]
     assert why and why[0] == ("not scored: its sensitivities at the current fit are not "
@@ -166,7 +168,7 @@ def test_a_candidate_whose_sensitivities_are_not_finite_is_rejected_not_the_run(
 
     monkeypatch.setattr(_workflow, "sensitivities", sensitivities)
     monkeypatch.setattr(_workflow, "score_tests", failing)
-    report = run_case((js.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
+    report = run_case((js.effects.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
     assert report.verdict == "nothing_missing" and report.rejected
     assert all(r.why == ("not scored: the scores failed numerically (SVD did not "
                          "converge)",) for r in report.rejected)
@@ -188,7 +190,7 @@ def test_a_held_out_prediction_that_blows_up_rejects_that_candidate(monkeypatch)
         return check(model, *args, **kwargs)
 
     monkeypatch.setattr(_workflow, "holdout_check", blowing_up)
-    report = run_case((js.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
+    report = run_case((js.effects.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
     failed = [r for r in report.rejected if r.id in offset and r.iteration == 1]
     assert failed and failed[0].why == ("a prediction with it is not finite (channel 'r': "
                                         "non-finite values at 12 valid samples.)",)
@@ -273,7 +275,7 @@ def test_a_predicted_overshoot_is_measured_between_the_logged_rudder_reversals()
     out = js.simulate(js.Nomoto1(K=K, T=25.0), js.ZigZag(10 * DEG, 10 * DEG, duration=400.0,
                                                          dt=0.5, rudder_rate=2.3 * DEG))
     t, delta, psi = (np.asarray(a) for a in (out.t, out.state.delta, out.state.psi))
-    imo = js.zigzag_indices(heading_switch=10 * DEG, t=t, psi=psi, delta=delta).overshoots
+    imo = js.indices.zigzag_indices(heading_switch=10 * DEG, t=t, psi=psi, delta=delta).overshoots
     measured = record_indices(t, delta, psi)
     assert [measured["overshoot_1_deg"], measured["overshoot_2_deg"]] == pytest.approx(
         np.rad2deg(imo[:2]), abs=1e-9)
@@ -282,7 +284,7 @@ def test_a_predicted_overshoot_is_measured_between_the_logged_rudder_reversals()
         assert weak[k] == pytest.approx(0.5 * (measured[k] + 10.0) - 10.0, abs=1e-9)
         assert weak[k] < 0
     with pytest.raises(ValueError, match="never reached the switch"):
-        js.zigzag_indices(heading_switch=10 * DEG, t=t, psi=0.5 * psi, delta=delta)
+        js.indices.zigzag_indices(heading_switch=10 * DEG, t=t, psi=0.5 * psi, delta=delta)
 
 
 def test_an_effect_in_family_units_is_sized_as_the_rudder_angle_of_its_loads():
@@ -296,14 +298,14 @@ def test_an_effect_in_family_units_is_sized_as_the_rudder_angle_of_its_loads():
     r = rng.normal(0.0, 0.01, num)
     data = as_dataset(js.Experiment(np.arange(num) * 0.5, delta, psi=np.zeros(num), r=r,
                                     u=np.full(num, 5.0), n=np.full(num, 1.5)))
-    model = js.augment(js.Nomoto1(K=K, T=25.0), js.YawMomentBias(n0=0.2 * K),
-                       js.YawQuadraticDamping(beta=50.0))
+    model = js.augment(js.Nomoto1(K=K, T=25.0), js.effects.YawMomentBias(n0=0.2 * K),
+                       js.effects.YawQuadraticDamping(beta=50.0))
     assert rudder_equivalent(model, "yaw_moment_bias", data) == pytest.approx(0.2, rel=1e-12)
     quadratic = np.linalg.norm(50.0 * r * np.abs(r)) / (K * np.sqrt(num))
     assert rudder_equivalent(model, "yaw_quadratic_damping", data) == pytest.approx(
         quadratic, rel=1e-12)
     # a race's share of the rudder force against the rudder's gain with it: at most delta
-    race = js.augment(js.Nomoto1(K=K, T=25.0), js.PropellerRace(gain=0.04))
+    race = js.augment(js.Nomoto1(K=K, T=25.0), js.effects.PropellerRace(gain=0.04))
     share = 0.04 * 1.5**2
     assert rudder_equivalent(race, "propeller_race", data) == pytest.approx(
         share * np.linalg.norm(delta) / ((K + share) * np.sqrt(num)), rel=1e-12)
@@ -314,7 +316,7 @@ def test_an_effect_in_family_units_is_sized_as_the_rudder_angle_of_its_loads():
                                         n=np.full(num, float(js.straight_run(mariner).n))))
     n_delta = np.diff([float(mariner.forces(u0, 0.0, 0.0, d, straight.n[0, 0])[2])
                        for d in (-1e-6, 1e-6)])[0] / 2e-6
-    vessel = js.augment(mariner, js.YawMomentBias(n0=3e6))
+    vessel = js.augment(mariner, js.effects.YawMomentBias(n0=3e6))
     assert rudder_equivalent(vessel, "yaw_moment_bias", straight) == pytest.approx(
         3e6 / abs(n_delta), rel=1e-5)
 
@@ -324,7 +326,7 @@ def test_an_implausibly_large_constant_moment_is_not_named():
     range is 5.7 deg): refitted, it fails the plausibility gate; one worth 1 deg passes."""
     only = tuple(c for c in js.DISCOVERY_CATALOGUE if c.id == "yaw_moment_bias")
     for angle, named in ((10 * DEG, False), (1 * DEG, True)):
-        report = run_case((js.YawMomentBias(n0=K * angle),), 3, catalogue=only,
+        report = run_case((js.effects.YawMomentBias(n0=K * angle),), 3, catalogue=only,
                           max_effects=1)[0]
         assert (report.verdict == "missing_effect") is named, report.to_markdown()
         record = (report.effects or report.rejected)[0]
@@ -335,7 +337,7 @@ def test_an_implausibly_large_constant_moment_is_not_named():
 
 
 def test_a_rudder_offset_is_named_with_its_class_and_the_gap_shrinks():
-    report = run(js.RudderOffset(delta0=0.5 * DEG), seed=3)
+    report = run(js.effects.RudderOffset(delta0=0.5 * DEG), seed=3)
     assert report.verdict == "missing_effect" and len(report.effects) == 1
     assert report.names_or_classes()[0] == {"rudder_offset", "yaw_moment_bias"}
     effect = report.effects[0]
@@ -363,10 +365,10 @@ def test_cubic_damping_is_named_and_closes_the_held_out_gap(monkeypatch):
         return sensitivities(model, dataset, estimator, names, *args, **kwargs)
 
     monkeypatch.setattr(discover_workflow, "sensitivities", recording)
-    report = run(js.YawCubicDamping(beta=300.0), seed=4)
+    report = run(js.effects.YawCubicDamping(beta=300.0), seed=4)
     assert report.named == ("yaw_cubic_damping",)
     assert len(scored) == 2 and scored[0] == scored[1]
-    assert [type(e) for e in report.model_after.effects] == [js.YawCubicDamping]
+    assert [type(e) for e in report.model_after.effects] == [js.effects.YawCubicDamping]
     p = report.effects[0].parameters["yaw_cubic_damping.beta"]
     assert abs(p.value - 300.0) < 4 * p.std
     assert report.holdout_cost_after < 0.5 * report.holdout_cost_before
@@ -376,7 +378,8 @@ def test_cubic_damping_is_named_and_closes_the_held_out_gap(monkeypatch):
 
 @pytest.mark.slow
 def test_two_effects_at_once_are_both_named_and_nothing_else():
-    report = run(js.RudderOffset(delta0=0.5 * DEG), js.YawCubicDamping(beta=300.0), seed=5)
+    report = run(js.effects.RudderOffset(delta0=0.5 * DEG),
+                 js.effects.YawCubicDamping(beta=300.0), seed=5)
     classes = report.names_or_classes()
     assert len(classes) == 2
     assert any("yaw_cubic_damping" in c for c in classes)
@@ -385,10 +388,11 @@ def test_two_effects_at_once_are_both_named_and_nothing_else():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("effect", [
-    js.RudderLag(time_constant=2.0), js.RudderDelay(delay=1.5),
-    js.RudderRateLimit(inverse_rate=1 / (1.0 * DEG)), js.YawRateSensorBias(bias=0.05 * DEG),
-    js.YawMomentBias(n0=K * 0.5 * DEG), js.YawQuadraticDamping(beta=10.0),
-    js.RudderStall(c=0.45),  # near the plausible bound 0.5: c = 0.3 scores 9.4 < 12.9
+    js.effects.RudderLag(time_constant=2.0), js.effects.RudderDelay(delay=1.5),
+    js.effects.RudderRateLimit(inverse_rate=1 / (1.0 * DEG)),
+    js.effects.YawRateSensorBias(bias=0.05 * DEG),
+    js.effects.YawMomentBias(n0=K * 0.5 * DEG), js.effects.YawQuadraticDamping(beta=10.0),
+    js.effects.RudderStall(c=0.45),  # near the plausible bound 0.5: c = 0.3 scores 9.4 < 12.9
 ], ids=lambda e: e.id)
 def test_every_steering_effect_is_named_or_its_class(effect):
     report = run(effect, seed=6)
@@ -399,9 +403,11 @@ def test_every_steering_effect_is_named_or_its_class(effect):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("effect, duration", [
-    (js.RudderOffset(delta0=0.5 * DEG), 400.0), (js.SwayForceBias(y0=3e4), 400.0),
-    (js.CrossflowDrag(coefficient=0.04), 400.0), (js.SurgeTurnResistance(x_vr=0.004), 400.0),
-    (js.AddedMassError(s_r=0.2), 400.0), (js.HeadingSensorBias(bias=1.0 * DEG), 800.0),
+    (js.effects.RudderOffset(delta0=0.5 * DEG), 400.0), (js.effects.SwayForceBias(y0=3e4), 400.0),
+    (js.effects.CrossflowDrag(coefficient=0.04), 400.0),
+    (js.effects.SurgeTurnResistance(x_vr=0.004), 400.0),
+    (js.effects.AddedMassError(s_r=0.2), 400.0),
+    (js.effects.HeadingSensorBias(bias=1.0 * DEG), 800.0),
 ], ids=lambda v: f"{v:g}s" if isinstance(v, float) else v.id)
 def test_every_vessel_effect_is_named(effect, duration):
     """Mariner records (4 zig-zags to train; turns and a 15/15 zig-zag held out; 8
@@ -413,9 +419,9 @@ def test_every_vessel_effect_is_named(effect, duration):
     named through `current`, measured 2026-11-26, but the held-out cost does not fall).
     The current's case (0.3 m/s north, 0.2 m/s west) is asserted by the discovery
     notebook, which runs it for its readers (`test_notebooks`): one run, not two."""
-    truth = js.augment(js.vessel("mariner"), effect)
+    truth = js.augment(js.get_vessel("mariner"), effect)
     train, holdout = vessel_records(truth, 0, duration=duration)
-    report = js.discover(js.vessel("mariner"), train, holdout)
+    report = js.discover(js.get_vessel("mariner"), train, holdout)
     assert outcome(report, (effect.id,)) == "correct", report.to_markdown()
     assert report.holdout_cost_after < report.holdout_cost_before
 
@@ -425,12 +431,12 @@ def test_a_vessel_effect_is_named_from_records_without_a_logged_drift():
     """The Mariner records of the test above with a hidden 30 kN sway force and no v
     logged (psi, r, u and the GNSS track): discover fits the channels logged, starts
     every window from the vessel's states smoothed from them, and names the force."""
-    truth = js.augment(js.vessel("mariner"), js.SwayForceBias(y0=3e4))
+    truth = js.augment(js.get_vessel("mariner"), js.effects.SwayForceBias(y0=3e4))
     drop = lambda e: js.Experiment(e.t, e.delta, psi=e.psi, r=e.r, u=e.u, x=e.x, y=e.y,
                                    n=e.n, name=e.name)
     train, holdout = ([drop(e) for e in records]
                       for records in vessel_records(truth, 0, duration=400.0))
-    report = js.discover(js.vessel("mariner"), train, holdout)
+    report = js.discover(js.get_vessel("mariner"), train, holdout)
     assert report.channels == ("psi", "r", "u", "x", "y")
     assert outcome(report, ("sway_force_bias",)) == "correct", report.to_markdown()
     force = report.effects[0].parameters["sway_force_bias.y0"]
@@ -445,9 +451,10 @@ def test_windage_is_named_on_a_vessel_in_a_logged_wind():
     is named, nothing else, both areas within 4 robust standard errors (measured
     371 +- 19 and 1950 +- 27 m^2), and the held-out cost falls."""
     areas = {"wind.frontal_area": 350.0, "wind.lateral_area": 2000.0}
-    truth = js.augment(js.vessel("mariner"), js.Windage(frontal_area=350.0, lateral_area=2000.0))
+    truth = js.augment(js.get_vessel("mariner"), js.effects.Windage(frontal_area=350.0,
+                                                                    lateral_area=2000.0))
     train, holdout = vessel_records(truth, 0, wind=js.Wind(15.0, 60 * DEG), duration=400.0)
-    report = js.discover(js.vessel("mariner"), train, holdout)
+    report = js.discover(js.get_vessel("mariner"), train, holdout)
     assert outcome(report, ("wind",)) == "correct", report.to_markdown()
     for name, area in areas.items():
         got = report.effects[0].parameters[name]
@@ -462,7 +469,7 @@ SPEED = 7.0  # [m/s], the mean logged speed of the runs at 5 and 9 m/s: the effe
 @pytest.mark.parametrize("hidden, value, at, channel, values, held", [
     # a propeller walk worth 1 deg of rudder at 2 rev/s, 0.25 deg at 1 rev/s
     ("propeller_asymmetry.moment", K * DEG / 4,
-     lambda n: js.augment(js.Nomoto1(K=K, T=25.0), js.YawMomentBias(n0=K * DEG / 4 * n**2)),
+     lambda n: js.augment(js.Nomoto1(K=K, T=25.0), js.effects.YawMomentBias(n0=K * DEG / 4 * n**2)),
      "n", (1.0, 2.0), None),
     # a rudder moment growing as 1 + 0.5 (u^2/U_0^2 - 1): K x 0.76 at 5 m/s, x 1.33 at 9
     ("speed_dependent_rudder.kappa", 0.5,
@@ -492,7 +499,7 @@ def test_the_discover_command(tmp_path, capsys):
     """`jaxship discover` on trial CSVs with a hidden cubic damping: each stage is shown on
     stderr, discovery.json has the documented keys, report.md and the figures are
     written."""
-    truth = js.augment(js.Nomoto1(K=K, T=25.0), js.YawCubicDamping(beta=300.0))
+    truth = js.augment(js.Nomoto1(K=K, T=25.0), js.effects.YawCubicDamping(beta=300.0))
     train, holdout = hidden_effect_records(truth, 4)
     holdout.append(record(truth, js.ZigZag(25 * DEG, 25 * DEG, duration=300.0, dt=0.5),
                           "zz25", np.random.default_rng(9)))
@@ -585,7 +592,7 @@ def test_wind_is_named_on_a_steering_model_with_logged_wind():
     """Nomoto 1 that feels a logged 15 m/s wind (`wind_records`: 10/10 zig-zags on four
     headings to train, +-20 deg turns held out): `wind` is named, nothing else, c2
     within 4 robust standard errors, and the held-out cost falls."""
-    truth = js.augment(js.Nomoto1(K=K, T=25.0), js.ApparentWind(c2=3e-6))
+    truth = js.augment(js.Nomoto1(K=K, T=25.0), js.effects.ApparentWind(c2=3e-6))
     train, holdout = wind_records(truth, 0)
     report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout)
     assert outcome(report, ("wind",)) == "correct", report.to_markdown()
@@ -614,9 +621,9 @@ def test_an_estimate_pinned_at_its_plausible_bound_is_at_the_edge():
     from jaxship._analysis._discover._workflow import _at_edge
 
     def fitted(delta0):
-        truth = js.augment(js.Nomoto1(K=K, T=25.0), js.RudderOffset(delta0=delta0))
+        truth = js.augment(js.Nomoto1(K=K, T=25.0), js.effects.RudderOffset(delta0=delta0))
         train, _ = hidden_effect_records(truth, 0)
-        return js.fit(js.augment(js.Nomoto1(K=0.05, T=20.0), js.RudderOffset()), train)
+        return js.fit(js.augment(js.Nomoto1(K=0.05, T=20.0), js.effects.RudderOffset()), train)
 
     pinned, inside = fitted(0.15), fitted(0.05)
     assert pinned.code == js.RESULTS.at_bound and inside.success
@@ -630,11 +637,11 @@ def test_the_loads_a_vessel_lacks_are_located_from_the_measured_states():
     mean missing load ($M\\dot\\nu - \\tau$ from the smoothed measured u, v, r) is that
     load within 10 %, the other loads' means below 5 % of it; on null records both
     below 5 %."""
-    mariner = js.vessel("mariner")
-    for effect, name, size in ((js.SwayForceBias(y0=3e4), "Y", 3e4),
-                               (js.YawMomentBias(n0=3e6), "N", 3e6), (None, None, None)):
+    mariner = js.get_vessel("mariner")
+    for effect, name, size in ((js.effects.SwayForceBias(y0=3e4), "Y", 3e4),
+                               (js.effects.YawMomentBias(n0=3e6), "N", 3e6), (None, None, None)):
         truth = mariner if effect is None else js.augment(mariner, effect)
-        forces = js.locate_disagreement(mariner, vessel_records(truth, 0)[0],
+        forces = locate_disagreement(mariner, vessel_records(truth, 0)[0],
                                         ("psi", "r", "u", "v"))["forces"]
         for load, scale in (("Y", 3e4), ("N", 3e6)):
             mean = forces[load]["mean"]
@@ -642,7 +649,7 @@ def test_the_loads_a_vessel_lacks_are_located_from_the_measured_states():
                 assert abs(mean - size) < 0.1 * size, (load, mean)
             else:
                 assert abs(mean) < 0.05 * scale, (effect, load, mean)
-    assert js.locate_disagreement(js.Nomoto1(K=0.05, T=20.0), vessel_records(mariner, 0)[0],
+    assert locate_disagreement(js.Nomoto1(K=0.05, T=20.0), vessel_records(mariner, 0)[0],
                                   ("psi", "r"))["forces"] is None  # a steering model
 
 
@@ -652,13 +659,13 @@ def test_the_loads_a_vessel_lacks_are_located_from_its_track_without_a_logged_dr
     within 10 % (30.9 kN, 2.95 MN m); on null records both means stay below 5 % of the
     scales (1.3 kN, 0.5 kN m); the other load's mean below 12 % (the sway force under
     the yaw moment: 3.2 kN, where the logged v gives 1.1 kN)."""
-    mariner = js.vessel("mariner")
-    for effect, name, size in ((js.SwayForceBias(y0=3e4), "Y", 3e4),
-                               (js.YawMomentBias(n0=3e6), "N", 3e6), (None, None, None)):
+    mariner = js.get_vessel("mariner")
+    for effect, name, size in ((js.effects.SwayForceBias(y0=3e4), "Y", 3e4),
+                               (js.effects.YawMomentBias(n0=3e6), "N", 3e6), (None, None, None)):
         truth = mariner if effect is None else js.augment(mariner, effect)
         records = [js.Experiment(e.t, e.delta, psi=e.psi, r=e.r, u=e.u, x=e.x, y=e.y, n=e.n,
                                  name=e.name) for e in vessel_records(truth, 0)[0]]
-        forces = js.locate_disagreement(mariner, records, ("psi", "r", "u"))["forces"]
+        forces = locate_disagreement(mariner, records, ("psi", "r", "u"))["forces"]
         for load, scale in (("Y", 3e4), ("N", 3e6)):
             mean = forces[load]["mean"]
             if load == name:
@@ -674,7 +681,8 @@ def test_the_missing_loads_count_the_logged_wind_where_asked():
     wind's moment is what is missing."""
     from jaxship._analysis._discover._forces import residual_loads
 
-    windy = js.augment(js.vessel("mariner"), js.Windage(frontal_area=350.0, lateral_area=2000.0))
+    windy = js.augment(js.get_vessel("mariner"), js.effects.Windage(frontal_area=350.0,
+                                                                    lateral_area=2000.0))
     wind = js.Wind(15.0, np.deg2rad(60.0))
     man = js.ZigZag(10 * DEG, 10 * DEG, duration=300.0, dt=0.5)
     e = js.Experiment.from_trajectory(js.simulate(windy, man, js.straight_run(windy),
@@ -693,7 +701,7 @@ def test_a_report_says_first_when_the_base_model_does_not_describe_the_records(m
     first sentence says so, with the fits before and after."""
     model = js.Nomoto1(K=0.05, T=20.0)
     report = js.DiscoveryReport(
-        verdict="missing_effect", effects=(js.CandidateOutcome("rudder_offset", "offset", 1,
+        verdict="missing_effect", effects=(CandidateOutcome("rudder_offset", "offset", 1,
                                                                30.0),),
         rejected=(), scores={}, model_before=model, model_after=model, train_cost_before=2.0,
         train_cost_after=1.0, holdout_cost_before=9.0, holdout_cost_after=8.0,

@@ -128,7 +128,7 @@ STEERING = {
     "linear1": lambda: Nomoto1(K=0.05, T=10.0),
     "nonlinear1": lambda: js.NonlinearNomoto(K=0.05, T=10.0),
     "linear2": lambda: Nomoto2(K=0.05, T1=10.0, T2=2.0, T3=1.0),
-    "nonlinear2": lambda: js.nonlinear_nomoto2(0.05, 10.0, 2.0, 1.0),
+    "nonlinear2": lambda: js.effects.nonlinear_nomoto2(0.05, 10.0, 2.0, 1.0),
 }
 
 

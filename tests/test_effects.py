@@ -26,7 +26,7 @@ def step(num=600, angle=10 * DEG):
 def test_rudder_lag_gives_the_two_time_constant_step_response():
     """Nomoto 1 behind a lag $T_l$: $r = K\\delta[1 - (Te^{-t/T} - T_le^{-t/T_l})/(T - T_l)]$."""
     lag = 4.0
-    model = js.augment(js.Nomoto1(K=K, T=T), js.RudderLag(time_constant=lag))
+    model = js.augment(js.Nomoto1(K=K, T=T), js.effects.RudderLag(time_constant=lag))
     assert model.state_names == ("r", "rudder_lag.delta_lagged")
     dt = 0.5
     delta = step()
@@ -44,7 +44,7 @@ def test_rudder_delay_follows_the_delayed_response():
     """A 2 s delay (first-order Pade) shifts Nomoto 1's step response by 2 s: within
     0.5 % of the step's final yaw rate once the delay has passed."""
     delay, dt = 2.0, 0.25
-    model = js.augment(js.Nomoto1(K=K, T=T), js.RudderDelay(delay=delay))
+    model = js.augment(js.Nomoto1(K=K, T=T), js.effects.RudderDelay(delay=delay))
     out = js.simulate(model, js.Replay(step(1200), dt=dt, delta_hold="zoh"),
                       simulator=per_sample(5))
     t = np.asarray(out.t) - dt
@@ -59,7 +59,7 @@ def test_rudder_rate_limit_ramps_the_acting_rudder():
     """The limiter tracks with a 0.1 s time constant, so it needs control steps of
     about that length (here 5 per 0.5 s sample)."""
     rate = 2.3 * DEG
-    model = js.augment(js.Nomoto1(K=K, T=T), js.RudderRateLimit(inverse_rate=1 / rate))
+    model = js.augment(js.Nomoto1(K=K, T=T), js.effects.RudderRateLimit(inverse_rate=1 / rate))
     out = js.simulate(model, js.Replay(step(200, 20 * DEG), dt=0.5, delta_hold="zoh"),
                       simulator=per_sample(5))
     acting = np.asarray(out.internal[:, 1])
@@ -68,9 +68,10 @@ def test_rudder_rate_limit_ramps_the_acting_rudder():
     assert acting[-1] == pytest.approx(20 * DEG, abs=1e-9)  # then reaches the order
 
 
-@pytest.mark.parametrize("effect", [js.RudderLag(), js.RudderDelay(), js.RudderRateLimit()])
+@pytest.mark.parametrize("effect", [js.effects.RudderLag(), js.effects.RudderDelay(),
+                                    js.effects.RudderRateLimit()])
 def test_stateful_effects_at_zero_equal_the_base_on_a_vessel(effect):
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     man, x0 = js.ZigZag(10 * DEG, 10 * DEG, duration=120.0, dt=1.0), js.straight_run(vessel)
     base = js.simulate(vessel, man, x0)
     same = js.simulate(js.augment(vessel, effect), man, x0)
@@ -81,15 +82,15 @@ def test_stateful_effects_at_zero_equal_the_base_on_a_vessel(effect):
 def test_rudder_lag_on_a_vessel_slows_the_zigzag_and_is_recovered_by_fit():
     """Mariner behind a 3 s rudder lag overshoots more; `fit` recovers the lag from the
     replayed rudder (prediction error, noise-free) within 1 %."""
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     man, x0 = js.ZigZag(10 * DEG, 10 * DEG, duration=300.0, dt=0.5), js.straight_run(vessel)
-    lagged = js.augment(vessel, js.RudderLag(time_constant=3.0))
+    lagged = js.augment(vessel, js.effects.RudderLag(time_constant=3.0))
     truth = js.simulate(lagged, man, x0)
     plain = js.simulate(vessel, man, x0)
-    over = lambda traj: js.zigzag_indices(traj, 10 * DEG).overshoots[0]
+    over = lambda traj: js.indices.zigzag_indices(traj, 10 * DEG).overshoots[0]
     assert float(over(truth)) > float(over(plain)) + 0.2 * DEG
     data = js.Experiment.from_trajectory(truth)
-    start = js.augment(vessel, js.RudderLag(time_constant=1.0))
+    start = js.augment(vessel, js.effects.RudderLag(time_constant=1.0))
     result = js.fit(start, data, estimator=js.PredictionError(horizon=60.0),
                     free=("rudder_lag.time_constant",))
     values = dict(zip(result.names, result.values))
@@ -97,14 +98,14 @@ def test_rudder_lag_on_a_vessel_slows_the_zigzag_and_is_recovered_by_fit():
 
 
 def test_fit_recovers_a_rudder_lag_on_a_steering_model():
-    truth = js.augment(js.Nomoto1(K=K, T=T), js.RudderLag(time_constant=3.0))
+    truth = js.augment(js.Nomoto1(K=K, T=T), js.effects.RudderLag(time_constant=3.0))
     delta = 10 * DEG * np.sign(np.sin(2 * np.pi * np.arange(800) / 160.0) + 1e-9)
     delta[0] = 0.0  # from a straight run, as trials start
     out = js.simulate(truth, js.Replay(delta, dt=0.5, delta_hold="foh"),
                       simulator=per_sample(20))  # a finer truth
     data = js.Experiment(np.asarray(out.t), delta, psi=np.asarray(out.state.psi),
                          r=np.asarray(out.state.r))
-    start = js.augment(js.Nomoto1(K=0.05, T=20.0), js.RudderLag(time_constant=1.0))
+    start = js.augment(js.Nomoto1(K=0.05, T=20.0), js.effects.RudderLag(time_constant=1.0))
     result = js.fit(start, data,
                     estimator=js.PredictionError(horizon=None, simulator=per_sample(5)),
                     free=("K", "T", "rudder_lag.time_constant"))
@@ -134,7 +135,7 @@ def test_nonlinear_nomoto2_is_nomoto2_with_cubic_damping():
     """Lu & Zhao (2008, eq. 4) in the states of `Nomoto2`: $\\dot r_{aux} = K(\\delta
     + \\delta_0) - r - \\beta_1 r^3$, $\\dot r$ as `Nomoto2`."""
     K2, T1, T2, T3, beta, d0 = 0.06, 25.0, 3.0, 5.0, 120.0, 0.01
-    model = js.nonlinear_nomoto2(K2, T1, T2, T3, beta1=beta, delta0=d0)
+    model = js.effects.nonlinear_nomoto2(K2, T1, T2, T3, beta1=beta, delta0=d0)
     rng = np.random.default_rng(0)
     for _ in range(5):
         r, r_aux, delta = rng.normal(0, [0.02, 0.5, 0.2])
@@ -151,9 +152,9 @@ def test_a_yaw_moment_on_nomoto_equals_a_rudder_offset():
     d0 = 0.01
     delta = 10 * DEG * np.sign(np.sin(2 * np.pi * np.arange(400) / 160.0) + 1e-9)
     for base in (js.Nomoto1(K=K, T=T), js.Nomoto2(K=K, T1=T, T2=3.0, T3=5.0)):
-        moment = js.simulate(js.augment(base, js.YawMomentBias(n0=K * d0)),
+        moment = js.simulate(js.augment(base, js.effects.YawMomentBias(n0=K * d0)),
                              js.Replay(delta, dt=0.5, delta_hold="foh"), simulator=per_sample())
-        offset = js.simulate(js.augment(base, js.RudderOffset(delta0=d0)),
+        offset = js.simulate(js.augment(base, js.effects.RudderOffset(delta0=d0)),
                              js.Replay(delta, dt=0.5, delta_hold="foh"), simulator=per_sample())
         if isinstance(base, js.Nomoto1):
             np.testing.assert_allclose(moment.state.r, offset.state.r, rtol=1e-12, atol=1e-15)
@@ -164,7 +165,7 @@ def test_a_yaw_moment_on_nomoto_equals_a_rudder_offset():
 
 # -- hull, rudder, propeller and environment effects (`_hydro_effects.py`) --
 
-MARINER = js.vessel("mariner")
+MARINER = js.get_vessel("mariner")
 U0 = MARINER.nominal_speed
 # (u, v, r, delta, n): straight, a starboard turn (v < 0 at midship), a port turn astern
 STATES = [(U0, 0.0, 0.0, 0.0, 1.5), (0.8 * U0, -0.4, 0.012, 0.3, 1.5),
@@ -177,10 +178,10 @@ def added_loads(effect, state):
 
 
 @pytest.mark.parametrize("effect, expected", [
-    (js.YawCubicDamping(beta=2e12), lambda u, v, r, d, n: (0, 0, -2e12 * r**3)),
-    (js.YawQuadraticDamping(beta=4e10), lambda u, v, r, d, n: (0, 0, -4e10 * r * abs(r))),
-    (js.PropellerAsymmetry(moment=1.4e6), lambda u, v, r, d, n: (0, 0, 1.4e6 * n * abs(n))),
-    (js.SurgeTurnResistance(x_vr=0.004),
+    (js.effects.YawCubicDamping(beta=2e12), lambda u, v, r, d, n: (0, 0, -2e12 * r**3)),
+    (js.effects.YawQuadraticDamping(beta=4e10), lambda u, v, r, d, n: (0, 0, -4e10 * r * abs(r))),
+    (js.effects.PropellerAsymmetry(moment=1.4e6), lambda u, v, r, d, n: (0, 0, 1.4e6 * n * abs(n))),
+    (js.effects.SurgeTurnResistance(x_vr=0.004),
      lambda u, v, r, d, n: (0.004 * 0.5 * 1025.0 * MARINER.length**3 * v * r, 0, 0)),
 ])
 def test_load_effects_add_their_closed_form_to_a_vessel(effect, expected):
@@ -190,9 +191,9 @@ def test_load_effects_add_their_closed_form_to_a_vessel(effect, expected):
         np.testing.assert_allclose(added_loads(effect, state), expected(*state), rtol=1e-6,
                                    atol=1e-9 * float(np.max(np.abs(MARINER.forces(*state)))))
     turning = STATES[1]
-    if isinstance(effect, (js.YawCubicDamping, js.YawQuadraticDamping)):
+    if isinstance(effect, (js.effects.YawCubicDamping, js.effects.YawQuadraticDamping)):
         assert added_loads(effect, turning)[2] < 0  # r > 0: a moment to port
-    if isinstance(effect, js.SurgeTurnResistance):
+    if isinstance(effect, js.effects.SurgeTurnResistance):
         assert added_loads(effect, turning)[0] < 0  # v r < 0: more resistance
 
 
@@ -207,7 +208,7 @@ def test_quadratic_damping_shifts_the_steady_turn_of_nomoto1():
     """$r + \\beta r|r| = K\\delta$: $r = (\\sqrt{1 + 4\\beta K\\delta} - 1)/(2\\beta)$, odd in
     the rudder (to 1e-9, after 32 time constants)."""
     beta, angle = 10.0, 10 * DEG
-    model = js.augment(js.Nomoto1(K=K, T=T), js.YawQuadraticDamping(beta=beta))
+    model = js.augment(js.Nomoto1(K=K, T=T), js.effects.YawQuadraticDamping(beta=beta))
     expected = (np.sqrt(1 + 4 * beta * K * angle) - 1) / (2 * beta)
     assert expected < 0.92 * K * angle  # a visible shift: 9 % below the linear turn
     assert steady_r(model, angle) == pytest.approx(expected, rel=1e-9)
@@ -219,7 +220,7 @@ def test_crossflow_drag_integrates_the_strip_loads_exactly():
     $N = -\\frac12\\rho cL^5r|r|/32$; a turn (the flow reverses along the hull) against
     an adaptive quadrature of the strip integrals."""
     c, L, rho = 0.04, MARINER.length, 1025.0
-    effect = js.CrossflowDrag(coefficient=c)
+    effect = js.effects.CrossflowDrag(coefficient=c)
     q = 0.5 * rho * c * L
     for v in (0.4, -0.7):
         np.testing.assert_allclose(added_loads(effect, (U0, v, 0.0, 0.0, 0.0)),
@@ -241,7 +242,7 @@ def test_speed_dependent_rudder_is_the_base_at_the_nominal_speed():
     rudder's share $\\tau(\\delta) - \\tau(0)$ is scaled by $1 + \\kappa(0.64 - 1)$.
     Nomoto 1: the steady turn is $K\\delta(1 + \\kappa(u^2/U_0^2 - 1))$."""
     kappa = 0.5
-    vessel = js.augment(MARINER, js.SpeedDependentRudder(kappa=kappa))
+    vessel = js.augment(MARINER, js.effects.SpeedDependentRudder(kappa=kappa))
     for _, v, r, d, n in STATES:
         np.testing.assert_array_equal(vessel.forces(U0, v, r, d, n),
                                       MARINER.forces(U0, v, r, d, n))
@@ -250,7 +251,7 @@ def test_speed_dependent_rudder_is_the_base_at_the_nominal_speed():
         np.testing.assert_allclose(vessel.forces(u, v, r, d, n),
                                    MARINER.forces(u, v, r, d, n) + kappa * (0.64 - 1) * share,
                                    rtol=1e-12, atol=1e-3)
-    effect = js.SpeedDependentRudder(kappa=kappa, nominal_speed=U0)
+    effect = js.effects.SpeedDependentRudder(kappa=kappa, nominal_speed=U0)
     model = js.augment(js.Nomoto1(K=K, T=T), effect)
     base = js.Nomoto1(K=K, T=T)
     delta = step(100)
@@ -263,7 +264,7 @@ def test_speed_dependent_rudder_is_the_base_at_the_nominal_speed():
     assert steady_r(model, 10 * DEG, slow) == pytest.approx(
         K * 10 * DEG * (1 + kappa * (0.64 - 1)), rel=1e-9)
     with pytest.raises(ValueError, match="nominal_speed"):
-        js.simulate(js.augment(base, js.SpeedDependentRudder(kappa=kappa)),
+        js.simulate(js.augment(base, js.effects.SpeedDependentRudder(kappa=kappa)),
                     js.Replay(delta, dt=1.0, delta_hold="foh"), simulator=per_sample())
 
 
@@ -271,8 +272,9 @@ def test_speed_dependent_damping_and_rudder_make_nomoto_speed_scaled():
     """With both kappa = 1 at a constant speed $u = sU_0$, Nomoto 1 is Nomoto's
     dimensionless model at that speed: $K = K's$, $T = T'/s$ (Nomoto 1957)."""
     s = 0.7
-    scaled = js.augment(js.Nomoto1(K=K, T=T), js.SpeedDependentRudder(kappa=1.0, nominal_speed=U0),
-                        js.SpeedDependentDamping(kappa=1.0, nominal_speed=U0))
+    scaled = js.augment(js.Nomoto1(K=K, T=T), js.effects.SpeedDependentRudder(kappa=1.0,
+                                                                              nominal_speed=U0),
+                        js.effects.SpeedDependentDamping(kappa=1.0, nominal_speed=U0))
     delta = step(200)
     aux = js.AuxInputs(u=s * U0)
     np.testing.assert_allclose(js.simulate(scaled, js.Replay(delta, dt=1.0, delta_hold="foh"),
@@ -283,13 +285,13 @@ def test_speed_dependent_damping_and_rudder_make_nomoto_speed_scaled():
                                rtol=1e-9, atol=1e-12)
     base = js.Nomoto1(K=K, T=T)
     np.testing.assert_allclose(  # the base model at the nominal speed (to rounding)
-        js.simulate(js.augment(base, js.SpeedDependentDamping(kappa=1.0, nominal_speed=U0)),
+        js.simulate(js.augment(base, js.effects.SpeedDependentDamping(kappa=1.0, nominal_speed=U0)),
                     js.Replay(delta, dt=1.0, delta_hold="foh"), aux=js.AuxInputs(u=U0),
                     simulator=per_sample()).state.r,
         js.simulate(base, js.Replay(delta, dt=1.0, delta_hold="foh"), aux=js.AuxInputs(u=U0),
                     simulator=per_sample()).state.r, rtol=1e-14, atol=0)
     with pytest.raises(ValueError, match="nominal_speed"):
-        js.simulate(js.augment(base, js.SpeedDependentDamping(kappa=1.0)),
+        js.simulate(js.augment(base, js.effects.SpeedDependentDamping(kappa=1.0)),
                     js.Replay(delta, dt=1.0, delta_hold="foh"), simulator=per_sample())
 
 
@@ -299,15 +301,15 @@ def test_rudder_stall_saturates_only_large_rudder_angles():
     $-c\\delta^2$ of the rudder's (third order) within 0.1 %."""
     upper = 0.5  # the plausible bound
     angles = np.deg2rad(np.linspace(0, 46, 47))
-    effect = js.RudderStall(c=upper)
+    effect = js.effects.RudderStall(c=upper)
     seen = np.array([effect.rudder(a, None) for a in angles])
     assert np.all(np.diff(seen) > 0)
     c = 0.3
-    model = js.augment(js.Nomoto1(K=K, T=T), js.RudderStall(c=c))
+    model = js.augment(js.Nomoto1(K=K, T=T), js.effects.RudderStall(c=c))
     angle = 30 * DEG
     assert steady_r(model, angle) == pytest.approx(K * (angle - c * angle**3), rel=1e-9)
     small = 0.01
-    stalled = js.augment(MARINER, js.RudderStall(c=c)).forces(U0, 0.0, 0.0, small, 0.0)
+    stalled = js.augment(MARINER, js.effects.RudderStall(c=c)).forces(U0, 0.0, 0.0, small, 0.0)
     rudder = MARINER.forces(U0, 0.0, 0.0, small, 0.0) - MARINER.forces(U0, 0.0, 0.0, 0.0, 0.0)
     change = stalled - MARINER.forces(U0, 0.0, 0.0, small, 0.0)
     assert float(change[2] / rudder[2]) == pytest.approx(-c * small**2, rel=1e-3)
@@ -317,7 +319,7 @@ def test_propeller_asymmetry_on_nomoto1_turns_with_the_propeller_rate():
     """$T\\dot r + r = K\\delta + a_pn|n|$: steady $r = K\\delta + a_pn|n|$ with the
     measured n, reversed when the propeller is."""
     a_p = 2.6e-4
-    model = js.augment(js.Nomoto1(K=K, T=T), js.PropellerAsymmetry(moment=a_p))
+    model = js.augment(js.Nomoto1(K=K, T=T), js.effects.PropellerAsymmetry(moment=a_p))
     for n in (2.0, -1.0):
         assert steady_r(model, 5 * DEG, js.AuxInputs(n=n)) == pytest.approx(
             K * 5 * DEG + a_p * n * abs(n), rel=1e-9)
@@ -327,7 +329,7 @@ def test_propeller_race_on_nomoto1_adds_rudder_gain_with_rpm_squared():
     """$T\\dot r + r = K\\delta + b n_+^2\\delta$: steady $r = (K + b n^2)\\delta$ ahead,
     $K\\delta$ with the propeller astern (its race off the rudder) or stopped."""
     b = 2e-4
-    model = js.augment(js.Nomoto1(K=K, T=T), js.PropellerRace(gain=b))
+    model = js.augment(js.Nomoto1(K=K, T=T), js.effects.PropellerRace(gain=b))
     delta = 5 * DEG
     assert steady_r(model, delta, js.AuxInputs(n=3.0)) == pytest.approx(
         (K + b * 9.0) * delta, rel=1e-9)
@@ -339,7 +341,7 @@ def test_added_mass_error_scales_the_mass_matrix():
     """$M_{22}(1 + s_v)$, $M_{33}(1 + s_r)$, the rest unchanged; the accelerations are
     $M^{-1}\\tau$ of that matrix."""
     s_v, s_r = 0.2, -0.1
-    vessel = js.augment(MARINER, js.AddedMassError(s_v=s_v, s_r=s_r))
+    vessel = js.augment(MARINER, js.effects.AddedMassError(s_v=s_v, s_r=s_r))
     m = np.asarray(MARINER.mass_matrix())
     expected = m.copy()
     expected[1, 1] *= 1 + s_v
@@ -358,7 +360,7 @@ def test_current_drifts_the_track_and_leaves_the_water_velocities():
     man, x0 = js.ZigZag(10 * DEG, 10 * DEG, duration=60.0, dt=1.0), js.straight_run(MARINER)
     environment = js.Environment(current=js.Current(0.2, np.pi / 2))
     base = js.simulate(MARINER, man, x0, environment=environment)
-    drifted = js.simulate(js.augment(MARINER, js.UniformCurrent(north=0.5, east=-0.3)), man,
+    drifted = js.simulate(js.augment(MARINER, js.effects.UniformCurrent(north=0.5, east=-0.3)), man,
                           x0, environment=environment)
     for key in ("u", "v", "r", "psi", "delta"):
         np.testing.assert_array_equal(getattr(drifted.state, key), getattr(base.state, key))
@@ -372,7 +374,7 @@ def test_windage_is_the_vessel_with_those_areas_when_wind_is_logged():
     logged wind (`PredictionError(wind=True)`), the Mariner with `Windage` equals the
     Mariner with those areas bit for bit; without the logged wind the effect is absent."""
     areas = {"frontal_wind_area": 350.0, "lateral_wind_area": 2000.0}
-    windy = js.augment(MARINER, js.Windage(frontal_area=350.0, lateral_area=2000.0))
+    windy = js.augment(MARINER, js.effects.Windage(frontal_area=350.0, lateral_area=2000.0))
     assert (windy.frontal_wind_area, windy.lateral_wind_area) == (350.0, 2000.0)
     with_areas = eqx.tree_at(lambda v: (v.frontal_wind_area, v.lateral_wind_area), MARINER,
                              tuple(areas.values()))
@@ -409,11 +411,11 @@ def test_apparent_wind_adds_its_yaw_term_to_a_steering_model():
     model = js.Nomoto1(K=K, T=T)
     base = js.simulate(model, js.Replay(delta, dt=0.5, delta_hold="foh"), aux=aux,
                        simulator=per_sample())
-    zero = js.augment(model, js.ApparentWind())
+    zero = js.augment(model, js.effects.ApparentWind())
     np.testing.assert_array_equal(js.simulate(zero, js.Replay(delta, dt=0.5, delta_hold="foh"),
                                               aux=aux,
                                               simulator=per_sample()).state.psi, base.state.psi)
-    windy = js.augment(model, js.ApparentWind(c2=3e-6, c1=-1e-6))
+    windy = js.augment(model, js.effects.ApparentWind(c2=3e-6, c1=-1e-6))
     np.testing.assert_array_equal(js.simulate(windy, js.Replay(delta, dt=0.5, delta_hold="foh"),
                                               simulator=per_sample()).state.psi,
                                   js.simulate(model, js.Replay(delta, dt=0.5, delta_hold="foh"),
@@ -426,7 +428,7 @@ def test_apparent_wind_adds_its_yaw_term_to_a_steering_model():
     term = 400.0 * (3e-6 * np.sin(1.4) - 1e-6 * np.sin(0.7))
     np.testing.assert_allclose(windy.rhs(x, 0.1, one) - model.rhs(x, 0.1, one),
                                model.forcing(x) * term, rtol=1e-12)
-    assert windy.wind_loads and not js.augment(model, js.RudderOffset()).wind_loads
+    assert windy.wind_loads and not js.augment(model, js.effects.RudderOffset()).wind_loads
 
 
 def test_apparent_wind_is_the_ship_velocity_through_the_air_in_body_axes():
@@ -448,11 +450,11 @@ def test_fit_recovers_the_wind_a_steering_model_feels_from_logged_wind():
     four headings): the wind's c2 and c1 (truth 0) within 3 robust standard errors; K
     and T within 2 % (1.2 and 1.4 % low here, with or without the wind: the noise's
     doing, as noiseless records give them to 1e-8)."""
-    from jaxship.cli._studies.discovery import wind_records
+    from benchmarks.studies.discovery import wind_records
 
-    truth = js.augment(js.Nomoto1(K=K, T=T), js.ApparentWind(c2=3e-6))
+    truth = js.augment(js.Nomoto1(K=K, T=T), js.effects.ApparentWind(c2=3e-6))
     train, _ = wind_records(truth, 0)
-    start = js.augment(js.Nomoto1(K=0.05, T=20.0), js.ApparentWind())
+    start = js.augment(js.Nomoto1(K=0.05, T=20.0), js.effects.ApparentWind())
     res = js.fit(start, train, estimator=js.PredictionError(horizon=60.0, wind=True,
                                                             initial=js.EstimatedStarts()))
     got = dict(zip(res.names, zip(res.values, res.parameters.std_robust)))
@@ -461,16 +463,17 @@ def test_fit_recovers_the_wind_a_steering_model_feels_from_logged_wind():
     np.testing.assert_allclose([got["K"][0], got["T"][0]], [K, T], rtol=0.02)
 
 
-@pytest.mark.parametrize("effect", [js.SwayForceBias(y0=1e4), js.CrossflowDrag(),
-                                    js.SurgeTurnResistance(), js.AddedMassError(),
-                                    js.UniformCurrent(), js.Windage()], ids=lambda e: e.id)
+@pytest.mark.parametrize("effect", [js.effects.SwayForceBias(y0=1e4), js.effects.CrossflowDrag(),
+                                    js.effects.SurgeTurnResistance(), js.effects.AddedMassError(),
+                                    js.effects.UniformCurrent(), js.effects.Windage()],
+                                        ids=lambda e: e.id)
 def test_a_vessel_only_effect_on_a_steering_model_is_an_error(effect):
     """Effects that act on a vessel's loads, mass, environment or wind areas only would
     add a parameter with no effect to a steering model (a singular fit): refused,
     while the same effect on a vessel is accepted."""
     with pytest.raises(ValueError, match="augment a vessel instead"):
         js.augment(js.Nomoto1(K=K, T=T), effect)
-    assert js.augment(js.vessel("mariner"), effect).effects == (effect,)
+    assert js.augment(js.get_vessel("mariner"), effect).effects == (effect,)
 
 
 def test_a_yaw_term_on_a_vessel_is_an_error():
@@ -478,7 +481,7 @@ def test_a_yaw_term_on_a_vessel_is_an_error():
     through its loads: `Windage`)."""
     with pytest.raises(ValueError, match="ApparentWind acts on nothing a vessel has .*"
                        "augment a steering model instead"):
-        js.augment(js.vessel("mariner"), js.ApparentWind())
+        js.augment(js.get_vessel("mariner"), js.effects.ApparentWind())
 
 
 def test_a_family_unit_is_read_on_the_model_it_acts_on():
@@ -486,12 +489,12 @@ def test_a_family_unit_is_read_on_the_model_it_acts_on():
     + f) and rad/s^2 on a model written as r' = ... (the Ross model)."""
     from jaxship._models._effects import family_unit
 
-    unit = js.YawMomentBias.__dataclass_fields__["n0"].metadata
+    unit = js.effects.YawMomentBias.__dataclass_fields__["n0"].metadata
     n0 = "N m | rad/s | rad/s^2"
     assert n0 in str(unit)
-    assert family_unit(n0, js.vessel("mariner")) == "N m"
+    assert family_unit(n0, js.get_vessel("mariner")) == "N m"
     assert family_unit(n0, js.Nomoto1(K=0.1, T=10.0)) == "rad/s"
     assert family_unit(n0, js.Nomoto2(K=0.1, T1=10.0, T2=1.0, T3=2.0)) == "rad/s"
     assert family_unit(n0, js.RossAutopilot()) == "rad/s^2"
     assert family_unit("s | -", js.Nomoto1(K=0.1, T=10.0)) == "-"
-    assert family_unit("rad", js.vessel("mariner")) == "rad"
+    assert family_unit("rad", js.get_vessel("mariner")) == "rad"

@@ -13,9 +13,8 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._foundation import _files
-from jaxship._foundation._files import MANIFEST, read_manifest, staged_folder
-from jaxship.cli import main
+from jaxship.cli import _files, main
+from jaxship.cli._files import MANIFEST, read_manifest, staged_folder
 
 
 def files(folder):

@@ -16,7 +16,7 @@ pd = pytest.importorskip("pandas")
 
 @pytest.fixture(scope="module")
 def zigzag():
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     x0 = js.straight_run(vessel)
     manoeuvre = js.ZigZag(np.deg2rad(10.0), np.deg2rad(10.0), duration=120.0, dt=1.0)
     return js.simulate(vessel, manoeuvre, x0)
@@ -36,7 +36,7 @@ def test_trajectory_frame_has_one_row_per_valid_sample(zigzag):
 
 
 def test_trajectory_frame_drops_padding():
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     x0 = js.straight_run(vessel)
     padded = js.Turn(np.deg2rad(10.0), duration=20.0, dt=1.0, num_samples=41)
     traj = js.simulate(vessel, padded, x0)
@@ -46,7 +46,7 @@ def test_trajectory_frame_drops_padding():
 
 
 def test_batched_trajectory_is_refused():
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     x0 = js.straight_run(vessel)
     turns = [js.Turn(np.deg2rad(a), duration=10.0, dt=1.0) for a in (5.0, 10.0)]
     batch = js.simulate_batch(vessel, js.stack(turns), x0)

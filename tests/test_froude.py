@@ -28,7 +28,7 @@ def test_the_exponents_follow_the_dimensions():
 
 @pytest.mark.parametrize("name", sorted(js.VESSELS))
 def test_scaling_a_vessel_and_back_is_the_identity(name):
-    vessel = js.vessel(name)
+    vessel = js.get_vessel(name)
     there = js.froude_scale(vessel, 12.5)
     assert float(there.length) == pytest.approx(12.5 * float(vessel.length))
     assert float(there.nominal_speed) == pytest.approx(np.sqrt(12.5) * float(vessel.nominal_speed))
@@ -36,7 +36,8 @@ def test_scaling_a_vessel_and_back_is_the_identity(name):
 
 
 def test_a_scaled_vessel_with_effects_and_its_records_scale_back():
-    vessel = js.augment(js.vessel("kvlcc2"), js.YawMomentBias(n0=2.0), js.RudderOffset(0.01))
+    vessel = js.augment(js.get_vessel("kvlcc2"), js.effects.YawMomentBias(n0=2.0),
+                        js.effects.RudderOffset(0.01))
     there = js.froude_scale(vessel, LAMBDA)
     assert float(there.effects[0].n0) == pytest.approx(2.0 * LAMBDA**4)  # N m
     assert float(there.effects[1].delta0) == 0.01  # an angle
@@ -60,7 +61,7 @@ def test_the_scaled_kvlcc2_model_turns_as_the_ship():
     Froude-scaled), each at its own scaled speed and time step: advance and tactical
     diameter over the length agree to 1e-6, and the ship's trajectory scaled down is the
     model's."""
-    model = js.vessel("kvlcc2")
+    model = js.get_vessel("kvlcc2")
     ship = js.froude_scale(model, LAMBDA)
     runs = {}
     for name, vessel, scale in (("model", model, 1.0), ("ship", ship, LAMBDA)):
@@ -68,7 +69,7 @@ def test_the_scaled_kvlcc2_model_turns_as_the_ship():
         x0 = js.straight_state(vessel.nominal_speed, vessel.nominal_n)
         # one RK4 step per control step, each the same fraction of the time scale L/U
         traj = js.simulate(vessel, turn, x0, simulator=js.Simulator(max_step=np.inf, substeps=2))
-        runs[name] = (traj, js.turning_indices(traj), float(vessel.length))
+        runs[name] = (traj, js.indices.turning_indices(traj), float(vessel.length))
     (small, a, la), (large, b, lb) = runs["model"], runs["ship"]
     assert a.advance / la == pytest.approx(b.advance / lb, rel=1e-6)
     assert a.tactical_diameter / la == pytest.approx(b.tactical_diameter / lb, rel=1e-6)

@@ -30,14 +30,14 @@ def results() -> dict:
     of three records whose 2 x 67 windows do not divide by four."""
     from benchmarks import sweep
 
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     zigzags = js.stack([js.ZigZag(a * DEG, 10 * DEG, duration=60.0, dt=0.5)
                         for a in np.linspace(-25.0, 25.0, 8)])
     traj = js.simulate_batch(vessel, zigzags, js.straight_state(np.linspace(6.0, 8.0, 8)))
     grid = SimpleNamespace(vessel="thesis", angles=3, rates=2, perturbations=1, duration=60.0)
     sv, sm, sx, _ = sweep.build(grid, 0.5)
     indices = js.simulate_batch(sv, sm, sx, in_axes=(0, 0, 0, None),
-                                output=js.batch_turning_indices)
+                                output=js.indices.batch_turning_indices)
     truth, start = js.Nomoto1(K=0.06, T=25.0), js.Nomoto1(K=0.04, T=15.0)
     records = []
     for k, num in enumerate((170, 230, 310)):

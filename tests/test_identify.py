@@ -504,7 +504,7 @@ def test_a_speed_beyond_froude_1_for_the_preset_is_refused(tmp_path, capsys):
     column and likely cause, exit 2 and nothing written: `identify`'s records and
     `discover`'s held-out ones."""
     def trial(preset, path):
-        vessel = js.vessel(preset)
+        vessel = js.get_vessel(preset)
         run_ = js.simulate(vessel, js.ZigZag(10 * DEG, 10 * DEG, duration=40.0, dt=1.0),
                            js.straight_run(vessel))
         js.write_trial_csv(path, js.Experiment.from_trajectory(run_))

@@ -6,18 +6,6 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship import (
-    format_table,
-    imo_criteria,
-    initial_turning_indices,
-    loop_width,
-    pull_out_indices,
-    reverse_spiral_curve,
-    spiral_curve,
-    stopping_indices,
-    turning_indices,
-    zigzag_indices,
-)
 from jaxship._analysis._indices import (
     CriterionRow,
     InitialTurningIndices,
@@ -26,8 +14,20 @@ from jaxship._analysis._indices import (
     TurningIndices,
     ZigZagIndices,
     imo_overshoot_limits_deg,
+    loop_width,
 )
 from jaxship.cli._trials import run_spec, trial_indices
+from jaxship.indices import (
+    format_table,
+    imo_criteria,
+    initial_turning_indices,
+    pull_out_indices,
+    reverse_spiral_curve,
+    spiral_curve,
+    stopping_indices,
+    turning_indices,
+    zigzag_indices,
+)
 
 
 DEG = np.pi / 180
@@ -412,7 +412,7 @@ def test_spiral_curves_count_a_last_hold_that_is_not_a_whole_number_of_samples()
 def test_kvlcc2_direct_spiral_shows_its_loop():
     # the simulated trial (`jaxship simulate --manoeuvre spiral`): finer steps near
     # midships; the loop of this MMG model lies between about 0 and 0.5 deg of rudder
-    vessel = js.vessel("kvlcc2")
+    vessel = js.get_vessel("kvlcc2")
     manoeuvre, traj = run_spec(vessel, "spiral")
     indices = trial_indices("spiral", manoeuvre, traj)
     hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
@@ -619,7 +619,7 @@ def test_mariner_cross_check_numbers():
     """Indices of the Mariner against the independent numpy/RK4 re-implementation in
     shared/reference/vessel-models.md sec. 6 (mariner.m equations, h = 0.05 s, order at
     t = 0 from a steady approach; its "internal delta = +35 deg" turn is a port turn here)."""
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     x0 = js.straight_run(vessel)
     turn = turning_indices(js.simulate(vessel, js.Turn(-35 * DEG, duration=700.0, dt=0.1), x0,
                                        simulator=js.Simulator(substeps=2)))

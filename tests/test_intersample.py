@@ -20,12 +20,12 @@ def test_zigzag_overshoots_do_not_depend_on_the_output_interval(angle):
     """The zig-zag logic runs at the simulator's control step (0.1 s), not at the output
     samples: at dt = 1, 0.5, 0.1 and 0.05 s the first two overshoots agree to 1 % with
     each other and with the published values (at dt = 1 s they were 12.6 % off)."""
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     x0 = js.straight_run(vessel)
     found = []
     for dt in (1.0, 0.5, 0.1, 0.05):
         man = js.ZigZag(angle * DEG, angle * DEG, duration=600.0, dt=dt)
-        ind = js.zigzag_indices(js.simulate(vessel, man, x0), angle * DEG)
+        ind = js.indices.zigzag_indices(js.simulate(vessel, man, x0), angle * DEG)
         found.append(np.array(ind.overshoots[:2]) / DEG)
     found = np.array(found)
     np.testing.assert_allclose(found, np.broadcast_to(PUBLISHED[angle], found.shape), rtol=0.01)

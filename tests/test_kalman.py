@@ -12,6 +12,7 @@ from test_estimate import zigzag_like
 import jaxship as js
 from jaxship import Nomoto1, NonlinearNomoto
 from jaxship._estimate import _likelihood
+from jaxship._estimate._kalman import rts_smoother
 from jaxship._estimate._likelihood import fit_ml
 
 
@@ -78,7 +79,7 @@ def test_ekf_of_a_linear_model_is_the_linear_kalman_filter():
     # the reference discretises the rudder held over each interval (zero-order hold)
     out = js.ekf(TRUTH, exp, process_noise={"rudder": Q_RUDDER},
                  measurement_noise={"psi": R_PSI, "r": R_R}, hold="zoh")
-    zs, Ps = js.rts_smoother(out)
+    zs, Ps = rts_smoother(out)
     y = np.stack([exp.psi, exp.r], axis=-1)
     zf, innov, nll, zs_ref, Ps_ref = numpy_kalman(0.06, 25.0, exp.delta, y, DT, Q_RUDDER,
                                                   np.diag([R_PSI, R_R]))
@@ -266,9 +267,9 @@ def test_a_vessels_smoother_recovers_the_unlogged_drift_and_a_fit_needs_no_logge
     missing."""
     import equinox as eqx
 
-    from jaxship.cli._studies.discovery import vessel_records
+    from benchmarks.studies.discovery import vessel_records
 
-    mariner = js.vessel("mariner")
+    mariner = js.get_vessel("mariner")
     logged, _ = vessel_records(mariner, 0)
     records = [js.Experiment(e.t, e.delta, psi=e.psi, r=e.r, u=e.u, x=e.x, y=e.y, n=e.n,
                              name=e.name) for e in logged]

@@ -61,7 +61,7 @@ def test_steady_turn_is_an_equilibrium():
         np.testing.assert_allclose(TRUTH.rhs(jnp.array([r, v]), d, aux), 0.0, atol=1e-12)
         assert np.sign(d) == np.sign(r) and np.sign(v) == -np.sign(r)
     np.testing.assert_array_equal(TRUTH.initial_state(0.0), [0.0, 0.0])
-    assert TRUTH.wind_loads and js.augment(TRUTH, js.RudderOffset()).wind_loads
+    assert TRUTH.wind_loads and js.augment(TRUTH, js.effects.RudderOffset()).wind_loads
 
 
 def low_speed_record(seed, truth=TRUTH, metadata=()):
@@ -120,7 +120,7 @@ def test_identify_takes_the_hull_length_from_the_records():
 def test_an_augmented_model_fits_the_base_outputs_by_default():
     """`augment` keeps `LowSpeedSwayYaw`'s fitted outputs (psi, r, v), so a fit of the
     augmented model and `discover`'s refits use v as the base fit does."""
-    model = js.augment(js.LowSpeedSwayYaw(), js.RudderOffset())
+    model = js.augment(js.LowSpeedSwayYaw(), js.effects.RudderOffset())
     assert model.default_channels == ("psi", "r", "v")
     assert model.built_in_effects == js.LowSpeedSwayYaw.built_in_effects
     free = HULL + ("rudder_offset.delta0",)
@@ -199,7 +199,7 @@ def noisy(record, truth, seed):
     return with_noise(clean, np.random.default_rng(100 + seed), name=f"run{seed}")
 
 
-@pytest.mark.parametrize("hidden", [None, js.RudderOffset(delta0=1.0 * DEG)],
+@pytest.mark.parametrize("hidden", [None, js.effects.RudderOffset(delta0=1.0 * DEG)],
                          ids=["null", "rudder_offset"])
 def test_discover_from_it_names_a_hidden_offset_and_nothing_on_null_data(hidden):
     """`discover` with `LowSpeedSwayYaw` as the base, on noisy records of the model

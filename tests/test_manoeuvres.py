@@ -226,13 +226,13 @@ def test_zigzag_overshoots_do_not_depend_on_the_control_step():
     the overshoots at the default 0.1 s step equal those at 0.002 s to 0.05 %
     (measured 2026-11-27: 10.4899 against 10.4893 deg, 0.006 %); reversed at the
     nearest step they move by 0.9 % (10.583 deg: the issue's 10.58 against 10.48)."""
-    ship = js.vessel("kvlcc2")
+    ship = js.get_vessel("kvlcc2")
     x0 = js.straight_run(ship)
 
     def overshoots(step, switch_at="exact"):
         zigzag = js.ZigZag(20 * DEG, 20 * DEG, duration=80.0, dt=0.1, switch_at=switch_at)
         traj = js.simulate(ship, zigzag, x0, simulator=js.Simulator(max_step=step))
-        return np.asarray(js.zigzag_indices(traj, 20 * DEG).overshoots[:2])
+        return np.asarray(js.indices.zigzag_indices(traj, 20 * DEG).overshoots[:2])
 
     fine = overshoots(0.002)
     np.testing.assert_allclose(overshoots(0.1), fine, rtol=5e-4)
@@ -325,10 +325,10 @@ def test_reverse_spiral_trial_reaches_every_level_across_the_direct_range(name):
     # issue 13: the levels were +-0.5/tau deg/s (+-0.025 deg/s for the Mariner, +-0.09
     # for the KVLCC2, against +-0.6 and +-3 in the direct spiral) and the last one was
     # dropped (7 of 8 reported)
-    vessel = js.vessel(name)
+    vessel = js.get_vessel(name)
     manoeuvre, traj = run_spec(vessel, "reverse-spiral")  # the CLI's trial spec
     assert isinstance(manoeuvre, js.ReverseSpiral)
-    curve = js.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
+    curve = js.indices.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
     ordered = np.asarray(manoeuvre.rates)
     assert curve.r.size == ordered.size == 12  # every level reported
     assert np.all(np.diff(ordered) < 0)  # from starboard to port
@@ -347,7 +347,7 @@ def test_reverse_spiral_trial_reaches_every_level_across_the_direct_range(name):
 
 
 def test_linear_yaw_and_gains_place_the_poles():
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     x0 = js.straight_run(vessel)
     b, a = linear_yaw(vessel, x0)
     assert b > 0 and a > 0  # course-stable: the rudder turns it to starboard, yaw damped
@@ -356,7 +356,7 @@ def test_linear_yaw_and_gains_place_the_poles():
     np.testing.assert_allclose(np.abs(roots), 0.05, rtol=1e-9)
     np.testing.assert_allclose(-roots.real / np.abs(roots), 0.8, rtol=1e-9)
     # the marginally unstable KVLCC2 (one pole at +4e-4 1/s): finite, a < 0
-    kv = js.vessel("kvlcc2")
+    kv = js.get_vessel("kvlcc2")
     b2, a2 = linear_yaw(kv, js.straight_run(kv))
     assert np.isfinite(b2) and b2 > 0 and a2 < 0
 
@@ -364,9 +364,9 @@ def test_linear_yaw_and_gains_place_the_poles():
 def test_crash_stop_trial_ends_when_the_ship_has_stopped():
     # issue 13: the KVLCC2 kept going full astern after it had stopped and spun at
     # -4 deg/s to a heading of -1534 deg
-    vessel = js.vessel("kvlcc2")
+    vessel = js.get_vessel("kvlcc2")
     manoeuvre, traj = run_spec(vessel, "stop")  # the CLI's trial spec
-    ind = js.stopping_indices(traj)
+    ind = js.indices.stopping_indices(traj)
     t = np.asarray(traj.t)
     assert t[-1] <= ind.execute_time + 1.1 * ind.time_to_stop + 3 * float(manoeuvre.dt)
     after = t >= ind.execute_time + ind.time_to_stop
@@ -390,7 +390,7 @@ def test_a_zigzag_rudder_rate_slower_than_the_servo_shows_in_the_rudder():
     5 deg/s) through a 20/20 zig-zag whose steering gear moves 2 deg/s: the actual
     rudder moves at 2 deg/s, the smaller of the two limits; without it, at the servo's
     5 deg/s; and the ordered rudder is the zig-zag's either way."""
-    mariner = js.vessel("mariner")
+    mariner = js.get_vessel("mariner")
     x0 = js.straight_run(mariner)
     servo = float(mariner.rudder.max_rate)
     assert servo == pytest.approx(5 * DEG)

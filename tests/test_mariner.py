@@ -304,7 +304,7 @@ def test_a_straight_run_the_mariner_cannot_hold_is_refused():
     """The Mariner's surge equation has no propeller: it balances at its nominal speed
     only, so a straight run at 5 m/s does not exist (the autopilot reported one, the ship
     running back to 7.7 m/s before its step); 7.7 m/s (0.2 % off) is accepted."""
-    mariner = js.vessel("mariner")
+    mariner = js.get_vessel("mariner")
     with pytest.raises(ValueError, match="no straight run at u = 5 m/s.*no propeller term"):
         js.straight_run(mariner, speed=5.0)
     assert float(js.straight_run(mariner, speed=7.7).u) == 7.7

@@ -26,3 +26,7 @@ def test_notebook_runs(path):
     client.execute()
     code = [c for c in notebook.cells if c.cell_type == "code" and c.source.strip()]
     assert code and all(c.execution_count is not None for c in code), path.name
+    # no warning reaches the rendered page (the site shows the stored outputs; issue 59)
+    warnings = [o["text"][:200] for c in code for o in c.get("outputs", [])
+                if o.get("name") == "stderr" and "Warning" in o.get("text", "")]
+    assert not warnings, (path.name, warnings)

@@ -132,7 +132,7 @@ def test_trajectory_heading_and_rudder_on_axes_of_their_own():
 
 def test_track_has_outlines_and_the_turning_indices_in_lengths_and_metres():
     traj = turning_run()
-    ind = js.turning_indices(t=traj.t, x=traj.state.x, y=traj.state.y, psi=traj.state.psi,
+    ind = js.indices.turning_indices(t=traj.t, x=traj.state.x, y=traj.state.y, psi=traj.state.psi,
                              u=traj.state.u, v=traj.state.v, r=traj.state.r,
                              delta=traj.state.delta)
     np.testing.assert_allclose([ind.advance, ind.transfer, ind.tactical_diameter],
@@ -158,7 +158,7 @@ def test_track_has_outlines_and_the_turning_indices_in_lengths_and_metres():
 
 def test_reference_values_are_drawn_and_named():
     traj = turning_run()
-    ind = js.turning_indices(t=traj.t, x=traj.state.x, y=traj.state.y, psi=traj.state.psi,
+    ind = js.indices.turning_indices(t=traj.t, x=traj.state.x, y=traj.state.y, psi=traj.state.psi,
                              u=traj.state.u, v=traj.state.v, r=traj.state.r,
                              delta=traj.state.delta)
     fig = plot_trajectory(traj, length=L, indices=ind, reference_label="thesis",
@@ -178,7 +178,7 @@ def test_reference_values_are_drawn_and_named():
 
 def test_zigzag_overshoots_annotated_on_the_heading_axes():
     traj = zigzag_run()
-    ind = js.zigzag_indices(t=traj.t, psi=traj.state.psi, delta=traj.state.delta,
+    ind = js.indices.zigzag_indices(t=traj.t, psi=traj.state.psi, delta=traj.state.delta,
                             heading_switch=10 * DEG)
     fig = plot_trajectory(traj, length=L, indices=ind, labels=["zig-zag"],
                           reference={"overshoot_1": (4 * DEG, 6 * DEG)},
@@ -201,7 +201,7 @@ def test_stop_marks_head_reach_and_the_propeller():
     n = np.where(t < 5, 1.5, np.where(u > 0, -1.5, 0.0))
     traj = run(t, x, np.zeros_like(t), np.zeros_like(t), np.zeros_like(t), np.zeros_like(t),
                u=u, n=n)
-    ind = js.stopping_indices(t=t, x=x, y=np.zeros_like(t), psi=np.zeros_like(t), u=u, n=n)
+    ind = js.indices.stopping_indices(t=t, x=x, y=np.zeros_like(t), psi=np.zeros_like(t), u=u, n=n)
     fig = plot_trajectory(traj, length=L, indices=ind, labels=["stop"])
     track = axes_by_label(fig, "north [L]")
     (text,) = texts(track, "head_reach")
@@ -214,7 +214,7 @@ def test_stop_marks_head_reach_and_the_propeller():
 
 
 def test_simulate_writes_the_trial_figures(tmp_path):
-    vessel = js.vessel("mariner")
+    vessel = js.get_vessel("mariner")
     indices = simulate_to_folder(vessel, "zigzag:10/10", tmp_path, title="mariner 10/10")
     assert (tmp_path / "trial.png").is_file() and (tmp_path / "imo_criteria.png").is_file()
     assert [row["criterion"] for row in indices["imo_criteria"]] == [
@@ -249,7 +249,7 @@ def test_spiral_draws_both_branches_and_the_loop():
 
 
 def test_imo_criteria_table():
-    rows = js.imo_criteria(L, 7.7, stopping=StoppingIndices(2800.0, 3100.0, 50.0, 400.0,
+    rows = js.indices.imo_criteria(L, 7.7, stopping=StoppingIndices(2800.0, 3100.0, 50.0, 400.0,
                                                                0.0))
     fig = plot_imo_criteria(rows)
     table = fig.axes[0].tables[0]
@@ -327,7 +327,7 @@ def test_the_trial_figure_gives_the_rudder_its_own_axis_and_keeps_thesis_ranges_
     a bar beside the axes."""
     from jaxship.plotting._report import plot_trial_vs_thesis
 
-    vessel = js.vessel("thesis")
+    vessel = js.get_vessel("thesis")
     traj = js.simulate(vessel, js.Turn(np.deg2rad(40.0), duration=60.0),
                        js.straight_run(vessel, n=500.0 / 60))
     fig = plot_trial_vs_thesis(traj, bands={"yaw_rate": [(0.0, 6.0, "axis 0-6 deg/s")]})

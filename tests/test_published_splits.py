@@ -67,7 +67,7 @@ def test_the_free_run_score_is_the_hand_computed_one():
     every error is minus the offset (RMSE = |offset|, position error = the offsets'
     distance) and the fit % is the textbook formula on those errors."""
     jax.config.update("jax_enable_x64", True)
-    vessel = js.vessel("esso_osaka")
+    vessel = js.get_vessel("esso_osaka")
     x0 = js.straight_run(vessel)  # the nominal straight run
     traj = js.simulate(vessel, js.ZigZag(20 * np.pi / 180, 20 * np.pi / 180, duration=20.0,
                                          dt=0.1), x0, simulator=js.Simulator(substeps=4))
@@ -158,7 +158,7 @@ def test_the_labs_simulator_scores_as_the_owner_measured_it():
     jax.config.update("jax_enable_x64", True)
     runs = read_runs(MIYAUCHI_2022["Test"][:3])
     published = lab_as_published()
-    generic = js.vessel("esso_osaka")
+    generic = js.get_vessel("esso_osaka")
     assert published.wind_model == js.FujiwaraWindLoads.esso_osaka()
     assert generic.wind_model == js.FossenWindLoads()
     r_rmse = {name: [np.rad2deg(s.rmse["r"]) for s in free_run_score(model, runs)]

@@ -71,6 +71,6 @@ def test_the_kvlcc2_drift_is_recovered_from_the_track_without_a_logged_v():
     _, holdout = kvlcc2_discovery_split(DATA)
     records = [js.Experiment(e.t, e.delta, psi=e.psi, r=e.r, u=e.u, x=e.x, y=e.y, n=e.n,
                              name=e.name) for e in holdout]
-    smoothed = smoothed_vessel_states(js.vessel("kvlcc2"), records)
+    smoothed = smoothed_vessel_states(js.get_vessel("kvlcc2"), records)
     for s, e in zip(smoothed, holdout):
         assert np.sqrt(np.mean((s.state("v") - e.v) ** 2)) < 0.1 * np.std(e.v), e.name

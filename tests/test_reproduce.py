@@ -14,7 +14,7 @@ import time
 import pytest
 
 from jaxship.cli import main
-from jaxship.cli._studies import (
+from jaxship.cli.reproduction import (
     autopilot_thesis as chapter5,
     reproduce as rp,
     reproduce_report,
@@ -133,7 +133,7 @@ def test_quick_reproduce_command_writes_the_report(tmp_path, capsys):
 
 def test_a_failed_reproduce_leaves_the_earlier_report(tmp_path, monkeypatch):
     # issue 13: reproduce writes into a temporary folder; nothing moves after an error
-    import jaxship.cli._studies.reproduce as job
+    import jaxship.cli.reproduction.reproduce as job
 
     out = tmp_path / "out"
     out.mkdir()
@@ -270,3 +270,22 @@ def test_ctrl_c_on_reproduce_ends_it_with_130_and_leaves_nothing_behind(tmp_path
         parent.kill()
         for pid in filter(_alive, workers):
             os.kill(pid, signal.SIGKILL)
+
+
+@pytest.mark.slow  # 20 s: six fine simulations twice
+def test_the_discovery_case_records_are_the_discovery_tests_records():
+    """`reproduce` draws its discovery case's records with its own copy of the generator
+    (the package never imports benchmarks/): the same records, sample for sample, as the
+    discovery tests' `benchmarks.studies.discovery.hidden_effect_records` for one seed."""
+    import numpy as np
+
+    import jaxship as js
+    from benchmarks.studies.discovery import hidden_effect_records as tests_records
+    from jaxship.cli.reproduction.discovery_case import hidden_effect_records
+
+    truth = js.augment(js.Nomoto1(K=0.06, T=25.0), js.effects.YawCubicDamping(beta=300.0))
+    mine, theirs = hidden_effect_records(truth, 3), tests_records(truth, 3)
+    for a, b in zip(mine[0] + mine[1], theirs[0] + theirs[1], strict=True):
+        assert a.name == b.name
+        for channel in ("t", "delta", "psi", "r"):
+            np.testing.assert_array_equal(getattr(a, channel), getattr(b, channel))

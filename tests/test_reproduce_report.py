@@ -11,7 +11,12 @@ import numpy as np
 import pytest
 import scipy.stats
 
-from jaxship.cli._studies import autopilot, autopilot_thesis as chapter5, reproduce_report, thesis
+from jaxship.cli.reproduction import (
+    autopilot,
+    autopilot_thesis as chapter5,
+    reproduce_report,
+    thesis,
+)
 from jaxship.plotting import plot_model_outputs
 
 

@@ -12,8 +12,6 @@ from helpers import central_difference, per_sample
 
 import jaxship as js
 from jaxship import (
-    ROSS_FREE,
-    SPEED_RUDDER,
     AuxInputs,
     LinearStart,
     PredictionError,
@@ -22,8 +20,8 @@ from jaxship import (
 )
 from jaxship._estimate._linear import initial_estimate
 from jaxship._foundation._params import parameter_fields
-from jaxship._models._steering.ross import HULL_TERMS
-from jaxship.cli._studies import thesis as ti
+from jaxship._models._steering.ross import HULL_TERMS, ROSS_FREE, SPEED_RUDDER
+from jaxship.cli.reproduction import thesis as ti
 
 
 DEG = np.pi / 180

@@ -309,7 +309,7 @@ def test_a_steering_simulation_starts_from_the_sway_velocity_it_is_given():
     """`simulate` takes psi, r and, on a model with a sway state, v from `x0` (a record's
     first sample): the linear sway-yaw model with the rudder amidships starts at the
     given drift and decays from it."""
-    model = js.LinearSwayYaw.from_vessel(js.vessel("sea_stratus_linear"))
+    model = js.LinearSwayYaw.from_vessel(js.get_vessel("sea_stratus_linear"))
     x0 = dataclasses.replace(js.straight_state(0.0, psi=0.2), r=0.001, v=0.1)
     tr = js.simulate(model, js.Replay(np.zeros(40), dt=0.5), x0,
                      aux=js.AuxInputs(u=8.0))

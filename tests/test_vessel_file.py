@@ -21,7 +21,7 @@ from jaxship.cli._identification import model_from_report, read_result
 def test_every_preset_round_trips_bit_for_bit(name, tmp_path):
     """Written and read back, each preset has the same class and leaves, bit for bit,
     and simulates to the same trajectory."""
-    vessel = js.vessel(name)
+    vessel = js.get_vessel(name)
     back = js.load_vessel(js.save_vessel(vessel, tmp_path / f"{name}.toml"))
     assert type(back) is type(vessel)
     leaves, tree = jax.tree.flatten(vessel)
@@ -71,7 +71,7 @@ BAD = [
 
 @pytest.mark.parametrize("old, new, message", BAD, ids=[b[2] for b in BAD])
 def test_a_bad_vessel_file_is_one_line_and_exit_2(old, new, message, tmp_path, capsys):
-    text = vessel_text(js.vessel("esso_osaka"))
+    text = vessel_text(js.get_vessel("esso_osaka"))
     assert old in text
     path = tmp_path / "bad.toml"
     path.write_text(text.replace(old, new, 1))
@@ -85,7 +85,7 @@ def test_a_bad_vessel_file_is_one_line_and_exit_2(old, new, message, tmp_path, c
 
 
 def test_degrees_and_rpm_are_read_in_a_file(tmp_path):
-    text = vessel_text(js.vessel("esso_osaka"))
+    text = vessel_text(js.get_vessel("esso_osaka"))
     text = text.replace('max_angle = { value = 0.6108652381980153, unit = "rad" }',
                         'max_angle = { value = 35, unit = "deg" }')
     text = text.replace('nominal_n = { value = 10.0, unit = "rev/s" }',
@@ -147,7 +147,7 @@ def test_imo_check_of_a_preset_and_a_steering_model_refused(tmp_path, capsys):
 
 def test_imo_band_from_the_standard_errors_of_a_result(tmp_path, capsys):
     """Independent normal draws from std where the result stores no correlation."""
-    vessel = js.vessel("kvlcc2")
+    vessel = js.get_vessel("kvlcc2")
     result = tmp_path / "result.json"
     result.write_text(json.dumps({"model": "kvlcc2", "parameters": {
         "n_r": {"value": float(vessel.n_r), "std": 0.002 * abs(float(vessel.n_r))}}}))
@@ -167,12 +167,12 @@ def test_imo_band_from_the_standard_errors_of_a_result(tmp_path, capsys):
 def test_a_result_of_ones_own_vessel_rebuilds_it_with_effects():
     """`result.json` keeps the vessel (`vessel`) and its effects (`effects`): a vessel of
     a file comes back with its fitted values, effect parameters included."""
-    vessel = js.vessel("kvlcc2")
+    vessel = js.get_vessel("kvlcc2")
     report = {"model": "vessel", "parameters": {
         "n_r": {"value": 0.01, "std": 0.001}, "rudder_offset.delta0": {"value": 0.02}},
         "vessel": _to_plain(vessel_to_dict(vessel)), "effects": ["RudderOffset"]}
     model = model_from_report(report)
-    assert isinstance(model, js.AugmentedVessel)
+    assert isinstance(model, js.effects.AugmentedVessel)
     assert model.base.n_r == 0.01 and model.effects[0].delta0 == 0.02
     assert model.base.shaft.max_rate == math.inf
 
@@ -209,7 +209,7 @@ def test_simulate_reads_the_fit_code_of_its_result(tmp_path, capsys):
     """Issue 57's "every command reads the code of what it consumes": a result whose fit
     did not converge simulates, says so first on stderr and exits 3 (the README's exit
     status for a fit that did not converge); the files are written."""
-    vessel = js.vessel("kvlcc2")
+    vessel = js.get_vessel("kvlcc2")
     result = tmp_path / "result.json"
     result.write_text(json.dumps({"model": "kvlcc2", "fit": {"code": "max_steps_reached"},
                                   "parameters": {"n_r": {"value": float(vessel.n_r)}}}))
@@ -225,11 +225,11 @@ def test_a_wind_model_round_trips_in_its_table(tmp_path):
     """The Esso Osaka preset with Fujiwara's wind loads (issue 58): written with a
     `[wind_model]` table, read back bit for bit; the default writes no table, and a
     table without a known model or with a field missing is one line naming it."""
-    lab = eqx.tree_at(lambda v: v.wind_model, js.vessel("esso_osaka"),
+    lab = eqx.tree_at(lambda v: v.wind_model, js.get_vessel("esso_osaka"),
                       js.FujiwaraWindLoads.esso_osaka())
     text = vessel_text(lab)
     assert '[wind_model]\nmodel = "FujiwaraWindLoads"' in text
-    assert "\n[wind_model]\n" not in vessel_text(js.vessel("esso_osaka"))
+    assert "\n[wind_model]\n" not in vessel_text(js.get_vessel("esso_osaka"))
     back = js.load_vessel(js.save_vessel(lab, tmp_path / "lab.toml"))
     assert back.wind_model == lab.wind_model
     assert jax.tree.structure(back) == jax.tree.structure(lab)

@@ -178,11 +178,11 @@ def test_fitting_the_positions_recovers_a_current():
     """x, y as outputs (GNSS positions, 1 m noise): the Mariner's zig-zags in a current
     of (0.3, -0.2) m/s north, east give it within 3 robust standard errors; through-water
     u, v, r, psi alone do not see it (the fit does not move from zero)."""
-    from jaxship.cli._studies.discovery import vessel_records
+    from benchmarks.studies.discovery import vessel_records
 
-    truth = js.augment(js.vessel("mariner"), js.UniformCurrent(north=0.3, east=-0.2))
+    truth = js.augment(js.get_vessel("mariner"), js.effects.UniformCurrent(north=0.3, east=-0.2))
     train, _ = vessel_records(truth, 0, duration=400.0)
-    start = js.augment(js.vessel("mariner"), js.UniformCurrent())
+    start = js.augment(js.get_vessel("mariner"), js.effects.UniformCurrent())
     free = ("current.north", "current.east")
     track = PredictionError(horizon=60.0, channels=("psi", "r", "u", "v", "x", "y"))
     res = fit(start, train[:2], estimator=track, free=free)
@@ -206,10 +206,10 @@ def test_over_ground_velocities_recover_a_current():
     give the current within 3 robust standard errors, with the positions and from u, v
     alone; the same numbers read as through the water give it 30 standard errors off
     with the positions (the hull fitted to unlike things) and nothing without them."""
-    from jaxship.cli._studies.discovery import vessel_records
+    from benchmarks.studies.discovery import vessel_records
 
     current = np.array([-0.5, 0.35])
-    truth = js.augment(js.vessel("mariner"), js.UniformCurrent(*current))
+    truth = js.augment(js.get_vessel("mariner"), js.effects.UniformCurrent(*current))
     train, _ = vessel_records(truth, 0, duration=400.0)
 
     def logged(e, over_ground):  # u, v of the track in body axes
@@ -218,7 +218,7 @@ def test_over_ground_velocities_recover_a_current():
         return js.Experiment(e.t, e.delta, psi=e.psi, r=e.r, u=u, v=v, x=e.x, y=e.y,
                              name=e.name, metadata=[OVER_GROUND] if over_ground else ())
 
-    start = js.augment(js.vessel("mariner"), js.UniformCurrent())
+    start = js.augment(js.get_vessel("mariner"), js.effects.UniformCurrent())
     free = ("current.north", "current.east")
     track = PredictionError(horizon=60.0, channels=("psi", "r", "u", "v", "x", "y"))
     for estimator in (track, PredictionError(horizon=60.0)):

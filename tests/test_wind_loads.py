@@ -58,7 +58,7 @@ def model_of(g) -> js.FujiwaraWindLoads:
 
 
 def lab_vessel():
-    return eqx.tree_at(lambda v: v.wind_model, js.vessel("esso_osaka"),
+    return eqx.tree_at(lambda v: v.wind_model, js.get_vessel("esso_osaka"),
                        js.FujiwaraWindLoads.esso_osaka())
 
 
@@ -76,7 +76,7 @@ def test_the_lab_preset_coefficients_at_a_few_angles():
     following wind 0.7067, C_Y on the beam 1.0227, C_N at 30 and 120 deg 0.0739 and
     -0.1168 (the paper's angle). With them the lab's simulator's published r RMSE is
     reproduced (test_published_splits)."""
-    model, v = js.FujiwaraWindLoads.esso_osaka(), js.vessel("esso_osaka")
+    model, v = js.FujiwaraWindLoads.esso_osaka(), js.get_vessel("esso_osaka")
     assert (model.length_overall, model.superstructure_x) == (LAB["L"], LAB["x_AOD"])
     c = model.load_coefficients(np.deg2rad([0.0, 180.0, 90.0, 30.0, 120.0]),
                                 v.frontal_wind_area, v.lateral_wind_area)
@@ -108,8 +108,8 @@ def test_the_default_is_fossens_with_the_winds_coefficients():
     from gamma its loads are Fossen's (2021, eqs. 10.7-10.10) with the `Wind`'s c_x,
     c_y, c_n: -c_x cos(gamma) q A_F, -c_y sin(gamma) q A_L, -c_n sin(2 gamma) q A_L L."""
     for name in js.VESSELS:
-        assert js.vessel(name).wind_model == js.FossenWindLoads()
-    vessel, gamma, speed = js.vessel("esso_osaka"), 0.7, 3.0
+        assert js.get_vessel(name).wind_model == js.FossenWindLoads()
+    vessel, gamma, speed = js.get_vessel("esso_osaka"), 0.7, 3.0
     wind = js.Wind(speed=speed, direction=gamma, cx=0.6, cy=0.9, cn=0.1)
     q = 0.5 * 1.225 * speed**2
     A_F, A_L, L = vessel.frontal_wind_area, vessel.lateral_wind_area, vessel.length
@@ -123,7 +123,7 @@ def test_the_equations_of_motion_use_the_vessels_wind_model():
     """The same state in a wind: the accelerations of the vessel with Fujiwara's loads
     and with the default differ by the mass matrix's inverse times the difference of
     the two loads (with effects too), and in calm water not at all."""
-    generic, lab = js.vessel("esso_osaka"), lab_vessel()
+    generic, lab = js.get_vessel("esso_osaka"), lab_vessel()
     state = eqx.tree_at(lambda s: (s.v, s.r, s.psi), js.straight_state(0.3, 10.0),
                         (0.02, 0.01, 0.4))
     command = js.Command(0.1, 10.0)

@@ -47,7 +47,7 @@ def simulate_disturbed(vessel, manoeuvre, x0, yaw_moment, *, sway_force=None,
     yaw_moment = jnp.asarray(yaw_moment, dtype=float)
     sway_force = jnp.zeros_like(yaw_moment) if sway_force is None else jnp.asarray(
         sway_force, dtype=float)
-    disturbance = js.RecordedDisturbance(manoeuvre.dt, yaw_moment, sway_force,
+    disturbance = js.effects.RecordedDisturbance(manoeuvre.dt, yaw_moment, sway_force,
                                          start=manoeuvre.start)
     return js.simulate(js.augment(vessel, disturbance), manoeuvre, x0, simulator=simulator)
 
@@ -151,7 +151,7 @@ def astrom_kallstrom(*, noise: NoiseLevels = NoiseLevels(), seed: int = 0, dt: f
     error (`horizon` [s]), channels psi, r, v, from `start` (default: Table 3's initial
     estimates, `TABLE3_START`).
     """
-    vessel = js.vessel("sea_stratus_nonlinear")
+    vessel = js.get_vessel("sea_stratus_nonlinear")
     truth_model = js.NorrbinCrossFlow.from_vessel(vessel)
     truth = np.array([getattr(truth_model, k) for k in FREE])
     start_model = eqx.tree_at(lambda m: tuple(getattr(m, k) for k in FREE), truth_model,

@@ -78,12 +78,12 @@ SPLITS = {"Miyauchi 2022": MIYAUCHI_2022, "Wakita 2022": WAKITA_2022}
 SCORED = ("u", "v", "r", "psi")
 
 
-def lab_as_published() -> js.LowSpeedMMGVessel:
+def lab_as_published() -> js.AbstractVessel:
     """The lab's simulator as published (GitHub NAOE-5thLab/mmg-1p1r-simulator): the
     `esso_osaka` preset, the lab's coefficients, with its wind loads, Fujiwara et al.'s
     (1998) regression for the lab's geometry (`jaxship.FujiwaraWindLoads.esso_osaka()`)
     instead of jaxship's generic `FossenWindLoads`."""
-    return eqx.tree_at(lambda v: v.wind_model, js.vessel("esso_osaka"),
+    return eqx.tree_at(lambda v: v.wind_model, js.get_vessel("esso_osaka"),
                        js.FujiwaraWindLoads.esso_osaka())
 
 
@@ -100,7 +100,7 @@ def read_runs(names, root=None) -> list[js.Experiment]:
         found = sorted(folder.glob(f"*/{name}.csv"))
         if not found:
             raise FileNotFoundError(f"run {name}.csv not found under {folder}.")
-        runs.append(js.read_esso_osaka(found[0]))
+        runs.append(js.read_measured(found[0]))
     return runs
 
 

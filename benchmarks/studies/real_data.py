@@ -57,21 +57,21 @@ def esso_osaka_split(root=None, *, factor: int = 5) -> tuple[list, list]:
     """`(train, test)` experiments of the Esso Osaka split (module docstring),
     decimated by `factor` (10 Hz / 5 = 2 Hz by default)."""
     folder = _root(root, "esso_osaka_frt")
-    train = [js.read_esso_osaka(p).decimate(factor) for p in sorted(folder.glob("random/*.csv"))
+    train = [js.read_measured(p).decimate(factor) for p in sorted(folder.glob("random/*.csv"))
              if p.stem not in ESSO_TEST]
     test = []
     for name in ESSO_TEST:
         found = sorted(folder.glob(f"*/{name}.csv"))
         if not found:
             raise FileNotFoundError(f"held-out run {name}.csv not found under {folder}.")
-        test.append(js.read_esso_osaka(found[0]).decimate(factor))
+        test.append(js.read_measured(found[0]).decimate(factor))
     return train, test
 
 
 def hsva_split(root=None, *, factor: int = 4, train=HSVA_TRAIN, test=HSVA_TEST):
     """`(train, test)` HSVA KVLCC2 zig-zags, decimated by `factor` (20 Hz / 4 = 5 Hz)."""
     folder = _root(root, "kvlcc2_simman2008_hsva")
-    read = lambda names: [js.read_hsva_kvlcc2(folder / f"{n}.dat").decimate(factor)
+    read = lambda names: [js.read_measured(folder / f"{n}.dat").decimate(factor)
                           for n in names]
     return read(train), read(test)
 
@@ -82,10 +82,10 @@ def kvlcc2_discovery_split(root=None, *, marin: bool = True) -> tuple[list, list
     MARIN zig-zags (Froude-scaled to the 7 m HSVA model) held out, all at 5 Hz."""
     folder = _root(root, "kvlcc2_simman2008_hsva")
     files = sorted(p for p in folder.glob("*.dat") if "_Z_" in p.name)
-    read = lambda paths: [js.read_hsva_kvlcc2(p).decimate(4) for p in paths]  # 20 Hz
+    read = lambda paths: [js.read_measured(p).decimate(4) for p in paths]  # 20 Hz
     held = [p for p in files if "_Z_10_10_" in p.name]
     return read([p for p in files if p not in held]), read(held) + [
-        js.read_marin_kvlcc2(p, model_scale=True).decimate(10)  # 50 Hz
+        js.read_measured(p, model_scale=True).decimate(10)  # 50 Hz
         for p in (sorted(_root(root, "kvlcc2_simman2008_marin").glob("*zz*.dat"))
                   if marin else ())]
 
@@ -177,7 +177,7 @@ def identify_esso_osaka(root=None, *, factor: int = 5, horizon: float = 20.0,
     **Raises:** `FileNotFoundError` when the data are absent.
     """
     train, test = esso_osaka_split(root, factor=factor)
-    vessel = js.vessel("esso_osaka")
+    vessel = js.get_vessel("esso_osaka")
     # tolerances of 1e-6: relative cost changes below that are far inside the noise
     solver = optx.LevenbergMarquardt(rtol=tol, atol=tol)
     est = js.PredictionError(horizon=horizon, wind=wind, max_steps=max_steps, solver=solver,
@@ -215,7 +215,7 @@ def esso_osaka_zigzag_split(root=None, *, factor: int = 5, trim: float = 20.0,
     copy, `turn_cut_...`, only the cut one, as the papers use it)."""
     folder = _root(root, "esso_osaka_frt")
     def read(path):
-        run = js.read_esso_osaka(path)
+        run = js.read_measured(path)
         return run.segment(start=run.t[0] + trim).decimate(factor)
 
     paths = sorted(folder.glob("zigzag/*.csv"))
@@ -258,7 +258,7 @@ def esso_osaka_low_speed_sway_yaw(root=None, *, factor: int = 5) -> RealDataRepo
     nomoto = dataclasses.replace(_low_speed_nomoto(train, test)[-1],
                                  label="speed-scaled Nomoto 1 + all terms, exponents free")
     est = js.PredictionError(horizon=None, channels=("r", "v"), wind=True, max_steps=400)
-    fit = js.fit(js.augment(js.LowSpeedSwayYaw(), js.RudderOffset()), train, estimator=est)
+    fit = js.fit(js.augment(js.LowSpeedSwayYaw(), js.effects.RudderOffset()), train, estimator=est)
     sway_yaw = Identified("low-speed sway-yaw + offset", fit, _validate(
         fit.model, test, dataclasses.replace(est, channels=("psi", "r", "v")), (None,)))
     return RealDataReport("Esso Osaka FRT, zig-zag split with turns", (nomoto, sway_yaw),
@@ -270,8 +270,8 @@ def _low_speed_nomoto(train, test) -> tuple[Identified, ...]:
     base, free = _speed_scaled_nomoto(train)
     est = js.PredictionError(horizon=None, channels=("r",), max_steps=400)
     fit0 = js.fit(base, train, estimator=est, free=free)
-    full = js.augment(fit0.model.base, *fit0.model.effects, js.PropellerRace(),
-                      js.ApparentWind(), js.YawQuadraticDamping())
+    full = js.augment(fit0.model.base, *fit0.model.effects, js.effects.PropellerRace(),
+                      js.effects.ApparentWind(), js.effects.YawQuadraticDamping())
     windy = dataclasses.replace(est, wind=True)
     terms = ("propeller_race.gain", "wind.c1", "wind.c2", "yaw_quadratic_damping.beta")
     fit1 = js.fit(full, train, estimator=windy, free=free + terms)
@@ -291,9 +291,9 @@ def _speed_scaled_nomoto(train):
     training runs' mean speed (`esso_osaka_low_speed_steering`)."""
     nominal = float(sum(e.u.sum() for e in train) / sum(e.u.size for e in train))
     base = js.augment(js.Nomoto1(K=0.3, T=10.0),
-                      js.SpeedDependentRudder(kappa=1.0, nominal_speed=nominal),
-                      js.SpeedDependentDamping(kappa=1.0, nominal_speed=nominal),
-                      js.RudderOffset())
+                      js.effects.SpeedDependentRudder(kappa=1.0, nominal_speed=nominal),
+                      js.effects.SpeedDependentDamping(kappa=1.0, nominal_speed=nominal),
+                      js.effects.RudderOffset())
     return base, ("K", "T", "rudder_offset.delta0")
 
 

@@ -413,8 +413,8 @@ def _prepare(model, dataset, estimator):
     check_data(ds, estimator.rudder, channels)
     if estimator.wind and not model.wind_loads:
         raise ValueError(f"`wind=True` is for vessels and steering models with a wind "
-                         f"effect (jaxship.ApparentWind); {type(model).__name__} has no wind "
-                         "loads.")
+                         f"effect (jaxship.effects.ApparentWind); {type(model).__name__} "
+                         "has no wind loads.")
     servo = estimator.rudder == "delta_c"
     smoothed = isinstance(estimator.initial, (list, tuple))
     starts = _smoothed_starts(ds, estimator.initial) if smoothed else None

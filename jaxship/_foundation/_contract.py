@@ -60,7 +60,8 @@ class AbstractModel(eqx.Module):
 
 
 class AbstractComposite(AbstractModel):
-    """A model with effects (`jaxship.AugmentedSteering`, `jaxship.AugmentedVessel`):
+    """A model with effects (`jaxship.effects.AugmentedSteering`,
+    `jaxship.effects.AugmentedVessel`):
     the `base` model's parameters and each effect's as `"<effect id>.<field>"`."""
 
     base: eqx.AbstractVar[AbstractModel]

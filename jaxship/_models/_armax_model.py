@@ -41,6 +41,11 @@ class ARMAXModel(eqx.Module):
         f = lambda *xs: np.array([float(x) for x in xs])
         return f(1.0, self.a1, self.a2), f(self.b0, self.b1), f(1.0, self.c1, self.c2)
 
+    def response(self, delta, r0) -> np.ndarray:
+        """The noise-free response $A r = B\\delta(t - n_k)$ to the rudder `delta`
+        (`simulate_armax`)."""
+        return simulate_armax(self, delta, r0)
+
     @classmethod
     def from_result(cls, result, dt: float) -> "ARMAXModel":
         """The model of an `ARMAXResult` of `fit_armax` with `ARMAX_ORDERS`."""

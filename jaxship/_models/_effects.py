@@ -519,7 +519,8 @@ class AugmentedSteering(_Augmented, AbstractSteeringModel):
 
     @property
     def wind_loads(self) -> bool:
-        """Whether the base or an effect reads the replayed wind (`jaxship.ApparentWind`)."""
+        """Whether the base or an effect reads the replayed wind
+        (`jaxship.effects.ApparentWind`)."""
         return self.base.wind_loads or any(e.uses_wind for e in self.effects)
 
     @property

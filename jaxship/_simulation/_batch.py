@@ -232,7 +232,7 @@ def _straight_runs(vessel, speed, n, iterations):
 def batch_turning_indices(traj: Trajectory) -> dict:
     """Advance, transfer, tactical diameter and more of turning circles, in JAX.
 
-    The jit- and vmap-friendly counterpart of `jaxship.turning_indices` (same
+    The jit- and vmap-friendly counterpart of `jaxship.indices.turning_indices` (same
     definitions: rudder order at the first sample whose rudder command leaves the
     initial rudder angle, positions rotated into the course frame there, 90 and 180 deg
     heading change located by linear interpolation between samples; steady diameter

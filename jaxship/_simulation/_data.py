@@ -183,7 +183,7 @@ class Experiment(eqx.Module):
         """Whether `u`, `v` are over ground (metadata `("velocities", "over ground")`);
         else through the water, as a simulation's. They differ by the current, which
         `fit` adds to a vessel's predicted u, v of such a record
-        (`jaxship.UniformCurrent`)."""
+        (`jaxship.effects.UniformCurrent`)."""
         return dict(self.metadata).get("velocities") == OVER_GROUND[1]
 
     @property

@@ -18,12 +18,11 @@ import matplotlib
 
 matplotlib.use("Agg")  # the command writes files; it never opens a window
 
-from .. import FitError, __version__  # noqa: E402
-from .._foundation._cache import enable_compilation_cache  # noqa: E402
-from .._foundation._files import discard_open_stages  # noqa: E402
+from .. import FitError, __version__, enable_compilation_cache  # noqa: E402
 from . import autopilot, discover, identify, reproduce, simulate, vessels  # noqa: E402
 from ._common import one_line  # noqa: E402
 from ._compiler import SMALL_PROGRAMS, compile_for_small_programs  # noqa: E402, F401
+from ._files import discard_open_stages  # noqa: E402
 from ._identification.workflow import FitDivergedError  # noqa: E402
 
 

@@ -7,10 +7,15 @@ import pathlib
 import sys
 import tempfile
 
-from tqdm.auto import tqdm
+from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
 
-from .._foundation._files import read_manifest
-from .._models._vessel._base import surge_force
+from ._files import read_manifest
+
+
+def surge_force(vessel, u, n):
+    """Net surge force [N] of `vessel` in straight motion at speed `u` [m/s] and
+    propeller rate `n` [rev/s] (`AbstractVessel.forces` at v = r = delta = 0)."""
+    return vessel.forces(u, 0.0, 0.0, 0.0, n)[0]
 
 
 def one_line(error) -> str:

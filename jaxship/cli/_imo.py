@@ -10,9 +10,8 @@ import numpy as np
 
 import jaxship as js
 
-from .._estimate._bands import normal_draws
 from .._foundation._params import rebuild
-from .._models._vessel._base import surge_force
+from ._common import surge_force
 from ._trials import (
     TrialSpec,
     _spec_text,
@@ -91,7 +90,11 @@ def parameter_draws(report, rng) -> tuple[tuple, np.ndarray, str]:
         corr, how = matrix[np.ix_(index, index)], "the covariance (std and correlation)"
     else:
         corr, how = None, "independent normal draws from std (no correlation stored)"
-    draws = normal_draws(values, [std[k] for k in names], corr, DRAWS, rng)
+    # draws from N(theta, D C D): D the standard errors, C the correlation (or identity)
+    sd = np.asarray([std[k] for k in names], np.float64)
+    cov = (np.eye(len(names)) if corr is None else np.asarray(corr, np.float64)) * np.outer(sd, sd)
+    draws = rng.multivariate_normal(np.asarray(values, np.float64), cov, size=DRAWS,
+                                    method="eigh", check_valid="ignore")  # rounding: slightly < 0
     if held:
         how += f"; held at the estimate (no finite std): {', '.join(held)}"
     return names, draws, how

@@ -16,15 +16,11 @@ import jax.numpy as jnp
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .._analysis import _indices as ix
-from .._foundation._state import straight_state
-from .._models import _manoeuvres as man
-from .._models._vessel._base import straight_run, surge_force
-from .._simulation._data import Experiment
-from .._simulation._integrate import Simulator
-from .._simulation._readers import write_trial_csv
-from .._simulation._simulate import simulate
+import jaxship as js
+
+from .. import Experiment, Simulator, simulate, straight_run, straight_state, write_trial_csv
 from ..plotting import plot_imo_criteria, plot_spiral, plot_trajectory
+from ._common import surge_force
 
 
 SPEC_HELP = (
@@ -116,16 +112,16 @@ def build_manoeuvre(spec: TrialSpec, vessel, x0, *, duration=None, dt=None):
     v = spec.values
     pick = lambda default: float(duration) if duration is not None else default
     if spec.kind == "turn":
-        return man.Turn(rad(v[0]), duration=pick(60 * tau), dt=dt)
+        return js.Turn(rad(v[0]), duration=pick(60 * tau), dt=dt)
     if spec.kind == "zigzag":
-        return man.ZigZag(rad(v[0]), rad(v[1]), duration=pick(35 * tau), dt=dt)
+        return js.ZigZag(rad(v[0]), rad(v[1]), duration=pick(35 * tau), dt=dt)
     if spec.kind == "spiral":
         return direct_spiral(_whole(30 * tau, dt), dt=dt)
     if spec.kind == "reverse-spiral":
         return reverse_spiral(vessel, x0, hold=_whole(30 * tau, dt), dt=dt)
     if spec.kind == "pullout":
         angle = rad(v[0]) if v else rad(20.0)
-        return man.pull_out(
+        return js.pull_out(
             angle, turn_time=30 * tau, release_time=pick(60 * tau) - 30 * tau, dt=dt
         )
     if spec.kind == "stop":
@@ -133,17 +129,17 @@ def build_manoeuvre(spec: TrialSpec, vessel, x0, *, duration=None, dt=None):
             raise ValueError(
                 f"{type(vessel).__name__} has no propeller model: a stop cannot be simulated."
             )
-        return man.Stop(-abs(float(x0.n)), duration=pick(80 * tau), dt=dt, until_stopped=True)
+        return js.Stop(-abs(float(x0.n)), duration=pick(80 * tau), dt=dt, until_stopped=True)
     if spec.kind == "prbs":
         amp = rad(v[0]) if v else rad(10.0)
-        return man.prbs(amp, bit_time=2 * tau, duration=pick(100 * tau), dt=dt)
+        return js.prbs(amp, bit_time=2 * tau, duration=pick(100 * tau), dt=dt)
     if spec.kind == "3211":
         amp = rad(v[0]) if v else rad(10.0)
-        return man.multi_step_3211(amp, unit=tau, settle=pick(30 * tau) - 7 * tau, dt=dt)
+        return js.multi_step_3211(amp, unit=tau, settle=pick(30 * tau) - 7 * tau, dt=dt)
     if spec.kind == "thesis":
-        return man.thesis_manoeuvre(dt=dt)
+        return js.thesis_manoeuvre(dt=dt)
     if spec.kind == "heading-steps":
-        return man.heading_perturbations(
+        return js.heading_perturbations(
             rad(v[0]),
             period=20 * tau,
             kp=2.0,
@@ -179,7 +175,7 @@ def direct_spiral(hold, *, dt, levels_deg=SPIRAL_LEVELS_DEG, n=None):
     levels = np.concatenate([down, down[::-1][1:]])
     edges = hold * np.arange(levels.size + 1)
     times = np.repeat(edges, 2)[1:-1]
-    return man.Schedule(times, np.repeat(levels, 2), duration=float(edges[-1]), dt=dt, n=n)
+    return js.Schedule(times, np.repeat(levels, 2), duration=float(edges[-1]), dt=dt, n=n)
 
 
 def linear_yaw(vessel, x0):
@@ -239,7 +235,7 @@ def reverse_spiral(vessel, x0, *, hold, dt, max_angle=np.deg2rad(25.0),
     tau = float(vessel.length) / speed
     turn = _whole(20 * tau, dt)
     angles = np.array([0.0, max_angle, max_angle, -max_angle])
-    both = simulate(vessel, man.Schedule(np.array([0.0, 0.0, turn, turn]), angles,
+    both = simulate(vessel, js.Schedule(np.array([0.0, 0.0, turn, turn]), angles,
                                          duration=2 * turn, dt=dt), x0)
     t, r = np.asarray(both.t), np.asarray(both.state.r)
     ends = np.array([turn, 2 * turn])
@@ -255,7 +251,7 @@ def reverse_spiral(vessel, x0, *, hold, dt, max_angle=np.deg2rad(25.0),
     rates = np.concatenate([side, -side[::-1]])  # from starboard to port
     kp, kd = yaw_rate_gains(*linear_yaw(vessel, x0), bandwidth=0.5 / tau)
     limit = float(vessel.rudder.max_angle)
-    return man.ReverseSpiral(rates, hold, kp=kp, kd=kd, duration=hold * rates.size, dt=dt,
+    return js.ReverseSpiral(rates, hold, kp=kp, kd=kd, duration=hold * rates.size, dt=dt,
                              max_angle=limit)
 
 
@@ -292,7 +288,7 @@ def run_spec(vessel, spec, *, speed=None, rpm=None, duration=None, dt=None, subs
             break
         if manoeuvre.duration > 1000 * float(vessel.length) / float(vessel.nominal_speed):
             break
-        manoeuvre = man.Turn(
+        manoeuvre = js.Turn(
             manoeuvre.angle, duration=2 * float(manoeuvre.duration), dt=manoeuvre.dt
         )
         traj = simulate(vessel, manoeuvre, x0, simulator=simulator)
@@ -304,7 +300,7 @@ def _cut_at_stop(traj):
     2.2.7): keep the samples up to the stop and a tenth of the time to stop after it
     (the ship lying stopped); the whole run if it did not stop."""
     try:
-        stop = ix.stopping_indices(traj)
+        stop = js.indices.stopping_indices(traj)
     except ValueError:
         return traj
     t = np.asarray(traj.t)
@@ -324,12 +320,12 @@ def trial_indices(spec, manoeuvre, traj) -> dict:
         "max_speed_m_s": float(np.max(traj.speed)),
     }
     if spec.kind == "turn" and spec.values[0] != 0:
-        return base | ix.turning_indices(traj).to_dict()
+        return base | js.indices.turning_indices(traj).to_dict()
     if spec.kind == "zigzag":
-        return base | ix.zigzag_indices(traj, manoeuvre.heading).to_dict()
+        return base | js.indices.zigzag_indices(traj, manoeuvre.heading).to_dict()
     if spec.kind == "spiral":
         hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
-        curve = ix.spiral_curve(traj, hold=hold)
+        curve = js.indices.spiral_curve(traj, hold=hold)
         return base | curve.to_dict() | curve.loop.to_dict()
     if spec.kind == "reverse-spiral":
         curve = _reverse_curve(manoeuvre, traj)
@@ -337,20 +333,20 @@ def trial_indices(spec, manoeuvre, traj) -> dict:
         return (base | curve.to_dict() | {"r_ordered_deg_s": np.rad2deg(ordered).tolist()}
                 | curve.loop.to_dict())
     if spec.kind == "pullout":
-        return base | ix.pull_out_indices(traj).to_dict()
+        return base | js.indices.pull_out_indices(traj).to_dict()
     if spec.kind == "stop":
-        return base | ix.stopping_indices(traj).to_dict()
+        return base | js.indices.stopping_indices(traj).to_dict()
     return base
 
 
 def _reverse_curve(manoeuvre, traj):
-    return ix.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
+    return js.indices.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
 
 
 def _spiral_curve(spec, manoeuvre, traj):
     if spec.kind == "spiral":
         hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
-        return ix.spiral_curve(traj, hold=hold)
+        return js.indices.spiral_curve(traj, hold=hold)
     return _reverse_curve(manoeuvre, traj)
 
 
@@ -358,11 +354,11 @@ def _trial_marks(spec, manoeuvre, traj):
     """The indices drawn on the trial figure: turning, zig-zag or stopping."""
     try:
         if spec.kind == "turn" and spec.values[0] != 0:
-            return ix.turning_indices(traj)
+            return js.indices.turning_indices(traj)
         if spec.kind == "zigzag":
-            return ix.zigzag_indices(traj, manoeuvre.heading)
+            return js.indices.zigzag_indices(traj, manoeuvre.heading)
         if spec.kind == "stop":
-            return ix.stopping_indices(traj)
+            return js.indices.stopping_indices(traj)
     except ValueError:  # the run is too short for them: the figure goes without
         return None
     return None
@@ -389,7 +385,7 @@ def trial_criteria(spec, vessel, traj, marks) -> list:
     if not kwargs:
         return []
     speed = float(np.hypot(traj.state.u[0], traj.state.v[0]))
-    return ix.imo_criteria(float(vessel.length), speed, **kwargs)
+    return js.indices.imo_criteria(float(vessel.length), speed, **kwargs)
 
 
 def simulate_to_folder(

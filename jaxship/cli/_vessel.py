@@ -5,9 +5,7 @@
 import dataclasses
 import pathlib
 
-from .._models._vessel._base import AbstractVessel
-from .._models._vessel.catalogue import VESSELS, get_vessel
-from .._models._vessel.file import load_vessel
+from .. import VESSELS, AbstractVessel, get_vessel, load_vessel
 from ._identification import read_result
 
 

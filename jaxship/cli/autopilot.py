@@ -6,15 +6,15 @@ import pathlib
 import sys
 
 import matplotlib.pyplot as plt
-from tqdm.auto import tqdm
+from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
 
-from .._foundation._files import staged_folder
 from ..plotting import plot_autopilot
 from ._common import check_operating_point, check_out, numbers
+from ._files import staged_folder
 from ._identification import read_result, unconverged_fit
-from ._studies import autopilot as autopilot_study
-from ._studies.autopilot import cell
 from ._vessel import VESSEL_HELP, read_vessel_option
+from .reproduction import autopilot as autopilot_study
+from .reproduction.autopilot import cell
 
 
 def register(sub) -> None:

@@ -3,7 +3,7 @@
 import pathlib
 import sys
 
-from tqdm.auto import tqdm
+from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
 
 from ._common import VELOCITIES, add_sample_interval, add_velocities, check_out, note
 from ._identification.discovery import run_discovery

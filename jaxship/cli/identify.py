@@ -8,10 +8,8 @@ import sys
 
 import jaxship as js
 
-from .._foundation._files import staged_folder
-from .._models._vessel.catalogue import VESSELS
-from ..plotting import save_identification_figures
-from ..plotting._fits import identification_figure_names
+from .. import VESSELS
+from ..plotting import identification_figure_names, save_identification_figures
 from ._common import (
     VELOCITIES,
     ProgressBar,
@@ -22,6 +20,7 @@ from ._common import (
     note,
     one_line,
 )
+from ._files import staged_folder
 from ._identification import MODELS, get_model_entry, identify, read_experiments
 from ._vessel import VESSEL_HELP, read_vessel_option
 

@@ -3,7 +3,7 @@
 import pathlib
 
 from ._common import check_out
-from ._studies.reproduce import reproduce
+from .reproduction.reproduce import reproduce
 
 
 def register(sub) -> None:

@@ -8,11 +8,10 @@ import sys
 
 import matplotlib.pyplot as plt
 
-from .._foundation._files import staged_folder
-from .._models._vessel._base import AbstractVessel
-from .._simulation._froude import froude_scale
+from .. import AbstractVessel, froude_scale
 from ..plotting import plot_imo_criteria, plot_trajectory
 from ._common import check_operating_point, check_out, note, positive
+from ._files import staged_folder
 from ._identification import unconverged_fit
 from ._imo import check_imo, imo_specs
 from ._trials import TrialSpec, simulate_steering_to_folder, simulate_to_folder

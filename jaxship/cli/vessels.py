@@ -1,7 +1,7 @@
 """`jaxship vessels`: the vessel presets with their size, speed, rpm and source; with
 `--show NAME`, a preset as a vessel file (TOML) to start one's own ship from."""
 
-from .._models._vessel.catalogue import VESSELS, get_vessel
+from .. import VESSELS, get_vessel
 from .._models._vessel.file import vessel_text
 
 

@@ -14,6 +14,7 @@ draws the reference's values or ranges on it.
 
 from ._closed_loop import plot_autopilot as plot_autopilot
 from ._fits import (
+    identification_figure_names as identification_figure_names,
     plot_comparison as plot_comparison,
     plot_parameter_correlation as plot_parameter_correlation,
     plot_residuals as plot_residuals,

@@ -46,7 +46,7 @@ def _span(smoothing, dt) -> int:
 
 
 def smoothed_vessel_states(vessel, data, *, smoothing: float = 10.0):
-    """`jaxship.SmoothedStates` of `vessel` for every record of `data`, each measuring
+    """`SmoothedStates` (`_estimate._kalman`) of `vessel` for every record of `data`, each measuring
     psi, r, u and the track x, y (module docstring; measurement noise: what a cubic
     Savitzky-Golay smoother over `smoothing` seconds leaves of each channel; the prior:
     the first sample's measured states, the drift unknown to 10 % of the speed). None

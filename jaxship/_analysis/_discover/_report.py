@@ -81,7 +81,7 @@ class DiscoveryReport(eqx.Module):
       held-out record `{index: {measured, before, after}}`;
     - `alpha`: the family-wise false-alarm rate; `channels`: the fitted outputs;
     - `disagreement`: where the simulated training records depart from the measured
-      ones, `{"before": ..., "after": ...}` (`jaxship.locate_disagreement`: by
+      ones, `{"before": ..., "after": ...}` (`locate_disagreement`: by
       record, time window, state region, turning side and correlated signal; for a
       vessel also the loads it lacks).
     """

@@ -27,7 +27,7 @@ class AuxInputs(eqx.Module):
     wind `wind_u`, `wind_v` [m/s]: the ship's velocity through the air in body axes,
     so that the wind comes from $\\gamma =$ atan2(`wind_v`, `wind_u`) off the bow,
     positive from starboard (`jaxship.Wind`'s convention). Unused by the Nomoto models;
-    effects use them (`jaxship.ApparentWind`)."""
+    effects use them (`jaxship.effects.ApparentWind`)."""
 
     u: ArrayLike = 0.0
     v: ArrayLike = 0.0
@@ -120,7 +120,7 @@ class AbstractSteeringModel(AbstractModel):
     def forcing(self, state: Array) -> Array:
         """$b(x) = \\partial\\dot x/\\partial f$: how a term $f$ added to the right-hand
         side of the yaw equation, where the rudder's moment enters, moves the state
-        (effects use it, `jaxship.YawMomentBias`). Here the yaw equation is
+        (effects use it, `jaxship.effects.YawMomentBias`). Here the yaw equation is
         $\\dot r = \\dots$, so $b = e_r$; Nomoto models override it."""
         return jnp.zeros_like(state).at[0].set(1.0)
 

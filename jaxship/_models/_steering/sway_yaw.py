@@ -1,7 +1,7 @@
 """Linear sway-yaw steering model in prime derivatives and Norrbin's cross-flow model
 (Astrom & Kallstrom 1979, eq. 3 and the "Nonlinear Models" paragraph of section 2).
 
-Both are the sway and yaw equations of `jaxship.SwayYawVessel` (the simulator vessel of
+Both are the sway and yaw equations of `SwayYawVessel` (the simulator vessel of
 the same report) as response models: the states are $(r, v)$, the rudder angle is the
 input and the surge speed is a *measured* input, $V = u$ at each sample (`AuxInputs.u`),
 as Astrom & Kallstrom did ("By using the measured value of the ship speed V at each

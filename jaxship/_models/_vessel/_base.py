@@ -52,7 +52,7 @@ class AbstractVessel(AbstractModel):
     wind_loads: ClassVar[bool] = True
     has_servo: ClassVar[bool] = True
     # states of effects (a rudder lag, ...) after the eight of `ShipState`; see
-    # `jaxship.AugmentedVessel`
+    # `jaxship.effects.AugmentedVessel`
     effect_state_size: ClassVar[int] = 0
 
     @abc.abstractmethod
@@ -61,12 +61,12 @@ class AbstractVessel(AbstractModel):
 
     def loads(self, t, u, v, r, delta, n) -> Array:
         """All loads at time `t` [s]: `forces` here; effects that vary in time add to
-        them (`jaxship.AugmentedVessel`)."""
+        them (`jaxship.effects.AugmentedVessel`)."""
         return self.forces(u, v, r, delta, n)
 
     def environment(self, environment: Environment) -> Environment:
         """The environment (current, wind) the equations of motion see for the given
-        one: itself here; effects change it (`jaxship.UniformCurrent`)."""
+        one: itself here; effects change it (`jaxship.effects.UniformCurrent`)."""
         return environment
 
     @abc.abstractmethod

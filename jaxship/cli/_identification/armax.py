@@ -8,8 +8,7 @@ import numpy as np
 
 import jaxship as js
 
-from ..._estimate._armax import fit_armax
-from ..._models._armax_model import ARMAX_ORDERS, ARMAXModel
+from ... import ARMAXModel
 from .starts import StartContext
 
 
@@ -26,18 +25,15 @@ def _record(train: js.Dataset, rudder: str):
         "file", train.names[0]))
 
 
-def _fit_raw(train: js.Dataset, rudder: str, **kwargs):
-    y, u, dt, source = _record(train, rudder)
+def start_armax(train: js.Dataset, context: StartContext) -> ARMAXModel:
+    """The pseudo-linear regression (extended least squares) start of `fit_armax`:
+    `jaxship.fit` with the `ARMAX` estimator and no Gauss-Newton iteration."""
+    _, _, dt, source = _record(train, context.rudder)
+    estimator = js.ARMAX(rudder=context.rudder, max_iter=0)
     try:
-        return fit_armax(y, u, dt=dt, **ARMAX_ORDERS, **kwargs), y, u, dt
+        return js.fit(ARMAXModel(dt=dt), train, estimator=estimator).model
     except ValueError as error:
         raise ValueError(f"{source}: armax: {error}") from None
-
-
-def start_armax(train: js.Dataset, context: StartContext) -> ARMAXModel:
-    """The pseudo-linear regression (extended least squares) start of `fit_armax`."""
-    res, _, _, dt = _fit_raw(train, context.rudder, max_iter=0)
-    return ARMAXModel.from_result(res, dt)
 
 
 def fit_armax_entry(start: ARMAXModel, train: js.Dataset, context: StartContext) -> js.FitResult:

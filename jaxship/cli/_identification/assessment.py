@@ -75,7 +75,7 @@ def _test_dict(corr) -> dict | None:
     }
 
 
-def _metrics_dict(m: js.ValidationReport, names) -> dict:
+def _metrics_dict(m, names) -> dict:
     unit = CHANNEL_UNITS.get(m.channel, "")
     return {
         "unit": unit,

@@ -11,7 +11,6 @@ from pathlib import Path
 import numpy as np
 
 import jaxship as js
-from jaxship._models._vessel.mmg import GRAVITY
 from jaxship._simulation._data import OVER_GROUND, check_uniform
 from jaxship._simulation._measured import header_names
 from jaxship._simulation._readers import UTF16_MARKS
@@ -211,11 +210,12 @@ def as_experiments(data, role: str) -> list[js.Experiment]:
 # channel beyond it, for the model's length, is in another unit (knots, km/h) or from
 # another ship.
 MAX_FROUDE = 1.0
+GRAVITY = 9.80665  # standard gravity g [m/s^2] (3rd CGPM, 1901), as the MMG vessels use
 
 
 def preset_length(model: str) -> float | None:
     """L_pp [m] of the vessel preset `model`; None for other models (no length)."""
-    vessel = js.vessel(model) if model in js.VESSELS else None
+    vessel = js.get_vessel(model) if model in js.VESSELS else None
     return float(vessel.length) if isinstance(vessel, js.AbstractVessel) else None
 
 

@@ -10,8 +10,8 @@ import numpy as np
 
 import jaxship as js
 
-from ..._foundation._files import staged_folder
 from .._common import check_writes
+from .._files import staged_folder
 from .data import check_froude, preset_length, read_experiments
 from .registry import model_key, start_entry
 from .workflow import identify, logs_wind

@@ -59,7 +59,7 @@ class ModelEntry:
 def _vessel_entry(name: str, vessel=None, description: str = "") -> ModelEntry:
     """The entry of the vessel preset `name`, or of the `vessel` given (`--vessel`)."""
     def start(train, context):
-        return js.vessel(name) if vessel is None else vessel
+        return js.get_vessel(name) if vessel is None else vessel
 
     return ModelEntry(
         "vessel preset (3-DOF, default_free estimated): " + js.VESSELS[name].description
@@ -154,7 +154,7 @@ def start_entry(name: str | None, start) -> tuple[str, ModelEntry]:
     steering model as the registry's `name`; the start values are `start`'s own."""
     if isinstance(start, js.AbstractVessel):
         key = name if name in js.VESSELS else OWN_VESSEL
-        base = start.base if isinstance(start, js.AugmentedVessel) else start
+        base = start.base if isinstance(start, js.effects.AugmentedVessel) else start
         description = f"vessel {type(base).__name__} (3-DOF, default_free estimated)"
         return key, _vessel_entry(key, start, description)
     key = model_key(name)

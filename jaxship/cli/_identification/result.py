@@ -169,8 +169,8 @@ def _with_effects(model, names):
     """`model` with the effects of the class names `names` (default values) added."""
     effects = []
     for name in names:
-        cls = getattr(js, str(name), None)
-        if not (isinstance(cls, type) and issubclass(cls, js.AbstractEffect)):
+        cls = getattr(js.effects, str(name), None)
+        if not (isinstance(cls, type) and issubclass(cls, js.effects.AbstractEffect)):
             raise ValueError(f"unknown effect {name!r} in the identify result.")
         try:
             effects.append(cls())
@@ -235,7 +235,7 @@ def model_from_report(report: dict):
         raise ValueError(f"the {name} result has effect parameters "
                          f"({', '.join(k for k in values if '.' in k)}) but no 'effects'.")
     if own_vessel or name in js.VESSELS:
-        base = vessel_from_dict(_finite(report["vessel"])) if own_vessel else js.vessel(name)
+        base = vessel_from_dict(_finite(report["vessel"])) if own_vessel else js.get_vessel(name)
         return _set_values(_with_effects(base, effects), values, name)
     cls = getattr(js, str(report.get("model_class", "")), None)
     if not (isinstance(cls, type) and issubclass(cls, js.AbstractSteeringModel)):

@@ -11,7 +11,7 @@ import numpy as np
 
 import jaxship as js
 
-from ..._models._armax_model import ARMAXModel, simulate_armax
+from ... import ARMAXModel
 
 
 def simulate_records(model, dataset: js.Dataset, rudder: str, channels=("psi", "r"),
@@ -49,7 +49,7 @@ def simulate_armax_records(model: ARMAXModel, dataset: js.Dataset, rudder: str,
     valid = np.arange(dataset.num_samples)[None, :] < lengths[:, None]
     r_measured = np.asarray(dataset.r, dtype=np.float64)
     rudder_values = np.asarray(getattr(dataset, rudder), dtype=np.float64)
-    r = simulate_armax(model, np.where(valid, rudder_values, 0.0), r_measured[:, 0])
+    r = model.response(np.where(valid, rudder_values, 0.0), r_measured[:, 0])
     dt = np.asarray(dataset.dt, dtype=np.float64)[:, None]
     steps = 0.5 * dt * (r[:, 1:] + r[:, :-1])
     psi = np.asarray(dataset.psi, dtype=np.float64)[:, :1] + np.concatenate(

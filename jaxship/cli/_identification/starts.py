@@ -12,7 +12,6 @@ import equinox as eqx
 import numpy as np
 
 import jaxship as js
-from jaxship._estimate._linear import initial_estimate
 
 from .data import mean_valid, rms, valid_samples
 
@@ -50,7 +49,7 @@ def neutral_nomoto1(train: js.Dataset, rudder: str = "delta") -> js.Nomoto1:
 
 
 def start_nomoto1(train: js.Dataset, context: StartContext) -> js.Nomoto1:
-    return initial_estimate(js.Nomoto1(K=1.0, T=1.0), train, rudder=context.rudder)
+    return js.LinearStart()(js.Nomoto1(K=1.0, T=1.0), train, None, context.rudder)
 
 
 def fallback_nomoto1(train: js.Dataset, context: StartContext) -> js.Nomoto1:
@@ -78,7 +77,7 @@ def fallback_nomoto2(train: js.Dataset, context: StartContext) -> js.Nomoto2:
 
 
 def _linear_nonlinear(train: js.Dataset, context: StartContext, why: str) -> js.NonlinearNomoto:
-    first = initial_estimate(js.Nomoto1(K=1.0, T=1.0), train, rudder=context.rudder)
+    first = js.LinearStart()(js.Nomoto1(K=1.0, T=1.0), train, None, context.rudder)
     context.note(f"nonlinear Nomoto start: {why}; started from the linear Nomoto1 "
                  "least-squares K, T with n3 = 0 instead.")
     return js.NonlinearNomoto(K=first.K, T=first.T, n3=0.0)
@@ -95,12 +94,12 @@ def start_nonlinear(train: js.Dataset, context: StartContext) -> js.NonlinearNom
     first failed on $T \\le 0$; when both fail, on the regressors (no excitation), and
     the first error is raised."""
     try:
-        start = initial_estimate(js.NonlinearNomoto(K=1.0, T=1.0, n1=1.0), train,
-                                    rudder=context.rudder)
+        start = js.LinearStart()(js.NonlinearNomoto(K=1.0, T=1.0, n1=1.0), train, None,
+                                 context.rudder)
     except ValueError as error:
         try:
-            start = initial_estimate(js.NonlinearNomoto(K=1.0, T=1.0, n1=-1.0), train,
-                                        rudder=context.rudder)
+            start = js.LinearStart()(js.NonlinearNomoto(K=1.0, T=1.0, n1=-1.0), train, None,
+                                     context.rudder)
         except ValueError:
             raise error from None
         if not start.n3 > 0:
@@ -152,7 +151,7 @@ def start_ross(train: js.Dataset, context: StartContext) -> js.RossAutopilot:
     context.note("RossAutopilot reference scales (frozen): L = {length:.6g} m, U0 = {speed:.6g} "
                  "m/s, n0 = {rate:.6g} rev/s; the estimates are the scaled coefficients a of "
                  "these (RossAutopilot.dimensional() converts them).".format(**scales))
-    return initial_estimate(js.RossAutopilot(**scales), train, rudder=context.rudder)
+    return js.LinearStart()(js.RossAutopilot(**scales), train, None, context.rudder)
 
 
 def fallback_ross(train: js.Dataset, context: StartContext) -> js.RossAutopilot:
@@ -180,12 +179,12 @@ def _sway_yaw_start(model, train: js.Dataset, context: StartContext, preset: str
 
 
 def start_linear_sway_yaw(train: js.Dataset, context: StartContext) -> js.LinearSwayYaw:
-    return _sway_yaw_start(js.LinearSwayYaw.from_vessel(js.vessel("sea_stratus_linear")), train,
+    return _sway_yaw_start(js.LinearSwayYaw.from_vessel(js.get_vessel("sea_stratus_linear")), train,
                            context, "sea_stratus_linear")
 
 
 def start_norrbin(train: js.Dataset, context: StartContext) -> js.NorrbinCrossFlow:
-    return _sway_yaw_start(js.NorrbinCrossFlow.from_vessel(js.vessel("sea_stratus_nonlinear")),
+    return _sway_yaw_start(js.NorrbinCrossFlow.from_vessel(js.get_vessel("sea_stratus_nonlinear")),
                            train, context, "sea_stratus_nonlinear")
 
 

@@ -23,8 +23,8 @@ import numpy as np
 
 import jaxship as js
 
+from ... import Progress
 from ..._foundation._params import parameter_fields
-from ..._foundation._progress import Progress
 from .assessment import assess
 from .data import (
     as_experiments,

@@ -3,7 +3,7 @@ seed 000, chapter 4) on the built-in thesis vessel.
 
 The experiment design of sec. 4.1 (turning circles at 5, 10, 20 and 40 deg, zig-zags
 5/5 to 40/40 and the thesis manoeuvre, each at 200 and 500 rpm) is simulated with
-`jaxship.vessel("thesis")`, measurement noise is added (`NOISE`), and three
+`jaxship.get_vessel("thesis")`, measurement noise is added (`NOISE`), and three
 response models are identified by prediction-error minimisation:
 
 - `Nomoto1` (thesis eq. 3.2-3.3; K and T),
@@ -33,7 +33,6 @@ import math
 import numpy as np
 
 import jaxship as js
-from jaxship._estimate._linear import initial_estimate
 from jaxship.cli._trials import initial_state
 
 
@@ -127,7 +126,7 @@ def simulate_design(vessel=None, *, families=None, settings: Settings = Settings
     manoeuvre, Trajectory)}` in the order of `families` (trials) and `RPMS`, at half the
     sample interval `settings.dt` (the trials of `jaxship reproduce`). `progress`: a
     callable taking the record name before each simulation, or None."""
-    vessel = js.vessel("thesis") if vessel is None else vessel
+    vessel = js.get_vessel("thesis") if vessel is None else vessel
     families = FAMILIES if families is None else families
     out = {}
     simulator = js.Simulator(substeps=2)
@@ -248,21 +247,23 @@ def identify(model_name, records, vessel, *, settings: Settings = Settings(), no
     """
     pe, oe = _estimators(settings)
     if nomoto is None or model_name == "nomoto":
-        nomoto = initial_estimate(js.Nomoto1(K=0.1, T=5.0), records)
+        nomoto = js.LinearStart()(js.Nomoto1(K=0.1, T=5.0), records, None, "delta")
         nomoto = js.fit(nomoto, records, free=("K", "T"), estimator=pe).model
     if model_name == "nomoto":
         if not settings.output_error:
             return js.fit(nomoto, records, free=("K", "T"), estimator=pe)
         return js.fit(nomoto, records, free=("K", "T"), estimator=oe)
-    free = js.ROSS_FREE if model_name == "ross" else js.SPEED_RUDDER
+    free = js.default_free(js.RossAutopilot())  # Ross' hull terms and his rudder term
+    if model_name != "ross":  # and the speed-dependent rudder (RossAutopilot's docstring)
+        free += ("n_delta_nn", "n_delta3", "n_delta3_nn")
     scales = reference_scales(vessel)
     if model_name == "ross_speed_rudder" and base is not None:
         starts = [base]
     else:
         starts = [nomoto_start(nomoto, scales)]
         try:
-            starts.append(initial_estimate(js.RossAutopilot(**scales), records, free=free,
-                                                span=settings.span))
+            starts.append(js.LinearStart(span=settings.span)(js.RossAutopilot(**scales),
+                                                             records, free, "delta"))
         except ValueError:  # singular regression: the Nomoto start only
             pass
     stages = [r for r in (_safe_fit(m, records, free, pe) for m in starts) if r is not None]
@@ -295,7 +296,7 @@ def identification_study(vessel=None, *, quick=False, settings: Settings = Setti
     `models` (a subset of `MODELS`, in order; "ross_speed_rudder" starts from "ross")
     and `cases` ("single", "merged") narrow the study (`jaxship reproduce --quick`).
     """
-    vessel = js.vessel("thesis") if vessel is None else vessel
+    vessel = js.get_vessel("thesis") if vessel is None else vessel
     if families is None:
         families = QUICK_FAMILIES if quick else FAMILIES
     if experiments is None:

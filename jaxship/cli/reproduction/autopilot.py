@@ -4,11 +4,11 @@ on a vessel: the backend of `jaxship autopilot`, and of each run of the thesis' 
 
 **Chapter 5.** The steering models of chapter 4 identified from the merged experiments
 (200 + 500 rpm) of each family (turning circles, zig-zags, the thesis manoeuvre;
-`jaxship.cli._studies.thesis`) each give a PID autopilot by pole placement (eq. 5.3-5.5)
+`jaxship.cli.reproduction.thesis`) each give a PID autopilot by pole placement (eq. 5.3-5.5)
 and a reference feed-forward (eq. 5.2 for Nomoto, eq. 5.6 for Ross), driven by the
 third-order reference model of Table 5.1 (45 deg step at 100 s, damping 1.0,
 natural frequency 0.2 rad/s). Each autopilot steers the *true* thesis vessel
-(`jaxship.vessel("thesis")`, rudder 45 deg and 15 deg/s through its servo) at 300
+(`jaxship.get_vessel("thesis")`, rudder 45 deg and 15 deg/s through its servo) at 300
 and 400 rpm, with feed-forward (`"pid+ff"`, the thesis' controller) and without
 (`"pid"`). The score is the thesis' closed-loop residual, eq. 3.19,
 $\\sum_k|\\psi_d(t_k) - \\psi(t_k)|$ in degrees, **sampled every 1 s over 100-200 s**

@@ -43,7 +43,7 @@ def merged_models(vessel=None, *, quick: bool = False,
     `thesis.identification_study`) but without its single-experiment fits: a dict
     like that study's (`models` keyed `"merged/<model>/<family>"`, `table` rows with
     the pooled simulation fit % `fit_family`)."""
-    vessel = js.vessel("thesis") if vessel is None else vessel
+    vessel = js.get_vessel("thesis") if vessel is None else vessel
     families = thesis.QUICK_FAMILIES if quick else thesis.FAMILIES
     if experiments is None:
         experiments = thesis.thesis_experiments(vessel, families=families, settings=settings)
@@ -67,7 +67,7 @@ def merged_models(vessel=None, *, quick: bool = False,
 def autopilot_study(vessel=None, *, identification=None, quick: bool = False,
                     settings: thesis.Settings = thesis.Settings(), design: Design = Design(),
                     rpms=RPMS, models=MODELS, progress=None) -> dict:
-    """Thesis chapter 5 on `vessel` (default `jaxship.vessel("thesis")`).
+    """Thesis chapter 5 on `vessel` (default `jaxship.get_vessel("thesis")`).
 
     - `identification`: the chapter-4 study (`thesis.identification_study`, e.g. from
       `jaxship reproduce`) whose merged models are reused; None: `merged_models`
@@ -82,7 +82,7 @@ def autopilot_study(vessel=None, *, identification=None, quick: bool = False,
     {"<model>/<family>": gains}, `goals`, `design`, `rpms`, and `evaluations` (the
     `Evaluation` objects, with the closed-loop runs; not JSON: see `to_json`).
     """
-    vessel = js.vessel("thesis") if vessel is None else vessel
+    vessel = js.get_vessel("thesis") if vessel is None else vessel
     say = progress or (lambda message: None)
     if identification is None:
         identification = merged_models(vessel, quick=quick, settings=settings, models=models,

@@ -19,8 +19,7 @@ import equinox as eqx
 import numpy as np
 
 import jaxship as js
-from jaxship._estimate._discrete import fit_discrete_response
-from jaxship.cli._trials import initial_state
+from jaxship import fit_discrete_response
 
 
 DEG = np.pi / 180.0
@@ -38,7 +37,8 @@ def _overshoots(t, psi, delta, switch):
     """First and second overshoot [rad]; NaN where the model never completes them
     (e.g. a fitted gain too small to reach the switch heading)."""
     try:
-        zz = js.zigzag_indices(t=np.asarray(t), psi=np.asarray(psi), delta=np.asarray(delta),
+        zz = js.indices.zigzag_indices(t=np.asarray(t), psi=np.asarray(psi),
+                                       delta=np.asarray(delta),
                             heading_switch=switch)
     except ValueError:
         return np.nan, np.nan
@@ -94,8 +94,8 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
     `"consistency"` (the Tables 2-4 quantities per model),
     `"generalisation"` {(structure, method): {trial: fit % of r}} and the records.
     """
-    v = js.vessel(vessel) if isinstance(vessel, str) else vessel
-    x0 = initial_state(v, rpm=rpm)
+    v = js.get_vessel(vessel) if isinstance(vessel, str) else vessel
+    x0 = js.straight_run(v, n=None if rpm is None else rpm / 60.0)  # nominal if None
     tau = float(v.length) / float(x0.u)
     duration = duration_lengths * tau
     rate = float(v.rudder.max_rate)
@@ -160,8 +160,8 @@ def design_study(vessel="thesis", *, rpm=500.0, dt=0.5, noise_r=0.05 * DEG, dura
 
     **Returns** `{"nominal": {...}, "reports": {(model, manoeuvre): DesignReport}}`.
     """
-    v = js.vessel(vessel) if isinstance(vessel, str) else vessel
-    x0 = initial_state(v, rpm=rpm)
+    v = js.get_vessel(vessel) if isinstance(vessel, str) else vessel
+    x0 = js.straight_run(v, n=None if rpm is None else rpm / 60.0)  # nominal if None
     thesis = js.thesis_manoeuvre(dt=dt)
     duration = float(thesis.duration) if duration is None else float(duration)
     rate = float(v.rudder.max_rate)

@@ -4,15 +4,15 @@ thesis vessel, written up as `report.md` with the thesis' numbers beside ours.
 1. **Trials** (thesis sec. 4.1): turning circles at 5, 10, 20 and 40 deg, zig-zags 5/5
    to 40/40 and the thesis manoeuvre, each at 200 and 500 rpm (`trials/*.csv`,
    `indices.json`), with what the thesis' figs. 4.2-4.7 state about them.
-2. **Identification** (chapter 4, `jaxship.cli._studies.thesis`): Nomoto and Ross models from
+2. **Identification** (chapter 4, `jaxship.cli.reproduction.thesis`): Nomoto and Ross models from
    the single 40 deg / 500 rpm record of each family and from the merged records
    (200 + 500 rpm) of each family; their yaw-rate fit % next to the fit % in the
    legends of the thesis' figs. 4.8-4.30 (`identification.json`).
-3. **Heading autopilot** (chapter 5, `jaxship.cli._studies.autopilot_thesis`): a PID with reference
-   feed-forward from each merged model, run on the vessel at 300 and 400 rpm; our
-   residuals next to the thesis' Tables 5.2-5.7 (`autopilot.json`).
+3. **Heading autopilot** (chapter 5, `jaxship.cli.reproduction.autopilot_thesis`): a PID
+   with reference feed-forward from each merged model, run on the vessel at 300 and 400 rpm;
+   our residuals next to the thesis' Tables 5.2-5.7 (`autopilot.json`).
 4. **Discovery** (`jaxship.discover`): a synthetic Nomoto case with cubic yaw damping
-   hidden, as the discovery tests use it (`jaxship.cli._studies.discovery`;
+   hidden, as the discovery tests use it (`jaxship.cli.reproduction.discovery_case`;
    `discovery.json`).
 
 The trials are those of chapter 4's experiment design (`thesis.simulate_design`), so
@@ -39,13 +39,14 @@ from multiprocessing import resource_tracker
 
 import jax
 import numpy as np
-from tqdm.auto import tqdm
+from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
 
 import jaxship as js
-from jaxship._foundation._files import staged_folder
 from jaxship.cli._trials import trial_indices
 
-from . import autopilot_thesis as chapter5, discovery, thesis
+from .._files import staged_folder
+from . import autopilot_thesis as chapter5, thesis
+from .discovery_case import hidden_effect_records
 from .reproduce_report import (
     DISCOVERY_HIDDEN,
     DISCOVERY_SEED,
@@ -128,7 +129,7 @@ def _run(out, quick, progress, identification, closed_loop, discover, parallel) 
     load = os.getloadavg()[0] if sys.platform != "win32" else None
     began, cpu0 = time.perf_counter(), time.process_time()
     timings, cpu, results, sections = {}, {}, {}, []
-    vessel = js.vessel("thesis")
+    vessel = js.get_vessel("thesis")
     families = QUICK_FAMILIES if quick else thesis.FAMILIES
 
     def stage_done(name, clock):
@@ -269,9 +270,9 @@ def _discovery(quick, out, say=None) -> dict:
     say = say or (lambda message: None)
     clock, cpu = time.perf_counter(), time.process_time()
     base = js.Nomoto1(K=0.06, T=25.0)  # as `discovery.run_case`
-    hidden = js.YawCubicDamping(beta=DISCOVERY_HIDDEN)
+    hidden = js.effects.YawCubicDamping(beta=DISCOVERY_HIDDEN)
     say("simulating the records")
-    train, holdout = discovery.hidden_effect_records(js.augment(base, hidden), DISCOVERY_SEED)
+    train, holdout = hidden_effect_records(js.augment(base, hidden), DISCOVERY_SEED)
     report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout,
                          max_effects=1 if quick else 3, progress=say)
     say("drawing the held-out records")

@@ -1,6 +1,6 @@
 """The pages of `jaxship reproduce`: what the thesis states next to our numbers, the
 sentences that explain the differences, the sections of `report.md` and their figures
-(`jaxship.cli._studies.reproduce` runs the study and calls these)."""
+(`jaxship.cli.reproduction.reproduce` runs the study and calls these)."""
 
 
 import matplotlib.pyplot as plt
@@ -148,7 +148,7 @@ def header(run, quick, per_rate, stages):
     }
     return (
         "# jaxship reproduce: Odegard (2009) on the built-in thesis vessel\n\n"
-        "On `jaxship.vessel(\"thesis\")` (the 4 m model of the thesis' Table 4.1, with "
+        "On `jaxship.get_vessel(\"thesis\")` (the 4 m model of the thesis' Table 4.1, with "
         "coefficients derived in docs/thesis_vessel.md because the thesis' are not "
         f"published), this run {'; '.join(done[s] for s in stages)}. "
         + ("Quick design (`--quick`): the 40 deg trial of each family (3 per rate), only the "
@@ -508,7 +508,8 @@ def discovery_section(data):
              f"{case['truth']}; the cubic yaw damping is hidden from the start model "
              f"({case['start']}). Training records: {', '.join(case['train'])}; held out: "
              f"{', '.join(case['holdout'])} (rudder rate 2.3 deg/s, noise: heading 0.1 deg, "
-             f"yaw rate 0.05 deg/s; `jaxship.cli._studies.discovery`, seed {case['seed']}). "
+             f"yaw rate 0.05 deg/s; `jaxship.cli.reproduction.discovery_case`, "
+             f"seed {case['seed']}). "
              f"`jaxship.discover` with at most {case['max_effects']} effect(s) took "
              f"{case['seconds']:.0f} s.\n"]
     if named:

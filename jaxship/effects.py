@@ -1,0 +1,84 @@
+"""The effects of the effect seam (docs/architecture.md): `jaxship.augment(model,
+*effects)` adds them to any vessel or steering model, and an effect is exactly the base
+model when its parameters are zero. A new effect derives from the small abstract class
+of each place it acts on (`AbstractRudderEffect`, `AbstractLoadEffect`,
+`AbstractYawTermEffect`, `AbstractVesselPropertyEffect`, `AbstractSensorEffect`).
+
+    import jaxship as js
+    model = js.augment(js.Nomoto1(K=0.06, T=25.0), js.effects.RudderOffset(delta0=0.01))
+"""
+
+from ._models._effects import (
+    AbstractEffect as AbstractEffect,
+    AbstractLoadEffect as AbstractLoadEffect,
+    AbstractRudderEffect as AbstractRudderEffect,
+    AbstractSensorEffect as AbstractSensorEffect,
+    AbstractVesselPropertyEffect as AbstractVesselPropertyEffect,
+    AbstractYawTermEffect as AbstractYawTermEffect,
+    AugmentedSteering as AugmentedSteering,
+    AugmentedVessel as AugmentedVessel,
+    HeadingSensorBias as HeadingSensorBias,
+    RecordedDisturbance as RecordedDisturbance,
+    RudderDelay as RudderDelay,
+    RudderLag as RudderLag,
+    RudderOffset as RudderOffset,
+    RudderRateLimit as RudderRateLimit,
+    SwayForceBias as SwayForceBias,
+    YawCubicDamping as YawCubicDamping,
+    YawMomentBias as YawMomentBias,
+    YawRateSensorBias as YawRateSensorBias,
+    nonlinear_nomoto2 as nonlinear_nomoto2,
+)
+from ._models._hydro_effects import (
+    AddedMassError as AddedMassError,
+    ApparentWind as ApparentWind,
+    CrossflowDrag as CrossflowDrag,
+    PropellerAsymmetry as PropellerAsymmetry,
+    PropellerRace as PropellerRace,
+    RudderStall as RudderStall,
+    SpeedDependentDamping as SpeedDependentDamping,
+    SpeedDependentRudder as SpeedDependentRudder,
+    SurgeTurnResistance as SurgeTurnResistance,
+    UniformCurrent as UniformCurrent,
+    Windage as Windage,
+    YawQuadraticDamping as YawQuadraticDamping,
+)
+
+
+__all__ = [
+    # the seam: the base class, the places an effect acts on, the augmented models
+    "AbstractEffect",
+    "AbstractRudderEffect",
+    "AbstractLoadEffect",
+    "AbstractYawTermEffect",
+    "AbstractVesselPropertyEffect",
+    "AbstractSensorEffect",
+    "AugmentedVessel",
+    "AugmentedSteering",
+    # rudder and sensors
+    "RudderOffset",
+    "RudderLag",
+    "RudderDelay",
+    "RudderRateLimit",
+    "HeadingSensorBias",
+    "YawRateSensorBias",
+    # loads and yaw terms
+    "YawMomentBias",
+    "SwayForceBias",
+    "YawCubicDamping",
+    "YawQuadraticDamping",
+    "nonlinear_nomoto2",
+    "SpeedDependentDamping",
+    "SpeedDependentRudder",
+    "RudderStall",
+    "PropellerRace",
+    "PropellerAsymmetry",
+    "CrossflowDrag",
+    "SurgeTurnResistance",
+    "AddedMassError",
+    # environment
+    "UniformCurrent",
+    "ApparentWind",
+    "Windage",
+    "RecordedDisturbance",
+]

@@ -1,0 +1,36 @@
+"""Manoeuvre indices (ITTC) and the IMO criteria (MSC.137(76)) of a simulated or
+measured `Trajectory`, in SI units and radians:
+
+    import jaxship as js
+    traj = js.simulate(js.get_vessel("mariner"), js.Turn(0.61, duration=600.0, dt=0.5))
+    js.indices.turning_indices(traj).tactical_diameter
+
+`batch_turning_indices` is the jittable form for `simulate_batch(..., output=)`.
+"""
+
+from ._analysis._indices import (
+    format_table as format_table,
+    imo_criteria as imo_criteria,
+    initial_turning_indices as initial_turning_indices,
+    pull_out_indices as pull_out_indices,
+    reverse_spiral_curve as reverse_spiral_curve,
+    spiral_curve as spiral_curve,
+    stopping_indices as stopping_indices,
+    turning_indices as turning_indices,
+    zigzag_indices as zigzag_indices,
+)
+from ._simulation._batch import batch_turning_indices as batch_turning_indices
+
+
+__all__ = [
+    "turning_indices",
+    "initial_turning_indices",
+    "zigzag_indices",
+    "pull_out_indices",
+    "spiral_curve",
+    "reverse_spiral_curve",
+    "stopping_indices",
+    "imo_criteria",
+    "format_table",
+    "batch_turning_indices",
+]
