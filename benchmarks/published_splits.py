@@ -105,7 +105,7 @@ class Reader:
         return found[0]
 
     def runs(self, names) -> list:
-        return [js.read_esso_osaka(self.path(n)) for n in names]
+        return [js.read_measured(self.path(n)) for n in names]
 
 
 def lab(wind: str):

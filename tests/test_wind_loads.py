@@ -128,7 +128,7 @@ def test_the_equations_of_motion_use_the_vessels_wind_model():
                         (0.02, 0.01, 0.4))
     command = js.Command(0.1, 10.0)
     wind = js.Wind(speed=1.5, direction=2.0)
-    windage = js.Windage(frontal_area=0.02, lateral_area=0.1)
+    windage = js.effects.Windage(frontal_area=0.02, lateral_area=0.1)
     for a, b in ((generic, lab), (js.augment(generic, windage), js.augment(lab, windage))):
         calm = [js.state_derivative(m, state, command, js.Environment()) for m in (a, b)]
         assert all(float(getattr(calm[0], c)) == float(getattr(calm[1], c)) for c in "uvr")
