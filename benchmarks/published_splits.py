@@ -10,7 +10,8 @@ Run: python benchmarks/published_splits.py [--select-only] [--sets Train-R ...]
    from: `jaxship identify` on three of its four runs, a free simulation of the fourth
    (`free_run_score`, 10 Hz), the r RMSE divided by the lab simulator's on that run,
    averaged over the four folds. A coordinate search starts from the command's settings
-   and tries each factor's values in turn, keeping the best. Every candidate's score is
+   and tries each factor's values in turn, keeping the best, pass after pass until a
+   pass changes nothing. Every candidate's score is
    printed; the run reader refuses every test run's name while this runs (`Reader`).
 2. **Headline** (`headline`). `jaxship identify --model esso_osaka` with no option (its
    defaults are the selection: `jaxship.VESSELS["esso_osaka"].fit_settings`, checked
@@ -31,6 +32,7 @@ no model fed these logs can follow them.
 import argparse
 import contextlib
 import dataclasses
+import io
 import json
 import pathlib
 import sys
@@ -139,9 +141,11 @@ def identify(reader, names, setting=None, *, workdir) -> object:
                  "--sample-interval", f"{setting['sample_interval']:g}", "--free", free]
         out = out / "fit"
         argv[argv.index("--out") + 1] = str(out)
-    code = jaxship.cli.main(argv)
+    with contextlib.redirect_stdout(io.StringIO()) as said, \
+            contextlib.redirect_stderr(said):  # the command's report: kept for an error
+        code = jaxship.cli.main(argv)
     if code not in (0, 3):
-        raise RuntimeError(f"jaxship {' '.join(argv)} exited {code}")
+        raise RuntimeError(f"jaxship {' '.join(argv)} exited {code}:\n{said.getvalue()}")
     return js.load_vessel(out / "vessel.toml"), code
 
 
@@ -187,13 +191,15 @@ def select(reader, names, *, workdir, say, known=None, evaluate=cv_score) -> dic
                 tried.append({"setting": dict(setting), "setting_key": k, **known[k]})
             return known[k]["score"]
 
-        best_score = score(best)
-        for factor, values in FACTORS.items():
-            for value in values:
-                candidate = {**best, factor: value}
-                s = score(candidate)
-                if s < best_score:
-                    best, best_score = candidate, s
+        best_score, previous = score(best), None
+        while best != previous:  # passes over the factors until none changes
+            previous = best
+            for factor, values in FACTORS.items():
+                for value in values:
+                    candidate = {**best, factor: value}
+                    s = score(candidate)
+                    if s < best_score:
+                        best, best_score = candidate, s
     return {"training_set": list(SELECTION_SET), "runs": list(names), "chosen": best,
             "score": best_score, "candidates": tried}
 
@@ -287,10 +293,10 @@ def tables(results) -> str:
                              f"{s['position_final']:.1f} | {s['r_fit']:.1f} |")
         if paper == SELECTION_SET[0] and "discover" in results:
             d = results["discover"]
-            lines.append(f"\n`discover` on {', '.join(d['train'])}, {d['held_out'][0]} held "
-                         f"out: {d['verdict']}; named {', '.join(d['named']) or 'nothing'}; "
-                         f"held-out cost {d['holdout_cost_before']:.4g} -> "
-                         f"{d['holdout_cost_after']:.4g}.")
+            lines.append(f"\n`discover` trained on {', '.join(d['train'])}, with "
+                         f"{d['held_out'][0]} held out for its checks: {d['verdict']}, "
+                         f"named {', '.join(d['named']) or 'nothing'}; held-out cost "
+                         f"{d['holdout_cost_before']:.4g} -> {d['holdout_cost_after']:.4g}.")
         for name, g in block["goals"].items():
             worse = "; ".join(f"{m} worse than the lab on {', '.join(runs)}"
                               for m, runs in g["worse_than_lab"].items() if runs) or "none worse"
@@ -357,8 +363,8 @@ def main(argv=None):
         results["headline"] = headline(reader, workdir=workdir, say=say)
         if args.discover:
             results["discover"], model = discovered(reader, say=say)
-            label = "Train-R + discover (" + (" + ".join(results["discover"]["named"])
-                                              or "nothing") + ")"
+        if args.discover and results["discover"]["named"]:  # a column for what it adds
+            label = "Train-R + discover (" + " + ".join(results["discover"]["named"]) + ")"
             block = results["headline"][SELECTION_SET[0]]
             test = reader.runs(block["test"])
             block["columns"][label] = scores(model, test)

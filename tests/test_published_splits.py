@@ -125,8 +125,8 @@ def test_the_presets_defaults_are_the_recorded_selection():
     assert settings.sample_interval == chosen["sample_interval"]
     extra = () if chosen["free"] == "default" else protocol.EXTRA_FREE
     assert settings.free == js.default_free(js.get_vessel("esso_osaka")) + extra
-    preset_wind = {js.FossenWindLoads: "jaxship", js.FujiwaraWindLoads: "fujiwara"}
-    assert preset_wind[type(js.get_vessel("esso_osaka").wind_model)] == chosen["wind"]
+    wind = {"jaxship": None, "fujiwara": js.FujiwaraWindLoads.esso_osaka()}[chosen["wind"]]
+    assert settings.wind_model == wind
     assert results["selection"]["training_set"] == ["Miyauchi 2022", "Train-R"]
 
 
@@ -166,3 +166,41 @@ def test_the_labs_simulator_scores_as_the_owner_measured_it():
     np.testing.assert_allclose(r_rmse["fujiwara"], [0.81, 0.87, 0.77], atol=0.01)
     np.testing.assert_allclose(r_rmse["generic"], [0.58, 0.57, 0.63], atol=0.01)
     assert all(f > g for f, g in zip(r_rmse["fujiwara"], r_rmse["generic"]))
+
+
+@needs_esso
+def test_identify_takes_the_presets_chosen_settings(tmp_path, monkeypatch, capsys):
+    """`jaxship identify --model esso_osaka` with no option fits with the preset's
+    `fit_settings` (horizon, free set, wind loads, sample interval: the records reach
+    the fit resampled); an option given wins, and `--free +name` adds to the set."""
+    import jaxship.cli.identify as command
+    from jaxship.cli import main
+
+    seen = {}
+
+    def fake_identify(train, **kwargs):
+        seen.update(kwargs, train=train)
+        raise StopBeforeFit  # stop before any fit
+
+    monkeypatch.setattr(command, "identify", fake_identify)
+    run = protocol.Reader().path(protocol.SPLITS["Miyauchi 2022"]["Train-R"][0])
+    settings = js.VESSELS["esso_osaka"].fit_settings
+    args = ["identify", str(run), "--model", "esso_osaka", "--out", str(tmp_path / "o"),
+            "--no-figures", "--quiet"]
+    with pytest.raises(StopBeforeFit):
+        main(args)
+    assert seen["horizon"] == settings.horizon and seen["free"] == settings.free
+    assert seen["start"].wind_model == settings.wind_model
+    dt = np.diff(seen["train"][0].t)
+    assert np.allclose(dt, settings.sample_interval)
+    with pytest.raises(StopBeforeFit):
+        main(args + ["--horizon", "10", "--free", "+k_x_reverse"])
+    assert seen["horizon"] == 10.0 and seen["free"] == settings.free + ("k_x_reverse",)
+    with pytest.raises(StopBeforeFit):
+        main(args + ["--free", "y_v,n_r"])
+    assert seen["free"] == ("y_v", "n_r")
+
+
+
+class StopBeforeFit(Exception):
+    """Raised by a stand-in for the fit: the command's choices are made by then."""

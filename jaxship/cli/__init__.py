@@ -15,9 +15,6 @@ import warnings
 import jax
 import matplotlib
 
-
-matplotlib.use("Agg")  # the command writes files; it never opens a window
-
 from .. import FitError, __version__, enable_compilation_cache  # noqa: E402
 from . import autopilot, discover, identify, reproduce, simulate, vessels  # noqa: E402
 from ._common import one_line  # noqa: E402
@@ -126,6 +123,9 @@ def run() -> None:
     inside a garbage-collection callback is swallowed, a watchdog ends the process
     `GRACE` seconds after the signal whatever the main thread is doing. Results are
     committed whole or not at all (`staged_folder`), so ending there loses nothing."""
+    # the command writes files and never opens a window; set here, not on import, so a
+    # notebook that calls `main` keeps its own backend (its inline figures)
+    matplotlib.use("Agg")
     _listen_for_interrupts()
     for signum in ENDINGS:
         signal.signal(signum, _interrupt)

@@ -6,6 +6,8 @@ import math
 import pathlib
 import sys
 
+import equinox as eqx
+
 import jaxship as js
 
 from .. import VESSELS
@@ -97,10 +99,17 @@ def _free(text, default):
     return None if default is None else tuple(dict.fromkeys(default + names))
 
 
+def _preset_fit_settings(name, args):
+    """The `fit_settings` of the preset `name` when the fit starts from the preset itself
+    (`--model NAME` or `--vessel NAME`, not a file or an earlier result), else None."""
+    given = args.model if args.vessel is None else args.vessel.strip().lower().replace("-", "_")
+    return VESSELS[name].fit_settings if name in VESSELS and given == name else None
+
+
 def preset_settings(name, args):
     """`(horizon, sample_interval, free, note)`: the options given, else the preset's
     `fit_settings` (a protocol's choice) where `name` is a preset that has them."""
-    settings = VESSELS[name].fit_settings if name in VESSELS else None
+    settings = _preset_fit_settings(name, args)
     horizon = _horizon(args.horizon) if args.horizon is not None or settings is None \
         else settings.horizon
     sample_interval = args.sample_interval if args.sample_interval is not None \
@@ -114,6 +123,8 @@ def preset_settings(name, args):
             (args.horizon, f"--horizon {settings.horizon:g}"),
             (args.sample_interval, f"--sample-interval {settings.sample_interval:g}"),
             (args.free, "--free " + ",".join(settings.free))) if given is None]
+    if settings is not None and settings.wind_model is not None:
+        used.append(f"wind loads {type(settings.wind_model).__name__}")
     note = None if not used else (f"the {name} preset's settings: {'; '.join(used)} "
                                   f"({settings.source}).")
     return horizon, sample_interval, free, note
@@ -135,6 +146,9 @@ def run(args) -> int:
     # every check before the fit; the files appear in --out only when all are written
     name, start = start_model(args.model, args.vessel)  # unknown ones fail before any file
     horizon, sample_interval, free, settings_note = preset_settings(name, args)
+    settings = _preset_fit_settings(name, args)
+    if settings is not None and settings.wind_model is not None:  # the chosen wind loads
+        start = eqx.tree_at(lambda v: v.wind_model, js.get_vessel(name), settings.wind_model)
     if args.max_steps < 1:
         raise ValueError(f"--max-steps {args.max_steps}: give a positive number of optimiser "
                          "steps (default 256).")

@@ -3,18 +3,21 @@
 import dataclasses
 from collections.abc import Callable
 
+from .._fujiwara_wind import FujiwaraWindLoads
 from . import esso_osaka, mariner, mmg, nomoto, ross, sway_yaw
 
 
 @dataclasses.dataclass(frozen=True)
 class FitSettings:
     """The settings `jaxship identify --model <preset>` uses when none is given: the
-    prediction `horizon` [s], the records' `sample_interval` [s] and the `free`
-    coefficients, as a protocol on training runs only chose them (`source`)."""
+    prediction `horizon` [s], the records' `sample_interval` [s], the `free`
+    coefficients and the `wind_model` the fit starts with (None: the preset's own), as a
+    protocol on training runs only chose them (`source`)."""
 
     horizon: float | None
     sample_interval: float | None
     free: tuple[str, ...]
+    wind_model: object
     source: str
 
 
@@ -39,6 +42,7 @@ ESSO_OSAKA_FIT = FitSettings(
     horizon=30.0, sample_interval=1.0,
     free=("x_0f", "y_v", "y_r", "n_v", "n_r", "c_d", "c_ry", "c_rn", "epsilon", "gamma_n",
           "gamma_p", "i_zz_j_zz", "k_x"),
+    wind_model=FujiwaraWindLoads.esso_osaka(),  # Fujiwara et al. (1998), the lab's geometry
     source="leave-one-run-out cross-validation on Miyauchi 2022 Train-R, "
            "benchmarks/published_splits.py")
 
