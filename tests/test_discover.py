@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._analysis._discover import _workflow as discover_workflow
+from jaxship._analysis._discover import _search as discover_search
 from jaxship._analysis._discover._holdout import cost_rise, record_indices
 from jaxship._analysis._discover._plausible import rudder_equivalent
 from jaxship._analysis._discover._workflow import heldout_rise
@@ -96,9 +96,9 @@ def test_a_refit_that_fails_numerically_rejects_that_candidate_not_the_run(monke
     on to the next (here the refit of the offset's class fails: the offset and the
     yaw-moment bias tie to rounding, so either may be the one refitted, and its
     class-mate is not refitted in the same iteration, so nothing is named)."""
-    from jaxship._analysis._discover import _workflow
+    from jaxship._analysis._discover import _search
 
-    fit = _workflow.fit
+    fit = _search.fit
     one_class = {"rudder_offset", "yaw_moment_bias"}
 
     def failing(model, *args, **kwargs):
@@ -106,7 +106,7 @@ def test_a_refit_that_fails_numerically_rejects_that_candidate_not_the_run(monke
             raise np.linalg.LinAlgError("SVD did not converge")
         return fit(model, *args, **kwargs)
 
-    monkeypatch.setattr(_workflow, "fit", failing)
+    monkeypatch.setattr(_search, "fit", failing)
     report = run(js.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
     failed = [r for r in report.rejected if r.id in one_class]
     assert failed and failed[0].why == (
@@ -143,9 +143,9 @@ def test_a_candidate_whose_sensitivities_are_not_finite_is_rejected_not_the_run(
     """A candidate whose model blows up in the scoring is rejected with that reason and
     the others are scored (the offset is still named); a score computation that fails
     numerically rejects the iteration's candidates, not the run."""
-    from jaxship._analysis._discover import _workflow
+    from jaxship._analysis._discover import _search
 
-    sensitivities = _workflow.sensitivities
+    sensitivities = _search.sensitivities
 
     def broken(*args, **kwargs):
         sens = sensitivities(*args, **kwargs)
@@ -153,8 +153,9 @@ def test_a_candidate_whose_sensitivities_are_not_finite_is_rejected_not_the_run(
         jac[:, sens.names.index("yaw_cubic_damping.beta")] = np.nan
         return dataclasses.replace(sens, jacobian=jac)
 
-    monkeypatch.setattr(_workflow, "sensitivities", broken)
-    report = run_case((js.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
+    monkeypatch.setattr(_search, "sensitivities", broken)
+    report = run_case((js.RudderOffset(delta0=1.0 * DEG),), 3,
+                      options=js.DiscoveryOptions(max_effects=1))[0]
     assert report.names_or_classes() and "rudder_offset" in report.names_or_classes()[0]
     why = [r.why for r in report.rejected if r.id == "yaw_cubic_damping"]
     assert why and why[0] == ("not scored: its sensitivities at the current fit are not "
@@ -164,9 +165,10 @@ def test_a_candidate_whose_sensitivities_are_not_finite_is_rejected_not_the_run(
     def failing(*args, **kwargs):
         raise np.linalg.LinAlgError("SVD did not converge")
 
-    monkeypatch.setattr(_workflow, "sensitivities", sensitivities)
-    monkeypatch.setattr(_workflow, "score_tests", failing)
-    report = run_case((js.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
+    monkeypatch.setattr(_search, "sensitivities", sensitivities)
+    monkeypatch.setattr(_search, "score_tests", failing)
+    report = run_case((js.RudderOffset(delta0=1.0 * DEG),), 3,
+                      options=js.DiscoveryOptions(max_effects=1))[0]
     assert report.verdict == "nothing_missing" and report.rejected
     assert all(r.why == ("not scored: the scores failed numerically (SVD did not "
                          "converge)",) for r in report.rejected)
@@ -188,7 +190,8 @@ def test_a_held_out_prediction_that_blows_up_rejects_that_candidate(monkeypatch)
         return check(model, *args, **kwargs)
 
     monkeypatch.setattr(_workflow, "holdout_check", blowing_up)
-    report = run_case((js.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
+    report = run_case((js.RudderOffset(delta0=1.0 * DEG),), 3,
+                      options=js.DiscoveryOptions(max_effects=1))[0]
     failed = [r for r in report.rejected if r.id in offset and r.iteration == 1]
     assert failed and failed[0].why == ("a prediction with it is not finite (channel 'r': "
                                         "non-finite values at 12 valid samples.)",)
@@ -325,7 +328,7 @@ def test_an_implausibly_large_constant_moment_is_not_named():
     only = tuple(c for c in js.DISCOVERY_CATALOGUE if c.id == "yaw_moment_bias")
     for angle, named in ((10 * DEG, False), (1 * DEG, True)):
         report = run_case((js.YawMomentBias(n0=K * angle),), 3, catalogue=only,
-                          max_effects=1)[0]
+                          options=js.DiscoveryOptions(max_effects=1))[0]
         assert (report.verdict == "missing_effect") is named, report.to_markdown()
         record = (report.effects or report.rejected)[0]
         assert record.rudder_equivalent_deg == pytest.approx(np.degrees(angle), rel=0.1)
@@ -362,7 +365,7 @@ def test_cubic_damping_is_named_and_closes_the_held_out_gap(monkeypatch):
         scored.append(([type(e) for e in model.effects], tuple(names)))
         return sensitivities(model, dataset, estimator, names, *args, **kwargs)
 
-    monkeypatch.setattr(discover_workflow, "sensitivities", recording)
+    monkeypatch.setattr(discover_search, "sensitivities", recording)
     report = run(js.YawCubicDamping(beta=300.0), seed=4)
     assert report.named == ("yaw_cubic_damping",)
     assert len(scored) == 2 and scored[0] == scored[1]
@@ -611,7 +614,7 @@ def test_an_estimate_pinned_at_its_plausible_bound_is_at_the_edge():
     """A 0.15 rad rudder offset lies beyond RudderOffset's +-0.1 rad range: the fit pins
     the estimate at the bound (the sigmoid leaves it about 1e-6 of the span short),
     which the refit gate reads as at the edge; a 0.05 rad offset is inside."""
-    from jaxship._analysis._discover._workflow import _at_edge
+    from jaxship._analysis._discover._plumbing import at_edge as _at_edge
 
     def fitted(delta0):
         truth = js.augment(js.Nomoto1(K=K, T=25.0), js.RudderOffset(delta0=delta0))
