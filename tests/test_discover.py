@@ -24,11 +24,13 @@ from jaxship._foundation._files import MANIFEST, staged_folder
 from jaxship.cli import main
 from jaxship.cli._studies.discovery import (
     condition_records,
+    covered,
     hidden_effect_records,
     outcome,
     race_records,
     record,
     run_case,
+    run_vessel_case,
     vessel_records,
     wind_records,
 )
@@ -346,6 +348,14 @@ def test_a_rudder_offset_is_named_with_its_class_and_the_gap_shrinks():
     value = next(iter(effect.parameters.values()))
     expected = 0.5 * DEG if effect.id == "rudder_offset" else K * 0.5 * DEG
     assert abs(value.value - expected) < 4 * value.std
+    # its interval: 3 robust standard errors either side, in the page and the JSON
+    assert value.interval == pytest.approx((value.value - 3 * value.std,
+                                            value.value + 3 * value.std))
+    assert value.covers(expected), value
+    assert f"{value.interval[0]:.4g} to {value.interval[1]:.4g}" in report.to_markdown()
+    assert report.to_dict()["effects"][0]["parameters"][effect.id + ".delta0" if
+                                                        effect.id == "rudder_offset" else
+                                                        "yaw_moment_bias.n0"]["interval"]
     assert report.holdout_cost_after < report.holdout_cost_before
     # located: a heading residual of one sign whichever way the ship turns (a bias, not a
     # term odd in r), gone after the offset is added
@@ -375,6 +385,69 @@ def test_cubic_damping_is_named_and_closes_the_held_out_gap(monkeypatch):
     assert report.holdout_cost_after < 0.5 * report.holdout_cost_before
     to_json = report.to_dict()
     assert to_json["verdict"] == "missing_effect" and to_json["effects"][0]["p_value"] < 1e-3
+
+
+def _path_of(values, std, correlation=None, joined=None):
+    """A `Path` naming a rudder offset and a gyro bias on Nomoto 1 with these estimates
+    `{name: value}` and robust standard errors (a stand-in for a fit)."""
+    from types import SimpleNamespace
+
+    from jaxship._analysis._discover._search import Path
+
+    model = js.augment(js.Nomoto1(K=K, T=25.0), js.RudderOffset(delta0=values[0]),
+                       js.YawRateSensorBias(bias=values[1]))
+    names = ("rudder_offset.delta0", "yaw_rate_sensor_bias.bias")
+    parameters = SimpleNamespace(std=np.array(std), std_robust=np.array(std),
+                                 correlation=np.eye(2) if correlation is None else correlation)
+    fit = SimpleNamespace(names=names, values=np.array(values), parameters=parameters,
+                          model=model)
+    return Path(fit, {"rudder_offset": names[:1], "yaw_rate_sensor_bias": names[1:]},
+                joined=dict(zip(names, values)) if joined is None else joined)
+
+
+def test_the_backward_step_removes_the_weakest_or_a_flipped_effect():
+    """The backward step (issue 60): an effect whose robust Wald statistic falls below the
+    forward test's threshold once others are in is the one removed; one whose sign flipped
+    beyond 3 standard errors since it joined goes first, however strong; strong
+    effects that kept their sign stay."""
+    from types import SimpleNamespace
+
+    from jaxship._analysis._discover._search import Search
+
+    search = Search(dict(entries={c.id: c for c in js.DISCOVERY_CATALOGUE}, data=None,
+                         loss=lambda m: SimpleNamespace(wind=False)))
+    search.level = 0.01 / 60  # threshold 14.2 for one degree of freedom
+    strong = (0.02, 1e-4)
+    assert search.weakest(_path_of(strong, (1e-3, 1e-5))) is None
+    k, why = search.weakest(_path_of(strong, (1e-3, 4e-5)))  # Wald 6.3: too weak
+    assert k == "yaw_rate_sensor_bias" and "Wald statistic 6.25 below" in why
+    # the offset joined at -0.02 and is +0.02 +- 0.001 now: flipped, removed before the
+    # weak bias
+    k, why = search.weakest(_path_of(strong, (1e-3, 4e-5),
+                                     joined={"rudder_offset.delta0": -0.02,
+                                             "yaw_rate_sensor_bias.bias": 1e-4}))
+    assert k == "rudder_offset" and "sign flipped" in why
+    # correlated estimates: the Wald statistic uses the joint covariance of an effect's
+    # own parameters only, so each of two strong effects stays
+    corr = np.array([[1.0, 0.9], [0.9, 1.0]])
+    assert search.weakest(_path_of(strong, (1e-3, 1e-5), correlation=corr)) is None
+
+
+@pytest.mark.slow
+def test_an_offset_and_a_current_are_both_named_from_over_ground_logs():
+    """Issue 60's hard case: a 1.5 deg rudder offset and a (0.3, -0.4) m/s current hidden
+    in Mariner records whose u, v are over ground (GNSS): both are named, with the right
+    signs and the truth within 3 standard errors, and nothing else."""
+    truth = {"rudder_offset.delta0": 1.5 * DEG, "current.north": 0.3, "current.east": -0.4}
+    report = run_vessel_case((js.RudderOffset(delta0=1.5 * DEG),
+                              js.UniformCurrent(north=0.3, east=-0.4)), 0)[0]
+    assert sorted(report.named) == ["current", "rudder_offset"], report.to_markdown()
+    assert outcome(report, ("rudder_offset", "current")) == "correct"
+    estimates = {n: p for e in report.effects for n, p in e.parameters.items()}
+    for name, value in truth.items():
+        assert np.sign(estimates[name].value) == np.sign(value), estimates[name]
+        assert estimates[name].covers(value), (name, estimates[name])
+    assert covered(report, truth)
 
 
 @pytest.mark.slow

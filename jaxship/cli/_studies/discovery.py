@@ -202,3 +202,22 @@ def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02,
                for a in (35, -35)]
     holdout.append(one(zigzag(15 * DEG, 15 * DEG), "zigzag 15/15"))
     return train, holdout
+
+
+def run_vessel_case(effects, seed, *, duration=400.0, over_ground=True, **options):
+    """Discovery from the Mariner preset on `vessel_records` of the Mariner with `effects`
+    hidden (u, v over ground by default, as GNSS logs them); returns `(report, seconds)`."""
+    truth = js.augment(js.vessel("mariner"), *effects)
+    train, holdout = vessel_records(truth, seed, duration=duration, over_ground=over_ground)
+    began = time.perf_counter()
+    report = js.discover(js.vessel("mariner"), train, holdout, **options)
+    return report, time.perf_counter() - began
+
+
+def covered(report, truth: dict) -> bool | None:
+    """Whether every named estimate of a parameter in `truth` `{name: value}` holds the
+    true value within its interval (`EffectParameter.covers`: 3 standard errors); None
+    where no named parameter is in `truth` (an effect named through its class)."""
+    checks = [p.covers(truth[n]) for e in report.effects for n, p in e.parameters.items()
+              if n in truth]
+    return all(checks) if checks else None
