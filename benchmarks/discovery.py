@@ -63,6 +63,7 @@ SCENARIOS = {  # name: (hidden effects, coloured-disturbance std [rad], true val
     # several effects at once (issue 60), Nomoto 1 truth
     "offset 1 deg + delay 1.5 s": ((js.RudderOffset(delta0=1.0 * DEG), js.RudderDelay(delay=1.5)),
                                    0.0, {"rudder_offset.delta0": 1.0 * DEG,
+                                         "yaw_moment_bias.n0": K * 1.0 * DEG,
                                          "rudder_delay.delay": 1.5}),
     "gyro bias 0.05 deg/s + cubic 300": ((js.YawRateSensorBias(bias=0.05 * DEG),
                                           js.YawCubicDamping(beta=300.0)), 0.0,
@@ -71,8 +72,8 @@ SCENARIOS = {  # name: (hidden effects, coloured-disturbance std [rad], true val
     "offset 1 deg + delay 1.5 s + cubic 300": (
         (js.RudderOffset(delta0=1.0 * DEG), js.RudderDelay(delay=1.5),
          js.YawCubicDamping(beta=300.0)), 0.0,
-        {"rudder_offset.delta0": 1.0 * DEG, "rudder_delay.delay": 1.5,
-         "yaw_cubic_damping.beta": 300.0}),
+        {"rudder_offset.delta0": 1.0 * DEG, "yaw_moment_bias.n0": K * 1.0 * DEG,
+         "rudder_delay.delay": 1.5, "yaw_cubic_damping.beta": 300.0}),
 }
 # Mariner truth, u and v logged over ground (GNSS), 400 s records (`run_vessel_case`)
 VESSEL_SCENARIOS = {
