@@ -433,6 +433,35 @@ def test_the_backward_step_removes_the_weakest_or_a_flipped_effect():
     assert search.weakest(_path_of(strong, (1e-3, 1e-5), correlation=corr)) is None
 
 
+def test_the_backward_step_refits_without_the_removed_effect_and_bars_it():
+    """`eliminate` refits the set less the effect that fails (from the current estimates,
+    the others free), records why, and bars the effect from that path."""
+    from types import SimpleNamespace
+
+    from jaxship._analysis._discover._report import CandidateOutcome
+    from jaxship._analysis._discover._search import Search
+
+    refits = []
+
+    def refit(start, free):
+        refits.append(([e.id for e in start.effects], free))
+        return _path_of((0.02, 1e-4), (1e-3, 1e-5)).fit  # a stand-in for the refit
+
+    search = Search(dict(entries={c.id: c for c in js.DISCOVERY_CATALOGUE}, data=None,
+                         loss=lambda m: SimpleNamespace(wind=False), say=lambda m: None,
+                         free=("K", "T"), holdout=None))
+    search.level, search.refit = 0.01 / 60, refit
+    path = _path_of((0.02, 1e-4), (1e-3, 4e-5))
+    path = dataclasses.replace(path, accepted=tuple(
+        CandidateOutcome(k, k, 1, 20.0) for k in path.names))
+    after = search.eliminate(path, 2)
+    assert refits == [(["rudder_offset"], ("K", "T", "rudder_offset.delta0"))]
+    assert list(after.names) == ["rudder_offset"] and after.barred == {"yaw_rate_sensor_bias"}
+    assert [r.id for r in after.accepted] == ["rudder_offset"]
+    assert after.rejected[-1].id == "yaw_rate_sensor_bias" and after.rejected[-1].iteration == 2
+    assert "Wald statistic" in after.rejected[-1].why[0]
+
+
 @pytest.mark.slow
 def test_an_offset_and_a_current_are_both_named_from_over_ground_logs():
     """Issue 60's hard case: a 1.5 deg rudder offset and a (0.3, -0.4) m/s current hidden

@@ -300,11 +300,11 @@ class Search:
             except (np.linalg.LinAlgError, OverflowError, FloatingPointError, NonFiniteError):
                 return path  # the set without it cannot be judged: it stays
             removed = next(r for r in path.accepted if r.id == k)
-            self.rejected.append(dataclasses.replace(removed, iteration=iteration,
-                                                     why=(why,), jointly_with=()))
+            removed = dataclasses.replace(removed, iteration=iteration, why=(why,),
+                                          jointly_with=())
             path = Path(trial, names, tuple(r for r in path.accepted if r.id != k), after,
                         path.barred | {k}, {n: v for n, v in path.joined.items()
-                                            if n.split(".")[0] != k}, path.rejected)
+                                            if n.split(".")[0] != k}, path.rejected + (removed,))
         return path
 
     def weakest(self, path):
