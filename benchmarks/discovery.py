@@ -126,6 +126,8 @@ def time_mariner():
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument("--first-seed", type=int, default=0,
+                        help="the first seed (offset from 1000): continue an earlier run")
     parser.add_argument("--only", nargs="*", default=None, help="scenario names to run")
     parser.add_argument("--mariner", action="store_true",
                         help="instead: time one discovery on Mariner records (4 + 3 records of "
@@ -141,24 +143,25 @@ def main():
              for name, (effects, colour, truth) in SCENARIOS.items()}
     cases |= {name: (effects, truth, lambda e, seed: run_vessel_case(e, 1000 + seed))
               for name, (effects, truth) in VESSEL_SCENARIOS.items()}
-    rows = [scenario(name, *cases[name], args.seeds) for name in cases
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
+    rows = [scenario(name, *cases[name], seeds) for name in cases
             if not args.only or name in args.only]
     print("\n| scenario | detected (null: silent) % | wrong name % | missed % | median rel. "
           "error % | truth within 3 SE % | s per run |\n|---|---|---|---|---|---|---|")
     for r in rows:
         print(f"| {r[0]} | {r[1]:.0f} | {r[2]:.0f} | {r[3]:.0f} | {r[4]:.2f} | {r[5]:.0f} | "
               f"{r[6]:.1f} |")
-    print(f"\n{args.seeds} seeds per scenario; {time.strftime('%Y-%m-%d')}.")
+    print(f"\n{args.seeds} seeds per scenario (from {1000 + args.first_seed}); {time.strftime('%Y-%m-%d')}.")
 
 
 def scenario(name, effects, truth, run, seeds):
-    """One scenario over `seeds` seeds: `(name, detected or silent %, wrong %, missed %,
+    """One scenario over the `seeds` (a range): `(name, detected or silent %, wrong %, missed %,
     median relative error % of the named parameters in `truth`, % of correct cases whose
     every estimate in `truth` holds the truth within 3 standard errors, median s per run)`.
     Detection: every hidden effect named (or its class), nothing else."""
     counts, errors, inside, times = {}, [], [], []
     hidden = tuple(e.id for e in effects)
-    for seed in range(seeds):
+    for seed in seeds:
         report, seconds = run(effects, seed)
         result = outcome(report, hidden)
         counts[result] = counts.get(result, 0) + 1
@@ -171,7 +174,7 @@ def scenario(name, effects, truth, run, seeds):
                 inside.append(covered(report, truth))
         print(f"  {name} seed {seed}: {result}, named {report.named}, "
               f"{seconds:.0f} s", flush=True)
-    share = lambda key: 100.0 * counts.get(key, 0) / seeds
+    share = lambda key: 100.0 * counts.get(key, 0) / len(seeds)
     row = (name, share("correct") if hidden else share("nothing"), share("wrong"),
            share("missed"), np.median(errors) * 100 if errors else np.nan,
            100.0 * np.mean(inside) if inside else np.nan, np.median(times))
