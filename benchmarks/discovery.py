@@ -151,7 +151,8 @@ def main():
     for r in rows:
         print(f"| {r[0]} | {r[1]:.0f} | {r[2]:.0f} | {r[3]:.0f} | {r[4]:.2f} | {r[5]:.0f} | "
               f"{r[6]:.1f} |")
-    print(f"\n{args.seeds} seeds per scenario (from {1000 + args.first_seed}); {time.strftime('%Y-%m-%d')}.")
+    print(f"\n{args.seeds} seeds per scenario (from {1000 + args.first_seed}); "
+          f"{time.strftime('%Y-%m-%d')}.")
 
 
 def scenario(name, effects, truth, run, seeds):
