@@ -150,7 +150,8 @@ class DiscoveryReport(eqx.Module):
                 for name, p in e.parameters.items():
                     unit = p.unit.replace("|", "or")
                     lines.append(f"| {e.name} | `{name}` | {p.value:.4g} | {p.std:.2g} | "
-                                 f"{p.interval[0]:.4g} to {p.interval[1]:.4g} | {unit} | {e.score:.3g} | {e.likelihood_ratio:.3g} | "
+                                 f"{p.interval[0]:.4g} to {p.interval[1]:.4g} | {unit} | "
+                                 f"{e.score:.3g} | {e.likelihood_ratio:.3g} | "
                                  f"{e.p_value:.2g} | {e.delta_bic:.1f} | {twins or '-'} |")
         else:
             best = max(self.scores.items(), key=lambda kv: kv[1].score, default=None)

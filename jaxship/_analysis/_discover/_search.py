@@ -117,8 +117,9 @@ class _Scored:
 class Search:
     """The fixed context of one `discover` run and its steps (module text). `setup`:
     the `discover` set-up (`free`, `data`, `train`, `holdout`, `catalogue`, `estimator`,
-    `loss`, `check`, `options`, `say`, `order` `{id: place in the model}`, `entries` `{id: Candidate}`, `before` the base model's
-    held-out check). Collects `rejected` outcomes and the base fit's `first_scores`."""
+    `loss`, `check`, `heldout_rise`, `options`, `say`, `order` `{id: place in the model}`,
+    `entries` `{id: Candidate}`, `before` the base model's held-out check). Collects
+    `rejected` outcomes and the base fit's `first_scores`."""
 
     def __init__(self, setup):
         self.__dict__.update(setup)

@@ -9,7 +9,6 @@ named effect is reported with its estimate from the final fit and its interval.
 import dataclasses
 import statistics
 
-import numpy as np
 
 from ..._estimate._excitation import TOO_POOR
 from ..._estimate._fit import PredictionError, fit
