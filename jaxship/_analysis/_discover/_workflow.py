@@ -9,7 +9,6 @@ named effect is reported with its estimate from the final fit and its interval.
 import dataclasses
 import statistics
 
-
 from ..._estimate._excitation import TOO_POOR
 from ..._estimate._fit import PredictionError, fit
 from ..._estimate._initial import EstimatedStarts, MeasuredStates
