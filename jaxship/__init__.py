@@ -31,8 +31,10 @@ from ._analysis._discover._report import (
     DiscoveryReport as DiscoveryReport,
     EffectParameter as EffectParameter,
 )
-from ._analysis._discover._workflow import DiscoveryOptions as DiscoveryOptions
-from ._analysis._discover._workflow import discover as discover
+from ._analysis._discover._workflow import (
+    DiscoveryOptions as DiscoveryOptions,
+    discover as discover,
+)
 from ._analysis._indices import (
     format_table as format_table,
     imo_criteria as imo_criteria,
