@@ -173,8 +173,8 @@ def scenario(name, effects, truth, run, seeds):
                            for n, p in e.parameters.items() if n in truth]
             if covered(report, truth) is not None:
                 inside.append(covered(report, truth))
-        print(f"  {name} seed {seed}: {result}, named {report.named}, "
-              f"{seconds:.0f} s", flush=True)
+        print(f"  {name} seed {seed}: {result}, named {report.named}, truth within 3 SE "
+              f"{covered(report, truth)}, {seconds:.0f} s", flush=True)
     share = lambda key: 100.0 * counts.get(key, 0) / len(seeds)
     row = (name, share("correct") if hidden else share("nothing"), share("wrong"),
            share("missed"), np.median(errors) * 100 if errors else np.nan,
