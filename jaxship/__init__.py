@@ -30,7 +30,10 @@ from ._analysis._discover._catalogue import (
     Candidate as Candidate,
 )
 from ._analysis._discover._report import DiscoveryReport as DiscoveryReport
-from ._analysis._discover._workflow import discover as discover
+from ._analysis._discover._workflow import (
+    DiscoveryOptions as DiscoveryOptions,
+    discover as discover,
+)
 
 # estimate: fit and predict, the estimator strategies, bands, the Kalman filter
 from ._estimate._armax import ARMAX as ARMAX
@@ -272,6 +275,7 @@ __all__ = [
     "fisher_information",
     "excitation_order",
     "discover",
+    "DiscoveryOptions",
     "DiscoveryReport",
     "Candidate",
     "DISCOVERY_CATALOGUE",

@@ -16,15 +16,18 @@ import pytest
 import jaxship as js
 from benchmarks.studies.discovery import (
     condition_records,
+    covered,
     hidden_effect_records,
     outcome,
     race_records,
     record,
     run_case,
+    run_vessel_case,
     vessel_records,
     wind_records,
 )
-from jaxship._analysis._discover import _workflow as discover_workflow
+from jaxship import effects
+from jaxship._analysis._discover import _search as discover_search
 from jaxship._analysis._discover._holdout import cost_rise, record_indices
 from jaxship._analysis._discover._locate import locate_disagreement
 from jaxship._analysis._discover._plausible import rudder_equivalent
@@ -74,7 +77,7 @@ def test_a_held_out_rise_within_the_disturbances_spread_keeps_the_true_effect():
     standard errors over 60 s stretches). A gate asking the cost to fall rejected it and
     named a yaw-rate sensor bias instead (3 of 40 Monte-Carlo seeds); the held-out gate
     now allows the spread the disturbance gives."""
-    report = run(js.effects.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
+    report = run(effects.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
     assert outcome(report, ("rudder_offset",)) == "correct", report.to_markdown()
     assert report.holdout_cost_after > report.holdout_cost_before  # the rise it allows
 
@@ -86,7 +89,7 @@ def test_the_held_out_check_vetoes_but_does_not_choose():
     veto): the data do not say which is missing, so nothing is named. The offset and a
     yaw-moment bias are one class on a Nomoto model (their scores tie to rounding), so the
     rejection names the class, whichever member was refitted."""
-    report = run(js.effects.RudderOffset(delta0=0.3 * DEG), seed=1018, disturbance=1.0 * DEG)
+    report = run(effects.RudderOffset(delta0=0.3 * DEG), seed=1018, disturbance=1.0 * DEG)
     assert report.verdict == "nothing_missing", report.to_markdown()
     assert any("rudder_offset or yaw_moment_bias explains the training data better" in why
                for r in report.rejected for why in r.why), report.to_markdown()
@@ -98,9 +101,9 @@ def test_a_refit_that_fails_numerically_rejects_that_candidate_not_the_run(monke
     on to the next (here the refit of the offset's class fails: the offset and the
     yaw-moment bias tie to rounding, so either may be the one refitted, and its
     class-mate is not refitted in the same iteration, so nothing is named)."""
-    from jaxship._analysis._discover import _workflow
+    from jaxship._analysis._discover import _search
 
-    fit = _workflow.fit
+    fit = _search.fit
     one_class = {"rudder_offset", "yaw_moment_bias"}
 
     def failing(model, *args, **kwargs):
@@ -108,8 +111,8 @@ def test_a_refit_that_fails_numerically_rejects_that_candidate_not_the_run(monke
             raise np.linalg.LinAlgError("SVD did not converge")
         return fit(model, *args, **kwargs)
 
-    monkeypatch.setattr(_workflow, "fit", failing)
-    report = run(js.effects.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
+    monkeypatch.setattr(_search, "fit", failing)
+    report = run(effects.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
     failed = [r for r in report.rejected if r.id in one_class]
     assert failed and failed[0].why == (
         "the refit failed numerically (LinAlgError: SVD did not converge)",)
@@ -145,9 +148,9 @@ def test_a_candidate_whose_sensitivities_are_not_finite_is_rejected_not_the_run(
     """A candidate whose model blows up in the scoring is rejected with that reason and
     the others are scored (the offset is still named); a score computation that fails
     numerically rejects the iteration's candidates, not the run."""
-    from jaxship._analysis._discover import _workflow
+    from jaxship._analysis._discover import _search
 
-    sensitivities = _workflow.sensitivities
+    sensitivities = _search.sensitivities
 
     def broken(*args, **kwargs):
         sens = sensitivities(*args, **kwargs)
@@ -155,8 +158,9 @@ def test_a_candidate_whose_sensitivities_are_not_finite_is_rejected_not_the_run(
         jac[:, sens.names.index("yaw_cubic_damping.beta")] = np.nan
         return dataclasses.replace(sens, jacobian=jac)
 
-    monkeypatch.setattr(_workflow, "sensitivities", broken)
-    report = run_case((js.effects.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
+    monkeypatch.setattr(_search, "sensitivities", broken)
+    report = run_case((effects.RudderOffset(delta0=1.0 * DEG),), 3,
+                      options=js.DiscoveryOptions(max_effects=1))[0]
     assert report.names_or_classes() and "rudder_offset" in report.names_or_classes()[0]
     why = [r.why for r in report.rejected if r.id == "yaw_cubic_damping"]
     assert why and why[0] == ("not scored: its sensitivities at the current fit are not "
@@ -166,9 +170,10 @@ def test_a_candidate_whose_sensitivities_are_not_finite_is_rejected_not_the_run(
     def failing(*args, **kwargs):
         raise np.linalg.LinAlgError("SVD did not converge")
 
-    monkeypatch.setattr(_workflow, "sensitivities", sensitivities)
-    monkeypatch.setattr(_workflow, "score_tests", failing)
-    report = run_case((js.effects.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
+    monkeypatch.setattr(_search, "sensitivities", sensitivities)
+    monkeypatch.setattr(_search, "score_tests", failing)
+    report = run_case((effects.RudderOffset(delta0=1.0 * DEG),), 3,
+                      options=js.DiscoveryOptions(max_effects=1))[0]
     assert report.verdict == "nothing_missing" and report.rejected
     assert all(r.why == ("not scored: the scores failed numerically (SVD did not "
                          "converge)",) for r in report.rejected)
@@ -190,7 +195,8 @@ def test_a_held_out_prediction_that_blows_up_rejects_that_candidate(monkeypatch)
         return check(model, *args, **kwargs)
 
     monkeypatch.setattr(_workflow, "holdout_check", blowing_up)
-    report = run_case((js.effects.RudderOffset(delta0=1.0 * DEG),), 3, max_effects=1)[0]
+    report = run_case((effects.RudderOffset(delta0=1.0 * DEG),), 3,
+                      options=js.DiscoveryOptions(max_effects=1))[0]
     failed = [r for r in report.rejected if r.id in offset and r.iteration == 1]
     assert failed and failed[0].why == ("a prediction with it is not finite (channel 'r': "
                                         "non-finite values at 12 valid samples.)",)
@@ -298,14 +304,14 @@ def test_an_effect_in_family_units_is_sized_as_the_rudder_angle_of_its_loads():
     r = rng.normal(0.0, 0.01, num)
     data = as_dataset(js.Experiment(np.arange(num) * 0.5, delta, psi=np.zeros(num), r=r,
                                     u=np.full(num, 5.0), n=np.full(num, 1.5)))
-    model = js.augment(js.Nomoto1(K=K, T=25.0), js.effects.YawMomentBias(n0=0.2 * K),
-                       js.effects.YawQuadraticDamping(beta=50.0))
+    model = js.augment(js.Nomoto1(K=K, T=25.0), effects.YawMomentBias(n0=0.2 * K),
+                       effects.YawQuadraticDamping(beta=50.0))
     assert rudder_equivalent(model, "yaw_moment_bias", data) == pytest.approx(0.2, rel=1e-12)
     quadratic = np.linalg.norm(50.0 * r * np.abs(r)) / (K * np.sqrt(num))
     assert rudder_equivalent(model, "yaw_quadratic_damping", data) == pytest.approx(
         quadratic, rel=1e-12)
     # a race's share of the rudder force against the rudder's gain with it: at most delta
-    race = js.augment(js.Nomoto1(K=K, T=25.0), js.effects.PropellerRace(gain=0.04))
+    race = js.augment(js.Nomoto1(K=K, T=25.0), effects.PropellerRace(gain=0.04))
     share = 0.04 * 1.5**2
     assert rudder_equivalent(race, "propeller_race", data) == pytest.approx(
         share * np.linalg.norm(delta) / ((K + share) * np.sqrt(num)), rel=1e-12)
@@ -316,7 +322,7 @@ def test_an_effect_in_family_units_is_sized_as_the_rudder_angle_of_its_loads():
                                         n=np.full(num, float(js.straight_run(mariner).n))))
     n_delta = np.diff([float(mariner.forces(u0, 0.0, 0.0, d, straight.n[0, 0])[2])
                        for d in (-1e-6, 1e-6)])[0] / 2e-6
-    vessel = js.augment(mariner, js.effects.YawMomentBias(n0=3e6))
+    vessel = js.augment(mariner, effects.YawMomentBias(n0=3e6))
     assert rudder_equivalent(vessel, "yaw_moment_bias", straight) == pytest.approx(
         3e6 / abs(n_delta), rel=1e-5)
 
@@ -326,8 +332,8 @@ def test_an_implausibly_large_constant_moment_is_not_named():
     range is 5.7 deg): refitted, it fails the plausibility gate; one worth 1 deg passes."""
     only = tuple(c for c in js.DISCOVERY_CATALOGUE if c.id == "yaw_moment_bias")
     for angle, named in ((10 * DEG, False), (1 * DEG, True)):
-        report = run_case((js.effects.YawMomentBias(n0=K * angle),), 3, catalogue=only,
-                          max_effects=1)[0]
+        report = run_case((effects.YawMomentBias(n0=K * angle),), 3, catalogue=only,
+                          options=js.DiscoveryOptions(max_effects=1))[0]
         assert (report.verdict == "missing_effect") is named, report.to_markdown()
         record = (report.effects or report.rejected)[0]
         assert record.rudder_equivalent_deg == pytest.approx(np.degrees(angle), rel=0.1)
@@ -337,7 +343,7 @@ def test_an_implausibly_large_constant_moment_is_not_named():
 
 
 def test_a_rudder_offset_is_named_with_its_class_and_the_gap_shrinks():
-    report = run(js.effects.RudderOffset(delta0=0.5 * DEG), seed=3)
+    report = run(effects.RudderOffset(delta0=0.5 * DEG), seed=3)
     assert report.verdict == "missing_effect" and len(report.effects) == 1
     assert report.names_or_classes()[0] == {"rudder_offset", "yaw_moment_bias"}
     effect = report.effects[0]
@@ -345,6 +351,14 @@ def test_a_rudder_offset_is_named_with_its_class_and_the_gap_shrinks():
     value = next(iter(effect.parameters.values()))
     expected = 0.5 * DEG if effect.id == "rudder_offset" else K * 0.5 * DEG
     assert abs(value.value - expected) < 4 * value.std
+    # its interval: 3 robust standard errors either side, in the page and the JSON
+    assert value.interval == pytest.approx((value.value - 3 * value.std,
+                                            value.value + 3 * value.std))
+    assert value.covers(expected), value
+    assert f"{value.interval[0]:.4g} to {value.interval[1]:.4g}" in report.to_markdown()
+    assert report.to_dict()["effects"][0]["parameters"][effect.id + ".delta0" if
+                                                        effect.id == "rudder_offset" else
+                                                        "yaw_moment_bias.n0"]["interval"]
     assert report.holdout_cost_after < report.holdout_cost_before
     # located: a heading residual of one sign whichever way the ship turns (a bias, not a
     # term odd in r), gone after the offset is added
@@ -364,11 +378,11 @@ def test_cubic_damping_is_named_and_closes_the_held_out_gap(monkeypatch):
         scored.append(([type(e) for e in model.effects], tuple(names)))
         return sensitivities(model, dataset, estimator, names, *args, **kwargs)
 
-    monkeypatch.setattr(discover_workflow, "sensitivities", recording)
-    report = run(js.effects.YawCubicDamping(beta=300.0), seed=4)
+    monkeypatch.setattr(discover_search, "sensitivities", recording)
+    report = run(effects.YawCubicDamping(beta=300.0), seed=4)
     assert report.named == ("yaw_cubic_damping",)
     assert len(scored) == 2 and scored[0] == scored[1]
-    assert [type(e) for e in report.model_after.effects] == [js.effects.YawCubicDamping]
+    assert [type(e) for e in report.model_after.effects] == [effects.YawCubicDamping]
     p = report.effects[0].parameters["yaw_cubic_damping.beta"]
     assert abs(p.value - 300.0) < 4 * p.std
     assert report.holdout_cost_after < 0.5 * report.holdout_cost_before
@@ -376,10 +390,102 @@ def test_cubic_damping_is_named_and_closes_the_held_out_gap(monkeypatch):
     assert to_json["verdict"] == "missing_effect" and to_json["effects"][0]["p_value"] < 1e-3
 
 
+def _path_of(values, std, correlation=None, joined=None):
+    """A `Path` naming a rudder offset and a gyro bias on Nomoto 1 with these estimates
+    `{name: value}` and robust standard errors (a stand-in for a fit)."""
+    from types import SimpleNamespace
+
+    from jaxship._analysis._discover._search import Path
+
+    model = js.augment(js.Nomoto1(K=K, T=25.0), effects.RudderOffset(delta0=values[0]),
+                       effects.YawRateSensorBias(bias=values[1]))
+    names = ("rudder_offset.delta0", "yaw_rate_sensor_bias.bias")
+    parameters = SimpleNamespace(std=np.array(std), std_robust=np.array(std),
+                                 correlation=np.eye(2) if correlation is None else correlation)
+    fit = SimpleNamespace(names=names, values=np.array(values), parameters=parameters,
+                          model=model)
+    return Path(fit, {"rudder_offset": names[:1], "yaw_rate_sensor_bias": names[1:]},
+                joined=dict(zip(names, values)) if joined is None else joined)
+
+
+def test_the_backward_step_removes_the_weakest_or_a_flipped_effect():
+    """The backward step (issue 60): an effect whose robust Wald statistic falls below the
+    forward test's threshold once others are in is the one removed; one whose sign flipped
+    beyond 3 standard errors since it joined goes first, however strong; strong
+    effects that kept their sign stay."""
+    from types import SimpleNamespace
+
+    from jaxship._analysis._discover._search import Search
+
+    search = Search(dict(entries={c.id: c for c in js.DISCOVERY_CATALOGUE}, data=None,
+                         loss=lambda m: SimpleNamespace(wind=False)))
+    search.level = 0.01 / 60  # threshold 14.2 for one degree of freedom
+    strong = (0.02, 1e-4)
+    assert search.weakest(_path_of(strong, (1e-3, 1e-5))) is None
+    k, why = search.weakest(_path_of(strong, (1e-3, 4e-5)))  # Wald 6.3: too weak
+    assert k == "yaw_rate_sensor_bias" and "Wald statistic 6.25 below" in why
+    # the offset joined at -0.02 and is +0.02 +- 0.001 now: flipped, removed before the
+    # weak bias
+    k, why = search.weakest(_path_of(strong, (1e-3, 4e-5),
+                                     joined={"rudder_offset.delta0": -0.02,
+                                             "yaw_rate_sensor_bias.bias": 1e-4}))
+    assert k == "rudder_offset" and "sign flipped" in why
+    # correlated estimates: the Wald statistic uses the joint covariance of an effect's
+    # own parameters only, so each of two strong effects stays
+    corr = np.array([[1.0, 0.9], [0.9, 1.0]])
+    assert search.weakest(_path_of(strong, (1e-3, 1e-5), correlation=corr)) is None
+
+
+def test_the_backward_step_refits_without_the_removed_effect_and_bars_it():
+    """`eliminate` refits the set less the effect that fails (from the current estimates,
+    the others free), records why, and bars the effect from that path."""
+    from types import SimpleNamespace
+
+    from jaxship._analysis._discover._report import CandidateOutcome
+    from jaxship._analysis._discover._search import Search
+
+    refits = []
+
+    def refit(start, free):
+        refits.append(([e.id for e in start.effects], free))
+        return _path_of((0.02, 1e-4), (1e-3, 1e-5)).fit  # a stand-in for the refit
+
+    search = Search(dict(entries={c.id: c for c in js.DISCOVERY_CATALOGUE}, data=None,
+                         loss=lambda m: SimpleNamespace(wind=False), say=lambda m: None,
+                         free=("K", "T"), holdout=None))
+    search.level, search.refit = 0.01 / 60, refit
+    path = _path_of((0.02, 1e-4), (1e-3, 4e-5))
+    path = dataclasses.replace(path, accepted=tuple(
+        CandidateOutcome(k, k, 1, 20.0) for k in path.names))
+    after = search.eliminate(path, 2)
+    assert refits == [(["rudder_offset"], ("K", "T", "rudder_offset.delta0"))]
+    assert list(after.names) == ["rudder_offset"] and after.barred == {"yaw_rate_sensor_bias"}
+    assert [r.id for r in after.accepted] == ["rudder_offset"]
+    assert after.rejected[-1].id == "yaw_rate_sensor_bias" and after.rejected[-1].iteration == 2
+    assert "Wald statistic" in after.rejected[-1].why[0]
+
+
+@pytest.mark.slow
+def test_an_offset_and_a_current_are_both_named_from_over_ground_logs():
+    """Issue 60's hard case: a 1.5 deg rudder offset and a (0.3, -0.4) m/s current hidden
+    in Mariner records whose u, v are over ground (GNSS): both are named, with the right
+    signs and the truth within 3 standard errors, and nothing else."""
+    truth = {"rudder_offset.delta0": 1.5 * DEG, "current.north": 0.3, "current.east": -0.4}
+    report = run_vessel_case((effects.RudderOffset(delta0=1.5 * DEG),
+                              effects.UniformCurrent(north=0.3, east=-0.4)), 0)[0]
+    assert sorted(report.named) == ["current", "rudder_offset"], report.to_markdown()
+    assert outcome(report, ("rudder_offset", "current")) == "correct"
+    estimates = {n: p for e in report.effects for n, p in e.parameters.items()}
+    for name, value in truth.items():
+        assert np.sign(estimates[name].value) == np.sign(value), estimates[name]
+        assert estimates[name].covers(value), (name, estimates[name])
+    assert covered(report, truth)
+
+
 @pytest.mark.slow
 def test_two_effects_at_once_are_both_named_and_nothing_else():
-    report = run(js.effects.RudderOffset(delta0=0.5 * DEG),
-                 js.effects.YawCubicDamping(beta=300.0), seed=5)
+    report = run(effects.RudderOffset(delta0=0.5 * DEG), effects.YawCubicDamping(beta=300.0),
+                 seed=5)
     classes = report.names_or_classes()
     assert len(classes) == 2
     assert any("yaw_cubic_damping" in c for c in classes)
@@ -388,11 +494,11 @@ def test_two_effects_at_once_are_both_named_and_nothing_else():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("effect", [
-    js.effects.RudderLag(time_constant=2.0), js.effects.RudderDelay(delay=1.5),
-    js.effects.RudderRateLimit(inverse_rate=1 / (1.0 * DEG)),
-    js.effects.YawRateSensorBias(bias=0.05 * DEG),
-    js.effects.YawMomentBias(n0=K * 0.5 * DEG), js.effects.YawQuadraticDamping(beta=10.0),
-    js.effects.RudderStall(c=0.45),  # near the plausible bound 0.5: c = 0.3 scores 9.4 < 12.9
+    effects.RudderLag(time_constant=2.0), effects.RudderDelay(delay=1.5),
+    effects.RudderRateLimit(inverse_rate=1 / (1.0 * DEG)),
+    effects.YawRateSensorBias(bias=0.05 * DEG),
+    effects.YawMomentBias(n0=K * 0.5 * DEG), effects.YawQuadraticDamping(beta=10.0),
+    effects.RudderStall(c=0.45),  # near the plausible bound 0.5: c = 0.3 scores 9.4 < 12.9
 ], ids=lambda e: e.id)
 def test_every_steering_effect_is_named_or_its_class(effect):
     report = run(effect, seed=6)
@@ -403,11 +509,10 @@ def test_every_steering_effect_is_named_or_its_class(effect):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("effect, duration", [
-    (js.effects.RudderOffset(delta0=0.5 * DEG), 400.0), (js.effects.SwayForceBias(y0=3e4), 400.0),
-    (js.effects.CrossflowDrag(coefficient=0.04), 400.0),
-    (js.effects.SurgeTurnResistance(x_vr=0.004), 400.0),
-    (js.effects.AddedMassError(s_r=0.2), 400.0),
-    (js.effects.HeadingSensorBias(bias=1.0 * DEG), 800.0),
+    (effects.RudderOffset(delta0=0.5 * DEG), 400.0), (effects.SwayForceBias(y0=3e4), 400.0),
+    (effects.CrossflowDrag(coefficient=0.04), 400.0), (effects.SurgeTurnResistance(x_vr=0.004),
+                                                       400.0),
+    (effects.AddedMassError(s_r=0.2), 400.0), (effects.HeadingSensorBias(bias=1.0 * DEG), 800.0),
 ], ids=lambda v: f"{v:g}s" if isinstance(v, float) else v.id)
 def test_every_vessel_effect_is_named(effect, duration):
     """Mariner records (4 zig-zags to train; turns and a 15/15 zig-zag held out; 8
@@ -431,7 +536,7 @@ def test_a_vessel_effect_is_named_from_records_without_a_logged_drift():
     """The Mariner records of the test above with a hidden 30 kN sway force and no v
     logged (psi, r, u and the GNSS track): discover fits the channels logged, starts
     every window from the vessel's states smoothed from them, and names the force."""
-    truth = js.augment(js.get_vessel("mariner"), js.effects.SwayForceBias(y0=3e4))
+    truth = js.augment(js.get_vessel("mariner"), effects.SwayForceBias(y0=3e4))
     drop = lambda e: js.Experiment(e.t, e.delta, psi=e.psi, r=e.r, u=e.u, x=e.x, y=e.y,
                                    n=e.n, name=e.name)
     train, holdout = ([drop(e) for e in records]
@@ -451,8 +556,8 @@ def test_windage_is_named_on_a_vessel_in_a_logged_wind():
     is named, nothing else, both areas within 4 robust standard errors (measured
     371 +- 19 and 1950 +- 27 m^2), and the held-out cost falls."""
     areas = {"wind.frontal_area": 350.0, "wind.lateral_area": 2000.0}
-    truth = js.augment(js.get_vessel("mariner"), js.effects.Windage(frontal_area=350.0,
-                                                                    lateral_area=2000.0))
+    truth = js.augment(js.get_vessel("mariner"), effects.Windage(frontal_area=350.0,
+                                                                 lateral_area=2000.0))
     train, holdout = vessel_records(truth, 0, wind=js.Wind(15.0, 60 * DEG), duration=400.0)
     report = js.discover(js.get_vessel("mariner"), train, holdout)
     assert outcome(report, ("wind",)) == "correct", report.to_markdown()
@@ -469,7 +574,7 @@ SPEED = 7.0  # [m/s], the mean logged speed of the runs at 5 and 9 m/s: the effe
 @pytest.mark.parametrize("hidden, value, at, channel, values, held", [
     # a propeller walk worth 1 deg of rudder at 2 rev/s, 0.25 deg at 1 rev/s
     ("propeller_asymmetry.moment", K * DEG / 4,
-     lambda n: js.augment(js.Nomoto1(K=K, T=25.0), js.effects.YawMomentBias(n0=K * DEG / 4 * n**2)),
+     lambda n: js.augment(js.Nomoto1(K=K, T=25.0), effects.YawMomentBias(n0=K * DEG / 4 * n**2)),
      "n", (1.0, 2.0), None),
     # a rudder moment growing as 1 + 0.5 (u^2/U_0^2 - 1): K x 0.76 at 5 m/s, x 1.33 at 9
     ("speed_dependent_rudder.kappa", 0.5,
@@ -499,7 +604,7 @@ def test_the_discover_command(tmp_path, capsys):
     """`jaxship discover` on trial CSVs with a hidden cubic damping: each stage is shown on
     stderr, discovery.json has the documented keys, report.md and the figures are
     written."""
-    truth = js.augment(js.Nomoto1(K=K, T=25.0), js.effects.YawCubicDamping(beta=300.0))
+    truth = js.augment(js.Nomoto1(K=K, T=25.0), effects.YawCubicDamping(beta=300.0))
     train, holdout = hidden_effect_records(truth, 4)
     holdout.append(record(truth, js.ZigZag(25 * DEG, 25 * DEG, duration=300.0, dt=0.5),
                           "zz25", np.random.default_rng(9)))
@@ -592,7 +697,7 @@ def test_wind_is_named_on_a_steering_model_with_logged_wind():
     """Nomoto 1 that feels a logged 15 m/s wind (`wind_records`: 10/10 zig-zags on four
     headings to train, +-20 deg turns held out): `wind` is named, nothing else, c2
     within 4 robust standard errors, and the held-out cost falls."""
-    truth = js.augment(js.Nomoto1(K=K, T=25.0), js.effects.ApparentWind(c2=3e-6))
+    truth = js.augment(js.Nomoto1(K=K, T=25.0), effects.ApparentWind(c2=3e-6))
     train, holdout = wind_records(truth, 0)
     report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout)
     assert outcome(report, ("wind",)) == "correct", report.to_markdown()
@@ -618,12 +723,12 @@ def test_an_estimate_pinned_at_its_plausible_bound_is_at_the_edge():
     """A 0.15 rad rudder offset lies beyond RudderOffset's +-0.1 rad range: the fit pins
     the estimate at the bound (the sigmoid leaves it about 1e-6 of the span short),
     which the refit gate reads as at the edge; a 0.05 rad offset is inside."""
-    from jaxship._analysis._discover._workflow import _at_edge
+    from jaxship._analysis._discover._plumbing import at_edge as _at_edge
 
     def fitted(delta0):
-        truth = js.augment(js.Nomoto1(K=K, T=25.0), js.effects.RudderOffset(delta0=delta0))
+        truth = js.augment(js.Nomoto1(K=K, T=25.0), effects.RudderOffset(delta0=delta0))
         train, _ = hidden_effect_records(truth, 0)
-        return js.fit(js.augment(js.Nomoto1(K=0.05, T=20.0), js.effects.RudderOffset()), train)
+        return js.fit(js.augment(js.Nomoto1(K=0.05, T=20.0), effects.RudderOffset()), train)
 
     pinned, inside = fitted(0.15), fitted(0.05)
     assert pinned.code == js.RESULTS.at_bound and inside.success
@@ -638,8 +743,8 @@ def test_the_loads_a_vessel_lacks_are_located_from_the_measured_states():
     load within 10 %, the other loads' means below 5 % of it; on null records both
     below 5 %."""
     mariner = js.get_vessel("mariner")
-    for effect, name, size in ((js.effects.SwayForceBias(y0=3e4), "Y", 3e4),
-                               (js.effects.YawMomentBias(n0=3e6), "N", 3e6), (None, None, None)):
+    for effect, name, size in ((effects.SwayForceBias(y0=3e4), "Y", 3e4),
+                               (effects.YawMomentBias(n0=3e6), "N", 3e6), (None, None, None)):
         truth = mariner if effect is None else js.augment(mariner, effect)
         forces = locate_disagreement(mariner, vessel_records(truth, 0)[0],
                                         ("psi", "r", "u", "v"))["forces"]
@@ -660,8 +765,8 @@ def test_the_loads_a_vessel_lacks_are_located_from_its_track_without_a_logged_dr
     scales (1.3 kN, 0.5 kN m); the other load's mean below 12 % (the sway force under
     the yaw moment: 3.2 kN, where the logged v gives 1.1 kN)."""
     mariner = js.get_vessel("mariner")
-    for effect, name, size in ((js.effects.SwayForceBias(y0=3e4), "Y", 3e4),
-                               (js.effects.YawMomentBias(n0=3e6), "N", 3e6), (None, None, None)):
+    for effect, name, size in ((effects.SwayForceBias(y0=3e4), "Y", 3e4),
+                               (effects.YawMomentBias(n0=3e6), "N", 3e6), (None, None, None)):
         truth = mariner if effect is None else js.augment(mariner, effect)
         records = [js.Experiment(e.t, e.delta, psi=e.psi, r=e.r, u=e.u, x=e.x, y=e.y, n=e.n,
                                  name=e.name) for e in vessel_records(truth, 0)[0]]
@@ -681,8 +786,8 @@ def test_the_missing_loads_count_the_logged_wind_where_asked():
     wind's moment is what is missing."""
     from jaxship._analysis._discover._forces import residual_loads
 
-    windy = js.augment(js.get_vessel("mariner"), js.effects.Windage(frontal_area=350.0,
-                                                                    lateral_area=2000.0))
+    windy = js.augment(js.get_vessel("mariner"), effects.Windage(frontal_area=350.0,
+                                                                 lateral_area=2000.0))
     wind = js.Wind(15.0, np.deg2rad(60.0))
     man = js.ZigZag(10 * DEG, 10 * DEG, duration=300.0, dt=0.5)
     e = js.Experiment.from_trajectory(js.simulate(windy, man, js.straight_run(windy),

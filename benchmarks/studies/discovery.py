@@ -159,14 +159,16 @@ def outcome(report, hidden_ids) -> str:
 
 
 def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02, 1.0),
-                   wind=None):
+                   wind=None, over_ground=False):
     """`(train, holdout)` of a 3-DOF `truth` vessel (e.g. the Mariner with an effect):
     10/10 and 20/20 zig-zags to both sides to train, +-35 deg turning circles and a
     15/15 zig-zag held out, `duration` s at 2 Hz from the nominal straight run, with
     the servo's rudder logged at the samples and noise on psi [deg], r [deg/s], u, v
     [m/s] and the positions x, y [m] (GNSS; rudder and rpm exact): 8 channels per
     record. With a steady true `wind` (`jaxship.Wind`) the ship sails in it and the
-    records log it (10 channels)."""
+    records log it (10 channels). With `over_ground` the logged u, v are over ground (GNSS:
+    `Experiment.over_ground`), the through-water ones plus the truth's current in body
+    axes (`AbstractVessel.with_current`)."""
     rng = np.random.default_rng(seed)
     x0 = js.straight_run(truth)
     environment = js.Environment() if wind is None else js.Environment(wind=wind)
@@ -174,15 +176,22 @@ def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02,
     def one(manoeuvre, name):
         traj = js.simulate(truth, manoeuvre, x0, environment=environment, simulator=FINE)
         e = js.Experiment.from_trajectory(traj, name=name)
+        u, v = e.u, e.v
+        if over_ground:  # u_g = u + V_N cos psi + V_E sin psi, v_g = v - V_N sin psi + V_E cos psi
+            north, east = (float(c) for c in truth.environment(environment).current.velocity())
+            u = u + north * np.cos(e.psi) + east * np.sin(e.psi)
+            v = v - north * np.sin(e.psi) + east * np.cos(e.psi)
         scale = {"psi": noise[0] * DEG, "r": noise[1] * DEG, "u": noise[2], "v": noise[3],
                  "x": noise[4], "y": noise[4]}
-        noisy = {c: getattr(e, c) + rng.normal(0, s, e.t.size) for c, s in scale.items()}
+        clean = {"psi": e.psi, "r": e.r, "u": u, "v": v, "x": e.x, "y": e.y}
+        noisy = {c: clean[c] + rng.normal(0, s, e.t.size) for c, s in scale.items()}
         logged = {} if wind is None else {
             "wind_speed": np.full(e.t.size, float(wind.speed)),
             "wind_dir": np.full(e.t.size, float(wind.direction))}
         return js.Experiment(e.t, e.delta, psi=truth.measure("psi", noisy["psi"]),
                              r=truth.measure("r", noisy["r"]), u=noisy["u"], v=noisy["v"],
-                             x=noisy["x"], y=noisy["y"], n=e.n, name=name, **logged)
+                             x=noisy["x"], y=noisy["y"], n=e.n, name=name, **logged,
+                             metadata=(("velocities", "over ground"),) if over_ground else ())
 
     # the helm reverses the rudder at the control step nearest to the crossing (10 Hz), as
     # a sampled autopilot does, not inside a step (the default)
@@ -193,3 +202,22 @@ def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02,
                for a in (35, -35)]
     holdout.append(one(zigzag(15 * DEG, 15 * DEG), "zigzag 15/15"))
     return train, holdout
+
+
+def run_vessel_case(effects, seed, *, duration=400.0, over_ground=True, **options):
+    """Discovery from the Mariner preset on `vessel_records` of the Mariner with `effects`
+    hidden (u, v over ground by default, as GNSS logs them); returns `(report, seconds)`."""
+    truth = js.augment(js.vessel("mariner"), *effects)
+    train, holdout = vessel_records(truth, seed, duration=duration, over_ground=over_ground)
+    began = time.perf_counter()
+    report = js.discover(js.vessel("mariner"), train, holdout, **options)
+    return report, time.perf_counter() - began
+
+
+def covered(report, truth: dict) -> bool | None:
+    """Whether every named estimate of a parameter in `truth` `{name: value}` holds the
+    true value within its interval (`EffectParameter.covers`: 3 standard errors); None
+    where no named parameter is in `truth` (an effect named through its class)."""
+    checks = [p.covers(truth[n]) for e in report.effects for n, p in e.parameters.items()
+              if n in truth]
+    return all(checks) if checks else None

@@ -21,12 +21,27 @@ class CandidateScore(eqx.Module):
     predicted_decrease: float
 
 
+# an estimate's interval: the value within this many standard errors (issue 60: a case
+# is right only where the truth lies inside)
+INTERVAL_SE = 3.0
+
+
 class EffectParameter(eqx.Module):
-    """A fitted effect parameter: `value`, robust standard error `std`, `unit`."""
+    """A fitted effect parameter: `value`, robust standard error `std`, `unit`, and
+    `interval` `(value - 3 std, value + 3 std)` (`INTERVAL_SE`)."""
 
     value: float
     std: float
     unit: str
+    interval: tuple[float, float] = (math.nan, math.nan)
+
+    @classmethod
+    def with_interval(cls, value: float, std: float, unit: str) -> "EffectParameter":
+        return cls(value, std, unit, (value - INTERVAL_SE * std, value + INTERVAL_SE * std))
+
+    def covers(self, truth: float) -> bool:
+        """Whether `truth` lies within the interval."""
+        return self.interval[0] <= truth <= self.interval[1]
 
 
 class Equivalent(eqx.Module):
@@ -126,15 +141,17 @@ class DiscoveryReport(eqx.Module):
         if self.effects:
             lines += [f"**Verdict: missing effect(s): {', '.join(self.named)}** (family-wise "
                       f"false-alarm rate {self.alpha:g}).", ""]
-            lines += ["| effect | parameter | value | std | unit | score | LR | p | dBIC | "
-                      "cannot be told from |", "|---|---|---|---|---|---|---|---|---|---|"]
+            lines += ["| effect | parameter | value | std | interval (+-3 std) | unit | score | "
+                      "LR | p | dBIC | cannot be told from |",
+                      "|---|---|---|---|---|---|---|---|---|---|---|"]
             for e in self.effects:
                 twins = "; ".join(f"{q.id} ({q.separate})" for q in e.equivalent_to)
                 twins = twins.replace("|", "\\|")  # r|r| inside a table cell
                 for name, p in e.parameters.items():
                     unit = p.unit.replace("|", "or")
                     lines.append(f"| {e.name} | `{name}` | {p.value:.4g} | {p.std:.2g} | "
-                                 f"{unit} | {e.score:.3g} | {e.likelihood_ratio:.3g} | "
+                                 f"{p.interval[0]:.4g} to {p.interval[1]:.4g} | {unit} | "
+                                 f"{e.score:.3g} | {e.likelihood_ratio:.3g} | "
                                  f"{e.p_value:.2g} | {e.delta_bic:.1f} | {twins or '-'} |")
         else:
             best = max(self.scores.items(), key=lambda kv: kv[1].score, default=None)

@@ -50,8 +50,8 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
         check_froude(holdout, length, "held-out", name)
     say(f"start values: identify {name} on {len(train)} training records")
     start = identify(train, model=name, start=start).fit.model
-    report = js.discover(start, train, holdout, max_effects=max_effects, alpha=alpha,
-                         progress=say)
+    report = js.discover(start, train, holdout, options=js.DiscoveryOptions(
+        max_effects=max_effects, alpha=alpha), progress=say)
     with staged_folder(pathlib.Path(out)) as stage:  # all or nothing
         figures = save_discovery_figures(report, train, holdout, stage / "figures")
         text = report.to_markdown()

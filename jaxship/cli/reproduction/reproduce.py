@@ -274,7 +274,8 @@ def _discovery(quick, out, say=None) -> dict:
     say("simulating the records")
     train, holdout = hidden_effect_records(js.augment(base, hidden), DISCOVERY_SEED)
     report = js.discover(js.Nomoto1(K=0.05, T=20.0), train, holdout,
-                         max_effects=1 if quick else 3, progress=say)
+                         options=js.DiscoveryOptions(max_effects=1 if quick else 3),
+                         progress=say)
     say("drawing the held-out records")
     discovery_figure(report, holdout, pathlib.Path(out) / "figures" / "discovery_holdout.png")
     case = {"truth": "Nomoto1(K=0.06 1/s, T=25 s) + YawCubicDamping(beta=300)",
