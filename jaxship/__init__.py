@@ -90,13 +90,7 @@ from ._models._control import (
     YawRateLevels as YawRateLevels,
 )
 from ._models._effects import augment as augment
-from ._models._environment import (
-    Current as Current,
-    Environment as Environment,
-    FossenWindLoads as FossenWindLoads,
-    Wind as Wind,
-)
-from ._models._fujiwara_wind import FujiwaraWindLoads as FujiwaraWindLoads
+from ._models._environment import Current as Current, Environment as Environment, Wind as Wind
 from ._models._manoeuvres import (
     AbstractController as AbstractController,
     Controlled as Controlled,
@@ -156,7 +150,7 @@ from ._simulation._simulate import simulate as simulate
 
 # isort: split
 # the namespaces: jaxship.effects.RudderOffset, jaxship.indices.turning_indices, ...
-from . import effects as effects, indices as indices
+from . import effects as effects, indices as indices, wind_loads as wind_loads
 
 
 __all__ = [
@@ -188,8 +182,7 @@ __all__ = [
     "Environment",
     "Current",
     "Wind",
-    "FossenWindLoads",
-    "FujiwaraWindLoads",
+    "wind_loads",
     # models: steering models
     "AbstractSteeringModel",
     "AuxInputs",

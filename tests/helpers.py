@@ -47,7 +47,7 @@ class LinearTestVessel(js.AbstractVessel):
     nominal_n: float = 1.5
     frontal_wind_area: float = 500.0
     lateral_wind_area: float = 2500.0
-    wind_model: js.FossenWindLoads = js.FossenWindLoads()
+    wind_model: js.wind_loads.FossenWindLoads = js.wind_loads.FossenWindLoads()
     mass: float = 1.7e7  # m [kg]
     yv: float = -0.0116  # Y'_v
     yr: float = -0.00499 + 0.0085  # Y'_r: Mariner's total Y'_r less the Coriolis -m11' r'

@@ -20,8 +20,9 @@ LAYERS = {
     "simulate": ["_simulation"],
     "estimate": ["_estimate"],
     "analysis": ["_analysis"],
-    # the public namespaces (effects, indices) only re-export, as __init__ does
-    "application": ["_trials", "cli", "plotting", "__init__", "effects", "indices"],
+    # the public namespaces (effects, indices, wind_loads) only re-export, as __init__ does
+    "application": ["_trials", "cli", "plotting", "__init__", "effects", "indices",
+                    "wind_loads"],
 }
 RANK = {name: i for i, names in enumerate(LAYERS.values()) for name in names}
 PUBLIC = set(ast.literal_eval(next(  # the names of `jaxship.__all__`, read without importing

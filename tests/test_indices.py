@@ -47,7 +47,7 @@ class ToyVessel(js.AbstractVessel):
     nominal_n: float = 1.0  # n_0 [rev/s]
     frontal_wind_area: float = 0.0
     lateral_wind_area: float = 0.0
-    wind_model: js.FossenWindLoads = js.FossenWindLoads()
+    wind_model: js.wind_loads.FossenWindLoads = js.wind_loads.FossenWindLoads()
     mass: float = 5.0e6  # m [kg]
     yv: float = -0.012  # Y'_v [-]
     yr: float = 0.003  # Y'_r [-], hydrodynamic part (m u r written separately)

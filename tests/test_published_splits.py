@@ -125,7 +125,8 @@ def test_the_presets_defaults_are_the_recorded_selection():
     assert settings.sample_interval == chosen["sample_interval"]
     extra = () if chosen["free"] == "default" else protocol.EXTRA_FREE
     assert settings.free == js.default_free(js.get_vessel("esso_osaka")) + extra
-    wind = {"jaxship": None, "fujiwara": js.FujiwaraWindLoads.esso_osaka()}[chosen["wind"]]
+    fujiwara = js.wind_loads.FujiwaraWindLoads.esso_osaka()
+    wind = {"jaxship": None, "fujiwara": fujiwara}[chosen["wind"]]
     assert settings.wind_model == wind
     assert results["selection"]["training_set"] == ["Miyauchi 2022", "Train-R"]
 
@@ -159,8 +160,8 @@ def test_the_labs_simulator_scores_as_the_owner_measured_it():
     runs = read_runs(MIYAUCHI_2022["Test"][:3])
     published = lab_as_published()
     generic = js.get_vessel("esso_osaka")
-    assert published.wind_model == js.FujiwaraWindLoads.esso_osaka()
-    assert generic.wind_model == js.FossenWindLoads()
+    assert published.wind_model == js.wind_loads.FujiwaraWindLoads.esso_osaka()
+    assert generic.wind_model == js.wind_loads.FossenWindLoads()
     r_rmse = {name: [np.rad2deg(s.rmse["r"]) for s in free_run_score(model, runs)]
               for name, model in (("fujiwara", published), ("generic", generic))}
     np.testing.assert_allclose(r_rmse["fujiwara"], [0.81, 0.87, 0.77], atol=0.01)

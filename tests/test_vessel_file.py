@@ -226,7 +226,7 @@ def test_a_wind_model_round_trips_in_its_table(tmp_path):
     `[wind_model]` table, read back bit for bit; the default writes no table, and a
     table without a known model or with a field missing is one line naming it."""
     lab = eqx.tree_at(lambda v: v.wind_model, js.get_vessel("esso_osaka"),
-                      js.FujiwaraWindLoads.esso_osaka())
+                      js.wind_loads.FujiwaraWindLoads.esso_osaka())
     text = vessel_text(lab)
     assert '[wind_model]\nmodel = "FujiwaraWindLoads"' in text
     assert "\n[wind_model]\n" not in vessel_text(js.get_vessel("esso_osaka"))

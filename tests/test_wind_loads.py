@@ -50,8 +50,8 @@ def by_hand(alpha, L, B, A_T, A_L, A_OD, x_AL, z_AL, x_AOD, H_BR):
             N1 * np.sin(a) + N2 * np.sin(2 * a) + N3 * np.sin(3 * a))
 
 
-def model_of(g) -> js.FujiwaraWindLoads:
-    return js.FujiwaraWindLoads(
+def model_of(g) -> js.wind_loads.FujiwaraWindLoads:
+    return js.wind_loads.FujiwaraWindLoads(
         length_overall=g["L"], breadth=g["B"], superstructure_area=g["A_OD"],
         area_centre_x=g["x_AL"], area_centre_height=g["z_AL"], superstructure_x=g["x_AOD"],
         bridge_height=g["H_BR"])
@@ -59,7 +59,7 @@ def model_of(g) -> js.FujiwaraWindLoads:
 
 def lab_vessel():
     return eqx.tree_at(lambda v: v.wind_model, js.get_vessel("esso_osaka"),
-                       js.FujiwaraWindLoads.esso_osaka())
+                       js.wind_loads.FujiwaraWindLoads.esso_osaka())
 
 
 @pytest.mark.parametrize("geometry", [LAB, WIND_EO], ids=["lab csv", "wind_EO"])
@@ -76,7 +76,7 @@ def test_the_lab_preset_coefficients_at_a_few_angles():
     following wind 0.7067, C_Y on the beam 1.0227, C_N at 30 and 120 deg 0.0739 and
     -0.1168 (the paper's angle). With them the lab's simulator's published r RMSE is
     reproduced (test_published_splits)."""
-    model, v = js.FujiwaraWindLoads.esso_osaka(), js.get_vessel("esso_osaka")
+    model, v = js.wind_loads.FujiwaraWindLoads.esso_osaka(), js.get_vessel("esso_osaka")
     assert (model.length_overall, model.superstructure_x) == (LAB["L"], LAB["x_AOD"])
     c = model.load_coefficients(np.deg2rad([0.0, 180.0, 90.0, 30.0, 120.0]),
                                 v.frontal_wind_area, v.lateral_wind_area)
@@ -108,7 +108,7 @@ def test_the_default_is_fossens_with_the_winds_coefficients():
     from gamma its loads are Fossen's (2021, eqs. 10.7-10.10) with the `Wind`'s c_x,
     c_y, c_n: -c_x cos(gamma) q A_F, -c_y sin(gamma) q A_L, -c_n sin(2 gamma) q A_L L."""
     for name in js.VESSELS:
-        assert js.get_vessel(name).wind_model == js.FossenWindLoads()
+        assert js.get_vessel(name).wind_model == js.wind_loads.FossenWindLoads()
     vessel, gamma, speed = js.get_vessel("esso_osaka"), 0.7, 3.0
     wind = js.Wind(speed=speed, direction=gamma, cx=0.6, cy=0.9, cn=0.1)
     q = 0.5 * 1.225 * speed**2

@@ -81,10 +81,10 @@ SCORED = ("u", "v", "r", "psi")
 def lab_as_published() -> js.AbstractVessel:
     """The lab's simulator as published (GitHub NAOE-5thLab/mmg-1p1r-simulator): the
     `esso_osaka` preset, the lab's coefficients, with its wind loads, Fujiwara et al.'s
-    (1998) regression for the lab's geometry (`jaxship.FujiwaraWindLoads.esso_osaka()`)
+    (1998) regression for the lab's geometry (`jaxship.wind_loads.FujiwaraWindLoads.esso_osaka()`)
     instead of jaxship's generic `FossenWindLoads`."""
     return eqx.tree_at(lambda v: v.wind_model, js.get_vessel("esso_osaka"),
-                       js.FujiwaraWindLoads.esso_osaka())
+                       js.wind_loads.FujiwaraWindLoads.esso_osaka())
 
 
 def read_runs(names, root=None) -> list[js.Experiment]:

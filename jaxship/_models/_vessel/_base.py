@@ -41,7 +41,7 @@ class AbstractVessel(AbstractModel):
     nominal_n: eqx.AbstractVar[float]  # propeller rate at U_0 in straight run [rev/s]
     frontal_wind_area: eqx.AbstractVar[float]  # A_F [m^2], 0 for no windage
     lateral_wind_area: eqx.AbstractVar[float]  # A_L [m^2]
-    # how the wind on those areas makes loads (`jaxship.FossenWindLoads()` in every
+    # how the wind on those areas makes loads (`jaxship.wind_loads.FossenWindLoads()` in every
     # class unless given another)
     wind_model: eqx.AbstractVar[AbstractWindLoads]
 

@@ -89,7 +89,7 @@ class LowSpeedMMGVessel(AbstractVessel):
     ($n = 0$ or $u = 0$); this implementation keeps those switches (finite forces, but
     derivatives there are one-sided). The upstream bow/stern thrusters are left out
     (no thruster signal is logged in the data set). Its wind loads are Fujiwara et al.'s
-    (1998) regression, `jaxship.FujiwaraWindLoads.esso_osaka()` as the `wind_model`;
+    (1998) regression, `jaxship.wind_loads.FujiwaraWindLoads.esso_osaka()` as the `wind_model`;
     the preset keeps every vessel's default, `FossenWindLoads` on the given areas.
     """
 
