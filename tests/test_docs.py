@@ -1,8 +1,8 @@
 """The documentation site (mkdocs.yml) documents the whole public API and nothing
 else: every name of `jaxship.__all__` (and of the namespaces `jaxship.effects`,
-`jaxship.indices` and `jaxship.plotting`) has its `::: jaxship.NAME` entry on an API
-reference page in the site's navigation, and every entry names one of them, so that a
-new export without docs, or docs of a name no longer exported, fails here;
+`jaxship.indices`, `jaxship.plotting` and `jaxship.wind_loads`) has its `::: jaxship.NAME`
+entry on an API reference page in the site's navigation, and every entry names one of
+them, so that a new export without docs, or docs of a name no longer exported, fails here;
 `mkdocs build --strict` (.ci/run) then checks that each entry renders. Reads the pages'
 text: mkdocs need not be installed."""
 
@@ -16,7 +16,7 @@ import jaxship.plotting
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 API = ROOT / "docs" / "api"
-NAMESPACES = ("effects", "indices", "plotting")  # public modules with their own names
+NAMESPACES = ("effects", "indices", "plotting", "wind_loads")  # public modules with their own names
 
 
 def public() -> set[str]:

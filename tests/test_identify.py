@@ -184,7 +184,8 @@ def test_folder_delta_c_horizon_and_channels(tmp_path, capsys):
     np.testing.assert_allclose([values["K"], values["T"], values["n3"]], [0.06, 25.0, 300.0],
                                rtol=1e-5)
     assert result["options"] == {"horizon_s": 10.0, "rudder": "delta_c", "channels": ["r"],
-                                 "initial": "measured", "max_steps": 256, "substeps": 1}
+                                 "initial": "measured", "max_steps": 256, "substeps": 1,
+                                 "free": None}
     assert result["train"]["kind"] == "prediction" and set(result["train"]["channels"]) == {"r"}
     assert set(result["train_simulation"]["channels"]) == {"psi", "r"}
     assert result["fit"]["window_samples"] == [20, 20]

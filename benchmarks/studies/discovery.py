@@ -207,10 +207,10 @@ def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02,
 def run_vessel_case(effects, seed, *, duration=400.0, over_ground=True, **options):
     """Discovery from the Mariner preset on `vessel_records` of the Mariner with `effects`
     hidden (u, v over ground by default, as GNSS logs them); returns `(report, seconds)`."""
-    truth = js.augment(js.vessel("mariner"), *effects)
+    truth = js.augment(js.get_vessel("mariner"), *effects)
     train, holdout = vessel_records(truth, seed, duration=duration, over_ground=over_ground)
     began = time.perf_counter()
-    report = js.discover(js.vessel("mariner"), train, holdout, **options)
+    report = js.discover(js.get_vessel("mariner"), train, holdout, **options)
     return report, time.perf_counter() - began
 
 
