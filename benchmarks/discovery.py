@@ -104,8 +104,8 @@ def time_mariner():
     train, holdout = vessel_records(truth, 0)
     began = time.perf_counter()
     report = js.discover(js.get_vessel("mariner"), train, holdout,
-                         progress=lambda m: print(f"{time.perf_counter() - began:6.1f} s {m}",
-                                                  flush=True))
+                         progress=lambda m: print(
+                             f"{time.perf_counter() - began:6.1f} s {m.message}", flush=True))
     print(report.to_markdown())
     print(f"Mariner discovery (library): {time.perf_counter() - began:.1f} s; named "
           f"{report.names_or_classes()}")

@@ -94,11 +94,13 @@ from ._models._environment import Current as Current, Environment as Environment
 from ._models._manoeuvres import (
     AbstractController as AbstractController,
     Controlled as Controlled,
+    FirstOrderHold as FirstOrderHold,
     Replay as Replay,
     ReverseSpiral as ReverseSpiral,
     Schedule as Schedule,
     Stop as Stop,
     Turn as Turn,
+    ZeroOrderHold as ZeroOrderHold,
     ZigZag as ZigZag,
     heading_perturbations as heading_perturbations,
     multi_step_3211 as multi_step_3211,

@@ -305,7 +305,8 @@ def test_every_public_estimator_is_accepted_by_fit_and_predict():
     assert estimators == {js.PredictionError, js.Innovations, js.ARMAX, js.DiscreteResponse}
     t = np.arange(0.0, 240.0, 1.0)
     delta = np.deg2rad(10.0) * np.sign(np.sin(2 * np.pi * t / 120.0))
-    truth = js.simulate(js.Nomoto1(K=0.06, T=25.0), js.Replay(delta, dt=1.0, delta_hold="foh"),
+    truth = js.simulate(js.Nomoto1(K=0.06, T=25.0),
+                        js.Replay(delta, dt=1.0, delta_hold=js.FirstOrderHold()),
                         simulator=js.Simulator(max_step=float("inf"), substeps=4))
     noise = np.random.default_rng(0).standard_normal((2, t.size))
     record = js.Experiment(t, delta, psi=np.asarray(truth.state.psi) + 0.01 * noise[0],
@@ -358,7 +359,7 @@ def test_a_replay_of_a_closed_loop_run_reproduces_it():
     delta = np.asarray(closed.state.delta)
     assert np.ptp(delta) > 15 * deg  # the rudder was reversed
     assert np.max(np.abs(np.diff(delta))) <= 2.0 * deg * 0.1 + 1e-12  # at the gear's rate
-    replay = js.simulate(model, js.Replay(delta, dt=0.1, delta_hold="zoh"))
+    replay = js.simulate(model, js.Replay(delta, dt=0.1, delta_hold=js.ZeroOrderHold()))
     np.testing.assert_allclose(replay.state.psi, closed.state.psi, rtol=0, atol=1e-9)
     np.testing.assert_allclose(replay.state.r, closed.state.r, rtol=0, atol=1e-9)
     np.testing.assert_allclose(replay.internal, closed.internal, rtol=0, atol=1e-9)

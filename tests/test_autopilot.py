@@ -297,7 +297,7 @@ def test_metrics_of_a_known_record():
                         r=shape(0 * t), r_d=shape(0 * t), delta=shape(0.1 * step),
                         delta_c=shape(0.1 * step), speed=jnp.ones(1),
                         max_rate=jnp.asarray([0.1]), control_period=jnp.asarray([0.1]),
-                        success=jnp.ones((1, 1), bool))
+                        result=js.RESULTS.successful)
     m = js.closed_loop_metrics(run, sample_interval=1.0)
     error = np.abs(step - psi)
     assert np.isclose(m.residual_sum[0, 0], error[::2].sum(), rtol=1e-14)
@@ -376,3 +376,21 @@ def test_a_closed_loop_and_its_metrics_run_in_float32():
                           text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.split() == ["float32", "True"], done.stdout
+
+
+def test_closed_loop_and_tuning_carry_a_result_code():
+    """Issue 59: `ClosedLoop` and `TunedAutopilot` carry a `RESULTS` code per run (not a
+    bare flag); a plant that blows up is `simulation_blew_up`, and `throw=True` raises."""
+    model = js.Nomoto1(K=0.06, T=25.0)
+    autopilot = js.design_autopilot(model, natural_frequency=0.1)
+    run = js.closed_loop(model, autopilot, speeds=[5.0, 7.0], duration=60.0, dt=1.0)
+    assert np.asarray(run.success).shape == (1, 2) and np.all(run.success)
+    assert np.all(run.result == js.RESULTS.successful)
+    unstable = js.Nomoto1(K=0.06, T=-1e-3)
+    bad = js.closed_loop(unstable, autopilot, speeds=[5.0], duration=60.0, dt=1.0)
+    assert np.all(bad.result == js.RESULTS.simulation_blew_up) and not np.any(bad.success)
+    with pytest.raises(Exception, match="the simulation blew up"):
+        js.closed_loop(unstable, autopilot, speeds=[5.0], duration=60.0, dt=1.0, throw=True)
+    tuned = js.tune_autopilot(model, autopilot, speeds=[5.0], duration=60.0, max_steps=1)
+    assert bool(tuned.result == js.RESULTS.nonlinear_max_steps_reached), tuned.result
+    assert not bool(tuned.success)

@@ -296,7 +296,7 @@ def _record(steps=2, points=3):
                          psi_ref=shape(ordered), r=shape(0 * t), r_d=shape(0 * t),
                          delta=shape(0.1 * ordered), delta_c=shape(0.1 * ordered),
                          speed=jnp.ones(points), max_rate=jnp.ones(steps),
-                         control_period=jnp.ones(steps), success=jnp.ones((steps, points), bool))
+                         control_period=jnp.ones(steps), result=js.RESULTS.successful)
 
 
 def test_plot_autopilot_draws_heading_error_rudder_with_limits_and_outside_legends():

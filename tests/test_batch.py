@@ -226,7 +226,7 @@ def test_a_batch_of_steering_runs_equals_the_single_runs():
                for a in (10.0, -15.0, 20.0)]
     batch = jb.simulate_batch(model, jb.stack(zigzags), in_axes=(None, 0, None, None))
     records = [np.asarray(js.simulate(model, z).state.delta) for z in zigzags]
-    replays = [js.Replay(d, dt=0.5, delta_hold="foh") for d in records]
+    replays = [js.Replay(d, dt=0.5, delta_hold=js.FirstOrderHold()) for d in records]
     replayed = jb.simulate_batch(model, jb.stack(replays), in_axes=(None, 0, None, None))
     for i, (z, r) in enumerate(zip(zigzags, replays)):
         for got, single in ((batch, js.simulate(model, z)), (replayed, js.simulate(model, r))):

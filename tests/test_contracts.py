@@ -16,6 +16,9 @@ from jaxship._foundation._params import default_free, get_path, rebuild
 from jaxship._models._steering._base import WindowStart
 
 
+FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+
+
 DEG = np.pi / 180
 VESSELS = sorted(js.VESSELS)
 STEERING = {
@@ -161,7 +164,7 @@ def steering_final(model, name):
     delta = np.deg2rad(10) * np.sign(np.sin(2 * np.pi * np.arange(120) / 60.0) + 1e-9)
     aux = js.AuxInputs(u=1.5, v=0.05, n=8.0)
     return lambda p: js.simulate(rebuild(model, (name,), (p,)),
-                                 js.Replay(delta, dt=0.5, delta_hold="foh"), aux=aux,
+                                 js.Replay(delta, dt=0.5, delta_hold=FOH), aux=aux,
                                  simulator=per_sample()).state.psi[-1]
 
 
@@ -219,10 +222,10 @@ def test_effect_contract(effect):
         delta = np.deg2rad(10) * np.sign(np.sin(2 * np.pi * np.arange(200) / 80.0) + 1e-9)
         measured = shown.get("aux", {})
         aux = js.AuxInputs(**measured)
-        base = js.simulate(model, js.Replay(delta, dt=0.5, delta_hold="foh"), aux=aux,
+        base = js.simulate(model, js.Replay(delta, dt=0.5, delta_hold=FOH), aux=aux,
                            simulator=per_sample())
         augmented = js.augment(model, zero)
-        same = js.simulate(augmented, js.Replay(delta, dt=0.5, delta_hold="foh"), aux=aux,
+        same = js.simulate(augmented, js.Replay(delta, dt=0.5, delta_hold=FOH), aux=aux,
                            simulator=per_sample())
         assert_equal_to_rounding(same.state.psi, base.state.psi)
         assert_equal_to_rounding(same.state.r, base.state.r)

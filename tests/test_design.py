@@ -16,6 +16,9 @@ from jaxship import (
 )
 
 
+FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+
+
 def test_excitation_order_known_signals():
     n = 2000
     t = np.arange(n)
@@ -56,7 +59,7 @@ def test_fisher_against_finite_differences(model, free):
         h = 1e-6 * abs(v)
         sim = lambda x: np.asarray(js.simulate(
             jax.tree_util.tree_map(lambda a: a, _with(model, name, x)),
-            js.Replay(delta, dt=dt, delta_hold="foh"), simulator=per_sample()).state.r)
+            js.Replay(delta, dt=dt, delta_hold=FOH), simulator=per_sample()).state.r)
         cols.append((sim(v + h) - sim(v - h)) / (2 * h))
     jac = np.stack(cols, axis=1)
     fd = jac.T @ jac / sigma**2

@@ -48,8 +48,15 @@ def run(*effects, seed=0, disturbance=0.0):
 
 
 def test_nothing_missing_on_white_null_data():
-    report = run(seed=1)
-    assert report.verdict == "nothing_missing" and report.effects == ()
+    """... with the verdict a code (`js.Verdict`, its name in the JSON) and each stage
+    reported as a `Progress` (issue 59: the one progress type of every long call)."""
+    reports = []
+    report = run_case((), 1, progress=reports.append)[0]
+    assert report.verdict == js.Verdict.nothing_missing and report.effects == ()
+    assert report.verdict_name == report.to_dict()["verdict"] == "nothing_missing"
+    assert reports and all(isinstance(p, js.Progress) and p.stage == "discover"
+                           for p in reports)
+    assert reports[0].message == "fitting the base model"
     best = max(s.score for s in report.scores.values())
     assert best < min(s.threshold for s in report.scores.values())
     assert "nothing missing" in report.to_markdown()
@@ -59,7 +66,7 @@ def test_nothing_missing_with_a_slowly_varying_yaw_moment():
     """A disturbance the model does not have colours the residuals: the naive score
     statistic of some candidate passes its threshold, the robust one does not."""
     report = run(seed=2, disturbance=1.0 * DEG)
-    assert report.verdict == "nothing_missing"
+    assert report.verdict == js.Verdict.nothing_missing
     # more than a couple of degrees: the records with and without it differ in heading
     # by 3.5-16 deg at most (each record)
     calm, disturbed = (sum(hidden_effect_records(js.Nomoto1(K=K, T=25.0), 2,
@@ -90,7 +97,7 @@ def test_the_held_out_check_vetoes_but_does_not_choose():
     yaw-moment bias are one class on a Nomoto model (their scores tie to rounding), so the
     rejection names the class, whichever member was refitted."""
     report = run(effects.RudderOffset(delta0=0.3 * DEG), seed=1018, disturbance=1.0 * DEG)
-    assert report.verdict == "nothing_missing", report.to_markdown()
+    assert report.verdict == js.Verdict.nothing_missing, report.to_markdown()
     assert any("rudder_offset or yaw_moment_bias explains the training data better" in why
                for r in report.rejected for why in r.why), report.to_markdown()
 
@@ -174,7 +181,7 @@ def test_a_candidate_whose_sensitivities_are_not_finite_is_rejected_not_the_run(
     monkeypatch.setattr(_search, "score_tests", failing)
     report = run_case((effects.RudderOffset(delta0=1.0 * DEG),), 3,
                       options=js.DiscoveryOptions(max_effects=1))[0]
-    assert report.verdict == "nothing_missing" and report.rejected
+    assert report.verdict == js.Verdict.nothing_missing and report.rejected
     assert all(r.why == ("not scored: the scores failed numerically (SVD did not "
                          "converge)",) for r in report.rejected)
     assert json.dumps(report.to_dict(), allow_nan=False)
@@ -334,7 +341,7 @@ def test_an_implausibly_large_constant_moment_is_not_named():
     for angle, named in ((10 * DEG, False), (1 * DEG, True)):
         report = run_case((effects.YawMomentBias(n0=K * angle),), 3, catalogue=only,
                           options=js.DiscoveryOptions(max_effects=1))[0]
-        assert (report.verdict == "missing_effect") is named, report.to_markdown()
+        assert bool(report.verdict == js.Verdict.missing_effect) is named, report.to_markdown()
         record = (report.effects or report.rejected)[0]
         assert record.rudder_equivalent_deg == pytest.approx(np.degrees(angle), rel=0.1)
         if not named:
@@ -344,7 +351,7 @@ def test_an_implausibly_large_constant_moment_is_not_named():
 
 def test_a_rudder_offset_is_named_with_its_class_and_the_gap_shrinks():
     report = run(effects.RudderOffset(delta0=0.5 * DEG), seed=3)
-    assert report.verdict == "missing_effect" and len(report.effects) == 1
+    assert report.verdict == js.Verdict.missing_effect and len(report.effects) == 1
     assert report.names_or_classes()[0] == {"rudder_offset", "yaw_moment_bias"}
     effect = report.effects[0]
     assert "two speeds" in effect.equivalent_to[0].separate

@@ -16,6 +16,9 @@ from jaxship._estimate._discrete import (
 )
 
 
+ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
+
+
 H = 0.2
 CASES = {
     "linear1": dict(K=0.1, T=20.0, delta_r=0.01),
@@ -62,7 +65,7 @@ def test_zoh_matches_continuous_models():
     d = _rudder(1500)
     for structure, model in (("linear1", Nomoto1(K=0.1, T=20.0, delta0=0.01)),
                              ("linear2", Nomoto2(K=0.1, T1=25.0, T2=3.0, T3=5.0, delta0=0.01))):
-        r = np.asarray(js.simulate(model, js.Replay(d, dt=H, delta_hold="zoh"),
+        r = np.asarray(js.simulate(model, js.Replay(d, dt=H, delta_hold=ZOH),
                                    simulator=per_sample(40)).state.r)
         e = Experiment(np.arange(d.size) * H, d, r=r)
         f = fit_discrete_response(structure, e)
@@ -74,9 +77,10 @@ def test_zoh_matches_continuous_models():
                              ("linear2", Nomoto2(K=0.1, T1=25.0, T2=3.0, T3=5.0))):
         params = {k: v for k, v in CASES[structure].items() if k != "delta_r"}
         c = discretise(structure, params, H)
-        r = np.asarray(js.simulate(model, js.Replay(d, dt=H, delta_hold="zoh"),
+        r = np.asarray(js.simulate(model, js.Replay(d, dt=H, delta_hold=ZOH),
                                    simulator=per_sample(40)).state.r)
-        sim = DiscreteResponseFit(structure, "ls", "zoh", H, c, {}, 0.0, 0).simulate(d)
+        sim = DiscreteResponseFit(structure, js.LeastSquaresRegression(), "zoh", H, c, {}, 0.0,
+                                  0).simulate(d)
         assert np.max(np.abs(sim - r)) < 1e-9 * np.max(np.abs(r))
 
 
@@ -93,7 +97,7 @@ def test_svr_recovers_noise_free(structure):
     pytest.importorskip("sklearn")
     c, e = _record(structure)
     ls = fit_discrete_response(structure, e)
-    svr = fit_discrete_response(structure, e, method="svr")
+    svr = fit_discrete_response(structure, e, method=js.SupportVectorRegression())
     assert svr.converged
     # an iterative QP solver (liblinear, tol 1e-8): agreement to its tolerance
     for k in COEFFICIENTS[structure]:
@@ -111,7 +115,7 @@ def test_bad_inputs():
     with pytest.raises(ValueError, match="structure"):
         fit_discrete_response("cubic", e)
     with pytest.raises(ValueError, match="method"):
-        fit_discrete_response("linear1", e, method="svm")
+        fit_discrete_response("linear1", e, method="svr")
     with pytest.raises(ValueError, match="zero-order-hold"):
         fit_discrete_response("nonlinear1", e, discretisation="zoh")
     with pytest.raises(ValueError, match="Experiment"):

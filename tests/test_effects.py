@@ -13,6 +13,10 @@ from scipy.integrate import quad
 import jaxship as js
 
 
+FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
+
+
 DEG = np.pi / 180
 K, T = 0.06, 25.0
 
@@ -30,7 +34,7 @@ def test_rudder_lag_gives_the_two_time_constant_step_response():
     assert model.state_names == ("r", "rudder_lag.delta_lagged")
     dt = 0.5
     delta = step()
-    out = js.simulate(model, js.Replay(delta, dt=dt, delta_hold="zoh"), simulator=per_sample(5))
+    out = js.simulate(model, js.Replay(delta, dt=dt, delta_hold=ZOH), simulator=per_sample(5))
     t = np.asarray(out.t) - dt  # the step acts from the second sample
     expected = K * 10 * DEG * (1 - (T * np.exp(-t / T) - lag * np.exp(-t / lag)) / (T - lag))
     # RK4 at 0.1 s control steps: error of order (h / T_l)^4 = 4e-7 of the final rate
@@ -45,7 +49,7 @@ def test_rudder_delay_follows_the_delayed_response():
     0.5 % of the step's final yaw rate once the delay has passed."""
     delay, dt = 2.0, 0.25
     model = js.augment(js.Nomoto1(K=K, T=T), js.effects.RudderDelay(delay=delay))
-    out = js.simulate(model, js.Replay(step(1200), dt=dt, delta_hold="zoh"),
+    out = js.simulate(model, js.Replay(step(1200), dt=dt, delta_hold=ZOH),
                       simulator=per_sample(5))
     t = np.asarray(out.t) - dt
     exact = K * 10 * DEG * (1 - np.exp(-np.clip(t - delay, 0, None) / T))
@@ -60,7 +64,7 @@ def test_rudder_rate_limit_ramps_the_acting_rudder():
     about that length (here 5 per 0.5 s sample)."""
     rate = 2.3 * DEG
     model = js.augment(js.Nomoto1(K=K, T=T), js.effects.RudderRateLimit(inverse_rate=1 / rate))
-    out = js.simulate(model, js.Replay(step(200, 20 * DEG), dt=0.5, delta_hold="zoh"),
+    out = js.simulate(model, js.Replay(step(200, 20 * DEG), dt=0.5, delta_hold=ZOH),
                       simulator=per_sample(5))
     acting = np.asarray(out.internal[:, 1])
     slope = np.diff(acting) / 0.5
@@ -101,7 +105,7 @@ def test_fit_recovers_a_rudder_lag_on_a_steering_model():
     truth = js.augment(js.Nomoto1(K=K, T=T), js.effects.RudderLag(time_constant=3.0))
     delta = 10 * DEG * np.sign(np.sin(2 * np.pi * np.arange(800) / 160.0) + 1e-9)
     delta[0] = 0.0  # from a straight run, as trials start
-    out = js.simulate(truth, js.Replay(delta, dt=0.5, delta_hold="foh"),
+    out = js.simulate(truth, js.Replay(delta, dt=0.5, delta_hold=FOH),
                       simulator=per_sample(20))  # a finer truth
     data = js.Experiment(np.asarray(out.t), delta, psi=np.asarray(out.state.psi),
                          r=np.asarray(out.state.r))
@@ -120,7 +124,7 @@ def test_a_model_augmented_with_no_effects_fits_as_its_base():
     lookup once failed on the empty effects tuple)."""
     delta = 10 * DEG * np.sign(np.sin(2 * np.pi * np.arange(400) / 160.0) + 1e-9)
     delta[0] = 0.0
-    out = js.simulate(js.Nomoto1(K=K, T=T), js.Replay(delta, dt=0.5, delta_hold="foh"),
+    out = js.simulate(js.Nomoto1(K=K, T=T), js.Replay(delta, dt=0.5, delta_hold=FOH),
                       simulator=per_sample())
     data = js.Experiment(np.asarray(out.t), delta, psi=np.asarray(out.state.psi),
                          r=np.asarray(out.state.r))
@@ -153,9 +157,9 @@ def test_a_yaw_moment_on_nomoto_equals_a_rudder_offset():
     delta = 10 * DEG * np.sign(np.sin(2 * np.pi * np.arange(400) / 160.0) + 1e-9)
     for base in (js.Nomoto1(K=K, T=T), js.Nomoto2(K=K, T1=T, T2=3.0, T3=5.0)):
         moment = js.simulate(js.augment(base, js.effects.YawMomentBias(n0=K * d0)),
-                             js.Replay(delta, dt=0.5, delta_hold="foh"), simulator=per_sample())
+                             js.Replay(delta, dt=0.5, delta_hold=FOH), simulator=per_sample())
         offset = js.simulate(js.augment(base, js.effects.RudderOffset(delta0=d0)),
-                             js.Replay(delta, dt=0.5, delta_hold="foh"), simulator=per_sample())
+                             js.Replay(delta, dt=0.5, delta_hold=FOH), simulator=per_sample())
         if isinstance(base, js.Nomoto1):
             np.testing.assert_allclose(moment.state.r, offset.state.r, rtol=1e-12, atol=1e-15)
         else:  # Nomoto 2: the offset also enters through K T3 (delta + delta0)
@@ -199,7 +203,7 @@ def test_load_effects_add_their_closed_form_to_a_vessel(effect, expected):
 
 def steady_r(model, angle, aux=None, num=800, dt=1.0):
     """The yaw rate after `num` samples of a rudder step to `angle` from rest."""
-    out = js.simulate(model, js.Replay(step(num, angle), dt=dt, delta_hold="zoh"), aux=aux,
+    out = js.simulate(model, js.Replay(step(num, angle), dt=dt, delta_hold=ZOH), aux=aux,
                       simulator=per_sample(2))
     return float(out.state.r[-1])
 
@@ -256,16 +260,16 @@ def test_speed_dependent_rudder_is_the_base_at_the_nominal_speed():
     base = js.Nomoto1(K=K, T=T)
     delta = step(100)
     at_nominal = js.AuxInputs(u=U0)
-    np.testing.assert_array_equal(js.simulate(model, js.Replay(delta, dt=1.0, delta_hold="foh"),
+    np.testing.assert_array_equal(js.simulate(model, js.Replay(delta, dt=1.0, delta_hold=FOH),
                                               aux=at_nominal, simulator=per_sample()).state.r,
-                                  js.simulate(base, js.Replay(delta, dt=1.0, delta_hold="foh"),
+                                  js.simulate(base, js.Replay(delta, dt=1.0, delta_hold=FOH),
                                               aux=at_nominal, simulator=per_sample()).state.r)
     slow = js.AuxInputs(u=0.8 * U0)
     assert steady_r(model, 10 * DEG, slow) == pytest.approx(
         K * 10 * DEG * (1 + kappa * (0.64 - 1)), rel=1e-9)
     with pytest.raises(ValueError, match="nominal_speed"):
         js.simulate(js.augment(base, js.effects.SpeedDependentRudder(kappa=kappa)),
-                    js.Replay(delta, dt=1.0, delta_hold="foh"), simulator=per_sample())
+                    js.Replay(delta, dt=1.0, delta_hold=FOH), simulator=per_sample())
 
 
 def test_speed_dependent_damping_and_rudder_make_nomoto_speed_scaled():
@@ -277,22 +281,22 @@ def test_speed_dependent_damping_and_rudder_make_nomoto_speed_scaled():
                         js.effects.SpeedDependentDamping(kappa=1.0, nominal_speed=U0))
     delta = step(200)
     aux = js.AuxInputs(u=s * U0)
-    np.testing.assert_allclose(js.simulate(scaled, js.Replay(delta, dt=1.0, delta_hold="foh"),
+    np.testing.assert_allclose(js.simulate(scaled, js.Replay(delta, dt=1.0, delta_hold=FOH),
                                            aux=aux, simulator=per_sample()).state.r,
                                js.simulate(js.Nomoto1(K=K * s, T=T / s),
-                                           js.Replay(delta, dt=1.0, delta_hold="foh"),
+                                           js.Replay(delta, dt=1.0, delta_hold=FOH),
                                            simulator=per_sample()).state.r,
                                rtol=1e-9, atol=1e-12)
     base = js.Nomoto1(K=K, T=T)
     np.testing.assert_allclose(  # the base model at the nominal speed (to rounding)
         js.simulate(js.augment(base, js.effects.SpeedDependentDamping(kappa=1.0, nominal_speed=U0)),
-                    js.Replay(delta, dt=1.0, delta_hold="foh"), aux=js.AuxInputs(u=U0),
+                    js.Replay(delta, dt=1.0, delta_hold=FOH), aux=js.AuxInputs(u=U0),
                     simulator=per_sample()).state.r,
-        js.simulate(base, js.Replay(delta, dt=1.0, delta_hold="foh"), aux=js.AuxInputs(u=U0),
+        js.simulate(base, js.Replay(delta, dt=1.0, delta_hold=FOH), aux=js.AuxInputs(u=U0),
                     simulator=per_sample()).state.r, rtol=1e-14, atol=0)
     with pytest.raises(ValueError, match="nominal_speed"):
         js.simulate(js.augment(base, js.effects.SpeedDependentDamping(kappa=1.0)),
-                    js.Replay(delta, dt=1.0, delta_hold="foh"), simulator=per_sample())
+                    js.Replay(delta, dt=1.0, delta_hold=FOH), simulator=per_sample())
 
 
 def test_rudder_stall_saturates_only_large_rudder_angles():
@@ -409,18 +413,18 @@ def test_apparent_wind_adds_its_yaw_term_to_a_steering_model():
                        wind_v=20.0 * np.sin(gamma))
     delta = np.deg2rad(10) * np.sign(np.sin(2 * np.pi * t / 80.0) + 1e-9)
     model = js.Nomoto1(K=K, T=T)
-    base = js.simulate(model, js.Replay(delta, dt=0.5, delta_hold="foh"), aux=aux,
+    base = js.simulate(model, js.Replay(delta, dt=0.5, delta_hold=FOH), aux=aux,
                        simulator=per_sample())
     zero = js.augment(model, js.effects.ApparentWind())
-    np.testing.assert_array_equal(js.simulate(zero, js.Replay(delta, dt=0.5, delta_hold="foh"),
+    np.testing.assert_array_equal(js.simulate(zero, js.Replay(delta, dt=0.5, delta_hold=FOH),
                                               aux=aux,
                                               simulator=per_sample()).state.psi, base.state.psi)
     windy = js.augment(model, js.effects.ApparentWind(c2=3e-6, c1=-1e-6))
-    np.testing.assert_array_equal(js.simulate(windy, js.Replay(delta, dt=0.5, delta_hold="foh"),
+    np.testing.assert_array_equal(js.simulate(windy, js.Replay(delta, dt=0.5, delta_hold=FOH),
                                               simulator=per_sample()).state.psi,
-                                  js.simulate(model, js.Replay(delta, dt=0.5, delta_hold="foh"),
+                                  js.simulate(model, js.Replay(delta, dt=0.5, delta_hold=FOH),
                                               simulator=per_sample()).state.psi)  # calm
-    assert np.max(np.abs(js.simulate(windy, js.Replay(delta, dt=0.5, delta_hold="foh"), aux=aux,
+    assert np.max(np.abs(js.simulate(windy, js.Replay(delta, dt=0.5, delta_hold=FOH), aux=aux,
                                      simulator=per_sample()).state.psi
                          - base.state.psi)) > 1 * DEG
     one = js.AuxInputs(u=7.0, wind_u=20.0 * np.cos(0.7), wind_v=20.0 * np.sin(0.7))

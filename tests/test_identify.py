@@ -32,6 +32,10 @@ from jaxship.cli._identification import (
 )
 
 
+FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
+
+
 DEG = np.pi / 180
 DT = 0.5
 NUM = 600
@@ -56,7 +60,7 @@ def record(model, delta, *, name, noise=0.0, seed=0, command=None):
     measurement noise of `noise` deg on psi and `noise / 10` deg/s on r. `command`:
     an optional commanded rudder written as `delta_c`, which then drives the model held
     over each interval (as `identify --rudder delta_c` replays a command)."""
-    tr = js.simulate(model, js.Replay(delta, dt=DT, delta_hold="foh" if command is None else "zoh"),
+    tr = js.simulate(model, js.Replay(delta, dt=DT, delta_hold=FOH if command is None else ZOH),
                      js.straight_state(0.0, psi=0.1), simulator=per_sample())
     rng = np.random.default_rng(seed)
     psi = np.asarray(tr.state.psi) + noise * DEG * rng.standard_normal(NUM)
@@ -340,7 +344,7 @@ def steering_csvs(folder, truth, dt, num, aux_of_t, seed=0):
     for k in range(2):
         t = dt * np.arange(num)
         delta, aux = steps(num, seed + k), aux_of_t(t)
-        tr = js.simulate(truth, js.Replay(delta, dt=dt, delta_hold="foh"),
+        tr = js.simulate(truth, js.Replay(delta, dt=dt, delta_hold=FOH),
                          js.straight_state(0.0, psi=0.2), aux=aux, simulator=per_sample())
         v = np.asarray(tr.internal[:, 1]) if "v" in truth.state_names else aux.v
         e = js.Experiment(t, delta, psi=np.asarray(tr.state.psi), r=np.asarray(tr.state.r),

@@ -445,7 +445,7 @@ def _as_trajectory(t, r, delta):
     state = js.ShipState(u=z + 5, v=z, r=jnp.asarray(r), x=z, y=z, psi=z,
                          delta=jnp.asarray(delta), n=z)
     return js.Trajectory(t=jnp.asarray(t), state=state, command=js.Command(jnp.asarray(delta), z),
-                         valid=jnp.ones(t.shape, bool), success=jnp.array(True))
+                         valid=jnp.ones(t.shape, bool), result=js.RESULTS.successful)
 
 
 def test_pull_out_indices_both_sides():

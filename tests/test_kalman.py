@@ -16,6 +16,10 @@ from jaxship._estimate._kalman import rts_smoother
 from jaxship._estimate._likelihood import fit_ml
 
 
+FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
+
+
 DEG = np.pi / 180
 DT = 0.5
 TRUTH = Nomoto1(K=0.06, T=25.0)
@@ -29,7 +33,7 @@ def noisy_record(model, num, seed, *, q=Q_RUDDER, r_psi=R_PSI, r_r=R_R, dt=DT):
     rng = np.random.default_rng(seed)
     delta = zigzag_like(num, seed)
     noisy = delta + math.sqrt(q) * rng.standard_normal(num)  # process noise on the rudder
-    tr = js.simulate(model, js.Replay(noisy, dt=dt, delta_hold="foh"), simulator=per_sample())
+    tr = js.simulate(model, js.Replay(noisy, dt=dt, delta_hold=FOH), simulator=per_sample())
     psi, r = np.asarray(tr.state.psi), np.asarray(tr.state.r)
     exp = js.Experiment(np.asarray(tr.t), delta,
                         psi=psi + math.sqrt(r_psi) * rng.standard_normal(num),
@@ -78,7 +82,7 @@ def test_ekf_of_a_linear_model_is_the_linear_kalman_filter():
     exp, _, _ = noisy_record(TRUTH, 300, 1)
     # the reference discretises the rudder held over each interval (zero-order hold)
     out = js.ekf(TRUTH, exp, process_noise={"rudder": Q_RUDDER},
-                 measurement_noise={"psi": R_PSI, "r": R_R}, hold="zoh")
+                 measurement_noise={"psi": R_PSI, "r": R_R}, hold=ZOH)
     zs, Ps = rts_smoother(out)
     y = np.stack([exp.psi, exp.r], axis=-1)
     zf, innov, nll, zs_ref, Ps_ref = numpy_kalman(0.06, 25.0, exp.delta, y, DT, Q_RUDDER,
@@ -147,7 +151,7 @@ def test_innovations_pem_beats_output_error_under_process_noise(process_noise_re
     off by many of its own standard errors; the innovations predictor is not."""
     exp, _, _ = process_noise_record
     start = Nomoto1(K=0.04, T=15.0)
-    pem = fit_ml(start, exp, criterion="pem")
+    pem = fit_ml(start, exp, criterion=js.InnovationsLeastSquares())
     oe = js.fit(start, exp, estimator=js.PredictionError(horizon=None))
     truth = np.array([0.06, 25.0])
     assert pem.success and oe.success
@@ -204,8 +208,8 @@ def test_ekf_rejects_bad_noise_specifications(kwargs, match):
 
 def test_fit_ml_rejects_bad_arguments_and_data():
     exp, _, _ = noisy_record(TRUTH, 50, 9)
-    with pytest.raises(ValueError, match="'ml' or 'pem'"):
-        fit_ml(TRUTH, exp, criterion="oe")
+    with pytest.raises(ValueError, match="MaximumLikelihood\\(\\) or InnovationsLeastSquares"):
+        fit_ml(TRUTH, exp, criterion="ml")
     with pytest.raises(ValueError, match="not a noise term"):
         fit_ml(TRUTH, exp, noise={"wind": 1.0})
     with pytest.raises(ValueError, match="AbstractSteeringModel"):
@@ -245,7 +249,7 @@ def test_fit_with_the_innovations_estimator_is_fit_ml():
     FitResult carries the noise, the criterion and the filter's one-step predictions."""
     exp, _, _ = noisy_record(TRUTH, 400, 11)
     start = Nomoto1(K=0.05, T=20.0)
-    direct = fit_ml(start, exp, criterion="pem")
+    direct = fit_ml(start, exp, criterion=js.InnovationsLeastSquares())
     res = js.fit(start, exp, estimator=js.Innovations(criterion=js.InnovationsLeastSquares()))
     assert isinstance(res, js.FitResult) and res.criterion == "pem"
     np.testing.assert_allclose(res.values, direct.values, rtol=1e-12)

@@ -13,6 +13,9 @@ import jaxship as js
 from jaxship._models._vessel.sway_yaw import _cross_flow_integrals
 
 
+FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+
+
 DEG = np.pi / 180
 # the values fitted on the Esso Osaka zig-zags and turns (studies.real_data), rounded
 ESSO = {"n_v": -0.22, "n_r": -0.53, "n_delta": 0.11, "y_v": -0.20, "y_r": -0.49,
@@ -77,7 +80,7 @@ def low_speed_record(seed, truth=TRUTH, metadata=()):
     delta = np.array(delta[:num])
     u = 0.3 + 0.15 * np.sin(2 * np.pi * t / rng.uniform(80, 200) + seed)
     n = np.full(num, rng.choice([8.0, 10.0, 15.0]))
-    tr = js.simulate(truth, js.Replay(delta, dt=dt, delta_hold="foh"), aux=js.AuxInputs(u=u, n=n),
+    tr = js.simulate(truth, js.Replay(delta, dt=dt, delta_hold=FOH), aux=js.AuxInputs(u=u, n=n),
                      simulator=per_sample())
     return js.Experiment(t, delta, psi=np.asarray(tr.state.psi), r=np.asarray(tr.state.r), u=u, n=n,
                          v=np.asarray(tr.internal[:, 1]), metadata=metadata)
@@ -145,7 +148,7 @@ def windy_record(seed, name):
     for _ in range(40):
         aux = js.AuxInputs(u=u, n=n, wind_u=u - (air_n * np.cos(psi) + air_e * np.sin(psi)),
                            wind_v=v - (-air_n * np.sin(psi) + air_e * np.cos(psi)))
-        tr = js.simulate(TRUTH, js.Replay(calm.delta, dt=0.5, delta_hold="foh"), aux=aux,
+        tr = js.simulate(TRUTH, js.Replay(calm.delta, dt=0.5, delta_hold=FOH), aux=aux,
                          simulator=per_sample())
         step = max(np.max(np.abs(tr.state.psi - psi)), np.max(np.abs(tr.internal[:, 1] - v)))
         psi, v = np.asarray(tr.state.psi), np.asarray(tr.internal[:, 1])
@@ -191,7 +194,7 @@ def with_noise(e, rng, name=None, v_noise=3e-3):
 
 def noisy(record, truth, seed):
     """`record`'s inputs driving `truth`, with measurement noise (`with_noise`)."""
-    tr = js.simulate(truth, js.Replay(record.delta, dt=0.5, delta_hold="foh"),
+    tr = js.simulate(truth, js.Replay(record.delta, dt=0.5, delta_hold=FOH),
                      aux=js.AuxInputs(u=record.u, n=record.n), simulator=per_sample())
     clean = js.Experiment(record.t, record.delta, psi=np.asarray(tr.state.psi),
                           r=np.asarray(tr.state.r), u=record.u, n=record.n,
@@ -212,9 +215,9 @@ def test_discover_from_it_names_a_hidden_offset_and_nothing_on_null_data(hidden)
     offered = {c.id for c in report.rejected} | set(report.named)
     assert not offered & set(js.LowSpeedSwayYaw.built_in_effects)
     if hidden is None:
-        assert report.verdict == "nothing_missing", report.to_markdown()
+        assert report.verdict == js.Verdict.nothing_missing, report.to_markdown()
     else:
-        assert report.verdict == "missing_effect" and len(report.effects) == 1
+        assert report.verdict == js.Verdict.missing_effect and len(report.effects) == 1
         assert "rudder_offset" in report.names_or_classes()[0], report.to_markdown()
         assert report.holdout_cost_after < report.holdout_cost_before
 

@@ -11,6 +11,9 @@ from helpers import per_sample
 import jaxship as js
 
 
+FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+
+
 DEG = np.pi / 180
 
 
@@ -18,7 +21,7 @@ def zigzag_record(dt, *, model=js.Nomoto1(K=0.06, T=25.0), duration=300.0, noise
     """A noise-free (or noisy) 10/10-like record of `model`, sampled every `dt` s."""
     t = np.arange(0.0, duration, dt)
     delta = np.where((t // 30.0) % 2 == 0, 10 * DEG, -10 * DEG)
-    out = js.simulate(model, js.Replay(delta, dt=dt, delta_hold="foh"), simulator=per_sample(20))
+    out = js.simulate(model, js.Replay(delta, dt=dt, delta_hold=FOH), simulator=per_sample(20))
     rng = np.random.default_rng(0)
     return js.Experiment(t, delta, psi=np.asarray(out.state.psi) + rng.normal(0, noise, t.size),
                          r=np.asarray(out.state.r) + rng.normal(0, noise / 10, t.size))
@@ -114,3 +117,27 @@ def test_progress_reaches_the_callable_and_nothing_is_printed(capfd):
     assert steps == sorted(steps) and len(steps) >= res.num_steps
     out, err = capfd.readouterr()
     assert out == "" and err == ""
+
+
+def test_a_fit_of_white_noise_is_undetermined():
+    """Issue 59's rule for `RESULTS.undetermined`: a converged fit whose every channel's fit %
+    stays below 5 %, with a parameter whose 95 % interval includes zero. Nomoto 1 fitted by
+    output error to white noise in rudder, heading and yaw rate: converged, fit -0.6 % and
+    -0.7 %, K = 0.0055 +- 0.0034 (within 1.96 standard errors of zero), now undetermined,
+    and `throw=True` raises with the flag. The zig-zag record of a Nomoto model, with
+    noise, stays successful."""
+    rng = np.random.default_rng(0)
+    t = np.arange(0.0, 300.0, 1.0)
+    noise = js.Experiment(t, rng.normal(0, 10 * DEG, t.size), psi=rng.normal(0, 3 * DEG, t.size),
+                          r=rng.normal(0, 0.6 * DEG, t.size))
+    res = js.fit(js.Nomoto1(K=0.1, T=0.31), noise)
+    assert res.code == js.RESULTS.undetermined and not res.success, res.message
+    assert max(m.fit_percent for m in res.metrics.values()) < 5.0
+    i = res.names.index("K")
+    assert abs(res.values[i]) <= 1.96 * max(res.std[i], res.parameters.std_robust[i])
+    assert any("95 % interval includes zero" in f and "determine K." in f
+               for f in res.parameters.undetermined)
+    with pytest.raises(js.FitError, match="interval includes zero"):
+        js.fit(js.Nomoto1(K=0.1, T=0.31), noise, throw=True)
+    good = js.fit(js.Nomoto1(K=0.05, T=20.0), zigzag_record(1.0, noise=0.5 * DEG))
+    assert good.success and good.code == js.RESULTS.successful, good.message

@@ -24,6 +24,10 @@ from jaxship._models._steering.ross import HULL_TERMS, ROSS_FREE, SPEED_RUDDER
 from jaxship.cli.reproduction import thesis as ti
 
 
+FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
+
+
 DEG = np.pi / 180
 DT = 0.2
 SCALES = dict(length=4.0, speed=1.5, rate=8.0)
@@ -53,9 +57,9 @@ def synthetic_inputs(num, seed, rpm):
 
 def record(model, num, seed, rpm, *, name="synthetic"):
     """Noise-free record of rudder steps held over each interval (a commanded,
-    piecewise-constant rudder; fitted with `hold="zoh"`)."""
+    piecewise-constant rudder; fitted with `hold=ZOH`)."""
     delta, aux = synthetic_inputs(num, seed, rpm)
-    tr = js.simulate(model, js.Replay(delta, dt=DT, delta_hold="zoh"),
+    tr = js.simulate(model, js.Replay(delta, dt=DT, delta_hold=ZOH),
                      js.straight_state(0.0, psi=0.2), aux=aux, simulator=per_sample())
     return js.Experiment(np.asarray(tr.t), delta, psi=np.asarray(tr.state.psi),
                          r=np.asarray(tr.state.r),
@@ -114,7 +118,7 @@ def test_least_squares_start_is_close_and_fit_recovers_to_1e6():
     so v'^3 and v'^2 r' are small signals; the error is the trapezoid/midpoint
     discretisation of the regression), and the prediction-error fit of all 16
     coefficients recovers them to 1e-6 relative."""
-    start = initial_estimate(RossAutopilot(**SCALES), DATA, free=SPEED_RUDDER, hold="zoh")
+    start = initial_estimate(RossAutopilot(**SCALES), DATA, free=SPEED_RUDDER, hold=ZOH)
     truth = np.array([getattr(TRUTH, n) for n in SPEED_RUDDER])
     got = np.array([getattr(start, n) for n in SPEED_RUDDER])
     weak = np.isin(SPEED_RUDDER, ("n_vvv", "n_vvr"))
@@ -122,8 +126,8 @@ def test_least_squares_start_is_close_and_fit_recovers_to_1e6():
     np.testing.assert_allclose(got[weak], truth[weak], rtol=0.1)
     # the same start as the estimator's strategy, then the fit: one door
     res = fit(RossAutopilot(**SCALES), DATA, free=SPEED_RUDDER,
-                    estimator=PredictionError(horizon=2.0, channels=("psi", "r"), hold="zoh",
-                                              start=LinearStart(hold="zoh")))
+                    estimator=PredictionError(horizon=2.0, channels=("psi", "r"), hold=ZOH,
+                                              start=LinearStart(hold=ZOH)))
     assert res.success and res.names == SPEED_RUDDER
     np.testing.assert_allclose(res.values, truth, rtol=1e-6)
     assert res.metrics["r"].fit_percent > 100 - 1e-6
@@ -131,7 +135,7 @@ def test_least_squares_start_is_close_and_fit_recovers_to_1e6():
 
 def test_frozen_terms_enter_the_start_as_known():
     start = initial_estimate(RossAutopilot(**SCALES, n_delta_nn=0.9, n_delta3=-0.8,
-                                           n_delta3_nn=-0.3), DATA, hold="zoh")
+                                           n_delta3_nn=-0.3), DATA, hold=ZOH)
     assert (start.n_delta_nn, start.n_delta3, start.n_delta3_nn) == (0.9, -0.8, -0.3)
     np.testing.assert_allclose([start.n_ur, start.n_delta], [-4.0, 2.5], rtol=2e-2)
     with pytest.raises(ValueError, match="span"):
@@ -142,7 +146,7 @@ def test_frozen_terms_enter_the_start_as_known():
 
 
 def _loss(model, delta, aux, target):
-    tr = js.simulate(model, js.Replay(delta, dt=DT, delta_hold="foh"),
+    tr = js.simulate(model, js.Replay(delta, dt=DT, delta_hold=FOH),
                      js.straight_state(0.0, psi=0.2), aux=aux, simulator=per_sample())
     return jnp.sum((tr.state.r - target) ** 2)
 
@@ -154,7 +158,7 @@ def test_gradient_matches_finite_differences():
     """Reverse- and forward-mode derivatives of the squared simulation error with
     respect to every coefficient equal central differences."""
     delta, aux = synthetic_inputs(150, 7, 500.0)
-    target = np.asarray(js.simulate(TRUTH, js.Replay(delta, dt=DT, delta_hold="foh"),
+    target = np.asarray(js.simulate(TRUTH, js.Replay(delta, dt=DT, delta_hold=FOH),
                                     js.straight_state(0.0, psi=0.2), aux=aux,
                                     simulator=per_sample()).state.r)
     model = eqx.tree_at(lambda m: (m.n_ur, m.n_delta), TRUTH, (-3.5, 2.2))

@@ -19,6 +19,9 @@ from jaxship._estimate import _fit
 from jaxship._models._vessel.catalogue import get_vessel
 
 
+FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+
+
 DEG = np.pi / 180
 
 
@@ -31,7 +34,7 @@ def results() -> dict:
     records = []
     for k, num in enumerate((170, 230, 310)):
         delta = np.where((np.arange(num) // 40) % 2 == 0, 10.0, -10.0) * DEG * (1 + 0.2 * k)
-        tr = js.simulate(truth, js.Replay(delta, dt=0.5, delta_hold="foh"), simulator=per_sample())
+        tr = js.simulate(truth, js.Replay(delta, dt=0.5, delta_hold=FOH), simulator=per_sample())
         records.append(js.Experiment(np.asarray(tr.t), delta,
                                      psi=np.asarray(tr.state.psi) + 1e-3 * rng.standard_normal(num),
                                      r=np.asarray(tr.state.r) + 1e-4 * rng.standard_normal(num),

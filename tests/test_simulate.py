@@ -235,3 +235,21 @@ def test_blow_up_is_reported(vessel):
     bad = eqx.tree_at(lambda s: s.resistance, vessel, -1e9)  # negative resistance: runaway
     traj = js.simulate(bad, js.Turn(0.0, duration=200.0), js.straight_state(7.7, 1.5))
     assert not bool(traj.success)
+    assert bool(traj.result == js.RESULTS.simulation_blew_up)
+    with pytest.raises(Exception, match="the simulation blew up"):
+        js.simulate(bad, js.Turn(0.0, duration=200.0), js.straight_state(7.7, 1.5), throw=True)
+    good = js.simulate(vessel, js.Turn(0.0, duration=20.0), throw=True)
+    assert bool(good.result == js.RESULTS.successful) and bool(good.success)
+
+
+def test_the_solvers_code_passes_through():
+    """Issue 59: `Simulator.step` passed diffrax's result on as a bool. An adaptive solver
+    allowed 2 steps per control step (of a whole 1 s sample) cannot finish one at a
+    tolerance of 1e-12: the trajectory carries diffrax's own code, `max_steps_reached`,
+    not `simulation_blew_up` or a bare False."""
+    model = js.Nomoto1(K=0.06, T=25.0)
+    tight = js.Simulator(solver=dfx.Tsit5(), stepsize_controller=dfx.PIDController(
+        rtol=1e-12, atol=1e-12), max_steps=2, max_step=math.inf)
+    traj = js.simulate(model, js.ZigZag(10 * DEG, 10 * DEG, duration=60.0, dt=1.0),
+                       simulator=tight)
+    assert bool(traj.result == js.RESULTS.max_steps_reached) and not bool(traj.success)

@@ -15,6 +15,10 @@ from jaxship import AuxInputs, Nomoto1, Nomoto2, NonlinearNomoto
 from jaxship._models._steering import WindowStart
 
 
+FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
+
+
 DEG = np.pi / 180
 
 
@@ -26,7 +30,7 @@ def test_nomoto1_step_response_is_exact():
     """T r' + r = K (delta + delta0): r = K (delta + delta0)(1 - exp(-t/T)) and
     psi = K (delta + delta0)(t - T (1 - exp(-t/T))) (thesis eq. 3.17 with r(0) = 0)."""
     m = Nomoto1(K=0.06, T=25.0, delta0=0.5 * DEG)
-    tr = js.simulate(m, js.Replay(step_input(), dt=0.5, delta_hold="foh"),
+    tr = js.simulate(m, js.Replay(step_input(), dt=0.5, delta_hold=FOH),
                      js.straight_state(0.0, psi=0.3), simulator=per_sample())
     t = np.asarray(tr.t)
     gain = 0.06 * 10.5 * DEG
@@ -51,7 +55,7 @@ def test_nomoto2_step_response_and_rk4_order():
     exact = 10 * DEG * nomoto2_step(K, T1, T2, T3, t)
     errors = []
     for substeps in (1, 2, 4):
-        tr = js.simulate(m, js.Replay(step_input(), dt=0.5, delta_hold="foh"),
+        tr = js.simulate(m, js.Replay(step_input(), dt=0.5, delta_hold=FOH),
                          simulator=per_sample(substeps))
         errors.append(np.max(np.abs(np.asarray(tr.state.r) - exact)))
     assert errors[-1] < 1e-9 * np.max(exact)
@@ -65,8 +69,8 @@ def test_nomoto2_with_cancelling_zero_is_nomoto1():
     rng = np.random.default_rng(0)
     delta = np.repeat(rng.choice([-1, 1], 20) * 15 * DEG, 30)
     a = js.simulate(Nomoto2(K=0.05, T1=20.0, T2=2.0, T3=2.0),
-                    js.Replay(delta, dt=0.25, delta_hold="foh"), simulator=per_sample(2))
-    b = js.simulate(Nomoto1(K=0.05, T=20.0), js.Replay(delta, dt=0.25, delta_hold="foh"),
+                    js.Replay(delta, dt=0.25, delta_hold=FOH), simulator=per_sample(2))
+    b = js.simulate(Nomoto1(K=0.05, T=20.0), js.Replay(delta, dt=0.25, delta_hold=FOH),
                     simulator=per_sample(2))
     np.testing.assert_allclose(a.state.r, b.state.r, rtol=1e-8, atol=1e-12)
     np.testing.assert_allclose(a.state.psi, b.state.psi, rtol=1e-8, atol=1e-10)
@@ -75,14 +79,14 @@ def test_nomoto2_with_cancelling_zero_is_nomoto1():
 def test_nonlinear_nomoto_steady_turn_and_linear_limit():
     """In a steady turn H_N(r) = K delta; with n3 = n2 = n0 = 0, n1 = 1 it is Nomoto1."""
     m = NonlinearNomoto(K=0.06, T=20.0, n3=400.0, n2=5.0, n0=1e-4)
-    tr = js.simulate(m, js.Replay(step_input(2001, 20 * DEG), dt=0.5, delta_hold="foh"),
+    tr = js.simulate(m, js.Replay(step_input(2001, 20 * DEG), dt=0.5, delta_hold=FOH),
                      simulator=per_sample())
     r_end = float(tr.state.r[-1])
     assert abs(float(m.characteristic(r_end)) - 0.06 * 20 * DEG) < 1e-12
     assert r_end < 0.06 * 20 * DEG  # the cubic term reduces the steady rate
     lin = js.simulate(NonlinearNomoto(K=0.06, T=20.0),
-                      js.Replay(step_input(), dt=0.5, delta_hold="foh"), simulator=per_sample())
-    ref = js.simulate(Nomoto1(K=0.06, T=20.0), js.Replay(step_input(), dt=0.5, delta_hold="foh"),
+                      js.Replay(step_input(), dt=0.5, delta_hold=FOH), simulator=per_sample())
+    ref = js.simulate(Nomoto1(K=0.06, T=20.0), js.Replay(step_input(), dt=0.5, delta_hold=FOH),
                       simulator=per_sample())
     np.testing.assert_allclose(lin.state.r, ref.state.r, rtol=1e-13, atol=1e-16)
 
@@ -94,7 +98,7 @@ def test_nomoto2_window_state_reconstructs_the_hidden_state():
     rng = np.random.default_rng(1)
     delta = np.repeat(rng.uniform(-20, 20, 25) * DEG, 16)
     dt, r_first = 0.5, 0.004
-    tr = js.simulate(m, js.Replay(delta, dt=dt, delta_hold="zoh"),
+    tr = js.simulate(m, js.Replay(delta, dt=dt, delta_hold=ZOH),
                      dataclasses.replace(js.straight_state(0.0, psi=0.2), r=r_first),
                      simulator=per_sample())
     integral = np.concatenate([[0.0], np.cumsum(delta[:-1]) * dt])
@@ -112,7 +116,7 @@ def test_forward_mode_derivatives_match_finite_differences():
 
     def psi_end(params):
         K, T = params
-        return js.simulate(Nomoto1(K=K, T=T), js.Replay(delta, dt=0.5, delta_hold="foh"),
+        return js.simulate(Nomoto1(K=K, T=T), js.Replay(delta, dt=0.5, delta_hold=FOH),
                            simulator=per_sample()).state.psi[-1]
 
     p = jnp.array([0.06, 25.0])
@@ -130,13 +134,13 @@ def test_vmap_over_parameters_equals_loop_and_no_retrace():
     delta = np.repeat(np.array([10, -10, 20]) * DEG, 30)
     gains = jnp.array([0.03, 0.05, 0.08])
     batched = jax.vmap(lambda K: js.simulate(Nomoto1(K=K, T=15.0),
-                                             js.Replay(delta, dt=0.5, delta_hold="foh"),
+                                             js.Replay(delta, dt=0.5, delta_hold=FOH),
                                              simulator=per_sample()).state.r)(gains)
-    js.simulate(Nomoto1(K=0.01, T=15.0), js.Replay(delta, dt=0.5, delta_hold="foh"),
+    js.simulate(Nomoto1(K=0.01, T=15.0), js.Replay(delta, dt=0.5, delta_hold=FOH),
                 simulator=per_sample())
     size = _replay._cached._cache_size()
     for i, K in enumerate([0.03, 0.05, 0.08]):
-        single = js.simulate(Nomoto1(K=K, T=15.0 + i), js.Replay(delta, dt=0.5, delta_hold="foh"),
+        single = js.simulate(Nomoto1(K=K, T=15.0 + i), js.Replay(delta, dt=0.5, delta_hold=FOH),
                              simulator=per_sample())
         if i == 0:
             np.testing.assert_allclose(batched[0], single.state.r, rtol=1e-14)
@@ -154,7 +158,7 @@ def test_vmap_over_parameters_equals_loop_and_no_retrace():
 def test_simulate_rejects_bad_arguments():
     m = Nomoto1(K=0.05, T=10.0)
     with pytest.raises(ValueError, match="delta"):
-        js.simulate(m, js.Replay(np.zeros((3, 3)), dt=0.5, delta_hold="foh"),
+        js.simulate(m, js.Replay(np.zeros((3, 3)), dt=0.5, delta_hold=FOH),
                     simulator=per_sample())
     with pytest.raises(ValueError, match="substeps"):
-        js.simulate(m, js.Replay(np.zeros(10), dt=0.5, delta_hold="foh"), simulator=per_sample(0))
+        js.simulate(m, js.Replay(np.zeros(10), dt=0.5, delta_hold=FOH), simulator=per_sample(0))

@@ -18,6 +18,9 @@ from jaxship._models._steering._base import AbstractSteeringModel
 from jaxship._simulation._data import OVER_GROUND
 
 
+FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+
+
 DEG = np.pi / 180
 THESIS = js.get_vessel("thesis")
 
@@ -160,7 +163,7 @@ class SwayYawTest(AbstractSteeringModel):
 def test_v_channel_for_steering_models_with_a_v_state():
     truth = SwayYawTest(a11=-0.5, a12=-0.8, a21=-0.02, a22=-0.6, b1=0.15, b2=-0.05)
     delta = np.repeat(np.array([1, -1, 1, 1, -1, -1, 1, -1]) * 10 * DEG, 40)
-    tr = js.simulate(truth, js.Replay(delta, dt=0.25, delta_hold="foh"), simulator=per_sample())
+    tr = js.simulate(truth, js.Replay(delta, dt=0.25, delta_hold=FOH), simulator=per_sample())
     v = np.asarray(tr.internal[:, 1])
     data = js.Experiment(np.asarray(tr.t), delta, psi=np.asarray(tr.state.psi),
                          r=np.asarray(tr.state.r),

@@ -113,9 +113,10 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
                            name="zigzag 20/20 noisy")
     fits = {}
     for method in methods:
-        opts = dict(svr_options or {}) if method == "svr" else {}
+        strategy = (js.SupportVectorRegression(**(svr_options or {})) if method == "svr"
+                    else js.LeastSquaresRegression())
         for s in STRUCTURES:
-            fits[(s, method)] = fit_discrete_response(s, train, method=method, **opts)
+            fits[(s, method)] = fit_discrete_response(s, train, method=strategy)
     test = records["zigzag 20/20"]
     table1 = [("test",) + _overshoots(test.t, test.psi, test.delta, 20 * DEG)]
     table1_discrete = []
@@ -134,7 +135,8 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
         table1.append((f"{key[0]} ({key[1]})", o1, o2))
         general[key] = {}
         for name, rec in records.items():
-            sim = js.simulate(model, js.Replay(rec.delta, dt=rec.dt, delta_hold="foh"),
+            replay = js.Replay(rec.delta, dt=rec.dt, delta_hold=js.FirstOrderHold())
+            sim = js.simulate(model, replay,
                               simulator=js.Simulator(max_step=math.inf, substeps=2))
             general[key][name] = js.fit_percent(rec.r, np.asarray(sim.state.r))
     table1 = [(n, o1 / DEG, o2 / DEG) for n, o1, o2 in table1]

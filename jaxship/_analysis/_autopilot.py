@@ -10,6 +10,7 @@ import optimistix as optx
 from jaxtyping import Array
 
 from .._foundation._kinematics import ssa
+from .._foundation._results import RESULTS, as_code
 from .._foundation._state import ShipState
 from .._models._control import (
     Feedforward,
@@ -115,13 +116,18 @@ def design_autopilot(model, *, bandwidth=None, natural_frequency=None, damping=1
 class TunedAutopilot(eqx.Module):
     """Result of `tune_autopilot`: the tuned `autopilot`, the objective
     (`tracking_objective`) of the start and of the result [rad^2] on the tuning runs,
-    the optimiser's step count and whether it converged."""
+    the optimiser's step count, its `RESULTS` code `result` (optimistix's, passed through)
+    and `success`, `result == successful`."""
 
     autopilot: HeadingAutopilot
     objective_before: Array
     objective_after: Array
     num_steps: Array
-    success: Array
+    result: RESULTS
+
+    @property
+    def success(self) -> Array:
+        return self.result == RESULTS.successful
 
 
 def _tuned_values(autopilot):
@@ -141,7 +147,7 @@ def tune_autopilot(plant, autopilot: HeadingAutopilot, *, speeds=None, rpm=None,
                    duration: float = 300.0, dt: float = 1.0, rudder_weight: float = 0.1,
                    disturbance: YawDisturbance | None = None, max_steps: int = 30,
                    rtol: float = 1e-4, atol: float = 1e-8,
-                   simulator: Simulator = Simulator()) -> TunedAutopilot:
+                   simulator: Simulator = Simulator(), throw: bool = False) -> TunedAutopilot:
     """Tune `kp`, `ki`, `kd` of `autopilot` on `plant` and, with a feed-forward, its
     `gain` and `steady_gain` (`Feedforward`: the model's inverse split into its
     acceleration and steady-turn parts), by minimising `tracking_objective` (mean
@@ -155,6 +161,8 @@ def tune_autopilot(plant, autopilot: HeadingAutopilot, *, speeds=None, rpm=None,
     Jacobian by forward mode through the simulation. One gain set for all speeds (no
     gain schedule). The reference model, the feed-forward's model and the limits stay
     as they are.
+    `throw`: raise (optimistix's error) unless the optimiser converged; default False, the
+    outcome in `TunedAutopilot.result`.
     """
     gains = np.array([np.asarray(g) for g in _tuned_values(autopilot)(autopilot)],
                      dtype=float)
@@ -178,11 +186,11 @@ def tune_autopilot(plant, autopilot: HeadingAutopilot, *, speeds=None, rpm=None,
     objective = lambda y: tracking_objective(run(y), rudder_weight)
     start = jnp.log(jnp.asarray(gains))
     solution = optx.least_squares(residuals, optx.LevenbergMarquardt(rtol=rtol, atol=atol),
-                                  start, max_steps=max_steps, throw=False)
+                                  start, max_steps=max_steps, throw=throw)
     return TunedAutopilot(
         autopilot=_with_gains(autopilot, solution.value),
         objective_before=objective(start),
         objective_after=objective(solution.value),
         num_steps=solution.stats["num_steps"],
-        success=solution.result == optx.RESULTS.successful,
+        result=as_code(solution.result),
     )

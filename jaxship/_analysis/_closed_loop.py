@@ -8,6 +8,7 @@ import numpy as np
 from jaxtyping import Array
 
 from .._foundation._kinematics import ssa
+from .._foundation._results import RESULTS, raise_unless_successful
 from .._foundation._state import ShipState, from_vector
 from .._models._control import HeadingAutopilot
 from .._models._effects import RecordedDisturbance, augment
@@ -57,7 +58,8 @@ class ClosedLoop(eqx.Module):
     reference model's output), ordered heading `psi_ref` [rad], yaw rate `r`, desired
     rate `r_d` [rad/s], actual rudder `delta` and rudder command `delta_c` [rad], each
     (autopilots, speeds, N); `speed` (speeds,) the initial surge speed [m/s];
-    `max_rate` [rad/s] and `control_period` [s] of each autopilot; `success` per run."""
+    `max_rate` [rad/s] and `control_period` [s] of each autopilot; `result`, the `RESULTS`
+    code of each run (as `Trajectory.result`), and `success`, `result == successful`."""
 
     t: Array
     psi: Array
@@ -70,7 +72,11 @@ class ClosedLoop(eqx.Module):
     speed: Array
     max_rate: Array
     control_period: Array
-    success: Array
+    result: RESULTS
+
+    @property
+    def success(self) -> Array:
+        return self.result == RESULTS.successful
 
 
 def _autopilot_batch(autopilots) -> HeadingAutopilot:
@@ -107,7 +113,7 @@ def initial_states(plant, speeds=None, rpm=None) -> ShipState:
 
 def closed_loop(plant, autopilots, *, speeds=None, rpm=None, duration: float = 300.0,
                 dt: float = 0.1, disturbance: YawDisturbance | None = None,
-                simulator: Simulator = Simulator()) -> ClosedLoop:
+                simulator: Simulator = Simulator(), throw: bool = False) -> ClosedLoop:
     """Run each autopilot on `plant` from straight runs at each of `speeds` [m/s] or
     `rpm` (see `initial_states`) for `duration` [s], output every `dt` [s].
 
@@ -119,10 +125,13 @@ def closed_loop(plant, autopilots, *, speeds=None, rpm=None, duration: float = 3
       shared by all runs.
 
     One compiled call, vmapped over autopilots x speeds; differentiable in the
-    autopilots' gains. **Returns:** a `ClosedLoop` with axes (autopilots, speeds, N).
+    autopilots' gains. `throw`: raise unless every run succeeded (default False: the
+    codes in `ClosedLoop.result`). **Returns:** a `ClosedLoop` with axes (autopilots,
+    speeds, N).
     """
     setup = _setup(plant, speeds, rpm, duration, dt, disturbance, simulator)
-    return _closed_loop(setup[0], _as_arrays(_autopilot_batch(autopilots)), *setup[1:])
+    runs = _closed_loop(setup[0], _as_arrays(_autopilot_batch(autopilots)), *setup[1:])
+    return raise_unless_successful(runs, throw)
 
 
 def _setup(plant, speeds, rpm, duration, dt, disturbance, simulator):
@@ -142,16 +151,17 @@ def _setup(plant, speeds, rpm, duration, dt, disturbance, simulator):
 def _closed_loop(plant, batch, x0, dt, num, simulator, steps):
     one = lambda autopilot, state0: _run(plant, autopilot, state0, dt, num, simulator, steps)
     runs = jax.vmap(jax.vmap(one, in_axes=(None, 0)), in_axes=(0, None))(batch, x0)
-    psi, psi_d, psi_ref, r, r_d, delta, delta_c, ok = runs
+    psi, psi_d, psi_ref, r, r_d, delta, delta_c, result = runs
     return ClosedLoop(t=jnp.arange(num) * dt, psi=psi, psi_d=psi_d, psi_ref=psi_ref, r=r,
                       r_d=r_d, delta=delta, delta_c=delta_c, speed=jnp.asarray(x0.u),
                       max_rate=jnp.asarray(batch.max_rate) + 0.0 * batch.kp,
                       control_period=jnp.maximum(batch.interval, dt / steps) + 0.0 * batch.kp,
-                      success=ok)
+                      result=result)
 
 
 def _run(plant, autopilot, x0, dt, num, simulator, steps):
-    """One closed-loop run from `x0` at t = 0: the records of `ClosedLoop` and success."""
+    """One closed-loop run from `x0` at t = 0: the records of `ClosedLoop` and the
+    `RESULTS` code."""
     vessel = isinstance(plant, AbstractVessel)
     if vessel:
         y0, base = initial_vector(plant, x0), vessel_field(plant, Environment(), wind=False)
@@ -183,9 +193,9 @@ def _run(plant, autopilot, x0, dt, num, simulator, steps):
             return y[5], psi_d, psi_ref, y[2], r_d, y[6], delta_c
         return y[-1], psi_d, psi_ref, plant.output(y[:-1]), r_d, delta_c, delta_c
 
-    out, ok = integrate(field, y0, policy, autopilot.init(x0), 0.0, dt, num, simulator, steps,
-                        observe)
-    return (*out, ok)
+    out, result = integrate(field, y0, policy, autopilot.init(x0), 0.0, dt, num, simulator,
+                            steps, observe)
+    return (*out, result)
 
 
 class ClosedLoopMetrics(eqx.Module):

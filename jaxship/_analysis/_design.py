@@ -23,7 +23,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._foundation._params import as_arrays, rebuild, resolve_free
-from .._models._manoeuvres import AbstractManoeuvre, Replay
+from .._models._manoeuvres import AbstractManoeuvre, FirstOrderHold, Replay
 from .._models._steering._base import AbstractSteeringModel
 from .._simulation._integrate import Simulator
 from .._simulation._simulate import simulate
@@ -182,7 +182,8 @@ def fisher_information(model: AbstractSteeringModel, manoeuvre, noise_std, *,
 def _jacobian(model, names, values, delta, dt, outputs, substeps):
     def sim(theta):
         # the rudder interpolated between samples, one RK4 step per sample (`substeps`)
-        replay = Replay(delta, dt=dt, duration=dt * (delta.shape[0] - 1), delta_hold="foh")
+        replay = Replay(delta, dt=dt, duration=dt * (delta.shape[0] - 1),
+                        delta_hold=FirstOrderHold())
         per_sample = Simulator(max_step=math.inf, substeps=substeps)
         traj = simulate(rebuild(model, names, theta), replay, simulator=per_sample)
         return tuple(getattr(traj.state, o) for o in outputs)

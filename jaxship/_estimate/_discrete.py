@@ -44,6 +44,7 @@ import math
 import warnings
 from collections.abc import Sequence
 
+import equinox as eqx
 import numpy as np
 import scipy  # scipy.linalg loads on first use (an import-time saving)
 
@@ -270,12 +271,55 @@ def _records(data, rudder):
     return list(data), float(np.mean(steps))
 
 
+class LeastSquaresRegression(eqx.Module):
+    """`DiscreteResponse(method=LeastSquaresRegression())` (the default): the discrete
+    coefficients by linear least squares (`numpy.linalg.lstsq` on the columns scaled to
+    unit norm)."""
+
+    name = "ls"  # the label of `FitResult.criterion`
+
+    def coefficients(self, x, y) -> tuple[np.ndarray, bool]:
+        """`(coefficients, converged)` of $y \\approx X c$."""
+        norms = np.sqrt(np.sum(x**2, axis=0))
+        return np.linalg.lstsq(x / norms, y, rcond=None)[0] / norms, True
+
+    def covariance(self, x, rms: float) -> np.ndarray:
+        """$\\hat\\sigma^2(X^TX)^{-1}$, $\\hat\\sigma^2 = \\mathrm{RSS}/(N - p)$, from the
+        equation-error RMS `rms`."""
+        rows, count = x.shape
+        sigma2 = rms**2 * rows / max(rows - count, 1)
+        return sigma2 * np.linalg.inv(x.T @ x)
+
+
+class SupportVectorRegression(eqx.Module):
+    """`DiscreteResponse(method=SupportVectorRegression(C, epsilon))`: the discrete
+    coefficients by epsilon-SVR with a linear kernel (scikit-learn `LinearSVR`; Lu & Zhao
+    2008), regulariser `C`, insensitivity `epsilon` [rad/s], liblinear's tolerance `tol`
+    and iteration limit `max_iter` (needs `pip install scikit-learn`)."""
+
+    C: float = 1e10
+    epsilon: float = 0.0
+    tol: float = 1e-8
+    max_iter: int = 20_000
+
+    name = "svr"  # the label of `FitResult.criterion`
+
+    def coefficients(self, x, y) -> tuple[np.ndarray, bool]:
+        """`(coefficients, converged)` of $y \\approx X c$ (`_svr`)."""
+        return _svr(x, y, self.C, self.epsilon, self.tol, self.max_iter)
+
+    def covariance(self, x, rms: float) -> np.ndarray:
+        """Not known for the epsilon-insensitive loss: NaN."""
+        return np.full((x.shape[1],) * 2, np.nan)
+
+
 def _svr(x, y, C, epsilon, tol, max_iter):
     try:
         from sklearn.exceptions import ConvergenceWarning as LiblinearWarning
         from sklearn.svm import LinearSVR
     except ImportError as err:  # pragma: no cover - depends on the environment
-        raise ImportError("method='svr' needs scikit-learn: pip install 'jaxship[svm]'.") from err
+        raise ImportError("SupportVectorRegression() needs scikit-learn: pip install "
+                          "'jaxship[svm]'.") from err
     # Precondition: regress on orthonormal features q = x R^-1 (x = QR) scaled to unit
     # RMS, then map back w = R^-1 w_q. The epsilon-insensitive loss depends on x w
     # only, so this changes nothing but the regulariser, ||w_q||^2 instead of ||w||^2,
@@ -300,11 +344,12 @@ def _svr(x, y, C, epsilon, tol, max_iter):
 class DiscreteResponseFit:
     """Result of `fit_discrete_response`: the discrete coefficients (Lu & Zhao eqs.
     7-10), the continuous indices (`continuous_parameters`), the sample interval `dt`
-    [s], the estimation `method` (`"ls"` or `"svr"`), whether the solver `converged`,
+    [s], the estimation `method` (`LeastSquaresRegression` or `SupportVectorRegression`),
+    whether the solver `converged`,
     the equation-error RMS `rms` [rad/s] and the number of regression rows `num_rows`."""
 
     structure: str
-    method: str
+    method: eqx.Module
     discretisation: str
     dt: float
     coefficients: dict
@@ -363,10 +408,11 @@ class DiscreteResponseFit:
                                  beta1=p["beta1"], delta0=p["delta_r"])
 
 
-def fit_discrete_response(structure: str, data, *, method: str = "ls",
+def fit_discrete_response(structure: str, data, *,
+                          method: LeastSquaresRegression | SupportVectorRegression = (
+                              LeastSquaresRegression()),
                           discretisation: str | None = None, rudder: str = "delta",
-                          C: float = 1e10, epsilon: float = 0.0, tol: float = 1e-8,
-                          max_iter: int = 20_000, alpha1: float = 1.0) -> DiscreteResponseFit:
+                          alpha1: float = 1.0) -> DiscreteResponseFit:
     """Fit one of Lu & Zhao's discrete response models (eqs. 7-10) to measured yaw
     rate and rudder and convert it to the continuous indices (eqs. 1-4).
 
@@ -375,10 +421,8 @@ def fit_discrete_response(structure: str, data, *, method: str = "ls",
     - `structure`: `"linear1"`, `"nonlinear1"`, `"linear2"` or `"nonlinear2"`.
     - `data`: an `Experiment` or a list of them (one sample interval); regressions
       never reach across records.
-    - `method`: `"ls"` (linear least squares, `numpy.linalg.lstsq`) or `"svr"`
-      (epsilon-SVR with a linear kernel, scikit-learn `LinearSVR`, regularisation
-      `C`, insensitivity `epsilon` [rad/s], solver `tol`, `max_iter`; needs
-      `pip install scikit-learn`).
+    - `method`: `LeastSquaresRegression()` (default) or `SupportVectorRegression(C,
+      epsilon, tol, max_iter)`: the strategy that computes the coefficients.
     - `discretisation`: `"zoh"` (linear models, default) or `"euler"`.
     - `rudder`: `"delta"` (actual) or `"delta_c"` (commanded).
     - `alpha1`: fixed linear coefficient of `nonlinear2` (1 as in Lu & Zhao).
@@ -387,8 +431,9 @@ def fit_discrete_response(structure: str, data, *, method: str = "ls",
     coefficients (singular regression).
     """
     how = _check_structure(structure, discretisation)
-    if method not in ("ls", "svr"):
-        raise ValueError(f"`method` must be 'ls' or 'svr', got {method!r}.")
+    if not isinstance(method, (LeastSquaresRegression, SupportVectorRegression)):
+        raise ValueError(f"`method` must be LeastSquaresRegression() or "
+                         f"SupportVectorRegression(), got {method!r}.")
     records, dt = _records(data, rudder)
     parts = [regressors(structure, e.r, getattr(e, rudder)) for e in records]
     x = np.concatenate([p[0] for p in parts])
@@ -403,11 +448,7 @@ def fit_discrete_response(structure: str, data, *, method: str = "ls",
         raise ValueError(f"{structure}: the regression is singular (condition number "
                          f"{sv[0] / max(sv[-1], 1e-300):.3g}); the data do not excite all of "
                          f"{', '.join(names)}.")
-    converged = True
-    if method == "ls":
-        coef = np.linalg.lstsq(x / norms, y, rcond=None)[0] / norms
-    else:
-        coef, converged = _svr(x, y, C, epsilon, tol, max_iter)
+    coef, converged = method.coefficients(x, y)
     coefficients = dict(zip(names, map(float, coef)))
     params = continuous_parameters(structure, coefficients, dt, discretisation=how,
                                    alpha1=alpha1)

@@ -19,11 +19,14 @@ import optimistix as optx
 from .._foundation._covariance import parameter_report
 from .._foundation._params import parameter_fields
 from .._models._effects import AugmentedSteering, YawCubicDamping
+from .._models._manoeuvres import ZeroOrderHold
 from .._models._steering.nomoto import Nomoto1, Nomoto2, NonlinearNomoto
 from .._simulation._data import Experiment
 from ._discrete import (
     COEFFICIENTS,
     DiscreteResponseFit,
+    LeastSquaresRegression,
+    SupportVectorRegression,
     continuous_parameters,
     fit_discrete_response,
     regressors,
@@ -61,20 +64,6 @@ def structure_of(model) -> str:
                      f"{type(model).__name__}.")
 
 
-class LeastSquaresRegression(eqx.Module):
-    """`DiscreteResponse(method=LeastSquaresRegression())` (the default): the discrete
-    coefficients by linear least squares (`numpy.linalg.lstsq`)."""
-
-
-class SupportVectorRegression(eqx.Module):
-    """`DiscreteResponse(method=SupportVectorRegression(C, epsilon))`: the discrete
-    coefficients by epsilon-SVR with a linear kernel (scikit-learn `LinearSVR`; Lu & Zhao
-    2008), regulariser `C`, insensitivity `epsilon` [rad/s]."""
-
-    C: float = 1e10
-    epsilon: float = 0.0
-
-
 class DiscreteResponse(AbstractEstimator):
     """Equation-error fit of Lu & Zhao's discrete response models for `jaxship.fit`:
     `method` `LeastSquaresRegression()` (default) or `SupportVectorRegression(C,
@@ -97,21 +86,13 @@ class DiscreteResponse(AbstractEstimator):
         ds = as_dataset(dataset)
         check_data(ds, self.rudder, ("r",))
         records = [_experiment(ds, i, self.rudder) for i in range(ds.num_experiments)]
-        if isinstance(self.method, SupportVectorRegression):
-            options = dict(method="svr", C=self.method.C, epsilon=self.method.epsilon)
-        elif isinstance(self.method, LeastSquaresRegression):
-            options = dict(method="ls")
-        else:
-            raise ValueError(f"`method` must be LeastSquaresRegression() or "
-                             f"SupportVectorRegression(), got {self.method!r}.")
-        res = fit_discrete_response(structure, records, discretisation=self.discretisation,
-                                    rudder="delta", **options)
+        res = fit_discrete_response(structure, records, method=self.method,
+                                    discretisation=self.discretisation, rudder="delta")
         fitted = res.to_steering()
         values = _PARAMETERS[structure](res.parameters)
         names = tuple(values)
         fields = parameter_fields(fitted)
-        covariance = _covariance(res, records) if options["method"] == "ls" else np.full(
-            (len(names),) * 2, np.nan)
+        covariance = _covariance(res, records)
         report = parameter_report(names, np.array([values[k] for k in names]), covariance,
                                   units=tuple(fields[k].unit for k in names))
         line, mask = np.zeros(ds.r.shape), np.zeros(ds.r.shape, bool)
@@ -126,17 +107,18 @@ class DiscreteResponse(AbstractEstimator):
             else optx.RESULTS.nonlinear_max_steps_reached, num_steps=1,
             cost=0.5 * float(np.sum(((r - line) * mask) ** 2)), weights={"r": 1.0},
             window_samples=(1,), horizon=res.dt,
-            criterion=f"equation error ({options['method']}, Lu & Zhao {structure})")
+            criterion=f"equation error ({self.method.name}, Lu & Zhao {structure})")
 
     def predict(self, model, dataset) -> Prediction:
         """One-step-ahead predictions of r by the continuous `model` over each sample
         interval from the measured state, the rudder held (`PredictionError(horizon=0,
-        hold="zoh")`): for the linear first-order structure the discrete model's own
+        hold=ZeroOrderHold())`): for the linear first-order structure the discrete model's
+        own
         zero-order-hold prediction; for the others the continuous model the estimate
         was converted to, integrated rather than differenced."""
         structure_of(model)  # one of Lu & Zhao's structures
         one_step = PredictionError(horizon=0.0, channels=("r",), rudder=self.rudder,
-                                   hold="zoh", max_lag=self.max_lag)
+                                   hold=ZeroOrderHold(), max_lag=self.max_lag)
         return one_step.predict(model, dataset)
 
 
@@ -147,13 +129,12 @@ def _experiment(ds, i, rudder) -> Experiment:
 
 
 def _covariance(res: DiscreteResponseFit, records) -> np.ndarray:
-    """Least-squares covariance of the discrete coefficients carried to the continuous
-    parameters by the delta method."""
+    """The covariance of the discrete coefficients (the method's own: least squares',
+    NaN for SVR) carried to the continuous parameters by the delta method."""
     parts = [regressors(res.structure, e.r, e.delta) for e in records]
     x = np.concatenate([p[0] for p in parts])
     keys = COEFFICIENTS[res.structure]
-    sigma2 = res.rms**2 * res.num_rows / max(res.num_rows - len(keys), 1)
-    cov_c = sigma2 * np.linalg.inv(x.T @ x)
+    cov_c = res.method.covariance(x, res.rms)
     coef = np.array([res.coefficients[k] for k in keys])
 
     def convert(c):

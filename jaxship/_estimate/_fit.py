@@ -32,6 +32,7 @@ from .._foundation._covariance import (
 from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
 from .._foundation._progress import ProgressCallback, reporting_steps, step_hook
 from .._foundation._sharding import sharded_vmap
+from .._models._manoeuvres import FirstOrderHold, ZeroOrderHold
 from .._simulation._integrate import Simulator, integrate, replay_policy
 from ._excitation import excitation_flags
 from ._initial import EstimatedStarts, MeasuredStates
@@ -48,6 +49,7 @@ from ._lm import (
 )
 from ._result import FitError, FitResult, Prediction, assemble_result
 from ._step import MAX_SUBSTEPS, stable_substeps
+from ._verdict import final_verdict
 from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_data, to_timeline
 
 
@@ -128,8 +130,9 @@ class PredictionError(AbstractEstimator):
     - `hold`: how the replayed signals are interpolated between samples (MATLAB's
       `InterSample`): `None` (default) linearly for measured, continuous signals
       (the rudder angle `delta`, `n`, `u`, `v`, the wind speed: first-order hold) and
-      held for commands (`delta_c`) and the wind direction (zero-order hold); `"zoh"`
-      or `"foh"` for all; or a dict by channel name overriding some.
+      held for commands (`delta_c`) and the wind direction (zero-order hold);
+      `ZeroOrderHold()` or `FirstOrderHold()` for all; or a dict by channel name
+      overriding some.
     """
 
     horizon: float | None = None
@@ -143,7 +146,7 @@ class PredictionError(AbstractEstimator):
     max_lag: int = 25
     initial: MeasuredStates | EstimatedStarts | list = MeasuredStates()
     wind: bool = False
-    hold: str | dict | None = None
+    hold: ZeroOrderHold | FirstOrderHold | dict | None = None
 
     def fit(self, model, dataset, free=None, progress=None) -> "FitResult":
         return _fit_prediction_error(self, model, dataset, free, progress)
@@ -244,19 +247,6 @@ def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
     return z, result, steps, q[: len(transform.names)], pred, jac
 
 
-def _offset_scales(ds) -> np.ndarray:
-    """Scales of the start corrections (r, psi): 1 % of each channel's spread."""
-    mask = np.asarray(ds.mask)
-    out = []
-    for name in ("r", "psi"):
-        y = np.asarray(getattr(ds, name), dtype=np.float64)
-        mean = np.sum(np.where(mask, y, 0.0), axis=1, keepdims=True) / mask.sum(axis=1,
-                                                                            keepdims=True)
-        spread = math.sqrt(np.sum(np.where(mask, (y - mean) ** 2, 0.0)) / mask.sum())
-        out.append(0.01 * spread if spread > 0 else 1e-3)
-    return np.array(out)
-
-
 def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), free=None,
         progress: ProgressCallback | None = None, throw: bool = False) -> FitResult:
     """Estimate the free parameters of a steering model or a vessel from measured data.
@@ -285,7 +275,9 @@ def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), fre
     **Returns:** a `FitResult` whose `result` code (`jaxship.RESULTS`) says what the fit
     knows: `successful` only when the optimiser converged, the simulation stayed finite,
     the estimates moved from a start where the cost was not stationary, no estimate sits
-    on a bound (`at_bound`) and the data determine every combination of the parameters
+    on a bound (`at_bound`), the fit explains more than noise would or determines every
+    parameter's sign (`undetermined`: no channel's fit reaches 5 % and a parameter's 95 %
+    interval includes zero) and the data determine every combination of the parameters
     (`poorly_determined`); the flags of `parameters` say which. The covariance is
     $\\hat\\sigma^2(J^TJ)^{-1}$ in the physical parameters (per-channel noise variances:
     see `jaxship._foundation._covariance.least_squares_covariance`), which is right for
@@ -301,49 +293,11 @@ def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), fre
         raise ValueError(f"`estimator` must be a jaxship estimator (PredictionError, "
                          f"Innovations, ARMAX, DiscreteResponse), got "
                          f"{type(estimator).__name__}.")
-    out = _final_verdict(estimator.fit(model, dataset, free, progress), model, free)
+    out = final_verdict(estimator.fit(model, dataset, free, progress), model, free)
     if throw and not out.success:
         raise FitError(f"fit of {type(model).__name__}: {out.message}"
                        + "".join(f" {f}" for f in out.parameters.undetermined
                                  + out.parameters.bound_flags))
-    return out
-
-
-# the optimiser's codes that an estimate on a bound explains: it crawls towards the
-# bound (softplus transform) until it settles or meets the step limit
-_BOUND_EXPLAINS = (RESULTS.successful, RESULTS.nonlinear_max_steps_reached,
-                   RESULTS.max_steps_reached)
-
-
-def _final_verdict(out: FitResult, model, free) -> FitResult:
-    """`at_bound` when an estimate ended within 1e-4 of its bound span (or scale) from a
-    bound, the optimiser having converged or crawled to its step limit; for a converged
-    fit `poorly_determined` when the data leave a combination of the parameters
-    undetermined; the sentences join the parameter flags. Any other code stands as the
-    estimator gave it."""
-    if out.code not in _BOUND_EXPLAINS:
-        return out
-    values = dict(zip(out.names, np.asarray(out.values, dtype=np.float64)))
-    hits = []
-    for spec in resolve_free(model, free):
-        value = values.get(spec.name)
-        if value is None:
-            continue
-        span = spec.upper - spec.lower if math.isfinite(spec.upper - spec.lower) else spec.scale
-        tol = 1e-4 * (span if span > 0 else 1.0)
-        for side, bound in (("lower", spec.lower), ("upper", spec.upper)):
-            if math.isfinite(bound) and abs(value - bound) <= tol:
-                unit = f" {spec.unit}" if spec.unit and spec.unit != "-" else ""
-                hits.append(f"{spec.name} = {value:.4g}{unit} ended on its {side} bound "
-                            f"{bound:g}{unit}: the data pull it beyond the bound, so the fit "
-                            "is not a proper optimum and its standard error means nothing.")
-    report = out.parameters
-    if hits:
-        report = dataclasses.replace(report, flags=report.flags + tuple(hits),
-                                     bound_flags=tuple(hits))
-        return dataclasses.replace(out, parameters=report, result=RESULTS.at_bound)
-    if out.code == RESULTS.successful and report.undetermined:
-        return dataclasses.replace(out, result=RESULTS.poorly_determined)
     return out
 
 
@@ -353,11 +307,8 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
         model = estimator.start(model, dataset, free, estimator.rudder)
     ds, windows, layout = _prepare(model, dataset, estimator)
     specs = resolve_free(model, free)
-    estimate_starts = isinstance(estimator.initial, EstimatedStarts)
-    if estimate_starts and min(layout["lengths"]) < 2:
-        raise ValueError("`initial=EstimatedStarts()` needs windows of at least 2 samples (with "
-                         "one sample the estimated start explains every residual); use a "
-                         "longer `horizon` or MeasuredStates().")
+    starts = _starts(estimator.initial)
+    starts.check(layout["lengths"])
     base = as_arrays(model)
     needed = stable_substeps(base, windows)
     if needed > windows.substeps:  # the step follows the start model's fastest mode
@@ -365,11 +316,10 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
     specs = _jacobian_scales(specs, base, windows)
     transform = Transform.from_specs(specs)
     z0 = transform.to_unconstrained(np.array([s.start for s in specs]))
-    offset_scale = None
-    if estimate_starts:
-        offset_scale = jnp.asarray(_offset_scales(ds), dtype=float)
-        z0 = np.concatenate([z0, np.zeros(windows.start.r.size * 2)])
-    z0 = jnp.asarray(z0, dtype=float)
+    offset_scale, offsets0 = starts.start_parameters(ds, windows.start.r.size)
+    if offset_scale is not None:
+        offset_scale = jnp.asarray(offset_scale, dtype=float)
+    z0 = jnp.asarray(np.concatenate([z0, offsets0]), dtype=float)
     solver = estimator.solver
     if progress is not None and isinstance(solver, LevenbergMarquardt):
         solver = eqx.tree_at(lambda s: s.verbose, solver, step_hook)
@@ -385,12 +335,17 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
                 break
             windows, z0 = dataclasses.replace(windows, substeps=needed), z
         out = _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
-                      result, num_steps, estimate_starts=estimate_starts)
+                      result, num_steps, starts=starts)
         finish(out.num_steps, out.cost)
-    if estimate_starts:
+    if offset_scale is not None:
         offsets = _split(z, transform, windows, offset_scale)[1]
         out = dataclasses.replace(out, start_offsets=np.asarray(offsets, dtype=np.float64))
     return out
+
+
+def _starts(initial) -> MeasuredStates | EstimatedStarts:
+    """The start strategy of `initial`: smoothed states (a list) start as measured ones."""
+    return MeasuredStates() if isinstance(initial, (list, tuple)) else initial
 
 
 def _prepare(model, dataset, estimator):
@@ -514,7 +469,7 @@ def _verdict(result, specs, values, rows, jac, pred, targets, mask, eps) -> RESU
 
 
 def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac, result,
-            num_steps, *, estimate_starts=False) -> FitResult:
+            num_steps, *, starts=MeasuredStates()) -> FitResult:
     """The `FitResult` from the optimum: residuals, covariance, identifiability and
     validation metrics on the host (shared by steering-model and vessel fits)."""
     channels = windows.channels
@@ -528,10 +483,8 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
     targets = np.asarray(windows.targets, dtype=np.float64)
     mask = layout["mask"]
     weights = layout["weights"]
-    columns = np.arange(d)
-    if estimate_starts:  # the start offsets of windows that exist
-        used = np.repeat(mask.any(axis=-1).reshape(-1), 2)
-        columns = np.concatenate([columns, d + np.nonzero(used)[0]])
+    # and the start offsets of windows that exist, where they are estimated
+    columns = np.concatenate([np.arange(d), d + starts.start_columns(mask)])
     resid = weights[:, None, None, None] * (targets - pred)
     rows = np.concatenate([resid[c][mask] for c in range(len(channels))])
     jrows = np.concatenate([jac[c][mask][:, columns] for c in range(len(channels))])

@@ -13,6 +13,7 @@ import optimistix as optx
 
 from .._foundation._covariance import least_squares_covariance, parameter_report
 from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
+from .._models._manoeuvres import FirstOrderHold, ZeroOrderHold
 from .._models._steering._base import AbstractSteeringModel
 from ._fit import AbstractEstimator, FitResult
 from ._kalman import (
@@ -219,10 +220,7 @@ def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
             raise ValueError(f"noise variance of {e!r} must be positive, got {v}.")
         values.append(math.log(v))
         estimated.append(e not in fixed_values)
-    if criterion == "pem":
-        # the innovations do not fix the overall noise scale (scaling Q, R and P0 by one
-        # number leaves the gains unchanged): hold the first channel's variance
-        estimated[len(process)] = False
+    estimated = criterion.held_noise(estimated, first_channel=len(process))
     layout = _Noise(names=entries, estimated=tuple(estimated),
                     fixed=jnp.asarray(values), state_index=index, num_states=len(names))
     z = np.array([v for v, est in zip(values, estimated) if est])
@@ -230,7 +228,7 @@ def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
 
 
 def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_CHANNELS,
-           criterion: str = "ml", process="rudder", noise="estimate", noise_start=None,
+           criterion=None, process="rudder", noise="estimate", noise_start=None,
            rudder: str = "delta", substeps: int = 1, max_steps: int = 512,
            solver=None, hold=None) -> FitResult:
     """Estimate a steering model with its noise by the Kalman filter's innovations.
@@ -240,12 +238,12 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
     - `model`, `dataset`, `free`: as `jaxship.fit` (start values in the model; `free`
       names or `Free` specs).
     - `channels`: measured outputs, `"psi"` and/or `"r"`.
-    - `criterion`: `"ml"` (default): minimise the negative log likelihood
+    - `criterion`: `MaximumLikelihood()` (default): minimise the negative log likelihood
       $\\tfrac12\\sum_k(\\log\\det S_k + \\varepsilon_k^TS_k^{-1}\\varepsilon_k)$ over the
       model parameters and the log noise variances with `optimistix.BFGS`; standard
       errors from the inverse Hessian (`jax.hessian`) of $-\\log L$ (Ljung 1999,
-      sec. 7.4 and eq. 9.29). `"pem"`: prediction-error method with the innovations
-      predictor (Ljung 1999, sec. 4.3 and 7.2): minimise
+      sec. 7.4 and eq. 9.29). `InnovationsLeastSquares()`: prediction-error method with
+      the innovations predictor (Ljung 1999, sec. 4.3 and 7.2): minimise
       $\\tfrac12\\sum_k\\|W\\varepsilon_k\\|^2$ ($W$ = 1/std of each channel) with
       Levenberg-Marquardt and forward-mode Jacobians; the noise variances set the
       filter gain and are estimated as well, except the first channel's, which fixes
@@ -265,8 +263,10 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
     **Returns:** a `FitResult` with the noise variances (`noise`, `noise_std`), the
     criterion, and the filter's one-step-ahead predictions and their metrics.
     """
-    if criterion not in ("ml", "pem"):
-        raise ValueError(f"`criterion` must be 'ml' or 'pem', got {criterion!r}.")
+    criterion = MaximumLikelihood() if criterion is None else criterion
+    if not isinstance(criterion, (MaximumLikelihood, InnovationsLeastSquares)):
+        raise ValueError(f"`criterion` must be MaximumLikelihood() or "
+                         f"InnovationsLeastSquares(), got {criterion!r}.")
     ds, channels = _check_inputs(model, dataset, channels, rudder, substeps, vessels=False)
     specs = resolve_free(model, free)
     transform = Transform.from_specs(specs)
@@ -274,34 +274,22 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
     rec = _records(ds, channels, rudder, substeps, hold)
     z0 = jnp.asarray(np.concatenate([transform.to_unconstrained([s.start for s in specs]),
                                      z_noise]), dtype=float)
-    base = as_arrays(model)
-    if criterion == "ml":
-        solver = optx.BFGS(rtol=1e-8, atol=1e-8) if solver is None else solver
-        z, result, steps = _ml_solve(z0, base, transform, layout, rec, solver, int(max_steps))
-        loss, hess = _ml_hessian(z, base, transform, layout, rec)
-        hess = np.asarray(hess, dtype=np.float64)
-        try:
-            cov = np.linalg.inv(hess)
-        except np.linalg.LinAlgError:
-            cov = np.full_like(hess, np.inf)
-        if not np.all(np.isfinite(cov)) or np.any(np.diag(cov) <= 0):
-            cov = np.where(np.eye(hess.shape[0], dtype=bool), np.inf, 0.0)
-        loss = float(loss)
-    else:
-        solver = LevenbergMarquardt(rtol=1e-9, atol=1e-9) if solver is None else solver
-        weights = jnp.asarray(channel_weights(ds, channels, None), dtype=float)
-        z, result, steps, res, jac = _pem_solve(z0, base, transform, layout, rec, weights,
-                                                solver, int(max_steps))
-        mask = np.asarray(ds.mask).copy()
-        mask[:, 0] = False  # sample 0 is the prior, never predicted
-        res, jac = np.asarray(res), np.asarray(jac)
-        rows = np.concatenate([res[..., c][mask] for c in range(len(channels))])
-        jrows = np.concatenate([jac[..., c, :][mask] for c in range(len(channels))])
-        groups = np.repeat(np.arange(len(channels)), int(mask.sum()))
-        cov, _ = least_squares_covariance(jrows, rows, groups)
-        loss = 0.5 * float(np.sum(rows**2))
+    problem = _Problem(as_arrays(model), transform, layout, rec, ds, channels)
+    z, result, steps, cov, loss = criterion.estimate(problem, z0, solver, int(max_steps))
     return _report(model, ds, channels, rudder, specs, transform, layout, rec, z, cov, loss,
-                   result, steps, criterion)
+                   result, steps, criterion.name)
+
+
+class _Problem(eqx.Module):
+    """What an innovations criterion minimises over: the model as arrays, the parameter
+    transform, the noise layout, the filter's records, the dataset and its channels."""
+
+    model: eqx.Module
+    transform: Transform
+    layout: _Noise
+    rec: eqx.Module
+    ds: eqx.Module
+    channels: tuple[str, ...] = eqx.field(static=True)
 
 
 class MaximumLikelihood(eqx.Module):
@@ -309,12 +297,64 @@ class MaximumLikelihood(eqx.Module):
     log likelihood of the innovations over the model parameters and the log noise
     variances (BFGS; standard errors from the inverse Hessian; Ljung 1999, sec. 7.4)."""
 
+    name = "ml"  # the `FitResult.criterion` label
+
+    def held_noise(self, estimated: list, first_channel: int) -> list:
+        """The likelihood fixes every noise variance: none is held."""
+        return estimated
+
+    def estimate(self, problem: _Problem, z0, solver, max_steps: int):
+        """`(z, result, steps, cov, loss)`: BFGS (default `rtol = atol = 1e-8`) on
+        $-\\log L$, the covariance the inverse of its Hessian (infinite variances where
+        the Hessian is not positive definite)."""
+        p = problem
+        solver = optx.BFGS(rtol=1e-8, atol=1e-8) if solver is None else solver
+        z, result, steps = _ml_solve(z0, p.model, p.transform, p.layout, p.rec, solver,
+                                     max_steps)
+        loss, hess = _ml_hessian(z, p.model, p.transform, p.layout, p.rec)
+        hess = np.asarray(hess, dtype=np.float64)
+        try:
+            cov = np.linalg.inv(hess)
+        except np.linalg.LinAlgError:
+            cov = np.full_like(hess, np.inf)
+        if not np.all(np.isfinite(cov)) or np.any(np.diag(cov) <= 0):
+            cov = np.where(np.eye(hess.shape[0], dtype=bool), np.inf, 0.0)
+        return z, result, steps, cov, float(loss)
+
 
 class InnovationsLeastSquares(eqx.Module):
     """`Innovations(criterion=InnovationsLeastSquares())`: the prediction-error method with
     the innovations predictor, the weighted innovations minimised as least squares
     (Levenberg-Marquardt; Ljung 1999, secs. 4.3, 7.2); the first channel's noise variance
     is held, as the innovations do not fix the overall noise scale."""
+
+    name = "pem"  # the `FitResult.criterion` label
+
+    def held_noise(self, estimated: list, first_channel: int) -> list:
+        """The innovations do not fix the overall noise scale (scaling Q, R and P0 by one
+        number leaves the gains unchanged): the first channel's variance is held."""
+        estimated = list(estimated)
+        estimated[first_channel] = False
+        return estimated
+
+    def estimate(self, problem: _Problem, z0, solver, max_steps: int):
+        """`(z, result, steps, cov, loss)`: Levenberg-Marquardt (default `rtol = atol =
+        1e-9`) on the weighted innovations $W\\varepsilon_k$, the covariance of
+        `least_squares_covariance` over the predicted samples."""
+        p = problem
+        solver = LevenbergMarquardt(rtol=1e-9, atol=1e-9) if solver is None else solver
+        weights = jnp.asarray(channel_weights(p.ds, p.channels, None), dtype=float)
+        z, result, steps, res, jac = _pem_solve(z0, p.model, p.transform, p.layout, p.rec,
+                                                weights, solver, max_steps)
+        mask = np.asarray(p.ds.mask).copy()
+        mask[:, 0] = False  # sample 0 is the prior, never predicted
+        res, jac = np.asarray(res), np.asarray(jac)
+        count = len(p.channels)
+        rows = np.concatenate([res[..., c][mask] for c in range(count)])
+        jrows = np.concatenate([jac[..., c, :][mask] for c in range(count)])
+        groups = np.repeat(np.arange(count), int(mask.sum()))
+        cov, _ = least_squares_covariance(jrows, rows, groups)
+        return z, result, steps, cov, 0.5 * float(np.sum(rows**2))
 
 
 class Innovations(AbstractEstimator):
@@ -333,15 +373,11 @@ class Innovations(AbstractEstimator):
     substeps: int = 1
     max_steps: int = 512
     solver: object = None
-    hold: str | dict | None = None
+    hold: ZeroOrderHold | FirstOrderHold | dict | None = None
 
     def fit(self, model, dataset, free=None, progress=None) -> FitResult:
-        if not isinstance(self.criterion, (MaximumLikelihood, InnovationsLeastSquares)):
-            raise ValueError(f"`criterion` must be MaximumLikelihood() or "
-                             f"InnovationsLeastSquares(), got {self.criterion!r}.")
-        criterion = "ml" if isinstance(self.criterion, MaximumLikelihood) else "pem"
         return fit_ml(model, dataset, free=free, channels=self.channels,
-                      criterion=criterion, process=self.process, noise=self.noise,
+                      criterion=self.criterion, process=self.process, noise=self.noise,
                       noise_start=self.noise_start, rudder=self.rudder,
                       substeps=self.substeps, max_steps=self.max_steps, solver=self.solver,
                       hold=self.hold)
@@ -352,7 +388,8 @@ class Innovations(AbstractEstimator):
         `FitResult` takes them from it)."""
         ds, channels = _check_inputs(model, dataset, self.channels, self.rudder,
                                      self.substeps, vessels=False)
-        layout, z = _noise_layout(model, ds, channels, self.process, self.noise, None, "ml")
+        layout, z = _noise_layout(model, ds, channels, self.process, self.noise, None,
+                                  MaximumLikelihood())
         missing = [n for n, estimated in zip(layout.names, layout.estimated) if estimated]
         if missing:
             raise ValueError(f"the innovations predictor needs every noise variance; "

@@ -25,6 +25,7 @@ import equinox as eqx
 import numpy as np
 
 from .._foundation._params import resolve_free
+from .._models._manoeuvres import FirstOrderHold, ZeroOrderHold
 from .._models._steering._base import AuxInputs
 from .._models._steering.nomoto import Nomoto1, NonlinearNomoto
 from .._models._steering.ross import HULL_TERMS, RUDDER_TERMS, RossAutopilot
@@ -70,7 +71,7 @@ class LinearStart(eqx.Module):
     PredictionError(start=LinearStart(), max_steps=0)).model` is the start itself."""
 
     span: int = 1
-    hold: str | dict | None = None
+    hold: ZeroOrderHold | FirstOrderHold | dict | None = None
 
     def __call__(self, model, dataset, free, rudder: str):
         return initial_estimate(model, dataset, free=free, rudder=rudder, hold=self.hold,
@@ -94,11 +95,11 @@ def initial_estimate(model, dataset, *, free=None, rudder: str = "delta", hold=N
     ds = as_dataset(dataset)
     check_data(ds, rudder, ("r",))
     names = tuple(s.name for s in resolve_free(model, free))
-    foh = dict(resolve_holds(rudder, hold, ("delta",)))["delta"] == "foh"
+    held = dict(resolve_holds(rudder, hold, ("delta",)))["delta"]
     if isinstance(model, Nomoto1):
-        return _nomoto1(model, ds, names, rudder, foh)
+        return _nomoto1(model, ds, names, rudder, held)
     if isinstance(model, NonlinearNomoto):
-        return _midpoint(model, ds, names, rudder, foh)
+        return _midpoint(model, ds, names, rudder, held)
     if isinstance(model, RossAutopilot):
         return _ross(model, ds, free=free, rudder=rudder, hold=hold, span=span)
     raise ValueError(f"no linear least-squares start for {type(model).__name__}; supported: "
@@ -106,18 +107,18 @@ def initial_estimate(model, dataset, *, free=None, rudder: str = "delta", hold=N
                      "Nomoto1).")
 
 
-def _nomoto1(model, ds, names, rudder, foh):
+def _nomoto1(model, ds, names, rudder, held):
     r0, r1, d0, d1, dt, _ = _pairs(ds, rudder)
     if np.ptp(np.asarray(ds.dt)) > 1e-9 * float(np.max(ds.dt)):
         as_nonlinear = NonlinearNomoto(K=model.K, T=model.T, n3=0.0, n2=0.0, n1=1.0,
                                        n0=-model.K * model.delta0)
         free = tuple(n for n in names if n in ("K", "T")) + (("n0",) if "delta0" in names else ())
-        fitted = _midpoint(as_nonlinear, ds, free, rudder, foh)
+        fitted = _midpoint(as_nonlinear, ds, free, rudder, held)
         values = {"K": fitted.K, "T": fitted.T,
                   "delta0": -fitted.n0 / fitted.K if "delta0" in names else model.delta0}
     else:
         step = float(dt[0])
-        rudders = [d0, d1] if foh else [d0]
+        rudders = held.interval_samples(d0, d1)
         if "delta0" in names:
             columns = [r0, *rudders, np.ones_like(r0)]
         else:
@@ -134,11 +135,11 @@ def _nomoto1(model, ds, names, rudder, foh):
     return _replace(model, {n: values[n] for n in names})
 
 
-def _midpoint(model, ds, names, rudder, foh):
+def _midpoint(model, ds, names, rudder, held):
     r0, r1, d0, d1, dt, _ = _pairs(ds, rudder)
     rdot = (r1 - r0) / dt
     rm = 0.5 * (r0 + r1)
-    d0 = 0.5 * (d0 + d1) if foh else d0  # the mean rudder over the interval
+    d0 = held.interval_mean(d0, d1)  # the mean rudder over the interval
     # T rdot + n3 rm^3 + n2 rm^2 + n1 rm + n0 - K delta = 0
     terms = {"T": rdot, "n3": rm**3, "n2": rm**2, "n1": rm, "n0": np.ones_like(rm), "K": -d0}
     known = sum(float(getattr(model, n)) * x for n, x in terms.items() if n not in names)
@@ -191,7 +192,7 @@ def _ross(model: RossAutopilot, dataset, *, free=None, rudder: str = "delta", sp
     ds = as_dataset(dataset)
     check_data(ds, rudder, ("r",))
     names = tuple(s.name for s in resolve_free(model, free))
-    foh = dict(resolve_holds(rudder, hold, ("delta",)))["delta"] == "foh"
+    held = dict(resolve_holds(rudder, hold, ("delta",)))["delta"]
     order = tuple(h for h, _ in HULL_TERMS) + RUDDER_TERMS
     gain = (float(model.speed) / float(model.length)) ** 2
     rows, targets = [], []
@@ -200,7 +201,7 @@ def _ross(model: RossAutopilot, dataset, *, free=None, rudder: str = "delta", sp
         r, d = get("r"), get(rudder)
         dt = float(np.asarray(ds.dt)[i])
         # the inputs over each interval: held, or (first-order hold) at its midpoint
-        over = (lambda a: 0.5 * (a[:-1] + a[1:])) if foh else (lambda a: a[:-1])
+        over = lambda a: held.interval_mean(a[:-1], a[1:])
         aux = AuxInputs(u=over(get("u")), v=over(get("v")), n=over(get("n")))
         phi = np.asarray(model.regressors(0.5 * (r[:-1] + r[1:]), over(d), aux), np.float64)
         count = (num - 1) // span

@@ -41,6 +41,8 @@ import jax
 import jax.numpy as jnp
 import optimistix as optx
 
+from .._foundation._results import RESULTS, as_code
+
 
 class _DampingState(eqx.Module):
     step_size: jax.Array  # 1 / lambda
@@ -176,30 +178,6 @@ class LevenbergMarquardt(optx.AbstractGaussNewton):
         half = jnp.where(use, half, 0.0)
         state = eqx.tree_at(lambda s: s.search_state.correction, state, half)
         return eqx.tree_at(lambda s: s.y_eval, state, state.y_eval + half)
-
-
-class RESULTS(optx.RESULTS):
-    """The outcome of a fit: optimistix's codes (`successful`, `max_steps_reached`,
-    `nonlinear_divergence`, `singular`, ...) and those only a fit can tell. `successful`
-    (converged) is the only success."""
-
-    simulation_blew_up = ("the model's simulation blew up (values not finite, or a "
-                          "thousand times beyond the measurements): the estimates mean "
-                          "nothing")
-    did_not_move = ("the optimiser did not move from the start values although the cost "
-                    "is not stationary there (a start value far out of scale?): the "
-                    "estimates are the start values")
-    at_bound = ("an estimate ended on a bound of its parameter: the data pull it beyond, "
-                "so the fit is not a proper optimum (see the parameter flags)")
-    poorly_determined = ("the data do not determine a combination of the parameters (a "
-                         "singular information matrix, no excitation, or a record too "
-                         "short): only other combinations are identified (see the "
-                         "parameter flags)")
-
-
-def as_code(result) -> RESULTS:
-    """`result` (a `RESULTS` or optimistix `RESULTS` item) as a `RESULTS` item."""
-    return result if result._enumeration is RESULTS else RESULTS.promote(result)
 
 
 class SolverOutcome(eqx.Module):

@@ -34,8 +34,10 @@ class FitResult(SolverOutcome):
       samples; `predicted`: (E, N) mask of samples that were predicted (the first
       sample of each experiment is a start value, never predicted);
     - `result`: the `jaxship.RESULTS` code (optimistix's, and `simulation_blew_up`,
-      `did_not_move`, `at_bound`, `poorly_determined`: a fit that blew up, never moved,
-      ended on a bound or left a combination undetermined is not a success);
+      `did_not_move`, `at_bound`, `poorly_determined`, `undetermined`: a fit that blew
+      up, never moved, ended on a bound, left a combination undetermined or explains almost
+      nothing (no channel's fit reaches 5 %) with a parameter whose 95 % interval includes
+      zero is not a success);
       `success` (converged); `message`;
     - `num_steps`: optimiser steps; `cost`: $\\frac12\\sum$ of the squared weighted
       residuals at the optimum;

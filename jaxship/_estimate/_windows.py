@@ -17,6 +17,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._models._manoeuvres import HOLDS, FirstOrderHold, ZeroOrderHold, check_hold
 from .._models._steering._base import AuxInputs, WindowStart
 from .._simulation._data import Dataset, Experiment, check_uniform
 from .._simulation._integrate import Simulator
@@ -86,8 +87,9 @@ def check_data(ds: Dataset, rudder: str, channels, *, rtol: float = 1e-6) -> Non
 
 # how each replayed signal is interpolated between samples (MATLAB's `InterSample`):
 # measured continuous signals linearly (first-order hold), commands held (zero-order)
-DEFAULT_HOLDS = {"delta": "foh", "delta_c": "zoh", "u": "foh", "v": "foh", "n": "foh",
-                 "wind_speed": "foh", "wind_dir": "zoh", "wind_u": "foh", "wind_v": "foh"}
+_FOH, _ZOH = FirstOrderHold(), ZeroOrderHold()
+DEFAULT_HOLDS = {"delta": _FOH, "delta_c": _ZOH, "u": _FOH, "v": _FOH, "n": _FOH,
+                 "wind_speed": _FOH, "wind_dir": _ZOH, "wind_u": _FOH, "wind_v": _FOH}
 
 
 def apparent_wind(ds: Dataset) -> dict:
@@ -104,11 +106,12 @@ def apparent_wind(ds: Dataset) -> dict:
 
 def resolve_holds(rudder: str, hold, names) -> tuple[tuple[str, str], ...]:
     """`(replayed name, hold)` pairs: `hold` None (the defaults by channel, the rudder
-    by the channel it is read from), one of "zoh"/"foh" for every signal, or a dict
-    overriding some channels (keys are channel names, e.g. "delta_c", "n")."""
+    by the channel it is read from), one `ZeroOrderHold()` or `FirstOrderHold()` for every
+    signal, or a dict overriding some channels (keys are channel names, e.g. "delta_c",
+    "n")."""
     source = {name: (rudder if name == "delta" else name) for name in names}
     chosen = {src: DEFAULT_HOLDS[src] for src in source.values()}
-    if isinstance(hold, str):
+    if isinstance(hold, HOLDS):
         chosen = dict.fromkeys(chosen, hold)
     elif isinstance(hold, dict):
         unknown = [k for k in hold if k not in chosen]
@@ -117,10 +120,10 @@ def resolve_holds(rudder: str, hold, names) -> tuple[tuple[str, str], ...]:
                              f"replayed channels are {sorted(chosen)}.")
         chosen.update(hold)
     elif hold is not None:
-        raise ValueError(f"`hold` must be None, 'zoh', 'foh' or a dict, got {hold!r}.")
+        raise ValueError(f"`hold` must be None, ZeroOrderHold(), FirstOrderHold() or a dict "
+                         f"of them, got {hold!r}.")
     for k, v in chosen.items():
-        if v not in ("zoh", "foh"):
-            raise ValueError(f"hold of {k!r} must be 'zoh' or 'foh', got {v!r}.")
+        check_hold(v, f"hold of {k!r}")
     return tuple((name, chosen[src]) for name, src in source.items())
 
 
@@ -242,10 +245,7 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
     # a first-order hold, rectangles for a zero-order hold: exact for either)
     names = ("delta", "u", "v", "n") + (("wind_speed", "wind_dir", *derived) if wind else ())
     holds = resolve_holds(rudder, hold, names)
-    if dict(holds)["delta"] == "foh":
-        pieces = 0.5 * (rud[:, 1:] + rud[:, :-1])
-    else:
-        pieces = rud[:, :-1]
+    pieces = dict(holds)["delta"].interval_mean(rud[:, :-1], rud[:, 1:])
     integral = np.concatenate([np.zeros((num_exp, 1)), np.cumsum(pieces, axis=1)], axis=1)
     integral = integral * dt_e[:, None]
     first = lambda name: np.broadcast_to(

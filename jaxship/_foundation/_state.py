@@ -6,6 +6,7 @@ import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike
 
 from ._frames import trajectory_to_dataframe
+from ._results import RESULTS
 
 
 class ShipState(eqx.Module):
@@ -102,8 +103,10 @@ class Trajectory(eqx.Module):
 
     `state.*` and `command.*` have shape `(num_samples,)` (plus any batch axes in
     front). `valid` marks samples inside the manoeuvre's duration (padding beyond it
-    is simulated but should be ignored); `success` is False when the solver failed or
-    a state became non-finite. A steering model's trajectory has its heading, yaw
+    is simulated but should be ignored); `result` is the `RESULTS` code: `successful`,
+    the code of the first failed solver step (diffrax's, passed through), or
+    `simulation_blew_up` when a state became non-finite; `success` is `result ==
+    successful` (an array for a batch). A steering model's trajectory has its heading, yaw
     rate and actual rudder in `state`, the replayed auxiliary inputs in `state.u`,
     `state.v`, `state.n` (zeros where none), no track (`state.x = state.y = 0`: a
     response model has no position), the ordered rudder in `command.delta`, and the
@@ -115,8 +118,12 @@ class Trajectory(eqx.Module):
     state: ShipState
     command: Command
     valid: Array
-    success: Array
+    result: RESULTS
     internal: Array | None = None
+
+    @property
+    def success(self) -> Array:
+        return self.result == RESULTS.successful
 
     def to_dataframe(self):
         """One row per valid sample (pandas, an optional dependency): t, the state, and

@@ -428,14 +428,89 @@ def heading_perturbations(amplitude, period, kp, ki, kd, duration, *, dt=0.1,
     return Controlled(pilot, duration=duration, dt=dt)
 
 
+def _sample_at(record, dt, tau):
+    """`(record, k)`: the record as an array and the index of its sample at or before
+    `tau` seconds after its first sample (the last beyond the end)."""
+    record = jnp.asarray(record)
+    position = tau / dt
+    return record, jnp.clip(jnp.floor(position + 1e-9).astype(int), 0, record.shape[0] - 1)
+
+
+class ZeroOrderHold(eqx.Module):
+    """A recorded signal held from each sample to the next (MATLAB's `InterSample='zoh'`):
+    right for a commanded, piecewise-constant signal."""
+
+    def interpolate(self, record, dt, tau):
+        """Value and slope (zero) of `record`, sampled every `dt`, at `tau` seconds after
+        its first sample; the last sample holds beyond the end."""
+        record, k = _sample_at(record, dt, tau)
+        return record[k], jnp.zeros_like(record[k])
+
+    def slope(self, first, second, dt):
+        """The slope over one sample interval from `first` to `second`: zero."""
+        return 0.0 * first
+
+    def interval_mean(self, first, second):
+        """The signal's mean over the interval from sample `first` to `second`."""
+        return first
+
+    def interval_samples(self, first, second) -> list:
+        """The samples the signal over the interval depends on."""
+        return [first]
+
+
+class FirstOrderHold(eqx.Module):
+    """A recorded signal interpolated linearly between samples (MATLAB's
+    `InterSample='foh'`): right for a measured, continuous signal such as a logged rudder
+    angle or shaft speed."""
+
+    def interpolate(self, record, dt, tau):
+        """Value and slope of `record`, sampled every `dt`, at `tau` seconds after its first
+        sample, linear between samples; the last sample holds beyond the end."""
+        record, k = _sample_at(record, dt, tau)
+        k1 = jnp.minimum(k + 1, record.shape[0] - 1)
+        slope = (record[k1] - record[k]) / dt
+        return record[k] + slope * jnp.clip(tau - k * dt, 0.0, None), slope
+
+    def slope(self, first, second, dt):
+        """The slope over one sample interval from `first` to `second`."""
+        return (second - first) / dt
+
+    def interval_mean(self, first, second):
+        """The signal's mean over the interval from sample `first` to `second`."""
+        return 0.5 * (first + second)
+
+    def interval_samples(self, first, second) -> list:
+        """The samples the signal over the interval depends on."""
+        return [first, second]
+
+
+HOLDS = (ZeroOrderHold, FirstOrderHold)
+
+
+def check_hold(hold, name: str):
+    """`hold` if it is a `ZeroOrderHold()` or `FirstOrderHold()`; `ValueError` naming
+    `name` otherwise."""
+    if not isinstance(hold, HOLDS):
+        raise ValueError(f"`{name}` must be ZeroOrderHold() or FirstOrderHold(), got "
+                         f"{hold!r}.")
+    return hold
+
+
+def interpolate(record, dt, tau, hold):
+    """Value and slope of a record sampled every `dt` at `tau` seconds after its first
+    sample, as `hold` (`ZeroOrderHold()` or `FirstOrderHold()`) interpolates it."""
+    return hold.interpolate(record, dt, tau)
+
+
 class Replay(AbstractTrial):
     """Open-loop replay of recorded rudder and propeller commands.
 
     `delta_record` [rad] and `n_record` [rev/s] are sampled every `dt` from `start`.
-    Between samples each channel is held (`"zoh"`, zero-order hold: right for a
-    commanded, piecewise-constant signal) or interpolated linearly (`"foh"`,
-    first-order hold: right for a measured, continuous signal such as a logged rudder
-    angle or shaft speed), as MATLAB's `InterSample`. Commands default to `"zoh"`.
+    Between samples each channel is held (`ZeroOrderHold()`: right for a commanded,
+    piecewise-constant signal) or interpolated linearly (`FirstOrderHold()`: right for a
+    measured, continuous signal such as a logged rudder angle or shaft speed), as
+    MATLAB's `InterSample`. Commands default to `ZeroOrderHold()`.
     `n_record=None` holds the initial propeller rate (and is what a steering model,
     which takes no propeller order, needs); `dt` is keyword-only.
     """
@@ -447,17 +522,16 @@ class Replay(AbstractTrial):
     duration: ArrayLike | None = None
     n: None = None
     num_samples: int | None = eqx.field(static=True, default=None)
-    delta_hold: str = eqx.field(static=True, default="zoh")
-    n_hold: str = eqx.field(static=True, default="zoh")
+    delta_hold: ZeroOrderHold | FirstOrderHold = eqx.field(static=True,
+                                                           default=ZeroOrderHold())
+    n_hold: ZeroOrderHold | FirstOrderHold = eqx.field(static=True, default=ZeroOrderHold())
 
     def __post_init__(self):
         length = np.shape(self.delta_record)[0]
         if self.n_record is not None and np.shape(self.n_record)[0] != length:
             raise ValueError("`delta_record` and `n_record` must have the same length.")
         for name in ("delta_hold", "n_hold"):
-            if getattr(self, name) not in HOLDS:
-                raise ValueError(f"`{name}` must be one of {HOLDS}, got "
-                                 f"{getattr(self, name)!r}.")
+            check_hold(getattr(self, name), name)
         if self.duration is None:
             self.duration = (length - 1) * float(self.dt)
         if self.num_samples is None:
@@ -476,21 +550,3 @@ class Replay(AbstractTrial):
             return Command(delta, memory[0], delta_rate, None), memory
         n, n_rate = interpolate(self.n_record, self.dt, tau, self.n_hold)
         return Command(delta, n, delta_rate, n_rate), memory
-
-
-HOLDS = ("zoh", "foh")
-
-
-def interpolate(record, dt, tau, hold: str):
-    """Value and slope of a record sampled every `dt` at `tau` seconds after its first
-    sample, held (`"zoh"`) or linearly interpolated (`"foh"`) between samples; the
-    last sample holds beyond the end."""
-    record = jnp.asarray(record)
-    last = record.shape[0] - 1
-    position = tau / dt
-    k = jnp.clip(jnp.floor(position + 1e-9).astype(int), 0, last)
-    if hold == "zoh":
-        return record[k], jnp.zeros_like(record[k])
-    k1 = jnp.minimum(k + 1, last)
-    slope = (record[k1] - record[k]) / dt
-    return record[k] + slope * jnp.clip(tau - k * dt, 0.0, None), slope

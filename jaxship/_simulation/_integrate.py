@@ -22,6 +22,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._foundation._results import RESULTS, as_code
 from .._foundation._state import Switched
 from .._models._manoeuvres import interpolate
 
@@ -151,7 +152,7 @@ class Simulator(eqx.Module):
 
     def step(self, field, t, h, y, args):
         """Advance `y` over `[t, t + h]` under `dy/dt = field(t, y, args)`; returns
-        `(y, success)`."""
+        `(y, result)`, `result` diffrax's code of the step (`diffrax.RESULTS`)."""
         term = dfx.ODETerm(field)
         if self.stepsize_controller is None:
             solver = self.solver
@@ -162,11 +163,11 @@ class Simulator(eqx.Module):
                                      is_leaf=lambda x: x is None)
             state = solver.init(term, t, t + h, y, args)
             y, _, _, _, result = solver.step(term, t, t + h, y, args, state, made_jump=False)
-            return y, result == dfx.RESULTS.successful
+            return y, result
         sol = dfx.diffeqsolve(term, self.solver, t, t + h, h, y, args,
                               stepsize_controller=self.stepsize_controller,
                               adjoint=self.adjoint, max_steps=self.max_steps, throw=False)
-        return sol.ys[-1], sol.result == dfx.RESULTS.successful
+        return sol.ys[-1], sol.result
 
 
 def integrate(field, y0, policy, policy_state, t0, dt, num, simulator: Simulator, steps: int,
@@ -184,8 +185,9 @@ def integrate(field, y0, policy, policy_state, t0, dt, num, simulator: Simulator
       integrated and dropped) or at its end (`emit="end"`: the `num` samples after
       the initial state, as predictions need).
 
-    Returns `(outputs, ok)`: the recorded pytree with a leading axis `num`, and whether
-    every step succeeded and stayed finite.
+    Returns `(outputs, result)`: the recorded pytree with a leading axis `num`, and the
+    `RESULTS` code: the first failed step's (diffrax's code passed through), else
+    `simulation_blew_up` when a recorded value is not finite, else `successful`.
     """
     h = dt / steps
     observe = (lambda y, inputs: (y, inputs)) if observe is None else observe
@@ -194,16 +196,17 @@ def integrate(field, y0, policy, policy_state, t0, dt, num, simulator: Simulator
         t_sample = t0 + k * dt
 
         def control_step(carry, j):
-            y, ps, ok = carry
+            y, ps, result = carry
             t = t_sample + j * h
             inputs, ps = policy(t, y, ps, h)
             if isinstance(inputs, Switched):  # two solver steps, split at the switch
                 s = jnp.clip(inputs.at, 0.0, h)
                 y, before = simulator.step(field, t, s, y, (inputs.before, t))
                 y, after = simulator.step(field, t + s, h - s, y, (inputs.after, t))
-                return (y, ps, ok & before & after), inputs.at_start()
-            y, success = simulator.step(field, t, h, y, (inputs, t))
-            return (y, ps, ok & success), inputs
+                return (y, ps, _first_failure(_first_failure(result, before), after)), \
+                    inputs.at_start()
+            y, step_result = simulator.step(field, t, h, y, (inputs, t))
+            return (y, ps, _first_failure(result, step_result)), inputs
 
         y = carry[0]
         carry, inputs = jax.lax.scan(control_step, carry, jnp.arange(steps),
@@ -211,10 +214,16 @@ def integrate(field, y0, policy, policy_state, t0, dt, num, simulator: Simulator
         y = carry[0] if emit == "end" else y
         return carry, observe(y, jax.tree.map(lambda a: a[0], inputs))
 
-    (_, _, ok), out = jax.lax.scan(sample, (y0, policy_state, jnp.array(True)),
-                                   jnp.arange(num))
+    (_, _, result), out = jax.lax.scan(sample, (y0, policy_state, RESULTS.successful),
+                                       jnp.arange(num))
     finite = jnp.all(jnp.stack([jnp.all(jnp.isfinite(a)) for a in jax.tree.leaves(out)]))
-    return out, ok & finite
+    blew_up = (result == RESULTS.successful) & ~finite
+    return out, RESULTS.where(blew_up, RESULTS.simulation_blew_up, result)
+
+
+def _first_failure(result: RESULTS, step) -> RESULTS:
+    """`result`, or the code `step` of the next solver step if `result` is `successful`."""
+    return RESULTS.where(result == RESULTS.successful, as_code(step), result)
 
 
 class Held(eqx.Module):
@@ -231,7 +240,8 @@ class Held(eqx.Module):
 def replay_policy(records: dict, dt, holds: dict):
     """A policy of `integrate` replaying recorded signals: `records` maps a name to
     its samples (the first at the start of the run, every `dt` seconds), `holds` maps
-    it to `"zoh"` or `"foh"` (see `jaxship.Replay`). Returns `Held` dictionaries."""
+    it to `ZeroOrderHold()` or `FirstOrderHold()` (see `jaxship.Replay`). Returns `Held`
+    dictionaries."""
 
     def policy(t, y, state, h):
         pairs = {k: interpolate(a, dt, t, holds[k]) for k, a in records.items()}

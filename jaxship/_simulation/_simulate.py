@@ -11,6 +11,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._foundation._results import raise_unless_successful
 from .._foundation._state import (
     STATE_FIELDS,
     Command,
@@ -39,6 +40,7 @@ def simulate(
     environment: Environment = Environment(),
     simulator: Simulator = Simulator(),
     aux: AuxInputs | None = None,
+    throw: bool = False,
 ) -> Trajectory:
     """Simulate `model` through `manoeuvre` from the initial state `x0`.
 
@@ -58,6 +60,8 @@ def simulate(
     - `aux`: steering models only: the measured `AuxInputs` (u, v, n, apparent
       wind) replayed beside a `Replay`'s rudder, leaves of shape `(N,)` or scalars
       (zeros, calm, by default), with the rudder's hold.
+    - `throw`: raise (an `equinox` runtime error with the code's sentence) unless the
+      simulation succeeded; default False: the outcome is `Trajectory.result`.
 
     A steering model through a `Replay` replays the rudder record (`delta_hold`;
     its `n_record` is not used: a response model takes a measured propeller rate
@@ -76,7 +80,8 @@ def simulate(
     Parameter values are traced, never baked in: changing them does not recompile.
     """
     if isinstance(model, AbstractSteeringModel):
-        return simulate_steering_model(model, manoeuvre, x0, aux=aux, simulator=simulator)
+        return raise_unless_successful(
+            simulate_steering_model(model, manoeuvre, x0, aux=aux, simulator=simulator), throw)
     if not isinstance(model, AbstractVessel):
         raise TypeError(f"`model` must be an AbstractVessel or an AbstractSteeringModel, got "
                         f"{type(model).__name__}.")
@@ -86,8 +91,9 @@ def simulate(
     x0 = straight_run(model) if x0 is None else x0
     wind = not _is_static_zero(environment.wind.speed)
     steps = simulator.steps_per_sample(manoeuvre.dt)
-    return _simulate(*_as_arrays((model, manoeuvre, x0, environment)), simulator, steps,
-                     wind=wind)
+    return raise_unless_successful(
+        _simulate(*_as_arrays((model, manoeuvre, x0, environment)), simulator, steps,
+                  wind=wind), throw)
 
 
 def _is_static_zero(x) -> bool:
@@ -162,7 +168,7 @@ def _simulate(vessel, manoeuvre, x0, environment, simulator, steps, wind=True, p
         return jnp.concatenate([y[:len(STATE_FIELDS)], jnp.stack([delta, n])])
 
     field = vessel_field(vessel, environment, wind=wind, rudder_rate=manoeuvre.rudder_rate)
-    out, ok = integrate(field, y0, policy,
+    out, result = integrate(field, y0, policy,
                         manoeuvre.init(x0), t0, dt, num, simulator, steps, observe)
     if not per_field:
         out = tuple(out[:, i] for i in range(len(STATE_FIELDS) + 2))
@@ -173,5 +179,5 @@ def _simulate(vessel, manoeuvre, x0, environment, simulator, steps, wind=True, p
         state=state,
         command=command,
         valid=t - t0 <= manoeuvre.duration + 1e-9 * dt,
-        success=ok,
+        result=result,
     )

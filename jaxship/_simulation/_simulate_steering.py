@@ -101,7 +101,7 @@ def replay_records(manoeuvre: Replay, aux: AuxInputs | None) -> tuple[dict, dict
     return records, dict.fromkeys(records, manoeuvre.delta_hold)
 
 
-def steering_trajectory(manoeuvre, psi, r, internal, delta, ordered, ok, *, u=None, v=None,
+def steering_trajectory(manoeuvre, psi, r, internal, delta, ordered, result, *, u=None, v=None,
                         n=None) -> Trajectory:
     """A steering model's `Trajectory`: heading, yaw rate, actual and ordered rudder and
     the model state at the samples; the aux inputs `u`, `v`, `n` (zeros where None);
@@ -115,7 +115,7 @@ def steering_trajectory(manoeuvre, psi, r, internal, delta, ordered, ok, *, u=No
         state=ShipState(u=u, v=v, r=r, x=zero, y=zero, psi=psi, delta=delta, n=n),
         command=Command(ordered, n),
         valid=t - manoeuvre.start <= manoeuvre.duration + 1e-9 * dt,
-        success=ok,
+        result=result,
         internal=internal,
     )
 
@@ -126,12 +126,12 @@ def _replay(model, manoeuvre, x0, aux, simulator, steps):
     records, holds = replay_records(manoeuvre, aux)
     dt = jnp.asarray(manoeuvre.dt, float)
     state0, psi0 = start_state(model, x0), x0.psi
-    (psi, r, states), ok = _propagate(model, state0, psi0, records, dt, holds, simulator,
+    (psi, r, states), result = _propagate(model, state0, psi0, records, dt, holds, simulator,
                                       steps)
     first = lambda a0, a: jnp.concatenate([jnp.asarray(a0)[None], a])
     return steering_trajectory(manoeuvre, first(psi0, psi), first(model.output(state0), r),
                                jnp.concatenate([state0[None], states]), records["delta"],
-                               records["delta"], ok, u=records["u"], v=records["v"],
+                               records["delta"], result, u=records["u"], v=records["v"],
                                n=records["n"])
 
 
@@ -166,7 +166,7 @@ def _steer(model, manoeuvre, x0, simulator, steps):
     memory = manoeuvre.init(ship(y0, zero))
     observe = lambda y, held: (y[-1], model.output(y[:-1]), y[:-1], held.value["delta"],
                                held.value["ordered"])
-    (psi, r, states, delta, ordered), ok = integrate(
+    (psi, r, states, delta, ordered), result = integrate(
         steering_field(model), y0, policy, (zero, memory), manoeuvre.start, dt,
         manoeuvre.num_samples, simulator, steps, observe)
-    return steering_trajectory(manoeuvre, psi, r, states, delta, ordered, ok)
+    return steering_trajectory(manoeuvre, psi, r, states, delta, ordered, result)

@@ -1,11 +1,15 @@
 """`jaxship discover`: find, name and add the effect a model is missing."""
 
 import pathlib
-import sys
 
-from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
-
-from ._common import VELOCITIES, add_sample_interval, add_velocities, check_out, note
+from ._common import (
+    VELOCITIES,
+    ProgressBar,
+    add_sample_interval,
+    add_velocities,
+    check_out,
+    note,
+)
 from ._identification.discovery import run_discovery
 from ._vessel import VESSEL_HELP
 from .identify import start_model
@@ -41,12 +45,11 @@ def run(args) -> int:
     name, start = start_model(args.model, args.vessel)
     check_out(args.out, writes=("discovery.json", "report.md", "figures/"),
               inputs=[*args.train, *(args.holdout or [])])
-    say = (lambda message: None) if args.quiet else (
-        lambda message: tqdm.write(f"jaxship: {message} ...", file=sys.stderr))
     report = run_discovery(args.train, args.holdout, model=name, start=start, out=args.out,
                            max_effects=args.max_effects, alpha=args.alpha,
                            sample_interval=args.sample_interval,
-                           over_ground=VELOCITIES.get(args.velocities), progress=say,
+                           over_ground=VELOCITIES.get(args.velocities),
+                           progress=ProgressBar(not args.quiet),
                            note=note)
     print(report.to_markdown())
     print(f"wrote {args.out}/discovery.json, {args.out}/report.md, {args.out}/figures/")

@@ -181,7 +181,11 @@ def run(args) -> int:
                            source=f"jaxship identify --model {name} ({result.fit.code_name})")
             written.append("vessel.toml")
     head, *lines = result.summary().splitlines()
-    if not result.fit.success:  # the optimiser's own words are on stderr, in plain ones
+    undetermined = result.fit.code == js.RESULTS.undetermined
+    if undetermined:  # the optimiser converged, on data that are noise to the model
+        head = (f"{result.model_name}: {type(result.model).__name__}, UNDETERMINED (the fit "
+                f"explains almost nothing, after {result.fit.num_steps} steps)")
+    elif not result.fit.success:  # the optimiser's own words are on stderr, in plain ones
         head = (f"{result.model_name}: {type(result.model).__name__}, NOT converged "
                 f"({result.fit.code_name}, after {result.fit.num_steps} steps)")
     print("\n".join([head, *lines]))
@@ -190,6 +194,11 @@ def run(args) -> int:
     for message in dict.fromkeys(result.warnings):
         print(f"jaxship: warning: {one_line(message)}", file=sys.stderr)
     print(f"wrote {args.out}/" + f", {args.out}/".join(written))
+    if undetermined:
+        print("jaxship: the fit explains almost nothing and leaves parameters undetermined "
+              "(undetermined: see the warnings above); the results were written for "
+              "inspection.", file=sys.stderr)
+        return 3
     if not result.fit.success:
         print(f"jaxship: the fit is not a converged estimate ({result.fit.code_name}: see "
               "the warnings above); the results were written for inspection.",

@@ -81,10 +81,20 @@ class CandidateOutcome(eqx.Module):
         return not self.why
 
 
+class Verdict(eqx.Enumeration):
+    """The outcome code of `discover` (`DiscoveryReport.verdict`)."""
+
+    missing_effect = ("the model misses effects the data show: candidates passed the score, "
+                      "likelihood-ratio, held-out and plausibility tests (see `effects`)")
+    nothing_missing = ("no candidate of the catalogue passed the tests: nothing it holds is "
+                       "missing from the model (see `rejected` and `scores`)")
+
+
 class DiscoveryReport(eqx.Module):
     """The outcome of `discover`.
 
-    - `verdict`: `"missing_effect"` or `"nothing_missing"`;
+    - `verdict`: the `Verdict` code, `Verdict.missing_effect` or `Verdict.nothing_missing`
+      (`verdict_name`: its name, as in the JSON);
     - `effects`: the accepted effects in order (`CandidateOutcome`s with empty `why`);
     - `rejected`: candidates refitted or scored that did not pass (`CandidateOutcome`s
       with their reasons in `why`; a joint step's set as one entry, its ids joined by
@@ -101,7 +111,7 @@ class DiscoveryReport(eqx.Module):
       vessel also the loads it lacks).
     """
 
-    verdict: str
+    verdict: "Verdict"
     effects: tuple[CandidateOutcome, ...]
     rejected: tuple[CandidateOutcome, ...]
     scores: dict[str, CandidateScore]
@@ -119,6 +129,11 @@ class DiscoveryReport(eqx.Module):
     disagreement: dict
 
     @property
+    def verdict_name(self) -> str:
+        """`"missing_effect"` or `"nothing_missing"`."""
+        return "missing_effect" if self.verdict == Verdict.missing_effect else "nothing_missing"
+
+    @property
     def named(self) -> tuple[str, ...]:
         """The ids of the accepted effects, in order."""
         return tuple(e.id for e in self.effects)
@@ -133,7 +148,8 @@ class DiscoveryReport(eqx.Module):
                 "train_cost_after", "holdout_cost_before", "holdout_cost_after",
                 "holdout_fit_percent_before", "holdout_fit_percent_after",
                 "holdout_indices", "alpha", "disagreement")
-        return _plain({k: getattr(self, k) for k in keys} | {"channels": list(self.channels)})
+        plain = {k: getattr(self, k) for k in keys} | {"verdict": self.verdict_name}
+        return _plain(plain | {"channels": list(self.channels)})
 
     def to_markdown(self) -> str:
         """The story in a page: verdict, effects, rejected candidates, the gap."""

@@ -16,13 +16,14 @@ from ..._estimate._lm import RESULTS, LevenbergMarquardt
 from ..._estimate._result import FitError
 from ..._estimate._windows import as_dataset
 from ..._foundation._params import default_free
+from ..._foundation._progress import Progress
 from ..._foundation._validate import NonFiniteError
 from ._catalogue import DISCOVERY_CATALOGUE
 from ._forces import smoothed_vessel_states
 from ._holdout import cost_rise, holdout_check, holdout_indices
 from ._locate import locate_disagreement
 from ._plumbing import parameters, split
-from ._report import DiscoveryReport
+from ._report import DiscoveryReport, Verdict
 from ._search import Path, Search
 
 
@@ -86,7 +87,8 @@ def _setup(model, train, holdout, estimator, progress) -> dict:
         estimator = dataclasses.replace(estimator, initial=smoothed[0])
         held_start = smoothed[-1]
     setup = dict(data=data, train=train, holdout=holdout, estimator=estimator,
-                 say=progress or (lambda message: None))
+                 say=(lambda message: None) if progress is None else (
+                     lambda message: progress(Progress("discover", message))))
     # the logged wind replayed where model `m` feels it
     setup["loss"] = lambda m: dataclasses.replace(estimator, wind=bool(windy and m.wind_loads))
     setup["check"] = lambda m: holdout_check(
@@ -148,7 +150,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
       track (`smoothed_vessel_states`).
     - `options`: `DiscoveryOptions` (most effects, family-wise false-alarm rate, classes
       refitted per step, equivalence, beam width).
-    - `progress`: a callable taking a message string (the CLI's progress bar).
+    - `progress`: a callable taking a `Progress` report (stage `"discover"`) at each stage.
 
     **Returns:** a `DiscoveryReport`; each named effect's parameters are those of the
     final fit, with their robust standard errors and +-3 standard-error intervals.
@@ -184,7 +186,7 @@ def discover(model, train, holdout=None, *, catalogue=DISCOVERY_CATALOGUE,
                                                wind=loss(r.model).wind)
                     for label, r in (("before", base_fit), ("after", current))}
     return DiscoveryReport(
-        verdict="missing_effect" if accepted else "nothing_missing", effects=accepted,
+        verdict=Verdict.missing_effect if accepted else Verdict.nothing_missing, effects=accepted,
         rejected=best.rejected, scores=search.first_scores or {},
         model_before=base_fit.model, model_after=current.model,
         train_cost_before=base_fit.cost, train_cost_after=current.cost,

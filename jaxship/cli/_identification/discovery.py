@@ -24,11 +24,12 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
     over ground if `over_ground`: `read_experiments`),
     fit `model` (as `jaxship identify` does, for start values), run discovery and write
     `out/discovery.json`, `out/report.md` and `out/figures/`. Returns the
-    `DiscoveryReport`. `progress` takes the stage messages, `note` (default `progress`)
-    what was done to the records (files skipped, resampling): the command prints notes
-    even when quiet. `start`: a model to start from (`--vessel`), fitted as `model`
-    (`start_entry`)."""
-    say = progress or (lambda message: None)
+    `DiscoveryReport`. `progress` takes the stage reports (`jaxship.Progress`), `note`
+    (default: a stage report) what was done to the records (files skipped,
+    resampling): the command prints notes even when quiet. `start`: a model to start
+    from (`--vessel`), fitted as `model` (`start_entry`)."""
+    say = (lambda message: None) if progress is None else (
+        lambda message: progress(js.Progress("discover", message)))
     note = note or say
     name = start_entry(model, start)[0] if start is not None else model_key(model)
     if max_effects < 1:
@@ -51,7 +52,7 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
     say(f"start values: identify {name} on {len(train)} training records")
     start = identify(train, model=name, start=start).fit.model
     report = js.discover(start, train, holdout, options=js.DiscoveryOptions(
-        max_effects=max_effects, alpha=alpha), progress=say)
+        max_effects=max_effects, alpha=alpha), progress=progress)
     with staged_folder(pathlib.Path(out)) as stage:  # all or nothing
         figures = save_discovery_figures(report, train, holdout, stage / "figures")
         text = report.to_markdown()

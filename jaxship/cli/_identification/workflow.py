@@ -345,7 +345,8 @@ def _convergence_problems(result, max_steps: int) -> list[str]:
     when its parameter flags already say why: an estimate on a bound, a combination the
     data do not determine)."""
     code = result.code
-    if result.success or code in (js.RESULTS.at_bound, js.RESULTS.poorly_determined):
+    if result.success or code in (js.RESULTS.at_bound, js.RESULTS.poorly_determined,
+                                     js.RESULTS.undetermined):
         return []
     if code in (js.RESULTS.simulation_blew_up, js.RESULTS.did_not_move):
         return [f"{result.message}."]
