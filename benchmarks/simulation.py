@@ -244,7 +244,8 @@ class Case:
         # the rudder reversed at the first step after the crossing, as the hand scan and
         # SciPy do (jaxship's default reverses it at the crossing, inside the step)
         manoeuvre = js.ZigZag(angles, angles, duration=self.duration, dt=DT,
-                              n=None if self.name == "mariner" else n0, switch_at="after")
+                              n=None if self.name == "mariner" else n0,
+                              switch_at=js.SwitchAtNextStep())
         x0 = js.straight_state(u0, n0)
         if self.name == "mariner":  # the approach speed is a vessel parameter
             vessel = eqx.tree_at(lambda v: v.nominal_speed, self.vessel, u0)
@@ -421,7 +422,8 @@ def run_case(case, args, devices, rows):
                                    else case.vessel.nominal_n]))
     x0 = js.straight_state(float(u0[0]), float(n0[0]))
     man = js.ZigZag(angle, angle, duration=case.duration, dt=DT,
-                    n=None if case.name == "mariner" else float(n0[0]), switch_at="after")
+                    n=None if case.name == "mariner" else float(n0[0]),
+                    switch_at=js.SwitchAtNextStep())
     p = {k: np.float64(v) for k, v in case.params.items()}
     if case.name == "mariner":
         p["nominal_speed"] = np.float64(u0[0])

@@ -59,9 +59,12 @@ from ._estimate._initial import (
 )
 from ._estimate._kalman import ekf as ekf, smooth_states as smooth_states
 from ._estimate._likelihood import (
+    EstimatedNoise as EstimatedNoise,
+    HeldNoise as HeldNoise,
     Innovations as Innovations,
     InnovationsLeastSquares as InnovationsLeastSquares,
     MaximumLikelihood as MaximumLikelihood,
+    ProcessNoise as ProcessNoise,
 )
 from ._estimate._linear import LinearStart as LinearStart
 from ._estimate._lm import RESULTS as RESULTS, LevenbergMarquardt as LevenbergMarquardt
@@ -99,6 +102,9 @@ from ._models._manoeuvres import (
     ReverseSpiral as ReverseSpiral,
     Schedule as Schedule,
     Stop as Stop,
+    SwitchAtCrossing as SwitchAtCrossing,
+    SwitchAtNearestStep as SwitchAtNearestStep,
+    SwitchAtNextStep as SwitchAtNextStep,
     Turn as Turn,
     ZeroOrderHold as ZeroOrderHold,
     ZigZag as ZigZag,
@@ -144,6 +150,8 @@ from ._simulation._measured import (
     shared_data_dir as shared_data_dir,
 )
 from ._simulation._readers import (
+    DisplayUnits as DisplayUnits,
+    SIUnits as SIUnits,
     read_trial_csv as read_trial_csv,
     write_trial_csv as write_trial_csv,
 )

@@ -380,17 +380,18 @@ def test_a_closed_loop_and_its_metrics_run_in_float32():
 
 def test_closed_loop_and_tuning_carry_a_result_code():
     """Issue 59: `ClosedLoop` and `TunedAutopilot` carry a `RESULTS` code per run (not a
-    bare flag); a plant that blows up is `simulation_blew_up`, and `throw=True` raises."""
+    bare flag); a plant that blows up after the heading step at 100 s (a time constant of
+    -1 ms) is `simulation_blew_up`, and `throw=True` raises."""
     model = js.Nomoto1(K=0.06, T=25.0)
     autopilot = js.design_autopilot(model, natural_frequency=0.1)
-    run = js.closed_loop(model, autopilot, speeds=[5.0, 7.0], duration=60.0, dt=1.0)
+    run = js.closed_loop(model, autopilot, speeds=[5.0, 7.0], duration=150.0, dt=1.0)
     assert np.asarray(run.success).shape == (1, 2) and np.all(run.success)
     assert np.all(run.result == js.RESULTS.successful)
     unstable = js.Nomoto1(K=0.06, T=-1e-3)
-    bad = js.closed_loop(unstable, autopilot, speeds=[5.0], duration=60.0, dt=1.0)
+    bad = js.closed_loop(unstable, autopilot, speeds=[5.0], duration=150.0, dt=1.0)
     assert np.all(bad.result == js.RESULTS.simulation_blew_up) and not np.any(bad.success)
     with pytest.raises(Exception, match="the simulation blew up"):
-        js.closed_loop(unstable, autopilot, speeds=[5.0], duration=60.0, dt=1.0, throw=True)
-    tuned = js.tune_autopilot(model, autopilot, speeds=[5.0], duration=60.0, max_steps=1)
+        js.closed_loop(unstable, autopilot, speeds=[5.0], duration=150.0, dt=1.0, throw=True)
+    tuned = js.tune_autopilot(model, autopilot, speeds=[5.0], duration=150.0, max_steps=1)
     assert bool(tuned.result == js.RESULTS.nonlinear_max_steps_reached), tuned.result
     assert not bool(tuned.success)

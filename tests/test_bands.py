@@ -116,3 +116,8 @@ def test_bands_refuse_what_they_cannot_do():
         js.Disturbance(std=0.01, tau=0.0)
     with pytest.raises(ValueError, match="needs the estimator to predict r and psi"):
         js.calibrate_disturbance(TRUTH, rec, estimator=js.PredictionError(channels=("r",)))
+    # the covariance is a strategy object (issue 59), not a string
+    with pytest.raises(ValueError, match="must be RobustCovariance\\(\\), WhiteCovariance"):
+        js.prediction_bands(TRUTH, rec, covariance="robust")
+    with pytest.raises(ValueError, match="a `covariance` array needs the `FitResult`"):
+        js.prediction_bands(TRUTH, rec, covariance=js.GivenCovariance(np.eye(2)))

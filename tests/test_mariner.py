@@ -131,7 +131,8 @@ def runs(vessel):
     """jaxship and reference trajectories of the six manoeuvres (the rudder reversed at
     the first step after the crossing, as mariner.m's zig-zag and the reference do)."""
     x0 = js.straight_run(vessel)
-    zigzag = lambda a, h: js.ZigZag(a * DEG, h * DEG, duration=800.0, dt=DT, switch_at="after")
+    zigzag = lambda a, h: js.ZigZag(a * DEG, h * DEG, duration=800.0, dt=DT,
+                                    switch_at=js.SwitchAtNextStep())
     manoeuvres = {
         "turn+35": js.Turn(35 * DEG, duration=800.0, dt=DT),
         "turn-35": js.Turn(-35 * DEG, duration=800.0, dt=DT),

@@ -100,12 +100,12 @@ def test_write_then_read_gives_the_same_numbers(tmp_path_factory, experiment, un
 @given(experiments(limit=1e308, both=True))
 def test_huge_values_round_trip_or_are_refused_in_display_units(tmp_path_factory, experiment):
     path = tmp_path_factory.mktemp("huge") / "trial.csv"
-    js.write_trial_csv(path, experiment, units="si")  # always writable in SI
+    js.write_trial_csv(path, experiment, units=js.SIUnits())  # always writable in SI
     assert js.read_trial_csv(path).channels == experiment.channels
     try:
-        js.write_trial_csv(path, experiment, units="display")
+        js.write_trial_csv(path, experiment, units=js.DisplayUnits())
     except ValueError as error:
-        assert "not finite in" in str(error) and "units='si'" in str(error)
+        assert "not finite in" in str(error) and "units=SIUnits()" in str(error)
     else:
         back = js.read_trial_csv(path)
         for key in experiment.channels:

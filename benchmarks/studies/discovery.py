@@ -196,7 +196,8 @@ def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02,
 
     # the helm reverses the rudder at the control step nearest to the crossing (10 Hz), as
     # a sampled autopilot does, not inside a step (the default)
-    zigzag = functools.partial(js.ZigZag, duration=duration, dt=0.5, switch_at="nearest")
+    zigzag = functools.partial(js.ZigZag, duration=duration, dt=0.5,
+                               switch_at=js.SwitchAtNearestStep())
     train = [one(zigzag(a * DEG, s * a * DEG),
                  f"zigzag {a}/{a} {'starboard' if s > 0 else 'port'}") for a, s in TRAIN]
     holdout = [one(js.Turn(a * DEG, duration=duration, dt=0.5), f"turn {a:+d}")

@@ -31,7 +31,7 @@ from .._models._armax_model import ARMAX_NAMES, ARMAX_ORDERS, ARMAXModel
 from ._discrete import continuous_parameters
 from ._excitation import excitation_flags
 from ._fit import AbstractEstimator
-from ._result import FitResult, Prediction, assemble_result
+from ._result import FitResult, Prediction, Validation, assemble_result
 from ._windows import as_dataset, check_data
 
 
@@ -268,8 +268,8 @@ class ARMAX(AbstractEstimator):
         line, mask = np.zeros((1, ds.num_samples)), np.zeros((1, ds.num_samples), bool)
         line[0, :n], mask[0, first:n] = y - eps, True
         return assemble_result(
-            fitted, report, ds, {"r": line}, mask, rudder=self.rudder,
-            num_params=len(ARMAX_NAMES), max_lag=self.max_lag,
+            fitted, report, ds, {"r": line}, mask,
+            validation=Validation(self.rudder, len(ARMAX_NAMES), self.max_lag),
             result=optx.RESULTS.successful if res.converged
             else optx.RESULTS.nonlinear_max_steps_reached, num_steps=res.iterations,
             cost=0.5 * float(np.sum(eps[first:] ** 2)), weights={"r": 1.0},

@@ -223,36 +223,70 @@ class _Runs:
             num_dropped=self.num_dropped, draw_coverage=draws)
 
 
+def _determined_std(report, std) -> np.ndarray:
+    """`std` as floats; `ValueError` where the fit does not determine a parameter."""
+    std = np.asarray(std, dtype=np.float64)
+    bad = [n for n, s in zip(report.names, std) if not np.isfinite(s)]
+    if bad:
+        raise ValueError(f"the fit does not determine {', '.join(bad)} (infinite standard "
+                         "error): no band from its covariance; fix them or pass "
+                         "`covariance=None`.")
+    return std
+
+
+class RobustCovariance(eqx.Module):
+    """`covariance=RobustCovariance()` (the default): parameters drawn from $N(\\hat\\theta,
+    D_r C D_r)$, the robust (HAC) standard errors $D_r$ with the fit's correlation $C$
+    (the white-noise ones where no robust ones were computed)."""
+
+    def draws(self, report, num_samples: int, rng) -> np.ndarray:
+        std = report.std if report.std_robust is None else report.std_robust
+        return normal_draws(report.values, _determined_std(report, std), report.correlation,
+                            num_samples, rng)
+
+
+class WhiteCovariance(eqx.Module):
+    """`covariance=WhiteCovariance()`: parameters drawn from the fit's usual (white-noise)
+    covariance $D C D$."""
+
+    def draws(self, report, num_samples: int, rng) -> np.ndarray:
+        return normal_draws(report.values, _determined_std(report, report.std),
+                            report.correlation, num_samples, rng)
+
+
+class GivenCovariance(eqx.Module):
+    """`covariance=GivenCovariance(matrix)`: parameters drawn from $N(\\hat\\theta,$
+    `matrix`$)$, a (d, d) covariance of the free parameters."""
+
+    matrix: np.ndarray
+
+    def draws(self, report, num_samples: int, rng) -> np.ndarray:
+        values = np.asarray(report.values, dtype=np.float64)
+        cov = np.asarray(self.matrix, dtype=np.float64)
+        if cov.shape != (values.size, values.size):
+            raise ValueError(f"`covariance` must be ({values.size}, {values.size}) for the "
+                             f"free parameters {report.names}, got {cov.shape}.")
+        return rng.multivariate_normal(values, cov, size=num_samples, method="eigh")
+
+
+COVARIANCES = (RobustCovariance, WhiteCovariance, GivenCovariance)
+
+
 def _parameter_draws(result, covariance, num_samples, rng) -> tuple[tuple, np.ndarray]:
-    """`(names, (S, d) draws)` of the free parameters of a `FitResult`; none of a model
-    taken as known."""
+    """`(names, (S, d) draws)` of the free parameters of a `FitResult` by the
+    `covariance` strategy (None: the estimates only); none of a model taken as known."""
+    if covariance is not None and not isinstance(covariance, COVARIANCES):
+        raise ValueError(f"`covariance` must be RobustCovariance(), WhiteCovariance(), "
+                         f"GivenCovariance(matrix) or None, got {covariance!r}.")
     if not isinstance(result, FitResult):
-        if covariance is not None and not isinstance(covariance, str):
+        if isinstance(covariance, GivenCovariance):
             raise ValueError("a `covariance` array needs the `FitResult` of its parameters.")
         return (), np.zeros((num_samples, 0))
     report = result.parameters
     values = np.asarray(report.values, dtype=np.float64)
     if covariance is None:
         return report.names, np.broadcast_to(values, (num_samples, values.size))
-    if isinstance(covariance, str):
-        if covariance not in ("robust", "white"):
-            raise ValueError(f"`covariance` must be 'robust', 'white', an array or None, got "
-                             f"{covariance!r}.")
-        std = report.std_robust if covariance == "robust" and report.std_robust is not None \
-            else report.std
-        std = np.asarray(std, dtype=np.float64)
-        bad = [n for n, s in zip(report.names, std) if not np.isfinite(s)]
-        if bad:
-            raise ValueError(f"the fit does not determine {', '.join(bad)} (infinite standard "
-                             "error): no band from its covariance; fix them or pass "
-                             "`covariance=None`.")
-        return report.names, normal_draws(values, std, report.correlation, num_samples, rng)
-    else:
-        cov = np.asarray(covariance, dtype=np.float64)
-        if cov.shape != (values.size, values.size):
-            raise ValueError(f"`covariance` must be ({values.size}, {values.size}) for the "
-                             f"free parameters {report.names}, got {cov.shape}.")
-    return report.names, rng.multivariate_normal(values, cov, size=num_samples, method="eigh")
+    return report.names, covariance.draws(report, num_samples, rng)
 
 
 def normal_draws(values, std, correlation, num_samples: int, rng) -> np.ndarray:
@@ -266,7 +300,9 @@ def normal_draws(values, std, correlation, num_samples: int, rng) -> np.ndarray:
 
 
 def prediction_bands(result, dataset, *, level: float = 0.9,
-                     disturbance: Disturbance = Disturbance(), covariance="robust",
+                     disturbance: Disturbance = Disturbance(),
+                     covariance: RobustCovariance | WhiteCovariance | GivenCovariance | None = (
+                         RobustCovariance()),
                      measurement_std: dict | None = None, num_samples: int = 200,
                      estimator: PredictionError = PredictionError(horizon=None),
                      seed: int = 0) -> PredictionBands:
@@ -280,8 +316,9 @@ def prediction_bands(result, dataset, *, level: float = 0.9,
       taken as known (no parameter uncertainty);
     - `dataset`: the records (`Experiment`s or a `Dataset`), replayed as `estimator`
       (a `PredictionError`: its horizon, channels, wind and holds) replays them;
-    - `covariance`: `"robust"` (default), `"white"` (the usual standard errors), a (d, d)
-      array for the free parameters, or None (the estimates only);
+    - `covariance`: how the parameters are drawn: `RobustCovariance()` (default),
+      `WhiteCovariance()` (the usual standard errors), `GivenCovariance(matrix)` (a
+      (d, d) array for the free parameters), or None (the estimates only);
     - `measurement_std`: `{channel: std}` of the sensors in SI (none by default);
     - `seed`: of the random draws (the same seed, the same bands).
 
@@ -293,7 +330,9 @@ def prediction_bands(result, dataset, *, level: float = 0.9,
                  ).bands(level, disturbance)
 
 
-def calibrate_disturbance(result, train, *, level: float = 0.9, covariance="robust",
+def calibrate_disturbance(result, train, *, level: float = 0.9,
+                          covariance: RobustCovariance | WhiteCovariance | GivenCovariance
+                          | None = RobustCovariance(),
                           measurement_std: dict | None = None, num_samples: int = 200,
                           estimator: PredictionError = PredictionError(horizon=None),
                           seed: int = 0, iterations: int = 14) -> Disturbance:

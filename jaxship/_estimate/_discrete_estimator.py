@@ -32,7 +32,7 @@ from ._discrete import (
     regressors,
 )
 from ._fit import AbstractEstimator, PredictionError
-from ._result import FitResult, Prediction, assemble_result
+from ._result import FitResult, Prediction, Validation, assemble_result
 from ._windows import as_dataset, check_data
 
 
@@ -102,8 +102,9 @@ class DiscreteResponse(AbstractEstimator):
             mask[i, order:e.t.size] = True
         r = np.asarray(ds.r, dtype=np.float64)
         return assemble_result(
-            fitted, report, ds, {"r": line}, mask, rudder=self.rudder, num_params=len(names),
-            max_lag=self.max_lag, result=optx.RESULTS.successful if res.converged
+            fitted, report, ds, {"r": line}, mask,
+            validation=Validation(self.rudder, len(names), self.max_lag),
+            result=optx.RESULTS.successful if res.converged
             else optx.RESULTS.nonlinear_max_steps_reached, num_steps=1,
             cost=0.5 * float(np.sum(((r - line) * mask) ** 2)), weights={"r": 1.0},
             window_samples=(1,), horizon=res.dt,

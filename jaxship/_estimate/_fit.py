@@ -47,7 +47,7 @@ from ._lm import (
     solve_least_squares,
     value_and_jacfwd,
 )
-from ._result import FitError, FitResult, Prediction, assemble_result
+from ._result import FitError, FitResult, Prediction, Validation, assemble_result
 from ._step import MAX_SUBSTEPS, stable_substeps
 from ._verdict import final_verdict
 from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_data, to_timeline
@@ -527,8 +527,10 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
                                 white=white, hac_lags=lags, robust_method=method)
 
     return assemble_result(
-        fitted, report, ds, predictions, hit, rudder=estimator.rudder,
-        num_params=columns.shape[0], max_lag=estimator.max_lag, result=result,
-        num_steps=num_steps, cost=cost, weights={c: float(w) for c, w in zip(channels, weights)},
-        window_samples=layout["lengths"], horizon=estimator.horizon, quiet=blown,
-        valid={c: hit & np.isfinite(line) for c, line in predictions.items()})  # blown: finite
+        fitted, report, ds, predictions, hit, validation=Validation(
+            estimator.rudder, columns.shape[0], estimator.max_lag, quiet=blown,
+            # blown up: the finite samples only
+            valid={c: hit & np.isfinite(line) for c, line in predictions.items()}),
+        result=result, num_steps=num_steps, cost=cost,
+        weights={c: float(w) for c, w in zip(channels, weights)},
+        window_samples=layout["lengths"], horizon=estimator.horizon)

@@ -25,7 +25,7 @@ from ._kalman import (
     _variance,
 )
 from ._lm import LevenbergMarquardt, solve_least_squares
-from ._result import Prediction, assemble_result
+from ._result import Prediction, Validation, assemble_result
 from ._windows import channel_weights
 
 
@@ -160,12 +160,63 @@ def _report(model, ds, channels, rudder, specs, transform, layout, rec, z, cov, 
     predictions = {name: np.where(predicted, pred[..., c], 0.0)
                    for c, name in enumerate(channels)}
     return assemble_result(
-        fitted, report, ds, predictions, predicted, rudder=rudder, num_params=int(q.shape[0]),
-        max_lag=max_lag, result=result, num_steps=steps, cost=loss,
+        fitted, report, ds, predictions, predicted,
+        validation=Validation(rudder, int(q.shape[0]), max_lag), result=result,
+        num_steps=steps, cost=loss,
         weights=dict(zip(channels, channel_weights(ds, channels, None).tolist())),
         window_samples=(1,) * ds.num_experiments, horizon=float(np.min(ds.dt)),
         criterion=criterion, noise={n: float(v) for n, v in zip(layout.names, var)},
         noise_std={n: float(v * s) for n, v, s in zip(layout.names, var, log_std)})
+
+
+class ProcessNoise(eqx.Module):
+    """Where the process noise of an innovations fit enters: `rudder` (default True) a
+    rudder-equivalent disturbance held over each interval (entry `"rudder"`), and
+    `states`, names of the model's states (or `"psi"`), a diagonal $Q$ entry each
+    (entries `"Q_<state>"`)."""
+
+    rudder: bool = True
+    states: tuple[str, ...] = ()
+
+    def entries(self, model) -> tuple[tuple[str, ...], tuple[int, ...]]:
+        """`(names, state index)` of the noise entries (-1: the rudder)."""
+        names = _augmented_names(model)
+        if not self.rudder and not self.states:
+            raise ValueError("`ProcessNoise` is empty: the rudder or states of the model.")
+        for p in self.states:
+            if p not in names:
+                raise ValueError(f"`ProcessNoise` names {p!r}, which is not a state of "
+                                 f"{type(model).__name__} ({', '.join(names)}).")
+        rudder = ("rudder",) if self.rudder else ()
+        return (rudder + tuple(f"Q_{p}" for p in self.states),
+                (-1,) * len(rudder) + tuple(names.index(p) for p in self.states))
+
+
+class EstimatedNoise(eqx.Module):
+    """`Innovations(noise=EstimatedNoise())` (the default): every noise variance is
+    estimated with the model."""
+
+    def held(self) -> dict:
+        """The variances held fixed: none."""
+        return {}
+
+    def given(self, estimated: dict) -> "HeldNoise":
+        """The noise a predictor uses after a fit that `estimated` these variances."""
+        return HeldNoise(dict(estimated))
+
+
+class HeldNoise(eqx.Module):
+    """`Innovations(noise=HeldNoise({name: variance}))`: these variances held fixed (names
+    `"rudder"`, `"Q_<state>"` and the channels), the others estimated; a predictor
+    needs every one (`HeldNoise(fit.noise)`)."""
+
+    variances: dict
+
+    def held(self) -> dict:
+        return dict(self.variances)
+
+    def given(self, estimated: dict) -> "HeldNoise":
+        return self
 
 
 def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
@@ -173,17 +224,13 @@ def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
     Entry names: `"rudder"`, `"Q_<state>"` for process noise on a state, and the
     channels `"psi"`, `"r"` for the measurement noise."""
     names = _augmented_names(model)
-    if isinstance(process, str):
-        process = (process,)
-    process = tuple(process)
-    if not process:
-        raise ValueError("`process` is empty: name 'rudder' or states of the model.")
-    for p in process:
-        if p != "rudder" and p not in names:
-            raise ValueError(f"`process` names {p!r}, which is neither 'rudder' nor a state "
-                             f"of {type(model).__name__} ({', '.join(names)}).")
-    entries = tuple(p if p == "rudder" else f"Q_{p}" for p in process) + channels
-    index = tuple(-1 if p == "rudder" else names.index(p) for p in process)
+    if not isinstance(process, ProcessNoise):
+        raise ValueError(f"`process` must be a ProcessNoise, got {process!r}.")
+    if not isinstance(noise, (EstimatedNoise, HeldNoise)):
+        raise ValueError(f"`noise` must be EstimatedNoise() or HeldNoise(variances), got "
+                         f"{noise!r}.")
+    process_entries, index = process.entries(model)
+    entries = process_entries + channels
     index = index + (-2,) * len(channels)
     # default start values: 10 % of the spread of each channel, 0.5 deg of rudder,
     # 1 % of the spread of the yaw rate (heading for psi) per sample on a state
@@ -196,14 +243,8 @@ def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
     default = {"rudder": math.radians(0.5) ** 2}
     default.update({c: (0.1 * spread[c]) ** 2 for c in channels})
     default.update({f"Q_{p}": (0.01 * spread["psi" if p == "psi" else "r"]) ** 2
-                    for p in process if p != "rudder"})
-    if isinstance(noise, str) and noise == "estimate":
-        fixed_values = {}
-    elif isinstance(noise, dict):
-        fixed_values = dict(noise)
-    else:
-        raise ValueError(f"`noise` must be 'estimate' or a dict of fixed variances, got "
-                         f"{noise!r}.")
+                    for p in process.states})
+    fixed_values = noise.held()
     starts = dict(noise_start or {})
     for what, given in (("noise", fixed_values), ("noise_start", starts)):
         for k in given:
@@ -220,7 +261,7 @@ def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
             raise ValueError(f"noise variance of {e!r} must be positive, got {v}.")
         values.append(math.log(v))
         estimated.append(e not in fixed_values)
-    estimated = criterion.held_noise(estimated, first_channel=len(process))
+    estimated = criterion.held_noise(estimated, first_channel=len(process_entries))
     layout = _Noise(names=entries, estimated=tuple(estimated),
                     fixed=jnp.asarray(values), state_index=index, num_states=len(names))
     z = np.array([v for v, est in zip(values, estimated) if est])
@@ -228,7 +269,7 @@ def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
 
 
 def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_CHANNELS,
-           criterion=None, process="rudder", noise="estimate", noise_start=None,
+           criterion=None, process=ProcessNoise(), noise=EstimatedNoise(), noise_start=None,
            rudder: str = "delta", substeps: int = 1, max_steps: int = 512,
            solver=None, hold=None) -> FitResult:
     """Estimate a steering model with its noise by the Kalman filter's innovations.
@@ -248,11 +289,12 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
       Levenberg-Marquardt and forward-mode Jacobians; the noise variances set the
       filter gain and are estimated as well, except the first channel's, which fixes
       the scale (the innovations are invariant to it); standard errors as `fit`.
-    - `process`: where the process noise enters: `"rudder"` (default; a rudder-equivalent
-      disturbance held over each interval) and/or names of the model's states or
-      `"psi"` (a diagonal $Q$ entry each, named `"Q_<state>"` in `noise`).
-    - `noise`: `"estimate"` (default) or a dict `{name: variance}` of values to hold
-      fixed (names `"rudder"`, `"Q_<state>"` and the channels; the others are estimated).
+    - `process`: where the process noise enters: a `ProcessNoise` (default: the rudder;
+      a rudder-equivalent disturbance held over each interval; `states=`: names of the
+      model's states or `"psi"`, a diagonal $Q$ entry each, named `"Q_<state>"`).
+    - `noise`: `EstimatedNoise()` (default) or `HeldNoise({name: variance})`, values to
+      hold fixed (names `"rudder"`, `"Q_<state>"` and the channels; the others are
+      estimated).
     - `noise_start`: dict of start variances (default: 10 % of each channel's spread
       for R, (0.5 deg)^2 for the rudder, 1 % of the spread on states).
     - `rudder`, `substeps`: as `PredictionError`.
@@ -366,8 +408,8 @@ class Innovations(AbstractEstimator):
 
     criterion: MaximumLikelihood | InnovationsLeastSquares = MaximumLikelihood()
     channels: tuple[str, ...] = KALMAN_CHANNELS
-    process: str | tuple = "rudder"
-    noise: str | dict = "estimate"
+    process: ProcessNoise = ProcessNoise()
+    noise: EstimatedNoise | HeldNoise = EstimatedNoise()
     noise_start: dict | None = None
     rudder: str = "delta"
     substeps: int = 1
@@ -384,7 +426,8 @@ class Innovations(AbstractEstimator):
 
     def predict(self, model, dataset) -> Prediction:
         """The filter's one-step-ahead predictions with the noise variances `noise`
-        (every entry given, e.g. `Innovations(noise=fit.noise)`; `jaxship.predict` of a
+        (every entry given, e.g. `Innovations(noise=HeldNoise(fit.noise))`; `jaxship.predict`
+        of a
         `FitResult` takes them from it)."""
         ds, channels = _check_inputs(model, dataset, self.channels, self.rudder,
                                      self.substeps, vessels=False)
@@ -394,7 +437,7 @@ class Innovations(AbstractEstimator):
         if missing:
             raise ValueError(f"the innovations predictor needs every noise variance; "
                              f"missing {', '.join(missing)} (pass `Innovations(noise="
-                             "fit.noise)` or predict from the FitResult).")
+                             "HeldNoise(fit.noise))` or predict from the FitResult).")
         rec = _records(ds, channels, self.rudder, self.substeps, self.hold)
         _, pred = _innovations(jnp.zeros(0), as_arrays(model), Transform.from_specs(()),
                                layout, rec)

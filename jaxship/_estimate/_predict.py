@@ -30,8 +30,7 @@ def predict(model, dataset, *, estimator: AbstractEstimator = PredictionError()
                          f"Innovations, ARMAX, DiscreteResponse), got "
                          f"{type(estimator).__name__}.")
     if isinstance(model, FitResult):
-        if (isinstance(estimator, Innovations) and isinstance(estimator.noise, str)
-                and model.noise is not None):
-            estimator = dataclasses.replace(estimator, noise=dict(model.noise))
+        if isinstance(estimator, Innovations) and model.noise is not None:
+            estimator = dataclasses.replace(estimator, noise=estimator.noise.given(model.noise))
         model = model.model
     return estimator.predict(model, dataset)

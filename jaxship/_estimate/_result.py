@@ -154,36 +154,46 @@ def _field_names(model):
     return tuple(parameter_fields(model))
 
 
-def assemble_result(model, parameters, ds, predictions: dict, predicted, *, rudder: str,
-                    num_params: int, max_lag: int, result, num_steps, cost, weights: dict,
-                    window_samples, horizon, criterion: str = "prediction error",
-                    noise: dict | None = None, noise_std: dict | None = None,
-                    valid: dict | None = None, quiet: bool = False) -> FitResult:
+@dataclasses.dataclass(frozen=True)
+class Validation:
+    """How `assemble_result` validates the predictions (`validate`): the rudder channel
+    `rudder` (for the residual-input correlation), the number of estimated values
+    `num_params` (FPE), `max_lag`; `valid` `{channel: mask}` where only some predicted
+    samples count (e.g. the finite ones of a simulation that blew up); `quiet`:
+    floating-point warnings silenced (nothing of a blown-up fit means anything)."""
+
+    rudder: str
+    num_params: int
+    max_lag: int
+    valid: dict | None = None
+    quiet: bool = False
+
+
+def assemble_result(model, parameters, ds, predictions: dict, predicted, *,
+                    validation: Validation, **stored) -> FitResult:
     """The one place a `FitResult` is built (every estimator's `fit` ends here): each
     channel of `predictions` `{channel: (E, N)}` validated against its measurement in the
-    dataset `ds` (`validate`, with `num_params`, the rudder channel `rudder` for the
-    residual-input correlation and `max_lag`), and the experiment names from `ds`.
+    dataset `ds` as `validation` says, and the experiment names from `ds`.
 
     - `parameters`: the `ParameterReport`, or a callable of the metrics `{channel:
       ValidationReport}` returning it (a report whose robust standard errors depend on
       the residuals' whiteness);
     - `predicted`: the (E, N) mask of predicted samples, the validation mask of every
-      channel unless `valid` `{channel: mask}` says otherwise (e.g. only the finite
-      samples of a simulation that blew up); `quiet`: floating-point warnings silenced
-      in the validation (nothing of a blown-up fit means anything);
-    - the rest is stored as given (see `FitResult`)."""
-    with np.errstate(all="ignore") if quiet else contextlib.nullcontext():
-        metrics = _validate_channels(ds, predictions, predicted, valid, rudder=rudder,
-                                     num_params=num_params, max_lag=max_lag)
+      channel unless `validation.valid` says otherwise;
+    - `stored`: the other fields of `FitResult` (`result`, `num_steps`, `cost`,
+      `weights`, `window_samples`, `horizon`, `criterion`, `noise`, `noise_std`), stored
+      as given."""
+    v = validation
+    with np.errstate(all="ignore") if v.quiet else contextlib.nullcontext():
+        metrics = _validate_channels(ds, predictions, predicted, v.valid, rudder=v.rudder,
+                                     num_params=v.num_params, max_lag=v.max_lag)
     if callable(parameters):
         parameters = parameters(metrics)
-    return FitResult(
-        model=model, parameters=parameters, metrics=metrics, predictions=predictions,
-        predicted=predicted, result=result, num_steps=int(num_steps), cost=float(cost),
-        weights=weights, window_samples=tuple(window_samples), horizon=horizon,
-        experiment_names=tuple(ds.names), criterion=criterion, noise=noise,
-        noise_std=noise_std,
-    )
+    stored |= dict(num_steps=int(stored["num_steps"]), cost=float(stored["cost"]),
+                   window_samples=tuple(stored["window_samples"]))
+    return FitResult(model=model, parameters=parameters, metrics=metrics,
+                     predictions=predictions, predicted=predicted,
+                     experiment_names=tuple(ds.names), **stored)
 
 
 def _validate_channels(ds, predictions: dict, predicted, valid=None, *, rudder: str,

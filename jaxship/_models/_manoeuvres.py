@@ -132,21 +132,98 @@ class Turn(AbstractTrial):
         return self.angle * _step(tau, self.execute), memory
 
 
+class SwitchAtCrossing(eqx.Module):
+    """`ZigZag(switch_at=SwitchAtCrossing())` (the default): the rudder is reversed at the
+    crossing itself, the time in the control step where the heading change extrapolated
+    over the step, $\\Delta\\psi + r\\tau + \\dot r\\tau^2/2 = \\pm\\psi_s$, reaches
+    the switch angle; the step is integrated in two parts (`Switched`), so the overshoots
+    do not depend on the control step."""
+
+    def memory(self, side, x0):
+        """The side and the yaw rate of the last step (for $\\dot r$)."""
+        return side, x0.r
+
+    def sampled(self):
+        """The rule where the rudder moves once per control step: the nearest step."""
+        return SwitchAtNearestStep()
+
+    def command(self, zigzag, sampled, t, state, memory, h):
+        """A `Switched` command at the crossing (`sampled`, the trial's per-step command,
+        is not used)."""
+        n0, psi0, (side, r_last) = memory
+        tau = t - zigzag.start
+        a = state.psi - psi0 - side * zigzag.heading
+        b, c = state.r, 0.5 * (state.r - r_last) / h
+        crossed = (side * (a + b * h + c * h * h) >= 0) & (tau >= zigzag.execute)
+        disc = b * b - 4 * a * c  # the root of a + b s + c s^2 nearest zero, stable as c -> 0
+        root = jnp.where(disc > 0, jnp.sqrt(jnp.where(disc > 0, disc, 1.0)), 0.0)
+        q = b + jnp.where(b >= 0, 1.0, -1.0) * root
+        at = jnp.clip(-2 * a / jnp.where(q == 0, 1.0, q), 0.0, h)
+        new = jnp.where(crossed, -side, side)
+        n = n0 if zigzag.n is None else zigzag.n
+        size = jnp.abs(zigzag.angle) * _step(tau, zigzag.execute)
+        switched = Switched(Command(side * size, n), Command(new * size, n),
+                            jnp.where(crossed, at, h))
+        return switched, (n0, psi0, (new, state.r))
+
+    def lookahead(self, h, r):
+        return 0.0 * r
+
+
+class SwitchAtNearestStep(eqx.Module):
+    """`ZigZag(switch_at=SwitchAtNearestStep())`: the rudder is reversed at the control step
+    nearest to the crossing (within half a step): the heading change half a step ahead,
+    $\\Delta\\psi + r h/2$, is compared with the switch angle."""
+
+    def memory(self, side, x0):
+        return side
+
+    def sampled(self):
+        return self
+
+    def command(self, zigzag, sampled, t, state, memory, h):
+        """The trial's per-step command `sampled()`."""
+        return sampled()
+
+    def lookahead(self, h, r):
+        """The heading change half a control step ahead."""
+        return 0.5 * h * r
+
+
+class SwitchAtNextStep(eqx.Module):
+    """`ZigZag(switch_at=SwitchAtNextStep())`: the rudder is reversed at the first control
+    step after the crossing (as MSS `zigzag.m` and sampled-logic implementations do, late
+    by up to one step)."""
+
+    def memory(self, side, x0):
+        return side
+
+    def sampled(self):
+        return self
+
+    def command(self, zigzag, sampled, t, state, memory, h):
+        """The trial's per-step command `sampled()`."""
+        return sampled()
+
+    def lookahead(self, h, r):
+        return 0.0 * r
+
+
+SWITCHES = (SwitchAtCrossing, SwitchAtNearestStep, SwitchAtNextStep)
+
+
 class ZigZag(AbstractTrial):
     """Kempf zig-zag `angle`/`heading` (IMO MSC.137(76) 4.2.7; ITTC 2.2.2).
 
     The rudder goes to `angle` at `execute` (negative `angle`: port first) and is
     reversed whenever the heading change from the initial heading passes
-    `heading` on the side the rudder is turning the ship to: at the crossing itself
-    (`switch_at="exact"`, the default: the time in the control step where the heading
-    change extrapolated over the step reaches it; the step is integrated in two parts,
-    so that the overshoots do not depend on the control step), at the control step
-    nearest to it (`"nearest"`, within half a step) or at the first control step after
-    it (`"after"`, as MSS `zigzag.m` and sampled-logic implementations do, late by up
-    to one step). A steering model's rudder moves once per control step, so `"exact"`
-    acts there as `"nearest"`. `rudder_rate` [rad/s]: the steering gear's rate limit
-    for the trial (a vessel's servo rate too applies, the smaller wins; None: the
-    servo's alone).
+    `heading` on the side the rudder is turning the ship to, as `switch_at` says: at the
+    crossing itself (`SwitchAtCrossing()`, the default), at the control step nearest to
+    it (`SwitchAtNearestStep()`) or at the first control step after it
+    (`SwitchAtNextStep()`). A steering model's rudder moves once per control step, so
+    the crossing acts there as the nearest step. `rudder_rate` [rad/s]: the steering
+    gear's rate limit for the trial (a vessel's servo rate too applies, the smaller
+    wins; None: the servo's alone).
     """
 
     angle: ArrayLike  # delta_0 [rad], sign gives the first side
@@ -157,45 +234,29 @@ class ZigZag(AbstractTrial):
     start: ArrayLike = 0.0
     n: ArrayLike | None = None
     num_samples: int | None = eqx.field(static=True, default=None)
-    switch_at: str = eqx.field(static=True, default="exact")
+    switch_at: SwitchAtCrossing | SwitchAtNearestStep | SwitchAtNextStep = eqx.field(
+        static=True, default=SwitchAtCrossing())
     rudder_rate: ArrayLike | None = None  # |d delta/dt| limit [rad/s]; None: none
 
     def __check_init__(self):
-        if self.switch_at not in ("exact", "nearest", "after"):
-            raise ValueError(f"`switch_at` must be 'exact', 'nearest' or 'after', got "
-                             f"{self.switch_at!r}.")
+        if not isinstance(self.switch_at, SWITCHES):
+            raise ValueError(f"`switch_at` must be SwitchAtCrossing(), SwitchAtNearestStep() "
+                             f"or SwitchAtNextStep(), got {self.switch_at!r}.")
         _check_rate(self.rudder_rate)
 
     def init_memory(self, x0):
         side = jnp.sign(jnp.asarray(self.angle, dtype=float))
-        return (side, x0.r) if self.switch_at == "exact" else side
+        return self.switch_at.memory(side, x0)
 
     def command(self, t, state, memory, h):
-        """The command for the control step `[t, t + h]`: with `switch_at="exact"` a
-        `Switched` one where the heading change, extrapolated over the step with the yaw
-        rate and its change since the last step, $\\Delta\\psi + r\\tau +
-        \\dot r\\tau^2/2 = \\pm\\psi_s$, crosses the switch angle."""
-        if self.switch_at != "exact":
-            return super().command(t, state, memory, h)
-        n0, psi0, (side, r_last) = memory
-        tau = t - self.start
-        a, b, c = state.psi - psi0 - side * self.heading, state.r, 0.5 * (state.r - r_last) / h
-        crossed = (side * (a + b * h + c * h * h) >= 0) & (tau >= self.execute)
-        disc = b * b - 4 * a * c  # the root of a + b s + c s^2 nearest zero, stable as c -> 0
-        root = jnp.where(disc > 0, jnp.sqrt(jnp.where(disc > 0, disc, 1.0)), 0.0)
-        q = b + jnp.where(b >= 0, 1.0, -1.0) * root
-        at = jnp.clip(-2 * a / jnp.where(q == 0, 1.0, q), 0.0, h)
-        new = jnp.where(crossed, -side, side)
-        n = n0 if self.n is None else self.n
-        size = jnp.abs(self.angle) * _step(tau, self.execute)
-        switched = Switched(Command(side * size, n), Command(new * size, n),
-                            jnp.where(crossed, at, h))
-        return switched, (n0, psi0, (new, state.r))
+        """The command for the control step `[t, t + h]`, as the `switch_at` rule gives it
+        (the trial's per-step command, or one switched inside the step)."""
+        sampled = lambda: super(ZigZag, self).command(t, state, memory, h)
+        return self.switch_at.command(self, sampled, t, state, memory, h)
 
     def rudder(self, tau, state, psi0, side, h):
         change = state.psi - psi0
-        if self.switch_at == "nearest":  # the heading change half a control step ahead
-            change = change + 0.5 * h * state.r
+        change = change + self.switch_at.lookahead(h, state.r)
         side = jnp.where((side > 0) & (change >= self.heading), -1.0, side)
         side = jnp.where((side < 0) & (change <= -self.heading), 1.0, side)
         side = jnp.where(tau >= self.execute, side, jnp.sign(self.angle))

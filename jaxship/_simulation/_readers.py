@@ -35,6 +35,7 @@ import math
 import re
 from pathlib import Path
 
+import equinox as eqx
 import numpy as np
 
 from .._foundation._state import Trajectory
@@ -392,11 +393,29 @@ def _check_plausible(path, header, key, unit, si, lines):
                      f"(at most {scale(limit):.4g} {shown or unit}){hint}")
 
 
-def write_trial_csv(path, data, units: str = "display") -> None:
+class DisplayUnits(eqx.Module):
+    """`write_trial_csv(units=DisplayUnits())` (the default): angles in degrees, rates in
+    deg/s, shaft speed in rpm (times in s, lengths in m, speeds in m/s)."""
+
+    def unit(self, si: str) -> str:
+        """The unit a quantity measured in the SI unit `si` is written in."""
+        return _DISPLAY_UNITS.get(si, si)
+
+
+class SIUnits(eqx.Module):
+    """`write_trial_csv(units=SIUnits())`: every quantity in its SI unit (rad, rad/s,
+    rev/s, s, m, m/s)."""
+
+    def unit(self, si: str) -> str:
+        """The unit a quantity measured in the SI unit `si` is written in: `si`."""
+        return si
+
+
+def write_trial_csv(path, data, units: DisplayUnits | SIUnits = DisplayUnits()) -> None:
     """Write an `Experiment` or an unbatched `jaxship.Trajectory` as a trial CSV.
 
-    `units="display"`: degrees, deg/s and rpm; `units="si"`: radians, rad/s and rev/s
-    (times in s, lengths in m and speeds in m/s either way). Values are written with
+    `units`: `DisplayUnits()` (degrees, deg/s and rpm) or `SIUnits()` (radians, rad/s and
+    rev/s; times in s, lengths in m and speeds in m/s either way). Values are written with
     `repr`, the shortest text that reads back to the same float, so a write-read round
     trip is exact up to the unit conversion (a few ulp for degrees and rpm). A value
     too large to write in display units (above about 3e306 rad) is a `ValueError`.
@@ -405,8 +424,8 @@ def write_trial_csv(path, data, units: str = "display") -> None:
     not, so reading back recomputes them identically); a trajectory's valid samples are
     written with t, delta, delta_c (`command.delta`), psi, r, u, v, x, y and n.
     """
-    if units not in ("display", "si"):
-        raise ValueError(f"`units` must be 'display' or 'si', got {units!r}.")
+    if not isinstance(units, (DisplayUnits, SIUnits)):
+        raise ValueError(f"`units` must be DisplayUnits() or SIUnits(), got {units!r}.")
     if isinstance(data, Trajectory):
         data = Experiment.from_trajectory(data)
     elif not isinstance(data, Experiment):
@@ -417,7 +436,7 @@ def write_trial_csv(path, data, units: str = "display") -> None:
     unit_of = {}
     for key in keys:
         si = next(u for u, f in _UNITS[key].items() if f == 1.0)
-        unit_of[key] = _DISPLAY_UNITS.get(si, si) if units == "display" else si
+        unit_of[key] = units.unit(si)
     with np.errstate(over="ignore"):  # an overflow is the error below, not a warning
         columns = [_from_si(np.asarray(getattr(data, k), dtype=np.float64), unit_of[k])
                    for k in keys]
@@ -426,7 +445,7 @@ def write_trial_csv(path, data, units: str = "display") -> None:
         if bad.size:  # finite in SI (an Experiment is) but too large in display units
             raise ValueError(
                 f"channel {key!r} sample {bad[0]} is {float(getattr(data, key)[bad[0]])!r} in SI, "
-                f"which is not finite in {unit_of[key]}; write it with units='si'."
+                f"which is not finite in {unit_of[key]}; write it with units=SIUnits()."
             )
     with open(path, "w", newline="", encoding="utf-8") as f:
         writer = csv.writer(f, lineterminator="\n")

@@ -101,13 +101,14 @@ def replay_records(manoeuvre: Replay, aux: AuxInputs | None) -> tuple[dict, dict
     return records, dict.fromkeys(records, manoeuvre.delta_hold)
 
 
-def steering_trajectory(manoeuvre, psi, r, internal, delta, ordered, result, *, u=None, v=None,
-                        n=None) -> Trajectory:
+def steering_trajectory(manoeuvre, psi, r, internal, delta, ordered, result,
+                        aux: dict | None = None) -> Trajectory:
     """A steering model's `Trajectory`: heading, yaw rate, actual and ordered rudder and
-    the model state at the samples; the aux inputs `u`, `v`, `n` (zeros where None);
-    no track (x = y = 0)."""
+    the model state at the samples; the aux inputs `aux` `{"u", "v", "n"}` (zeros where
+    None); no track (x = y = 0)."""
     zero = jnp.zeros_like(psi)
-    u, v, n = (zero if a is None else a for a in (u, v, n))
+    aux = {} if aux is None else aux
+    u, v, n = (aux.get(k, zero) for k in ("u", "v", "n"))
     dt = jnp.asarray(manoeuvre.dt, float)
     t = manoeuvre.start + dt * jnp.arange(psi.shape[0])
     return Trajectory(
@@ -131,8 +132,8 @@ def _replay(model, manoeuvre, x0, aux, simulator, steps):
     first = lambda a0, a: jnp.concatenate([jnp.asarray(a0)[None], a])
     return steering_trajectory(manoeuvre, first(psi0, psi), first(model.output(state0), r),
                                jnp.concatenate([state0[None], states]), records["delta"],
-                               records["delta"], result, u=records["u"], v=records["v"],
-                               n=records["n"])
+                               records["delta"], result,
+                               {k: records[k] for k in ("u", "v", "n")})
 
 
 @eqx.filter_jit
@@ -140,8 +141,8 @@ def _steer(model, manoeuvre, x0, simulator, steps):
     """The jitted body of a steering model through a closed-loop manoeuvre: the rudder
     moves towards the order by at most `manoeuvre.rudder_rate * h` per control step
     (so a zig-zag reverses it at the step nearest to the crossing)."""
-    if isinstance(manoeuvre, ZigZag) and manoeuvre.switch_at == "exact":
-        manoeuvre = dataclasses.replace(manoeuvre, switch_at="nearest")
+    if isinstance(manoeuvre, ZigZag):
+        manoeuvre = dataclasses.replace(manoeuvre, switch_at=manoeuvre.switch_at.sampled())
     dt = jnp.asarray(manoeuvre.dt, float)
     psi0 = x0.psi
     zero = jnp.zeros_like(psi0)

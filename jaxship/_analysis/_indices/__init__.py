@@ -34,6 +34,8 @@ from .spiral import (
 )
 from .turning import (
     InitialTurningIndices as InitialTurningIndices,
+    SteadyFromCircle as SteadyFromCircle,
+    SteadyFromRate as SteadyFromRate,
     TurningIndices as TurningIndices,
     ZigZagIndices as ZigZagIndices,
     initial_turning_indices as initial_turning_indices,

@@ -2,6 +2,7 @@
 
 import dataclasses
 
+import equinox as eqx
 import numpy as np
 
 from ._series import (
@@ -59,18 +60,51 @@ def _fit_circle(x, y):
     return cx, cy, float(np.sqrt(sol[2] + cx**2 + cy**2))
 
 
+class SteadyFromRate(eqx.Module):
+    """`turning_indices(steady=SteadyFromRate())`: the steady diameter $D = 2U/|r|$ and
+    speed from the last sample (needs `u, v, r`)."""
+
+    name = "rate"  # `TurningIndices.steady_method`
+
+    def diameter_and_speed(self, s, h, side, speed, reached) -> tuple[float, float]:
+        s.need("u", "v", "r", what="steady=SteadyFromRate()")
+        u_end, r_end = float(speed[-1]), float(s.r[-1])
+        if r_end * side <= 0:
+            raise ValueError("the yaw rate at the last sample is not turning the ship.")
+        return 2 * u_end / abs(r_end), u_end
+
+
+class SteadyFromCircle(eqx.Module):
+    """`turning_indices(steady=SteadyFromCircle())`: the steady diameter of a least-squares
+    circle through the track over the last 360 deg of heading change and the mean track
+    speed over it."""
+
+    name = "circle"  # `TurningIndices.steady_method`
+
+    def diameter_and_speed(self, s, h, side, speed, reached) -> tuple[float, float]:
+        last = h >= h[-1] - 2 * np.pi
+        if h[-1] - 2 * np.pi < 0 or np.count_nonzero(last) < 4:
+            raise ValueError("steady=SteadyFromCircle() needs a full 360 deg turn after the "
+                             f"order, got {reached:.1f} deg.")
+        _, _, radius = _fit_circle(s.x[last], s.y[last])
+        i0 = np.nonzero(last)[0][0]
+        path = _path_length(s.t, s.x, s.y)
+        return 2 * radius, float((path[-1] - path[i0]) / (s.t[-1] - s.t[i0]))
+
+
 @_docstring
-def turning_indices(traj=None, *, execute_time=None, steady="auto", **arrays) -> TurningIndices:
+def turning_indices(traj=None, *, execute_time=None,
+                    steady: SteadyFromRate | SteadyFromCircle | None = None,
+                    **arrays) -> TurningIndices:
     """Advance, transfer, tactical and steady diameters, speed loss and times of a turn.
 
     {arrays}
 
     - `execute_time`: time of the rudder order [s]; by default the first sample at which
       the rudder order leaves the initial (actual) rudder angle.
-    - `steady`: `"rate"`: steady diameter $D = 2U/|r|$ and speed from the last sample
-      (needs `u, v, r`); `"circle"`: least-squares circle through the track over the
-      last 360 deg of heading change and the mean track speed over it; `"auto"`: `"rate"`
-      when `u, v, r` are known.
+    - `steady`: how the steady diameter and speed are found: `SteadyFromRate()` (from the
+      last sample's $U$ and $r$), `SteadyFromCircle()` (a circle through the track's last
+      turn); None (default): from the rate when `u, v, r` are known, else the circle.
 
     Port and starboard turns are treated alike: distances to the turning side and heading
     changes are magnitudes. Raises `ValueError` if the heading never changes 180 deg.
@@ -93,27 +127,13 @@ def turning_indices(traj=None, *, execute_time=None, steady="auto", **arrays) ->
         )
     speed = s.speed()
     u0 = float(np.interp(t_e, s.t, speed))
-    if steady == "auto":
-        steady = "rate" if all(a is not None for a in (s.u, s.v, s.r)) else "circle"
-    if steady == "rate":
-        s.need("u", "v", "r", what='steady="rate"')
-        u_end, r_end = float(speed[-1]), float(s.r[-1])
-        if r_end * side <= 0:
-            raise ValueError("the yaw rate at the last sample is not turning the ship.")
-        diameter = 2 * u_end / abs(r_end)
-    elif steady == "circle":
-        last = h >= h[-1] - 2 * np.pi
-        if h[-1] - 2 * np.pi < 0 or np.count_nonzero(last) < 4:
-            raise ValueError(
-                f'steady="circle" needs a full 360 deg turn after the order, got {reached:.1f} deg.'
-            )
-        _, _, radius = _fit_circle(s.x[last], s.y[last])
-        diameter = 2 * radius
-        i0 = np.nonzero(last)[0][0]
-        u_end = float((_path_length(s.t, s.x, s.y)[-1] - _path_length(s.t, s.x, s.y)[i0])
-                      / (s.t[-1] - s.t[i0]))
-    else:
-        raise ValueError(f"`steady` must be 'auto', 'rate' or 'circle', got {steady!r}.")
+    if steady is None:
+        known = all(a is not None for a in (s.u, s.v, s.r))
+        steady = SteadyFromRate() if known else SteadyFromCircle()
+    if not isinstance(steady, (SteadyFromRate, SteadyFromCircle)):
+        raise ValueError(f"`steady` must be SteadyFromRate(), SteadyFromCircle() or None, got "
+                         f"{steady!r}.")
+    diameter, u_end = steady.diameter_and_speed(s, h, side, speed, reached)
     return TurningIndices(
         advance=float(np.interp(t90, s.t, along)),
         transfer=float(side * np.interp(t90, s.t, athwart)),
@@ -121,7 +141,7 @@ def turning_indices(traj=None, *, execute_time=None, steady="auto", **arrays) ->
         steady_turning_diameter=float(diameter),
         speed_loss=1.0 - u_end / u0,
         time_to_90=t90 - t_e, time_to_180=t180 - t_e, execute_time=t_e, side=side,
-        steady_method=steady,
+        steady_method=steady.name,
     )
 
 
