@@ -45,6 +45,8 @@ from ._estimate._bands import (
 from ._estimate._discrete import fit_discrete_response as fit_discrete_response
 from ._estimate._discrete_estimator import (
     DiscreteResponse as DiscreteResponse,
+    EulerDiscretisation as EulerDiscretisation,
+    ExactDiscretisation as ExactDiscretisation,
     LeastSquaresRegression as LeastSquaresRegression,
     SupportVectorRegression as SupportVectorRegression,
 )

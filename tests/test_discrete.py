@@ -16,6 +16,9 @@ from jaxship._estimate._discrete import (
 )
 
 
+EXACT, EULER = js.ExactDiscretisation(), js.EulerDiscretisation()
+
+
 ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
 
 
@@ -34,9 +37,9 @@ def _rudder(n=3000, seed=0):
 
 
 def _record(structure, how=None):
-    how = how or ("zoh" if structure.startswith("linear") else "euler")
+    how = how or (EXACT if structure.startswith("linear") else EULER)
     c = discretise(structure, CASES[structure], H, discretisation=how)
-    model = DiscreteResponseFit(structure, "ls", how, H, c, {}, 0.0, 0)
+    model = DiscreteResponseFit(structure, js.LeastSquaresRegression(), how, H, c, {}, 0.0, 0)
     d = _rudder()
     return c, Experiment(np.arange(d.size) * H, d, r=model.simulate(d))
 
@@ -53,8 +56,8 @@ def test_ls_exact_recovery(structure):
 
 @pytest.mark.parametrize("structure", ["linear1", "linear2"])
 def test_euler_linear_roundtrip(structure):
-    c, e = _record(structure, "euler")
-    f = fit_discrete_response(structure, e, discretisation="euler")
+    c, e = _record(structure, EULER)
+    f = fit_discrete_response(structure, e, discretisation=EULER)
     for k, v in CASES[structure].items():
         assert f.parameters[k] == pytest.approx(v, rel=1e-6)
 
@@ -79,14 +82,14 @@ def test_zoh_matches_continuous_models():
         c = discretise(structure, params, H)
         r = np.asarray(js.simulate(model, js.Replay(d, dt=H, delta_hold=ZOH),
                                    simulator=per_sample(40)).state.r)
-        sim = DiscreteResponseFit(structure, js.LeastSquaresRegression(), "zoh", H, c, {}, 0.0,
+        sim = DiscreteResponseFit(structure, js.LeastSquaresRegression(), EXACT, H, c, {}, 0.0,
                                   0).simulate(d)
         assert np.max(np.abs(sim - r)) < 1e-9 * np.max(np.abs(r))
 
 
 def test_to_steering_nonlinear1_matches_norrbin():
     p = continuous_parameters("nonlinear1", discretise("nonlinear1", CASES["nonlinear1"], H), H)
-    f = DiscreteResponseFit("nonlinear1", "ls", "euler", H, {}, p, 0.0, 0)
+    f = DiscreteResponseFit("nonlinear1", js.LeastSquaresRegression(), EULER, H, {}, p, 0.0, 0)
     m = f.to_steering()
     assert m.K == pytest.approx(0.1) and m.T == pytest.approx(20.0)
     assert m.n3 == pytest.approx(600.0) and m.n0 == pytest.approx(-0.001)
@@ -117,7 +120,9 @@ def test_bad_inputs():
     with pytest.raises(ValueError, match="method"):
         fit_discrete_response("linear1", e, method="svr")
     with pytest.raises(ValueError, match="zero-order-hold"):
-        fit_discrete_response("nonlinear1", e, discretisation="zoh")
+        fit_discrete_response("nonlinear1", e, discretisation=EXACT)
+    with pytest.raises(ValueError, match="ExactDiscretisation\\(\\) or EulerDiscretisation"):
+        fit_discrete_response("linear1", e, discretisation="zoh")
     with pytest.raises(ValueError, match="Experiment"):
         fit_discrete_response("linear1", np.zeros(10))
     const = Experiment(e.t, np.zeros_like(e.t), r=np.zeros_like(e.t))
@@ -159,7 +164,7 @@ def test_discrete_response_standard_errors_by_the_delta_method():
     """linear1 with equation noise: $K = a_2/(1 - a_1)$, $T = -h/\\ln a_1$; the reported
     std equals the delta method written out from the least-squares covariance."""
     rng = np.random.default_rng(3)
-    c = discretise("linear1", CASES["linear1"], H, discretisation="zoh")
+    c = discretise("linear1", CASES["linear1"], H, discretisation=EXACT)
     d = _rudder()
     r = np.zeros(d.size)
     for k in range(1, d.size):

@@ -17,13 +17,13 @@ The continuous models (Lu & Zhao eqs. 1-4; $\\delta_r$ the rudder offset):
 with $\\alpha_2 = K/T$ in (2) (their Table 2) and $\\alpha_1 = 1$ in (4) (fixed, as
 they do, for identifiability). The paper does not say how it discretised; here:
 
-- `discretisation="zoh"` (default for the linear models): the exact zero-order-hold
+- `discretisation=ExactDiscretisation()` (default for the linear models): the exact zero-order-hold
   sampling (the rudder held over each sample interval, as recorded and replayed
   data are). (7): $a_1 = e^{-h/T}$, $a_2 = K(1 - a_1)$, $b_0 = a_2\\delta_r$; (9): the
   zero-order-hold transfer function of $K(1 + T_3s)/((1 + T_1s)(1 + T_2s))$
   (`scipy.signal.cont2discrete`), $c_0 = (b_1 + b_2)\\delta_r$. Exact on noise-free
   data of the continuous model.
-- `discretisation="euler"` (the only one for the nonlinear models, which have no
+- `discretisation=EulerDiscretisation()` (the only one for the nonlinear models, which have no
   exact sampled form): finite differences at sample $k-1$,
   $\\dot r \\approx (r_k - r_{k-1})/h$ for (8), and
   $\\ddot r \\approx (r_k - 2r_{k-1} + r_{k-2})/h^2$,
@@ -64,16 +64,110 @@ COEFFICIENTS = {
 _ORDER = {"linear1": 1, "nonlinear1": 1, "linear2": 2, "nonlinear2": 2}
 
 
+class ExactDiscretisation(eqx.Module):
+    """`discretisation=ExactDiscretisation()`: the exact zero-order-hold sampling of the
+    linear models (module docstring); the default for them."""
+
+    name = "zoh"  # the label of `DiscreteResponseFit.discretisation`
+
+    def check(self, structure: str) -> None:
+        if structure.startswith("nonlinear"):
+            raise ValueError(f"the nonlinear structure {structure!r} has no exact "
+                             "zero-order-hold form; use EulerDiscretisation().")
+
+    def pole(self, T: float, h: float) -> float:
+        """$a_1 = e^{-h/T}$ of eq. (7)."""
+        return math.exp(-h / T)
+
+    def time_constant(self, a1: float, h: float) -> float:
+        """$T$ from $a_1$ of eq. (7) (NaN where no positive real pole gives it)."""
+        return -h / math.log(a1) if a1 > 0 and a1 != 1.0 else math.nan
+
+    def second_order(self, structure, p, K, P, S, T3, dr, h) -> dict:
+        """The coefficients of eq. (9) (`_zoh2_ps`), $c_0 = (b_1 + b_2)\\delta_r$."""
+        a1, a2, b1, b2 = _zoh2_ps(K, P, S, T3, h)
+        return {"a1": a1, "a2": a2, "b1": b1, "b2": b2, "c0": (b1 + b2) * dr}
+
+    def second_order_inverse(self, structure, c, h, alpha1, out) -> tuple:
+        """`(P, S, K, T3)` from the coefficients of eq. (9): the poles by the matrix
+        logarithm of the sampled ones, $T_3$ by least squares on $b_1, b_2$."""
+        a1, a2, b1, b2 = c["a1"], c["a2"], c["b1"], c["b2"]
+        z = np.roots([1.0, -a1, -a2]).astype(complex)
+        if np.any(np.abs(z) == 0):
+            raise ValueError(f"{structure}: a pole at z = 0 has no continuous counterpart.")
+        s = [cmath.log(zi) / h for zi in z]
+        prod, total = s[0] * s[1], s[0] + s[1]
+        ok = abs(prod.imag) <= 1e-9 * abs(prod) and abs(total.imag) <= 1e-9 * abs(total) + 1e-300
+        P = 1.0 / prod.real if ok else math.nan
+        S = -total.real / prod.real if ok else math.nan
+        K = (b1 + b2) / (1.0 - a1 - a2)
+        if not ok:
+            return P, S, K, math.nan
+        # b1, b2 are affine in T3 for given K, P, S: least squares for T3
+        _, _, u1, u2 = _zoh2_ps(K, P, S, 0.0, h)
+        _, _, v1, v2 = _zoh2_ps(K, P, S, 1.0, h)
+        d = np.array([v1 - u1, v2 - u2])
+        return P, S, K, float(d @ np.array([b1 - u1, b2 - u2]) / (d @ d))
+
+
+class EulerDiscretisation(eqx.Module):
+    """`discretisation=EulerDiscretisation()`: finite differences at sample $k-1$ (module
+    docstring); the only one for the nonlinear models."""
+
+    name = "euler"  # the label of `DiscreteResponseFit.discretisation`
+
+    def check(self, structure: str) -> None:
+        """Every structure has an Euler form."""
+
+    def pole(self, T: float, h: float) -> float:
+        """$a_1 = 1 - h/T$."""
+        return 1.0 - h / T
+
+    def time_constant(self, a1: float, h: float) -> float:
+        return h / (1.0 - a1)
+
+    def second_order(self, structure, p, K, P, S, T3, dr, h) -> dict:
+        """The coefficients of eqs. (9), (10) by finite differences."""
+        al1 = float(p.get("alpha1", 1.0))
+        be1 = float(p.get("beta1", 0.0))
+        out = {"a1": 2.0 - h * S / P - h * h * al1 / P, "a2": -1.0 + h * S / P,
+               "b1": h * h * K / P + h * K * T3 / P, "b2": -h * K * T3 / P}
+        if structure == "nonlinear2":
+            out["c1"] = -h * h * be1 / P
+        elif be1 != 0.0:
+            raise ValueError("`beta1` is not a parameter of 'linear2'; use 'nonlinear2'.")
+        out["c0"] = h * h * K * dr / P
+        return out
+
+    def second_order_inverse(self, structure, c, h, alpha1, out) -> tuple:
+        """`(P, S, K, T3)` from the finite-difference coefficients; for `nonlinear2`
+        `alpha1` and `beta1` join `out`."""
+        al1 = float(alpha1) if structure == "nonlinear2" else 1.0
+        P = h * h * al1 / (1.0 - c["a1"] - c["a2"])
+        S = P * (1.0 + c["a2"]) / h
+        K = (c["b1"] + c["b2"]) * P / (h * h)
+        if structure == "nonlinear2":
+            out["alpha1"] = al1
+            out["beta1"] = -c["c1"] * P / (h * h)
+        return P, S, K, -c["b2"] * P / (h * K)
+
+
+DISCRETISATIONS = (ExactDiscretisation, EulerDiscretisation)
+Discretisation = ExactDiscretisation | EulerDiscretisation
+
+
 def _check_structure(structure, discretisation=None):
+    """The discretisation of `structure`: `discretisation`, or by default the exact one
+    for the linear models and Euler's for the nonlinear ones."""
     if structure not in STRUCTURES:
         raise ValueError(f"`structure` must be one of {STRUCTURES}, got {structure!r}.")
     if discretisation is None:
-        return "zoh" if structure.startswith("linear") else "euler"
-    if discretisation not in ("zoh", "euler"):
-        raise ValueError(f"`discretisation` must be 'zoh' or 'euler', got {discretisation!r}.")
-    if discretisation == "zoh" and structure.startswith("nonlinear"):
-        raise ValueError(f"the nonlinear structure {structure!r} has no exact zero-order-hold "
-                         "form; use discretisation='euler'.")
+        linear = structure.startswith("linear")
+        return ExactDiscretisation() if linear else EulerDiscretisation()
+    if not isinstance(discretisation, DISCRETISATIONS):
+        raise ValueError(f"`discretisation` must be ExactDiscretisation() or "
+                         f"EulerDiscretisation(), got {discretisation!r}.")
+    discretisation.check(structure)
     return discretisation
 
 
@@ -123,7 +217,7 @@ def _zoh2_ps(K, P, S, T3, h):
 
 
 def discretise(structure: str, parameters: dict, dt: float, *,
-               discretisation: str | None = None) -> dict[str, float]:
+               discretisation: Discretisation | None = None) -> dict[str, float]:
     """The coefficients of the discrete model (Lu & Zhao eqs. 7-10) sampled from the
     continuous one (eqs. 1-4) at interval `dt` [s] (see the module docstring).
 
@@ -139,27 +233,14 @@ def discretise(structure: str, parameters: dict, dt: float, *,
     dr = float(p.get("delta_r", 0.0))
     if structure == "linear1":
         K, T = float(p["K"]), float(p["T"])
-        a1 = math.exp(-h / T) if how == "zoh" else 1.0 - h / T
+        a1 = how.pole(T, h)
         a2 = K * (1.0 - a1)
         return {"a1": a1, "a2": a2, "b0": a2 * dr}
     if structure == "nonlinear1":
         al1, be1, al2 = float(p["alpha1"]), float(p["beta1"]), float(p["alpha2"])
         return {"a1": 1.0 - h * al1, "a2": -h * be1, "a3": h * al2, "b0": h * al2 * dr}
     K, T1, T2, T3 = (float(p[k]) for k in ("K", "T1", "T2", "T3"))
-    P, S = T1 * T2, T1 + T2
-    if how == "zoh":
-        a1, a2, b1, b2 = _zoh2_ps(K, P, S, T3, h)
-        return {"a1": a1, "a2": a2, "b1": b1, "b2": b2, "c0": (b1 + b2) * dr}
-    al1 = float(p.get("alpha1", 1.0))
-    be1 = float(p.get("beta1", 0.0))
-    out = {"a1": 2.0 - h * S / P - h * h * al1 / P, "a2": -1.0 + h * S / P,
-           "b1": h * h * K / P + h * K * T3 / P, "b2": -h * K * T3 / P}
-    if structure == "nonlinear2":
-        out["c1"] = -h * h * be1 / P
-    elif be1 != 0.0:
-        raise ValueError("`beta1` is not a parameter of 'linear2'; use 'nonlinear2'.")
-    out["c0"] = h * h * K * dr / P
-    return out
+    return how.second_order(structure, p, K, T1 * T2, T1 + T2, T3, dr, h)
 
 
 def _time_constants(P, S):
@@ -172,7 +253,7 @@ def _time_constants(P, S):
 
 
 def continuous_parameters(structure: str, coefficients: dict, dt: float, *,
-                          discretisation: str | None = None, alpha1: float = 1.0
+                          discretisation: Discretisation | None = None, alpha1: float = 1.0
                           ) -> dict[str, float]:
     """Invert `discretise`: the manoeuvring indices of Lu & Zhao eqs. 1-4 from the
     discrete coefficients (eqs. 7-10), plus the combinations of their Tables 2-4.
@@ -195,49 +276,18 @@ def continuous_parameters(structure: str, coefficients: dict, dt: float, *,
     how = _check_structure(structure, discretisation)
     h = float(dt)
     c = {k: float(coefficients[k]) for k in COEFFICIENTS[structure]}
-    nan = math.nan
     if structure == "linear1":
         a1, a2, b0 = c["a1"], c["a2"], c["b0"]
-        if how == "zoh":
-            T = -h / math.log(a1) if a1 > 0 and a1 != 1.0 else nan
-        else:
-            T = h / (1.0 - a1)
+        T = how.time_constant(a1, h)
         K = a2 / (1.0 - a1)
         return {"K": K, "T": T, "delta_r": b0 / a2, "K_over_T": K / T}
     if structure == "nonlinear1":
         al1, be1, al2 = (1.0 - c["a1"]) / h, -c["a2"] / h, c["a3"] / h
         return {"alpha1": al1, "beta1": be1, "alpha2": al2, "delta_r": c["b0"] / c["a3"],
                 "K": al2 / abs(al1), "T": 1.0 / abs(al1)}
-    a1, a2, b1, b2, c0 = c["a1"], c["a2"], c["b1"], c["b2"], c["c0"]
-    gain = b1 + b2
     out = {}
-    if how == "zoh":
-        z = np.roots([1.0, -a1, -a2]).astype(complex)
-        if np.any(np.abs(z) == 0):
-            raise ValueError(f"{structure}: a pole at z = 0 has no continuous counterpart.")
-        s = [cmath.log(zi) / h for zi in z]
-        prod, total = s[0] * s[1], s[0] + s[1]
-        ok = abs(prod.imag) <= 1e-9 * abs(prod) and abs(total.imag) <= 1e-9 * abs(total) + 1e-300
-        P = 1.0 / prod.real if ok else nan
-        S = -total.real / prod.real if ok else nan
-        K = gain / (1.0 - a1 - a2)
-        if ok:
-            # b1, b2 are affine in T3 for given K, P, S: least squares for T3
-            _, _, u1, u2 = _zoh2_ps(K, P, S, 0.0, h)
-            _, _, v1, v2 = _zoh2_ps(K, P, S, 1.0, h)
-            d = np.array([v1 - u1, v2 - u2])
-            T3 = float(d @ np.array([b1 - u1, b2 - u2]) / (d @ d))
-        else:
-            T3 = nan
-    else:
-        al1 = float(alpha1) if structure == "nonlinear2" else 1.0
-        P = h * h * al1 / (1.0 - a1 - a2)
-        S = P * (1.0 + a2) / h
-        K = gain * P / (h * h)
-        T3 = -b2 * P / (h * K)
-        if structure == "nonlinear2":
-            out["alpha1"] = al1
-            out["beta1"] = -c["c1"] * P / (h * h)
+    P, S, K, T3 = how.second_order_inverse(structure, c, h, alpha1, out)
+    c0, gain = c["c0"], c["b1"] + c["b2"]
     T1, T2 = _time_constants(P, S)
     out.update({"K": K, "T1": T1, "T2": T2, "T3": T3, "delta_r": c0 / gain,
                 "S_over_P": S / P, "K_over_P": K / P, "KT3_over_P": K * T3 / P,
@@ -350,7 +400,7 @@ class DiscreteResponseFit:
 
     structure: str
     method: eqx.Module
-    discretisation: str
+    discretisation: Discretisation
     dt: float
     coefficients: dict
     parameters: dict
@@ -411,7 +461,7 @@ class DiscreteResponseFit:
 def fit_discrete_response(structure: str, data, *,
                           method: LeastSquaresRegression | SupportVectorRegression = (
                               LeastSquaresRegression()),
-                          discretisation: str | None = None, rudder: str = "delta",
+                          discretisation: Discretisation | None = None, rudder: str = "delta",
                           alpha1: float = 1.0) -> DiscreteResponseFit:
     """Fit one of Lu & Zhao's discrete response models (eqs. 7-10) to measured yaw
     rate and rudder and convert it to the continuous indices (eqs. 1-4).
@@ -423,7 +473,8 @@ def fit_discrete_response(structure: str, data, *,
       never reach across records.
     - `method`: `LeastSquaresRegression()` (default) or `SupportVectorRegression(C,
       epsilon, tol, max_iter)`: the strategy that computes the coefficients.
-    - `discretisation`: `"zoh"` (linear models, default) or `"euler"`.
+    - `discretisation`: `ExactDiscretisation()` (linear models, default) or
+      `EulerDiscretisation()`.
     - `rudder`: `"delta"` (actual) or `"delta_c"` (commanded).
     - `alpha1`: fixed linear coefficient of `nonlinear2` (1 as in Lu & Zhao).
 

@@ -25,6 +25,8 @@ from .._simulation._data import Experiment
 from ._discrete import (
     COEFFICIENTS,
     DiscreteResponseFit,
+    EulerDiscretisation,
+    ExactDiscretisation,
     LeastSquaresRegression,
     SupportVectorRegression,
     continuous_parameters,
@@ -67,14 +69,15 @@ def structure_of(model) -> str:
 class DiscreteResponse(AbstractEstimator):
     """Equation-error fit of Lu & Zhao's discrete response models for `jaxship.fit`:
     `method` `LeastSquaresRegression()` (default) or `SupportVectorRegression(C,
-    epsilon)`; `discretisation` `"zoh"` (linear models'
-    default) or `"euler"`; `rudder` `"delta"` or `"delta_c"`. Equation-error
+    epsilon)`; `discretisation` `ExactDiscretisation()` (linear models' default) or
+    `EulerDiscretisation()`; `rudder` `"delta"` or `"delta_c"`. Equation-error
     estimates are biased by noise on r (errors in variables): use them as start values
     or quick looks, `PredictionError` for final estimates. `free` must be None: the
     structure fixes the parameters (with $n_1 = 1$ and $\\alpha_1 = 1$ frozen)."""
 
     method: LeastSquaresRegression | SupportVectorRegression = LeastSquaresRegression()
-    discretisation: str | None = eqx.field(static=True, default=None)
+    discretisation: ExactDiscretisation | EulerDiscretisation | None = eqx.field(
+        static=True, default=None)
     rudder: str = eqx.field(static=True, default="delta")
     max_lag: int = 25
 
