@@ -446,13 +446,15 @@ def _smoothed_starts(ds, smoothed) -> dict:
     return out
 
 
-def _verdict(result, specs, values, rows, jac, pred, targets, mask, eps) -> RESULTS:
+def _verdict(result, specs, p, rows, jac, pred, targets, mask) -> RESULTS:
     """The optimiser's code, unless the fit blew up (predictions not finite, or a
     thousand times the measured range of a channel) or stopped as converged without
     moving from a start where the cost is not stationary: the largest cosine between
     the residuals and a Jacobian column (the scaled gradient) above 1e-3. "Not moved":
-    within 1e-10 of the start, or a few roundings of the solver's float type `eps`
+    within 1e-10 of the start, or a few roundings of the float type of the estimates `p`
     (float32 stores a start of 1e-12 as 9.99999996e-13)."""
+    values = np.asarray(p, dtype=np.float64)
+    eps = float(np.finfo(np.asarray(p).dtype).eps)
     size = [np.max(np.abs(t[mask])) + np.std(t[mask]) for t in targets]
     blown = [np.max(np.abs(np.where(mask, p, 0.0))) > 1e3 * (s + 1e-9)
              for p, s in zip(pred, size)]
@@ -489,8 +491,7 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
     rows = np.concatenate([resid[c][mask] for c in range(len(channels))])
     jrows = np.concatenate([jac[c][mask][:, columns] for c in range(len(channels))])
     groups = np.concatenate([np.full(int(mask.sum()), c) for c in range(len(channels))])
-    result = _verdict(as_code(result), specs, values, rows, jrows[:, :d], pred, targets, mask,
-                      float(np.finfo(np.asarray(p).dtype).eps))
+    result = _verdict(as_code(result), specs, p, rows, jrows[:, :d], pred, targets, mask)
     blown = result == RESULTS.simulation_blew_up  # nothing below means anything: NaN
     with np.errstate(all="ignore") if blown else contextlib.nullcontext():
         cost = 0.5 * float(np.sum(rows**2))

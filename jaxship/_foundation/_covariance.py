@@ -413,30 +413,9 @@ def parameter_report(names, values, covariance, *, units=(), corr_threshold: flo
     d = values.shape[0]
     if cov.shape != (d, d):
         raise ValueError(f"`covariance` must be ({d}, {d}), got {cov.shape}.")
-    var = np.diag(cov).copy()
-    std = np.sqrt(np.where(var >= 0, var, np.nan))
-    finite = np.isfinite(std) & (std > 0)
-    corr = np.full((d, d), np.nan)
-    sub = np.ix_(finite, finite)
-    corr[sub] = cov[sub] / std[finite][:, None] / std[finite][None, :]
-    np.fill_diagonal(corr, np.where(finite, 1.0, np.nan))
-    if finite.all() and d:
-        eig = np.linalg.eigvalsh(corr)
-        condition = float(eig[-1] / eig[0]) if eig[0] > 0 else math.inf
-    else:
-        condition = math.inf
-    flags = []
-    for v in null_directions:
-        v = np.asarray(v, dtype=float)
-        involved = [names[i] for i in np.nonzero(np.abs(v) > 1e-3)[0]]
-        if len(involved) == 1:
-            flags.append(f"{involved[0]} does not affect the fitted outputs: the data say "
-                         "nothing about it (freeze it or use data that excite it).")
-        else:
-            flags.append(f"the data do not determine the combination {_combination(names, v)} "
-                         f"of {', '.join(involved)} (information matrix singular): only other "
-                         "combinations of these parameters are identifiable.")
-    null_flags = tuple(flags)
+    std, corr, condition = _correlation(cov)
+    null_flags = _null_flags(names, null_directions)
+    flags = list(null_flags)
     for i in range(d):
         for j in range(i + 1, d):
             rho = corr[i, j]
@@ -472,6 +451,39 @@ def parameter_report(names, values, covariance, *, units=(), corr_threshold: flo
                            else bool(white), hac_lags=None if hac_lags is None
                            else int(hac_lags), uncertainty_flags=uncertainty,
                            undetermined=undetermined)
+
+
+def _correlation(cov) -> tuple[np.ndarray, np.ndarray, float]:
+    """`(std, correlation, condition number)` of a covariance (d, d): NaN correlations of
+    parameters without a finite positive variance, whose condition number is infinite."""
+    d = cov.shape[0]
+    var = np.diag(cov).copy()
+    std = np.sqrt(np.where(var >= 0, var, np.nan))
+    finite = np.isfinite(std) & (std > 0)
+    corr = np.full((d, d), np.nan)
+    sub = np.ix_(finite, finite)
+    corr[sub] = cov[sub] / std[finite][:, None] / std[finite][None, :]
+    np.fill_diagonal(corr, np.where(finite, 1.0, np.nan))
+    if finite.all() and d:
+        eig = np.linalg.eigvalsh(corr)
+        return std, corr, float(eig[-1] / eig[0]) if eig[0] > 0 else math.inf
+    return std, corr, math.inf
+
+
+def _null_flags(names, null_directions) -> tuple[str, ...]:
+    """A sentence for each direction (d,) of the parameters the data do not determine."""
+    flags = []
+    for v in null_directions:
+        v = np.asarray(v, dtype=float)
+        involved = [names[i] for i in np.nonzero(np.abs(v) > 1e-3)[0]]
+        if len(involved) == 1:
+            flags.append(f"{involved[0]} does not affect the fitted outputs: the data say "
+                         "nothing about it (freeze it or use data that excite it).")
+        else:
+            flags.append(f"the data do not determine the combination {_combination(names, v)} "
+                         f"of {', '.join(involved)} (information matrix singular): only other "
+                         "combinations of these parameters are identifiable.")
+    return tuple(flags)
 
 
 def _not_white_flag(names, std, std_robust, hac_lags, robust_method=None) -> str:

@@ -111,7 +111,25 @@ def simulate_batch(
                              "`straight_run_batch`).")
         x0 = straight_run(model)
     wind = not _is_static_zero(getattr(getattr(environment, "wind", None), "speed", None))
-    args = _as_arrays((model, manoeuvre, x0, environment))
+    batched, shared, size = _split_batch(in_axes,
+                                         _as_arrays((model, manoeuvre, x0, environment)))
+    mesh = batch_mesh(devices)
+    b_dyn, b_static = eqx.partition(batched, eqx.is_array)
+    s_dyn, s_static = eqx.partition(shared, eqx.is_array)
+    if isinstance(simulator.solver, RK4) and simulator.solver.rolled is None \
+            and size >= WRITTEN_OUT_BATCH:
+        simulator = eqx.tree_at(lambda s: s.solver, simulator, RK4(rolled=False))
+    steps = simulator.steps_per_sample(manoeuvre.dt)
+    return _batched(
+        b_dyn, s_dyn, b_static, s_static, simulator, steps, output, wind, size, mesh, chunk_size
+    )
+
+
+def _split_batch(in_axes, args):
+    """`(batched, shared, size)`: the leaves of `args` (model, manoeuvre, x0, environment)
+    with a batch axis by `in_axes` (None elsewhere), the shared ones (None where
+    batched), and the batch size they agree on; `ValueError` if none is batched or their
+    sizes differ."""
     names = ("model", "manoeuvre", "x0", "environment")
     axes = tuple(_resolve_axes(a, arg, name) for a, arg, name in zip(in_axes, args, names))
     is_none = lambda x: x is None
@@ -131,17 +149,7 @@ def simulate_batch(
             if jax.tree.leaves(b)
         }
         raise ValueError(f"batched inputs disagree on the batch size: {detail}.")
-    size = sizes.pop()
-    mesh = batch_mesh(devices)
-    b_dyn, b_static = eqx.partition(batched, eqx.is_array)
-    s_dyn, s_static = eqx.partition(shared, eqx.is_array)
-    if isinstance(simulator.solver, RK4) and simulator.solver.rolled is None \
-            and size >= WRITTEN_OUT_BATCH:
-        simulator = eqx.tree_at(lambda s: s.solver, simulator, RK4(rolled=False))
-    steps = simulator.steps_per_sample(manoeuvre.dt)
-    return _batched(
-        b_dyn, s_dyn, b_static, s_static, simulator, steps, output, wind, size, mesh, chunk_size
-    )
+    return batched, shared, sizes.pop()
 
 
 def _resolve_axes(prefix, tree, name):

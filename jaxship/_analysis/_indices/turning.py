@@ -180,6 +180,45 @@ class ZigZagIndices:
         return _named(items, units)
 
 
+def _zigzag_executes(s, execute_times) -> list[float]:
+    """The rudder executes [s]: `execute_times`, or the first departure of the rudder
+    order from the initial angle and then every reversal of its sign."""
+    if execute_times is not None:
+        times = [float(e) for e in np.atleast_1d(execute_times)]
+        if not times or np.any(np.diff(times) <= 0):
+            raise ValueError("`execute_times` must be a non-empty increasing sequence.")
+        return times
+    t1 = _rudder_execute(s, None)
+    order, i = s.rudder_order, int(np.searchsorted(s.t, t1))
+    times, current = [t1], int(np.sign(order[i]))
+    for j in range(i + 1, s.t.size):
+        if abs(order[j]) > _TOL and np.sign(order[j]) == -current:
+            times.append(float(s.t[j]))
+            current = -current
+    return times
+
+
+def _first_side(s, t0, psi_s) -> tuple[int, float]:
+    """`(side, rudder angle)` of the first order at `t0` (side 0: not told)."""
+    i = int(np.searchsorted(s.t, t0))
+    if s.delta is not None and i < s.t.size:
+        # side of the first order relative to the rudder before it (a neutral-helm offset,
+        # as in the MARIN runs, must not decide it): where it has moved half its way; a
+        # record that starts with the order given (the rudder already over) has no before
+        baseline = (s.delta[0] if s.delta_command is not None else
+                    s.rudder_order[0] if i > 0 else 0.0)
+        moved = s.rudder_order[i:] - baseline
+        k = i + int(np.argmax(np.abs(moved) >= 0.5 * np.max(np.abs(moved))))
+        return int(np.sign(s.rudder_order[k])), abs(float(s.rudder_order[k]))
+    # no rudder history: the side the heading first passes the switch angle
+    change = s.psi - np.interp(t0, s.t, s.psi)
+    up = _crossing(s.t, change, psi_s, t0)
+    down = _crossing(s.t, -change, psi_s, t0)
+    side = 0 if up is None and down is None else (
+        1 if down is None or (up is not None and up < down) else -1)
+    return side, float("nan")
+
+
 @_docstring
 def zigzag_indices(traj=None, heading_switch=None, *, execute_times=None, initial_heading=None,
                    **arrays) -> ZigZagIndices:
@@ -202,35 +241,8 @@ def zigzag_indices(traj=None, heading_switch=None, *, execute_times=None, initia
     psi_s = float(heading_switch)
     s = _series(traj, arrays)
     s.need("psi", what="zigzag_indices")
-    if execute_times is None:
-        t1 = _rudder_execute(s, None)
-        order, i = s.rudder_order, int(np.searchsorted(s.t, t1))
-        times, current = [t1], int(np.sign(order[i]))
-        for j in range(i + 1, s.t.size):
-            if abs(order[j]) > _TOL and np.sign(order[j]) == -current:
-                times.append(float(s.t[j]))
-                current = -current
-    else:
-        times = [float(e) for e in np.atleast_1d(execute_times)]
-        if not times or np.any(np.diff(times) <= 0):
-            raise ValueError("`execute_times` must be a non-empty increasing sequence.")
-    i = int(np.searchsorted(s.t, times[0]))
-    if s.delta is not None and i < s.t.size:
-        # side of the first order relative to the rudder before it (a neutral-helm offset,
-        # as in the MARIN runs, must not decide it): where it has moved half its way; a
-        # record that starts with the order given (the rudder already over) has no before
-        baseline = (s.delta[0] if s.delta_command is not None else
-                    s.rudder_order[0] if i > 0 else 0.0)
-        moved = s.rudder_order[i:] - baseline
-        k = i + int(np.argmax(np.abs(moved) >= 0.5 * np.max(np.abs(moved))))
-        side, rudder_angle = int(np.sign(s.rudder_order[k])), abs(float(s.rudder_order[k]))
-    else:  # no rudder history: the side the heading first passes the switch angle
-        change = s.psi - np.interp(times[0], s.t, s.psi)
-        up = _crossing(s.t, change, psi_s, times[0])
-        down = _crossing(s.t, -change, psi_s, times[0])
-        side = 0 if up is None and down is None else (
-            1 if down is None or (up is not None and up < down) else -1)
-        rudder_angle = float("nan")
+    times = _zigzag_executes(s, execute_times)
+    side, rudder_angle = _first_side(s, times[0], psi_s)
     if side == 0:
         raise ValueError("could not tell the side of the first rudder order.")
     psi0 = np.interp(times[0], s.t, s.psi) if initial_heading is None else float(initial_heading)

@@ -296,8 +296,28 @@ def thesis_vessel() -> RossVessel:
     friction, a Wageningen B-series K_T fit and Fujii's rudder formula; see
     docs/thesis_vessel.md. 500 rpm gives about 1.55 m/s, 600 rpm about 1.8 m/s.
     """
+    L, B = 4.002, 0.538  # thesis Table 4.1
+    return RossVessel(
+        length=L,
+        rudder=RudderServo(
+            max_angle=float(np.deg2rad(45.0)),  # thesis sec. 4.1
+            max_rate=float(np.deg2rad(15.0)),  # thesis Table 4.1
+            time_constant=1.0,  # T_delta [s], MSS convention
+        ),
+        shaft=Shaft(max_rate=10.0, time_constant=1.0),  # 600 rpm, T_n = 1 s (docs sec. 9)
+        nominal_speed=1.5429721868551294,  # straight run at 500 rpm (tests/test_ross.py)
+        nominal_n=500.0 / 60.0,  # thesis sec. 4.1
+        frontal_wind_area=float(B * 0.2),  # bare hull, freeboard ~0.2 m (docs sec. 11)
+        lateral_wind_area=float(L * 0.2),
+        **_thesis_hull(L, B),
+        **_thesis_propulsion(L),
+    )
+
+
+def _thesis_hull(L: float, B: float) -> dict:
+    """The thesis vessel's mass, added mass and hull forces (`thesis_vessel`'s sources)."""
     rho, nu = 1000.0, 1.14e-6  # fresh water at 15 deg C (ITTC 7.5-02-01-03)
-    L, B, T, disp = 4.002, 0.538, 0.172, 0.188  # thesis Table 4.1
+    T, disp = 0.172, 0.188  # thesis Table 4.1
     Cb = disp / (L * B * T)
     m = rho * disp
     xg = -0.018  # LCG [m], SIMMAN 5415 (MARIN model), midship origin
@@ -330,19 +350,7 @@ def thesis_vessel() -> RossVessel:
     # induced drag of the hull lift as a wing of span 2T: X_vv = -Y_uv^2 / (2 pi rho T^2)
     x_vv = -(y_uv**2) / (2 * np.pi * rho * T**2)
 
-    aspect = 1.5  # rudder geometric aspect ratio Lambda (assumed, docs sec. 10)
-    return RossVessel(
-        length=L,
-        rudder=RudderServo(
-            max_angle=float(np.deg2rad(45.0)),  # thesis sec. 4.1
-            max_rate=float(np.deg2rad(15.0)),  # thesis Table 4.1
-            time_constant=1.0,  # T_delta [s], MSS convention
-        ),
-        shaft=Shaft(max_rate=10.0, time_constant=1.0),  # 600 rpm, T_n = 1 s (docs sec. 9)
-        nominal_speed=1.5429721868551294,  # straight run at 500 rpm (tests/test_ross.py)
-        nominal_n=500.0 / 60.0,  # thesis sec. 4.1
-        frontal_wind_area=float(B * 0.2),  # bare hull, freeboard ~0.2 m (docs sec. 11)
-        lateral_wind_area=float(L * 0.2),
+    return dict(
         rho=rho,
         mass=float(m),
         xg=xg,
@@ -369,6 +377,13 @@ def thesis_vessel() -> RossVessel:
         n_absr_v=0.0,
         n_absv_r=float(-kcf * cn * L**3),
         n_absr_r=float(-kcf * L**4 / 32),
+    )
+
+
+def _thesis_propulsion(L: float) -> dict:
+    """The thesis vessel's propellers and rudders (`thesis_vessel`'s sources)."""
+    aspect = 1.5  # rudder geometric aspect ratio Lambda (assumed, docs sec. 10)
+    return dict(
         n_propellers=2.0,  # twin screws, SIMMAN 5415
         prop_diameter=0.173,  # SIMMAN 5415 model propeller
         kt0=0.5012,  # quadratic fit of B5-58, P/D = 1.15, J in [0, 1.2] (docs sec. 9)
