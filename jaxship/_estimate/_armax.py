@@ -131,6 +131,24 @@ def _check(y, u, na, nb, nc, nk):
     return y, u, n0
 
 
+def _pseudo_linear_start(y, ud, start: int, orders, arx_order) -> np.ndarray:
+    """The start of `fit_armax`: the innovations of a long ARX model (order `arx_order`,
+    default `max(20, 4 (na + nb + nc))`, capped by the data) as the lagged noise
+    regressors of a linear least-squares fit of (A, B, C) from sample `start` on (the
+    pseudo-linear regression of the module docstring); `ud` is the delayed input."""
+    na, nb, nc = orders
+    e = np.zeros_like(y)
+    if nc:
+        m = int(arx_order or max(20, 4 * (na + nb + nc)))
+        m = min(m, (y.size - 10) // 3)
+        xa = np.hstack([-_lags(y, range(1, m + 1), m), _lags(ud, range(0, m), m)])
+        th = np.linalg.lstsq(xa, y[m:], rcond=None)[0]
+        e[m:] = y[m:] - xa @ th
+    phi = np.hstack([-_lags(y, range(1, na + 1), start), _lags(ud, range(0, nb), start),
+                     _lags(e, range(1, nc + 1), start)])
+    return np.linalg.lstsq(phi, y[start:], rcond=None)[0]
+
+
 def fit_armax(y, u, *, na: int = 2, nb: int = 2, nc: int = 2, nk: int = 1,
               dt: float | None = None, max_iter: int = 100, tol: float = 1e-10,
               arx_order: int | None = None) -> ARMAXResult:
@@ -151,21 +169,8 @@ def fit_armax(y, u, *, na: int = 2, nb: int = 2, nc: int = 2, nk: int = 1,
     """
     y, u, n0 = _check(y, u, na, nb, nc, nk)
     ud = _delay(u, nk)
-    a_lags, b_lags, c_lags = range(1, na + 1), range(0, nb), range(1, nc + 1)
-    # -- pseudo-linear regression start ---------------------------------------------
-    if nc:
-        m = int(arx_order or max(20, 4 * (na + nb + nc)))
-        m = min(m, (y.size - 10) // 3)
-        xa = np.hstack([-_lags(y, range(1, m + 1), m), _lags(ud, range(0, m), m)])
-        th = np.linalg.lstsq(xa, y[m:], rcond=None)[0]
-        e = np.zeros_like(y)
-        e[m:] = y[m:] - xa @ th
-    else:
-        e = np.zeros_like(y)
-    start = max(n0, 1)
-    phi = np.hstack([-_lags(y, a_lags, start), _lags(ud, b_lags, start),
-                     _lags(e, c_lags, start)])
-    theta = np.linalg.lstsq(phi, y[start:], rcond=None)[0]
+    a_lags, b_lags, c_lags, start = range(1, na + 1), range(0, nb), range(1, nc + 1), max(n0, 1)
+    theta = _pseudo_linear_start(y, ud, start, (na, nb, nc), arx_order)
 
     def polys(th):
         A = np.concatenate([[1.0], th[:na]])
