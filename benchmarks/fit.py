@@ -8,7 +8,7 @@ shortened thesis manoeuvre, PRBS, 3-2-1-1 and pull-out) at 200 and 500 rpm, 0.1 
 samples, about 21,000 samples in all. The data are simulated by `jaxship.simulate`
 with 4 RK4 substeps per sample (so neither fit's integrator is the data's; the zig-zags
 reverse the rudder at the sample nearest the heading crossing,
-`switch_at=js.SwitchAtNearestStep()`, so that the command both fits replay, held over
+`switch_at=js.strategies.SwitchAtNearestStep()`, so that the command both fits replay, held over
 each sample, is the data's) and get white measurement noise (0.02 deg heading,
 0.01 deg/s yaw rate, 1 mm/s in u and v; the windows start from these noisy states, so
 the estimates carry a small errors-in-variables bias, the same for both fits).
@@ -80,9 +80,9 @@ def manoeuvres(rpm):
         ("turn35", js.Turn(35 * DEG, duration=120.0, execute=5.0, n=n)),
         ("turn-20", js.Turn(-20 * DEG, duration=120.0, execute=5.0, n=n)),
         ("zigzag10", js.ZigZag(10 * DEG, 10 * DEG, duration=150.0, n=n,
-                               switch_at=js.SwitchAtNearestStep())),
+                               switch_at=js.strategies.SwitchAtNearestStep())),
         ("zigzag-20", js.ZigZag(-20 * DEG, 20 * DEG, duration=150.0, n=n,
-                                switch_at=js.SwitchAtNearestStep())),
+                                switch_at=js.strategies.SwitchAtNearestStep())),
         ("thesis", js.thesis_manoeuvre((10, 25), hold_per_deg=1.0, ramp_deg_per_s=1.0,
                                        end_hold=20.0, n=n)),
         ("prbs", js.prbs(15 * DEG, 5.0, 150.0, n=n)),

@@ -236,7 +236,7 @@ class Case:
         """Initial straight runs: speeds and rates (numpy arrays)."""
         if self.name == "mariner":
             return np.asarray(second, float), np.zeros_like(second)
-        x = js.straight_run_batch(self.vessel, n=np.asarray(second, float))
+        x = js.straight_run(self.vessel, n=np.asarray(second, float))
         return np.asarray(x.u), np.asarray(x.n)
 
     def jaxship_args(self, angles, second):
@@ -245,7 +245,7 @@ class Case:
         # SciPy do (jaxship's default reverses it at the crossing, inside the step)
         manoeuvre = js.ZigZag(angles, angles, duration=self.duration, dt=DT,
                               n=None if self.name == "mariner" else n0,
-                              switch_at=js.SwitchAtNextStep())
+                              switch_at=js.strategies.SwitchAtNextStep())
         x0 = js.straight_state(u0, n0)
         if self.name == "mariner":  # the approach speed is a vessel parameter
             vessel = eqx.tree_at(lambda v: v.nominal_speed, self.vessel, u0)
@@ -423,7 +423,7 @@ def run_case(case, args, devices, rows):
     x0 = js.straight_state(float(u0[0]), float(n0[0]))
     man = js.ZigZag(angle, angle, duration=case.duration, dt=DT,
                     n=None if case.name == "mariner" else float(n0[0]),
-                    switch_at=js.SwitchAtNextStep())
+                    switch_at=js.strategies.SwitchAtNextStep())
     p = {k: np.float64(v) for k, v in case.params.items()}
     if case.name == "mariner":
         p["nominal_speed"] = np.float64(u0[0])

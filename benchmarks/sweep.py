@@ -93,7 +93,7 @@ def build(args, dt):
     a, k, j = a.ravel(), k.ravel(), j.ravel()
     if args.vessel == "thesis":
         rates = np.linspace(400, 600, args.rates) / 60  # [rev/s]
-        starts = js.straight_run_batch(vessel, n=rates)
+        starts = js.straight_run(vessel, n=rates)
         u0, n0 = np.asarray(starts.u)[k], rates[k]
         second = rates[k] * 60
     else:

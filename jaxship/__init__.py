@@ -2,7 +2,8 @@
 
 The public API is `__all__` (grouped by layer as in docs/architecture.md; the API pages
 of the documentation list the same names, tests/test_docs.py). The effects of the effect
-seam are one namespace, `jaxship.effects`; the figures another, `jaxship.plotting`.
+seam are one namespace, `jaxship.effects`; the figures another, `jaxship.plotting`; the
+strategy objects a third, `jaxship.strategies`.
 """
 
 __version__ = "0.1.0"  # the one place of the version (pyproject.toml reads it)
@@ -25,11 +26,10 @@ from ._analysis._design import (
     excitation_order as excitation_order,
     fisher_information as fisher_information,
 )
-from ._analysis._discover._catalogue import (
-    DISCOVERY_CATALOGUE as DISCOVERY_CATALOGUE,
-    Candidate as Candidate,
+from ._analysis._discover._report import (
+    DiscoveryReport as DiscoveryReport,
+    Verdict as Verdict,
 )
-from ._analysis._discover._report import DiscoveryReport as DiscoveryReport
 from ._analysis._discover._workflow import (
     DiscoveryOptions as DiscoveryOptions,
     discover as discover,
@@ -45,8 +45,6 @@ from ._estimate._bands import (
 from ._estimate._discrete import fit_discrete_response as fit_discrete_response
 from ._estimate._discrete_estimator import (
     DiscreteResponse as DiscreteResponse,
-    EulerDiscretisation as EulerDiscretisation,
-    ExactDiscretisation as ExactDiscretisation,
     LeastSquaresRegression as LeastSquaresRegression,
     SupportVectorRegression as SupportVectorRegression,
 )
@@ -61,12 +59,9 @@ from ._estimate._initial import (
 )
 from ._estimate._kalman import ekf as ekf, smooth_states as smooth_states
 from ._estimate._likelihood import (
-    EstimatedNoise as EstimatedNoise,
-    HeldNoise as HeldNoise,
     Innovations as Innovations,
     InnovationsLeastSquares as InnovationsLeastSquares,
     MaximumLikelihood as MaximumLikelihood,
-    ProcessNoise as ProcessNoise,
 )
 from ._estimate._linear import LinearStart as LinearStart
 from ._estimate._lm import RESULTS as RESULTS, LevenbergMarquardt as LevenbergMarquardt
@@ -99,16 +94,11 @@ from ._models._environment import Current as Current, Environment as Environment
 from ._models._manoeuvres import (
     AbstractController as AbstractController,
     Controlled as Controlled,
-    FirstOrderHold as FirstOrderHold,
     Replay as Replay,
     ReverseSpiral as ReverseSpiral,
     Schedule as Schedule,
     Stop as Stop,
-    SwitchAtCrossing as SwitchAtCrossing,
-    SwitchAtNearestStep as SwitchAtNearestStep,
-    SwitchAtNextStep as SwitchAtNextStep,
     Turn as Turn,
-    ZeroOrderHold as ZeroOrderHold,
     ZigZag as ZigZag,
     heading_perturbations as heading_perturbations,
     multi_step_3211 as multi_step_3211,
@@ -142,7 +132,6 @@ from ._models._vessel.ross import RossVessel as RossVessel
 from ._simulation._batch import (
     simulate_batch as simulate_batch,
     stack as stack,
-    straight_run_batch as straight_run_batch,
 )
 from ._simulation._data import Dataset as Dataset, Experiment as Experiment
 from ._simulation._froude import froude_scale as froude_scale
@@ -152,8 +141,6 @@ from ._simulation._measured import (
     shared_data_dir as shared_data_dir,
 )
 from ._simulation._readers import (
-    DisplayUnits as DisplayUnits,
-    SIUnits as SIUnits,
     read_trial_csv as read_trial_csv,
     write_trial_csv as write_trial_csv,
 )
@@ -162,7 +149,12 @@ from ._simulation._simulate import simulate as simulate
 
 # isort: split
 # the namespaces: jaxship.effects.RudderOffset, jaxship.indices.turning_indices, ...
-from . import effects as effects, indices as indices, wind_loads as wind_loads
+from . import (
+    effects as effects,
+    indices as indices,
+    strategies as strategies,
+    wind_loads as wind_loads,
+)
 
 
 __all__ = [
@@ -179,6 +171,7 @@ __all__ = [
     "validate",
     "fit_percent",
     "enable_compilation_cache",
+    "strategies",
     # models: vessels
     "AbstractVessel",
     "MMGVessel",
@@ -235,7 +228,6 @@ __all__ = [
     "RK4",
     "simulate_batch",
     "stack",
-    "straight_run_batch",
     "froude_scale",
     "Experiment",
     "Dataset",
@@ -282,6 +274,5 @@ __all__ = [
     "discover",
     "DiscoveryOptions",
     "DiscoveryReport",
-    "Candidate",
-    "DISCOVERY_CATALOGUE",
+    "Verdict",
 ]

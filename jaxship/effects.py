@@ -6,7 +6,16 @@ of each place it acts on (`AbstractRudderEffect`, `AbstractLoadEffect`,
 
     import jaxship as js
     model = js.augment(js.Nomoto1(K=0.06, T=25.0), js.effects.RudderOffset(delta0=0.01))
+
+`DISCOVERY_CATALOGUE` is the catalogue of effects `jaxship.discover` tries, each a
+`Candidate` (an effect with its family, bounds and what tells it apart); a catalogue of
+one's own is a tuple of them.
 """
+
+from ._analysis._discover._catalogue import (
+    DISCOVERY_CATALOGUE as DISCOVERY_CATALOGUE,
+    Candidate as Candidate,
+)
 
 from ._models._effects import (
     AbstractEffect as AbstractEffect,
@@ -81,4 +90,7 @@ __all__ = [
     "ApparentWind",
     "Windage",
     "RecordedDisturbance",
+    # what discover tries
+    "Candidate",
+    "DISCOVERY_CATALOGUE",
 ]

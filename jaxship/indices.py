@@ -9,6 +9,8 @@ measured `Trajectory`, in SI units and radians:
 """
 
 from ._analysis._indices import (
+    SteadyFromCircle as SteadyFromCircle,
+    SteadyFromRate as SteadyFromRate,
     format_table as format_table,
     imo_criteria as imo_criteria,
     initial_turning_indices as initial_turning_indices,
@@ -33,4 +35,6 @@ __all__ = [
     "imo_criteria",
     "format_table",
     "batch_turning_indices",
+    "SteadyFromRate",
+    "SteadyFromCircle",
 ]

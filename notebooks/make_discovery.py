@@ -74,7 +74,7 @@ nb.cells = [
         "10/10 and 20/20 zig-zags to both sides and checked on +-20 deg turning circles."),
     nbf.v4.new_code_cell(SETUP + "\n" + RESIDUALS),
     nbf.v4.new_markdown_cell("## The catalogue"),
-    nbf.v4.new_code_cell("for c in js.DISCOVERY_CATALOGUE:\n"
+    nbf.v4.new_code_cell("for c in js.effects.DISCOVERY_CATALOGUE:\n"
                          "    print(f'{c.id:24s} {c.name}')"),
     nbf.v4.new_markdown_cell(
         "## A hidden cubic yaw damping\n\nThe truth is $T\\dot r + r + \\beta r^3 = K\\delta$ "

@@ -92,7 +92,7 @@ a, k, j = (g.ravel() for g in np.meshgrid(angles, np.arange(rpms.size), np.arang
 vessel = result.model
 for i, name in enumerate(result.names):
     vessel = eqx.tree_at(lambda v, n=name: getattr(v, n), vessel, samples[j, i])
-starts = js.straight_run_batch(result.model, n=rpms / 60)
+starts = js.straight_run(result.model, n=rpms / 60)
 x0 = js.straight_state(np.asarray(starts.u)[k], rpms[k] / 60)
 manoeuvre = js.Turn(a, duration=100.0, dt=0.5, n=rpms[k] / 60)
 
@@ -105,7 +105,7 @@ print(f"{a.size} turning circles in {time.perf_counter() - began:.1f} s (with co
 
 nominal = js.simulate_batch(truth, js.Turn(np.repeat(angles, rpms.size), duration=100.0, dt=0.5,
                                            n=np.tile(rpms, angles.size) / 60),
-                            js.straight_state(np.tile(np.asarray(js.straight_run_batch(
+                            js.straight_state(np.tile(np.asarray(js.straight_run(
                                 truth, n=rpms / 60).u), angles.size),
                                 np.tile(rpms, angles.size) / 60),
                             output=js.indices.batch_turning_indices)

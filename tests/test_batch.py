@@ -163,15 +163,15 @@ def test_turning_indices_match_numpy_indices():
     assert np.all(np.isnan(short["tactical_diameter"]))
 
 
-def test_straight_run_batch_matches_straight_run():
+def test_straight_run_of_arrays_matches_straight_run_of_each():
     from jaxship._models._vessel.catalogue import get_vessel
 
     vessel = get_vessel("kvlcc2")
     rates = np.array([0.8, 1.0, 1.2]) * vessel.nominal_n
-    got = jb.straight_run_batch(vessel, n=rates)
+    got = js.straight_run(vessel, n=rates)
     for i, n in enumerate(rates):
         np.testing.assert_allclose(got.u[i], js.straight_run(vessel, n=n).u, rtol=1e-10)
-    back = jb.straight_run_batch(vessel, speed=got.u)
+    back = js.straight_run(vessel, speed=got.u)
     np.testing.assert_allclose(back.n, rates, rtol=1e-9)
 
 
@@ -226,7 +226,7 @@ def test_a_batch_of_steering_runs_equals_the_single_runs():
                for a in (10.0, -15.0, 20.0)]
     batch = jb.simulate_batch(model, jb.stack(zigzags), in_axes=(None, 0, None, None))
     records = [np.asarray(js.simulate(model, z).state.delta) for z in zigzags]
-    replays = [js.Replay(d, dt=0.5, delta_hold=js.FirstOrderHold()) for d in records]
+    replays = [js.Replay(d, dt=0.5, delta_hold=js.strategies.FirstOrderHold()) for d in records]
     replayed = jb.simulate_batch(model, jb.stack(replays), in_axes=(None, 0, None, None))
     for i, (z, r) in enumerate(zip(zigzags, replays)):
         for got, single in ((batch, js.simulate(model, z)), (replayed, js.simulate(model, r))):

@@ -114,7 +114,7 @@ def _record(path, *, psi=True, seed=0, num=400, dt=0.5):
     """A trial CSV of Nomoto1(K=0.06, T=25) driven by random rudder steps."""
     rng = np.random.default_rng(seed)
     delta = np.repeat(np.where(rng.random(num // 20) < 0.5, -1.0, 1.0) * np.deg2rad(10), 20)
-    replay = js.Replay(delta, dt=dt, delta_hold=js.FirstOrderHold())
+    replay = js.Replay(delta, dt=dt, delta_hold=js.strategies.FirstOrderHold())
     tr = js.simulate(js.Nomoto1(K=0.06, T=25.0), replay,
                      js.straight_state(0.0, psi=0.1), simulator=per_sample())
     channels = {"psi": np.asarray(tr.state.psi)} if psi else {}

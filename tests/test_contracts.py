@@ -16,7 +16,7 @@ from jaxship._foundation._params import default_free, get_path, rebuild
 from jaxship._models._steering._base import WindowStart
 
 
-FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
 
 
 DEG = np.pi / 180

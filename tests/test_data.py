@@ -45,13 +45,13 @@ def assert_channels_equal(a: Experiment, b: Experiment, rtol=1e-12):
 # --- trial CSV round trip ------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("units", [js.DisplayUnits(), js.SIUnits()], ids=["display", "si"])
+@pytest.mark.parametrize("units", [js.strategies.DisplayUnits(), js.strategies.SIUnits()], ids=["display", "si"])
 def test_round_trip_all_channels(tmp_path, units):
     exp = synthetic_experiment()
     path = tmp_path / "trial.csv"
     write_trial_csv(path, exp, units=units)
     header = path.read_text().splitlines()[0]
-    if units == js.DisplayUnits():
+    if units == js.strategies.DisplayUnits():
         assert "psi [deg]" in header and "r [deg/s]" in header and "n [rpm]" in header
     else:
         assert "psi [rad]" in header and "r [rad/s]" in header and "n [rps]" in header

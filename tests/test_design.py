@@ -16,7 +16,7 @@ from jaxship import (
 )
 
 
-FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
 
 
 def test_excitation_order_known_signals():

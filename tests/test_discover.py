@@ -337,7 +337,7 @@ def test_an_effect_in_family_units_is_sized_as_the_rudder_angle_of_its_loads():
 def test_an_implausibly_large_constant_moment_is_not_named():
     """A yaw moment worth 10 deg of rudder is no hidden asymmetry (the rudder offset's
     range is 5.7 deg): refitted, it fails the plausibility gate; one worth 1 deg passes."""
-    only = tuple(c for c in js.DISCOVERY_CATALOGUE if c.id == "yaw_moment_bias")
+    only = tuple(c for c in js.effects.DISCOVERY_CATALOGUE if c.id == "yaw_moment_bias")
     for angle, named in ((10 * DEG, False), (1 * DEG, True)):
         report = run_case((effects.YawMomentBias(n0=K * angle),), 3, catalogue=only,
                           options=js.DiscoveryOptions(max_effects=1))[0]
@@ -424,7 +424,7 @@ def test_the_backward_step_removes_the_weakest_or_a_flipped_effect():
 
     from jaxship._analysis._discover._search import Search
 
-    search = Search(dict(entries={c.id: c for c in js.DISCOVERY_CATALOGUE}, data=None,
+    search = Search(dict(entries={c.id: c for c in js.effects.DISCOVERY_CATALOGUE}, data=None,
                          loss=lambda m: SimpleNamespace(wind=False)))
     search.level = 0.01 / 60  # threshold 14.2 for one degree of freedom
     strong = (0.02, 1e-4)
@@ -457,7 +457,7 @@ def test_the_backward_step_refits_without_the_removed_effect_and_bars_it():
         refits.append(([e.id for e in start.effects], free))
         return _path_of((0.02, 1e-4), (1e-3, 1e-5)).fit  # a stand-in for the refit
 
-    search = Search(dict(entries={c.id: c for c in js.DISCOVERY_CATALOGUE}, data=None,
+    search = Search(dict(entries={c.id: c for c in js.effects.DISCOVERY_CATALOGUE}, data=None,
                          loss=lambda m: SimpleNamespace(wind=False), say=lambda m: None,
                          free=("K", "T"), holdout=None))
     search.level, search.refit = 0.01 / 60, refit

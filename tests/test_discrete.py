@@ -16,10 +16,10 @@ from jaxship._estimate._discrete import (
 )
 
 
-EXACT, EULER = js.ExactDiscretisation(), js.EulerDiscretisation()
+EXACT, EULER = js.strategies.ExactDiscretisation(), js.strategies.EulerDiscretisation()
 
 
-ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
+ZOH = js.strategies.ZeroOrderHold()  # the replayed rudder held over each interval
 
 
 H = 0.2

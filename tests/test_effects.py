@@ -13,8 +13,8 @@ from scipy.integrate import quad
 import jaxship as js
 
 
-FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
-ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
+FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
+ZOH = js.strategies.ZeroOrderHold()  # the replayed rudder held over each interval
 
 
 DEG = np.pi / 180

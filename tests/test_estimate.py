@@ -21,7 +21,7 @@ from jaxship._estimate._linear import initial_estimate
 from jaxship._foundation._params import Free, Transform, resolve_free
 
 
-FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
 
 
 DEG = np.pi / 180

@@ -57,7 +57,7 @@ def test_batched_trajectory_is_refused():
 def test_fit_frame_has_one_row_per_free_parameter():
     model = js.Nomoto1(K=0.1, T=20.0)
     delta = np.deg2rad(10.0) * np.sign(np.sin(2 * np.pi * np.arange(400) / 120.0) + 1e-9)
-    sim = js.simulate(model, js.Replay(delta, dt=0.5, delta_hold=js.FirstOrderHold()),
+    sim = js.simulate(model, js.Replay(delta, dt=0.5, delta_hold=js.strategies.FirstOrderHold()),
                       simulator=per_sample())  # a logged rudder angle
     rng = np.random.default_rng(0)
     data = js.Experiment(0.5 * np.arange(400), delta, psi=np.asarray(sim.state.psi),

@@ -42,7 +42,7 @@ def results() -> dict:
     records = []
     for k, num in enumerate((170, 230, 310)):
         delta = np.where((np.arange(num) // 40) % 2 == 0, 10.0, -10.0) * DEG * (1 + 0.2 * k)
-        tr = js.simulate(truth, js.Replay(delta, dt=0.5, delta_hold=js.FirstOrderHold()),
+        tr = js.simulate(truth, js.Replay(delta, dt=0.5, delta_hold=js.strategies.FirstOrderHold()),
                          simulator=per_sample())
         noise = 1e-3 * np.sin(np.arange(num) * (1.3 + k))
         records.append(js.Experiment(np.asarray(tr.t), delta,

@@ -32,8 +32,8 @@ from jaxship.cli._identification import (
 )
 
 
-FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
-ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
+FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
+ZOH = js.strategies.ZeroOrderHold()  # the replayed rudder held over each interval
 
 
 DEG = np.pi / 180
@@ -465,7 +465,7 @@ def test_vessel_preset_recovers_its_default_free_coefficients(tmp_path, capsys):
     # the zig-zag logic at the 1 s samples, reversing at a step (not inside one), so that
     # the logged command is all it ordered
     trial = js.simulate(truth, js.ZigZag(20 * DEG, 20 * DEG, duration=200.0, dt=1.0,
-                                         switch_at=js.SwitchAtNearestStep()),
+                                         switch_at=js.strategies.SwitchAtNearestStep()),
                         js.straight_run(truth), simulator=js.Simulator(max_step=1.0))
     path = write(tmp_path / "zz.csv", js.Experiment.from_trajectory(trial, name="zz"))
     out = tmp_path / "id"

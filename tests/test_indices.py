@@ -100,7 +100,7 @@ def circle_track(*, side, psi0=30 * DEG, u0=8.0, u1=5.0, radius=400.0, t_e=20.0,
 def test_turning_indices_of_a_perfect_circle(side):
     radius, u0, u1, t_e = 400.0, 8.0, 5.0, 20.0
     data = circle_track(side=side, radius=radius, u0=u0, u1=u1, t_e=t_e)
-    for steady in (js.SteadyFromRate(), js.SteadyFromCircle()):
+    for steady in (js.indices.SteadyFromRate(), js.indices.SteadyFromCircle()):
         ind = turning_indices(**data, steady=steady)
         assert ind.side == side and ind.steady_method == steady.name
         assert ind.execute_time == t_e
@@ -134,7 +134,7 @@ def test_turning_errors():
         turning_indices(**data)
     data = circle_track(side=1, turned=200 * DEG)
     with pytest.raises(ValueError, match="360"):
-        turning_indices(**data, steady=js.SteadyFromCircle())
+        turning_indices(**data, steady=js.indices.SteadyFromCircle())
     with pytest.raises(ValueError, match="steady"):
         turning_indices(**circle_track(side=1), steady="circle")
     straight = circle_track(side=1, turned=0.0, t_e=50.0)
@@ -546,7 +546,7 @@ def test_turning_indices_of_a_simulated_turn_port_and_starboard(toy):
                  "time_to_90", "time_to_180", "speed_loss"):
         np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=1e-9, err_msg=name)
     # a steady turn: the fitted circle over the last turn agrees with 2 U / r
-    circle = turning_indices(stbd, steady=js.SteadyFromCircle())
+    circle = turning_indices(stbd, steady=js.indices.SteadyFromCircle())
     np.testing.assert_allclose(circle.steady_turning_diameter, a.steady_turning_diameter,
                                rtol=1e-3)
     assert 0 < a.transfer < a.tactical_diameter and a.speed_loss > 0
@@ -630,7 +630,7 @@ def test_mariner_cross_check_numbers():
         # the reference's convention: the rudder reversed at its first 0.05 s step after
         # the crossing
         zigzag = js.ZigZag(angle * DEG, angle * DEG, duration=500.0, dt=0.05,
-                           switch_at=js.SwitchAtNextStep())
+                           switch_at=js.strategies.SwitchAtNextStep())
         traj = js.simulate(vessel, zigzag, x0, simulator=js.Simulator(max_step=0.05))
         ind = zigzag_indices(traj, angle * DEG)
         np.testing.assert_allclose(np.array(ind.overshoots[:4]) / DEG, overshoots, atol=0.006)

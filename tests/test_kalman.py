@@ -16,8 +16,8 @@ from jaxship._estimate._kalman import rts_smoother
 from jaxship._estimate._likelihood import fit_ml
 
 
-FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
-ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
+FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
+ZOH = js.strategies.ZeroOrderHold()  # the replayed rudder held over each interval
 
 
 DEG = np.pi / 180
@@ -177,8 +177,8 @@ def test_ml_intervals_cover_the_truth_at_about_the_nominal_rate():
 
 def test_noise_can_be_held_fixed_and_states_can_carry_process_noise():
     exp, _, _ = noisy_record(TRUTH, 400, 7)
-    res = fit_ml(Nomoto1(K=0.05, T=20.0), exp, process=js.ProcessNoise(states=("r",)),
-                    noise=js.HeldNoise({"psi": R_PSI}), channels=("psi", "r"))
+    res = fit_ml(Nomoto1(K=0.05, T=20.0), exp, process=js.strategies.ProcessNoise(states=("r",)),
+                    noise=js.strategies.HeldNoise({"psi": R_PSI}), channels=("psi", "r"))
     assert set(res.noise) == {"rudder", "Q_r", "psi", "r"}
     assert res.noise["psi"] == pytest.approx(R_PSI) and res.noise_std["psi"] == 0.0
     assert "rudder" in res.summary()
@@ -211,7 +211,7 @@ def test_fit_ml_rejects_bad_arguments_and_data():
     with pytest.raises(ValueError, match="MaximumLikelihood\\(\\) or InnovationsLeastSquares"):
         fit_ml(TRUTH, exp, criterion="ml")
     with pytest.raises(ValueError, match="not a noise term"):
-        fit_ml(TRUTH, exp, noise=js.HeldNoise({"wind": 1.0}))
+        fit_ml(TRUTH, exp, noise=js.strategies.HeldNoise({"wind": 1.0}))
     with pytest.raises(ValueError, match="AbstractSteeringModel"):
         fit_ml("nomoto1", exp)
     with pytest.raises(ValueError, match="Experiment"):

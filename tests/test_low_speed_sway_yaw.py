@@ -13,7 +13,7 @@ import jaxship as js
 from jaxship._models._vessel.sway_yaw import _cross_flow_integrals
 
 
-FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
 
 
 DEG = np.pi / 180

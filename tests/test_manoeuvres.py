@@ -171,7 +171,7 @@ def test_replay_reproduces_a_closed_loop_run_and_pads(vessel, x0):
     # the zig-zag logic acting at the samples (one control step per sample, the rudder
     # reversed at a step, not inside it), so that the sampled commands are all it ordered
     zigzag = js.simulate(vessel, js.ZigZag(15 * DEG, 5 * DEG, duration=150.0, dt=0.5,
-                                           switch_at=js.SwitchAtNearestStep()),
+                                           switch_at=js.strategies.SwitchAtNearestStep()),
                          x0, simulator=AT_SAMPLES)
     rec_delta, rec_n = np.asarray(zigzag.command.delta), np.asarray(zigzag.command.n)
     replay = js.Replay(rec_delta, rec_n, dt=0.5)
@@ -223,21 +223,21 @@ def test_zigzag_switches_when_the_heading_passes_the_switch_angle(vessel, x0, an
 
 def test_zigzag_overshoots_do_not_depend_on_the_control_step():
     """Issue 34.2: the 7 m KVLCC2's 20/20 zig-zag. The rudder reverses at the heading
-    crossing inside the control step (`switch_at=js.SwitchAtCrossing()`, the step split there), so
+    crossing inside the control step (`switch_at=js.strategies.SwitchAtCrossing()`, the step split there), so
     the overshoots at the default 0.1 s step equal those at 0.002 s to 0.05 %
     (measured 2026-11-27: 10.4899 against 10.4893 deg, 0.006 %); reversed at the
     nearest step they move by 0.9 % (10.583 deg: the issue's 10.58 against 10.48)."""
     ship = js.get_vessel("kvlcc2")
     x0 = js.straight_run(ship)
 
-    def overshoots(step, switch_at=js.SwitchAtCrossing()):
+    def overshoots(step, switch_at=js.strategies.SwitchAtCrossing()):
         zigzag = js.ZigZag(20 * DEG, 20 * DEG, duration=80.0, dt=0.1, switch_at=switch_at)
         traj = js.simulate(ship, zigzag, x0, simulator=js.Simulator(max_step=step))
         return np.asarray(js.indices.zigzag_indices(traj, 20 * DEG).overshoots[:2])
 
     fine = overshoots(0.002)
     np.testing.assert_allclose(overshoots(0.1), fine, rtol=5e-4)
-    assert abs(overshoots(0.1, js.SwitchAtNearestStep())[0] / fine[0] - 1) > 5e-3
+    assert abs(overshoots(0.1, js.strategies.SwitchAtNearestStep())[0] / fine[0] - 1) > 5e-3
 
 
 def test_reverse_spiral_reaches_the_yaw_rate_levels(vessel, x0):

@@ -132,7 +132,7 @@ def runs(vessel):
     the first step after the crossing, as mariner.m's zig-zag and the reference do)."""
     x0 = js.straight_run(vessel)
     zigzag = lambda a, h: js.ZigZag(a * DEG, h * DEG, duration=800.0, dt=DT,
-                                    switch_at=js.SwitchAtNextStep())
+                                    switch_at=js.strategies.SwitchAtNextStep())
     manoeuvres = {
         "turn+35": js.Turn(35 * DEG, duration=800.0, dt=DT),
         "turn-35": js.Turn(-35 * DEG, duration=800.0, dt=DT),

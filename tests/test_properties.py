@@ -71,7 +71,7 @@ def assert_close(read, written, key):
 
 
 @SETTINGS
-@given(experiments(), st.sampled_from([js.DisplayUnits(), js.SIUnits()]))
+@given(experiments(), st.sampled_from([js.strategies.DisplayUnits(), js.strategies.SIUnits()]))
 def test_write_then_read_gives_the_same_numbers(tmp_path_factory, experiment, units):
     path = tmp_path_factory.mktemp("roundtrip") / "trial.csv"
     js.write_trial_csv(path, experiment, units=units)
@@ -80,7 +80,7 @@ def test_write_then_read_gives_the_same_numbers(tmp_path_factory, experiment, un
     np.testing.assert_array_equal(back.t, experiment.t)  # seconds: written exactly
     for key in experiment.channels:
         written, read = getattr(experiment, key), getattr(back, key)
-        if units == js.SIUnits() or (key not in ANGLES and key != "n"):
+        if units == js.strategies.SIUnits() or (key not in ANGLES and key != "n"):
             np.testing.assert_array_equal(read, written, err_msg=key)  # no conversion: exact
         else:
             assert_close(read, written, key)
@@ -100,10 +100,10 @@ def test_write_then_read_gives_the_same_numbers(tmp_path_factory, experiment, un
 @given(experiments(limit=1e308, both=True))
 def test_huge_values_round_trip_or_are_refused_in_display_units(tmp_path_factory, experiment):
     path = tmp_path_factory.mktemp("huge") / "trial.csv"
-    js.write_trial_csv(path, experiment, units=js.SIUnits())  # always writable in SI
+    js.write_trial_csv(path, experiment, units=js.strategies.SIUnits())  # always writable in SI
     assert js.read_trial_csv(path).channels == experiment.channels
     try:
-        js.write_trial_csv(path, experiment, units=js.DisplayUnits())
+        js.write_trial_csv(path, experiment, units=js.strategies.DisplayUnits())
     except ValueError as error:
         assert "not finite in" in str(error) and "units=SIUnits()" in str(error)
     else:
@@ -114,7 +114,7 @@ def test_huge_values_round_trip_or_are_refused_in_display_units(tmp_path_factory
 
 @SETTINGS
 @given(experiments(), st.sampled_from(sorted(_PLAUSIBLE)), st.floats(1.0 + 1e-9, 1e6),
-       st.sampled_from([js.DisplayUnits(), js.SIUnits()]))
+       st.sampled_from([js.strategies.DisplayUnits(), js.strategies.SIUnits()]))
 def test_values_beyond_any_ship_are_refused_naming_the_column(tmp_path_factory, experiment,
                                                               key, factor, units):
     """A channel the reader checks, beyond what any ship logs (degrees in a column
@@ -317,14 +317,14 @@ def relabel(columns, old, new, factor=1.0):
 # of the column named, the unit it likely holds); r in deg/s labelled rad/s is left to
 # the yaw-rate bound (`_PLAUSIBLE`) when beyond it
 CORRUPTIONS = {
-    "psi in deg labelled rad": (js.SIUnits(), lambda c: relabel(c, "psi [rad]", "psi [rad]",
+    "psi in deg labelled rad": (js.strategies.SIUnits(), lambda c: relabel(c, "psi [rad]", "psi [rad]",
                                                         180 / math.pi), "psi [rad]", "deg"),
-    "psi in rad labelled deg": (js.DisplayUnits(), lambda c: relabel(c, "psi [deg]", "psi [deg]",
+    "psi in rad labelled deg": (js.strategies.DisplayUnits(), lambda c: relabel(c, "psi [deg]", "psi [deg]",
                                                              math.pi / 180), "psi [deg]", "rad"),
-    "r in rad/s labelled deg/s": (js.DisplayUnits(), lambda c: relabel(c, "r [deg/s]", "r [deg/s]",
+    "r in rad/s labelled deg/s": (js.strategies.DisplayUnits(), lambda c: relabel(c, "r [deg/s]", "r [deg/s]",
                                                                math.pi / 180), "r [deg/s]",
                                   "rad/s"),
-    "t in ms labelled s": (js.DisplayUnits(),
+    "t in ms labelled s": (js.strategies.DisplayUnits(),
                            lambda c: relabel(c, "t [s]", "t [s]", 1000.0), "t [s]", "ms"),
 }
 

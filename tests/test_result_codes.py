@@ -11,7 +11,7 @@ from helpers import per_sample
 import jaxship as js
 
 
-FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
 
 
 DEG = np.pi / 180

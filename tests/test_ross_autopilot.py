@@ -24,8 +24,8 @@ from jaxship._models._steering.ross import HULL_TERMS, ROSS_FREE, SPEED_RUDDER
 from jaxship.cli.reproduction import thesis as ti
 
 
-FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
-ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
+FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
+ZOH = js.strategies.ZeroOrderHold()  # the replayed rudder held over each interval
 
 
 DEG = np.pi / 180

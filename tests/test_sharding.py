@@ -19,7 +19,7 @@ from jaxship._estimate import _fit
 from jaxship._models._vessel.catalogue import get_vessel
 
 
-FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
 
 
 DEG = np.pi / 180

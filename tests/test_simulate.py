@@ -225,7 +225,7 @@ def test_replay_reproduces_closed_loop_run(vessel, x0):
     # reversed at a 0.1 s control step (not inside one): the commands at the 0.1 s
     # samples are all it ordered
     closed = js.simulate(vessel, js.ZigZag(10 * DEG, 10 * DEG, duration=200.0,
-                                           switch_at=js.SwitchAtNearestStep()), x0)
+                                           switch_at=js.strategies.SwitchAtNearestStep()), x0)
     replay = js.Replay(closed.command.delta, closed.command.n, dt=0.1)
     opened = js.simulate(vessel, replay, x0)
     np.testing.assert_allclose(opened.state.psi, closed.state.psi, atol=1e-12)

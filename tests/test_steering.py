@@ -15,8 +15,8 @@ from jaxship import AuxInputs, Nomoto1, Nomoto2, NonlinearNomoto
 from jaxship._models._steering import WindowStart
 
 
-FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
-ZOH = js.ZeroOrderHold()  # the replayed rudder held over each interval
+FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
+ZOH = js.strategies.ZeroOrderHold()  # the replayed rudder held over each interval
 
 
 DEG = np.pi / 180

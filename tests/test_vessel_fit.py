@@ -18,7 +18,7 @@ from jaxship._models._steering._base import AbstractSteeringModel
 from jaxship._simulation._data import OVER_GROUND
 
 
-FOH = js.FirstOrderHold()  # the replayed rudder linear between samples
+FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
 
 
 DEG = np.pi / 180
@@ -42,10 +42,10 @@ def perturbed(vessel, names, factors):
 def two_trials():
     """A 20/20 zig-zag at 500 rpm (60 s) and a PRBS at 300 rpm (45 s): merged experiments
     of different lengths and propeller rates. The zig-zag reverses the rudder at a control
-    step (`switch_at=js.SwitchAtNearestStep()`), so that the 0.1 s samples replay it exactly."""
+    step (`switch_at=js.strategies.SwitchAtNearestStep()`), so that the 0.1 s samples replay it exactly."""
     return [
         trial(THESIS, js.ZigZag(20 * DEG, 20 * DEG, duration=60.0, dt=0.1, n=500 / 60,
-                                switch_at=js.SwitchAtNearestStep()), 500, "zigzag"),
+                                switch_at=js.strategies.SwitchAtNearestStep()), 500, "zigzag"),
         trial(THESIS, js.prbs(15 * DEG, 4.0, 45.0, dt=0.1, n=300 / 60), 300, "prbs"),
     ]
 
@@ -272,9 +272,9 @@ def test_recovers_twenty_coefficients_with_wind_and_a_zero_start():
     names = FREE20 + ("y_uuv",)
     # the zig-zags reverse at a control step, so that the 0.1 s samples replay them exactly
     mans = [(js.ZigZag(20 * DEG, 20 * DEG, duration=80.0, dt=0.1, n=500 / 60,
-                       switch_at=js.SwitchAtNearestStep()), 500),
+                       switch_at=js.strategies.SwitchAtNearestStep()), 500),
             (js.ZigZag(-10 * DEG, 10 * DEG, duration=60.0, dt=0.1, n=300 / 60,
-                       switch_at=js.SwitchAtNearestStep()), 300),
+                       switch_at=js.strategies.SwitchAtNearestStep()), 300),
             (js.prbs(20 * DEG, 3.0, 60.0, dt=0.1, n=400 / 60), 400),
             (js.Turn(35 * DEG, duration=50.0, dt=0.1, n=500 / 60), 500)]
     data = []

@@ -46,7 +46,7 @@ def record(truth, manoeuvre, name, rng, *, disturbance_std=0.0, noise=(0.1, 0.05
     psi, r = np.asarray(out.state.psi), np.asarray(out.state.r)
     if disturbance_std:
         w = disturbance(t, disturbance_std, int(rng.integers(2**31)))
-        replay = js.Replay(delta + w, dt=float(t[1] - t[0]), delta_hold=js.FirstOrderHold())
+        replay = js.Replay(delta + w, dt=float(t[1] - t[0]), delta_hold=js.strategies.FirstOrderHold())
         out = js.simulate(truth, replay,
                           simulator=js.Simulator(max_step=math.inf, substeps=25))
         psi, r = np.asarray(out.state.psi), np.asarray(out.state.r)
@@ -197,7 +197,7 @@ def vessel_records(truth, seed, *, duration=800.0, noise=(0.1, 0.05, 0.02, 0.02,
     # the helm reverses the rudder at the control step nearest to the crossing (10 Hz), as
     # a sampled autopilot does, not inside a step (the default)
     zigzag = functools.partial(js.ZigZag, duration=duration, dt=0.5,
-                               switch_at=js.SwitchAtNearestStep())
+                               switch_at=js.strategies.SwitchAtNearestStep())
     train = [one(zigzag(a * DEG, s * a * DEG),
                  f"zigzag {a}/{a} {'starboard' if s > 0 else 'port'}") for a, s in TRAIN]
     holdout = [one(js.Turn(a * DEG, duration=duration, dt=0.5), f"turn {a:+d}")

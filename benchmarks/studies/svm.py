@@ -135,7 +135,7 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
         table1.append((f"{key[0]} ({key[1]})", o1, o2))
         general[key] = {}
         for name, rec in records.items():
-            replay = js.Replay(rec.delta, dt=rec.dt, delta_hold=js.FirstOrderHold())
+            replay = js.Replay(rec.delta, dt=rec.dt, delta_hold=js.strategies.FirstOrderHold())
             sim = js.simulate(model, replay,
                               simulator=js.Simulator(max_step=math.inf, substeps=2))
             general[key][name] = js.fit_percent(rec.r, np.asarray(sim.state.r))

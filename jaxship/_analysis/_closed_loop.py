@@ -15,7 +15,7 @@ from .._models._effects import RecordedDisturbance, augment
 from .._models._environment import Environment
 from .._models._steering._base import AbstractSteeringModel
 from .._models._vessel._base import AbstractVessel, straight_run
-from .._simulation._batch import stack, straight_run_batch
+from .._simulation._batch import stack
 from .._simulation._data import sampling_tolerance
 from .._simulation._integrate import Held, Simulator, integrate
 from .._simulation._simulate import _as_arrays, initial_vector, vessel_field
@@ -100,7 +100,7 @@ def initial_states(plant, speeds=None, rpm=None) -> ShipState:
     if isinstance(plant, AbstractVessel):
         if speeds is None and n is None:
             return jax.tree.map(lambda a: jnp.asarray(a)[None], straight_run(plant))
-        return straight_run_batch(plant, speed=speeds, n=n)
+        return straight_run(plant, speed=speeds, n=n)
     if not isinstance(plant, AbstractSteeringModel):
         raise ValueError(f"`plant` must be a vessel or a steering model, got "
                          f"{type(plant).__name__}.")

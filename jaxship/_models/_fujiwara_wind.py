@@ -55,8 +55,12 @@ TERMS = {
 }
 
 
-def _ratios(L, B, A_T, A_L, A_OD, x_AL, z_AL, x_AOD, H_BR) -> dict:
-    """The geometric ratios of `TERMS`, by name."""
+def _ratios(loads, A_T, A_L) -> dict:
+    """The geometric ratios of `TERMS`, by name, of a `FujiwaraWindLoads` and the
+    projected areas $A_T$, $A_L$."""
+    L, B, A_OD = loads.length_overall, loads.breadth, loads.superstructure_area
+    x_AL, z_AL = loads.area_centre_x, loads.area_centre_height
+    x_AOD, H_BR = loads.superstructure_x, loads.bridge_height
     return {
         "B H_BR/A_T": B * H_BR / A_T, "x_AL/z_AL": x_AL / z_AL, "A_OD/L^2": A_OD / L**2,
         "A_L/(L B)": A_L / (L * B), "L z_AL/A_L": L * z_AL / A_L,
@@ -87,9 +91,7 @@ class FujiwaraWindLoads(AbstractWindLoads):
     def coefficients(self, frontal_area, lateral_area) -> dict:
         """$X_0, X_1, X_3, X_5, Y_1, Y_3, Y_5, N_1, N_2, N_3$ [-] by name, for the
         vessel's transverse and lateral projected areas $A_T$, $A_L$ [m^2]."""
-        ratios = _ratios(self.length_overall, self.breadth, frontal_area, lateral_area,
-                         self.superstructure_area, self.area_centre_x,
-                         self.area_centre_height, self.superstructure_x, self.bridge_height)
+        ratios = _ratios(self, frontal_area, lateral_area)
         return {name: constant + sum(a * ratios[ratio] for a, ratio in terms)
                 for name, (constant, terms) in TERMS.items()}
 

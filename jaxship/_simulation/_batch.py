@@ -16,11 +16,11 @@ import numpy as np
 from jax.sharding import PartitionSpec as P
 
 from .._foundation._sharding import AXIS, batch_mesh, gathered, pad_batch
-from .._foundation._state import Trajectory, straight_state
+from .._foundation._state import Trajectory
 from .._models._environment import Environment
 from .._models._manoeuvres import Replay
 from .._models._steering._base import AbstractSteeringModel
-from .._models._vessel._base import straight_run, surge_force
+from .._models._vessel._base import straight_run
 from ._integrate import RK4, WRITTEN_OUT_BATCH, Simulator
 from ._simulate import _as_arrays, _is_static_zero, _simulate
 from ._simulate_steering import _replay, _steer, at_rest
@@ -108,7 +108,7 @@ def simulate_batch(
     elif x0 is None:
         if in_axes[0] is not None:
             raise ValueError("a batch of vessels needs its initial states `x0` (e.g. "
-                             "`straight_run_batch`).")
+                             "`straight_run` of arrays).")
         x0 = straight_run(model)
     wind = not _is_static_zero(getattr(getattr(environment, "wind", None), "speed", None))
     batched, shared, size = _split_batch(in_axes,
@@ -196,42 +196,6 @@ def _batched(b_dyn, s_dyn, b_static, s_static, simulator, steps, output, wind, s
     # trimming the padding gathers the result (XLA shards only evenly): choose batch
     # sizes divisible by the device count to keep large outputs split over the devices
     return out if padded == size else jax.tree.map(lambda a: a[:size], out)
-
-
-def straight_run_batch(vessel, *, speed=None, n=None, iterations: int = 40):
-    """Straight runs for arrays of propeller rates `n` [rev/s] or speeds `speed` [m/s].
-
-    The vectorised counterpart of `jaxship.straight_run` (one compiled Newton
-    iteration on the surge force for all values at once): give `n` to solve for the
-    equilibrium speed, or `speed` to solve for the self-propulsion rate. Returns a
-    `ShipState` with the batch axis of the input. For vessels without a propeller term
-    give both (nothing to solve).
-    """
-    if speed is None and n is None:
-        raise ValueError("give `speed` or `n` (arrays).")
-    speed = None if speed is None else jnp.asarray(speed, dtype=float)
-    n = None if n is None else jnp.asarray(n, dtype=float)
-    u, rate = _straight_runs(_as_arrays(vessel), speed, n, iterations)
-    return straight_state(u, rate)
-
-
-@eqx.filter_jit
-def _straight_runs(vessel, speed, n, iterations):
-    def newton(f, x):
-        def body(_, x):
-            fx, dfx = jax.value_and_grad(f)(x)
-            return jnp.where(jnp.abs(dfx) > 1e-300, x - fx / jnp.where(dfx == 0, 1.0, dfx), x)
-
-        return jax.lax.fori_loop(0, iterations, body, x)
-
-    if speed is not None and n is not None:
-        return speed, n
-    if n is None:
-        guess = jnp.asarray(vessel.nominal_n, dtype=float)
-        rate = jax.vmap(lambda uu: newton(lambda nn: surge_force(vessel, uu, nn), guess))(speed)
-        return speed, rate
-    guess = jnp.asarray(vessel.nominal_speed, dtype=float)
-    return jax.vmap(lambda nn: newton(lambda uu: surge_force(vessel, uu, nn), guess))(n), n
 
 
 # --------------------------------------------------------------------------- indices

@@ -6,6 +6,7 @@ from typing import ClassVar
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jaxtyping import Array
 
 from ..._foundation._contract import AbstractModel
@@ -231,6 +232,9 @@ def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> Ship
     solve for the equilibrium speed; with neither, the vessel's nominal approach.
     Vessels without a propeller term keep `n` as given and `speed` as given.
 
+    Arrays of `speed` or `n` give a batch of straight runs (a `ShipState` with their
+    shape: a sweep's starts), solved by one compiled Newton iteration for all values.
+
     Raises `ValueError` where no such state exists: the surge force left at the state
     found exceeds $10^{-3}\\,m_{11} U^2/L$, $U$ the larger of u and the nominal speed
     (0.45 % off its nominal speed on the Mariner, whose surge equation has no propeller
@@ -238,6 +242,8 @@ def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> Ship
     """
     if speed is None and n is None:
         speed, n = vessel.nominal_speed, vessel.nominal_n
+    if np.ndim(speed) or np.ndim(n):
+        return _straight_runs(vessel, speed, n, psi)
     if n is None:
         n = _newton(lambda nn: _surge_and_slope(vessel, _f(speed), nn, "n"), vessel.nominal_n)
     elif speed is None:
@@ -253,6 +259,55 @@ def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> Ship
             f"equation balances at {float(vessel.nominal_speed):.4g} m/s"
             + (" only: it has no propeller term)." if not _has_propeller(vessel) else ")."))
     return straight_state(speed, n, psi)
+
+
+def _straight_runs(vessel, speed, n, psi) -> ShipState:
+    """`straight_run` for arrays of `speed` or `n` (the other None, or both given: nothing
+    to solve), with the same check of the surge force left."""
+    speed = None if speed is None else _f(speed)
+    n = None if n is None else _f(n)
+    dtype = jax.dtypes.canonicalize_dtype(np.float64)  # numbers traced, not static
+    arrays = jax.tree.map(lambda x: np.asarray(x, dtype=dtype)
+                          if isinstance(x, (float, int)) and not isinstance(x, bool) else x,
+                          vessel)
+    speed, n, residual = _solve_straight_runs(arrays, speed, n)
+    reference = np.maximum(np.abs(np.asarray(speed)), float(vessel.nominal_speed))
+    scale = float(_surge_mass(vessel)) * reference**2 / float(vessel.length)
+    bad = ~(np.abs(np.asarray(residual)) <= 1e-3 * scale)
+    if bad.any():
+        i = np.flatnonzero(bad.ravel())[0]
+        u_bad, n_bad = (float(np.ravel(np.asarray(x))[i]) for x in np.broadcast_arrays(speed, n))
+        raise ValueError(
+            f"{type(vessel).__name__} has no straight run at u = {u_bad:.4g} m/s, n = "
+            f"{n_bad:.4g} rev/s ({int(bad.sum())} of {bad.size} values): a surge force is "
+            f"left (its surge equation balances at {float(vessel.nominal_speed):.4g} m/s"
+            + (" only: it has no propeller term)." if not _has_propeller(vessel) else ")."))
+    return straight_state(speed, n, psi)
+
+
+@eqx.filter_jit
+def _solve_straight_runs(vessel, speed, n, iterations=40):
+    """Newton's iteration on the surge force X(u, n) = 0 for every value at once (a
+    fixed count of steps, a guard where X does not depend on the unknown), and the force
+    left."""
+    def newton(f, x):
+        def body(_, x):
+            fx, dfx = jax.value_and_grad(f)(x)
+            return jnp.where(jnp.abs(dfx) > 1e-300, x - fx / jnp.where(dfx == 0, 1.0, dfx), x)
+
+        return jax.lax.fori_loop(0, iterations, body, x)
+
+    if n is None:
+        guess = jnp.asarray(vessel.nominal_n, dtype=float)
+        n = jax.vmap(lambda uu: newton(lambda nn: surge_force(vessel, uu, nn), guess))(
+            speed.ravel()).reshape(speed.shape)
+    elif speed is None:
+        guess = jnp.asarray(vessel.nominal_speed, dtype=float)
+        speed = jax.vmap(lambda nn: newton(lambda uu: surge_force(vessel, uu, nn), guess))(
+            n.ravel()).reshape(n.shape)
+    speed, n = jnp.broadcast_arrays(speed, n)
+    residual = jax.vmap(lambda uu, nn: surge_force(vessel, uu, nn))(speed.ravel(), n.ravel())
+    return speed, n, residual.reshape(speed.shape)
 
 
 def _has_propeller(vessel) -> bool:

@@ -176,7 +176,7 @@ def thesis_experiments(vessel=None, *, families=None, settings: Settings = Setti
 def simulate_record(model, e: js.Experiment, substeps: int = 2) -> np.ndarray:
     """Yaw rate [rad/s] of `model` simulated over the record `e` from its first
     sample with its rudder, u, v and n replayed (no restarts: output error)."""
-    tr = js.simulate(model, js.Replay(e.delta, dt=e.dt, delta_hold=js.FirstOrderHold()),
+    tr = js.simulate(model, js.Replay(e.delta, dt=e.dt, delta_hold=js.strategies.FirstOrderHold()),
                      dataclasses.replace(js.straight_state(0.0, psi=e.psi[0]), r=e.r[0]),
                      aux=js.AuxInputs(u=e.u, v=e.v, n=e.n),
                      simulator=js.Simulator(max_step=math.inf, substeps=substeps))
