@@ -101,7 +101,7 @@ def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 6
     for e, name in enumerate(ds.names):
         n, dt = int(ds.lengths[e]), float(ds.dt[e])
         hit = np.asarray(out.predicted[e, :n] & ds.mask[e, :n])
-        records[name], worst = {}, None
+        records[name] = {}
         for c in channels:
             y = np.asarray(getattr(ds, c)[e, :n], dtype=float)
             err = np.where(hit, (y - out.predictions[c][e, :n]) / (np.std(y[hit]) or 1.0), 0.0)
@@ -110,15 +110,7 @@ def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 6
                                 "rms": float(np.sqrt(np.mean(err[hit] ** 2)))}
         # the heading's output error integrates every earlier error: windows by the rest
         local = [c for c in channels if c != "psi"] or list(channels)
-        total = sum(res[c][-1] ** 2 for c in local)
-        span = max(int(round(window / dt)), 1)
-        if n > span:
-            moving = np.convolve(total, np.ones(span) / span, mode="valid")
-            k = int(np.argmax(moving))
-            worst = {"start_s": float(ds.t[e, k]), "end_s": float(ds.t[e, k + span - 1]),
-                     "rms": float(np.sqrt(moving[k])),
-                     "record_rms": float(np.sqrt(np.mean(total)))}
-        windows[name] = worst
+        windows[name] = _worst_window(ds, e, sum(res[c][-1] ** 2 for c in local), window)
         signals = _signals(ds, e, n)
         for key, value in signals.items():
             sig.setdefault(key, []).append(value)
@@ -128,6 +120,34 @@ def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 6
             reg.setdefault(key, []).append(mask & hit)
     res = {c: np.concatenate(v) for c, v in res.items()}
     total = sum(v**2 for v in res.values())
+    regions, band = _region_shares(reg, total), 1.96 / np.sqrt(total.size)
+    correlations, whiteness = _residual_correlations(res, sig, ds, band)
+    loads = residual_loads(model, ds, wind=wind, smoothed=smoothed) if vessel else None
+    forces = None if loads is None else {
+        name: _describe_load(loads[name], sig, ds, unit) for name, unit in LOADS}
+    return {"records": records, "windows": windows, "regions": regions,
+            "sides": _turning_sides(res, sig), "correlations": correlations,
+            "band": float(band), "whiteness": whiteness,
+            "regions_defined": {k: REGIONS[k] for k in regions}, "forces": forces}
+
+
+def _worst_window(ds, e, total, window) -> dict | None:
+    """The `window`-second stretch of record `e` with the largest mean of `total` (the
+    squared residuals summed over channels), with the record's RMS; None for a record
+    no longer than the window."""
+    n, dt = int(ds.lengths[e]), float(ds.dt[e])
+    span = max(int(round(window / dt)), 1)
+    if n <= span:
+        return None
+    moving = np.convolve(total, np.ones(span) / span, mode="valid")
+    k = int(np.argmax(moving))
+    return {"start_s": float(ds.t[e, k]), "end_s": float(ds.t[e, k + span - 1]),
+            "rms": float(np.sqrt(moving[k])), "record_rms": float(np.sqrt(np.mean(total)))}
+
+
+def _region_shares(reg, total) -> dict:
+    """Per state region: the fraction of samples in it, its share of the squared residual
+    `total`, and their ratio (None for an empty region)."""
     regions = {}
     for key, masks in reg.items():
         mask = np.concatenate(masks)
@@ -135,30 +155,36 @@ def locate_disagreement(model, data, channels=("psi", "r"), *, window: float = 6
         share = float(np.sum(total[mask]) / (np.sum(total) or 1.0))
         regions[key] = {"fraction": fraction, "share": share,
                         "ratio": share / fraction if fraction > 0 else None}
+    return regions
+
+
+def _turning_sides(res, sig) -> dict:
+    """Per channel the mean residual turning to starboard (r > 0) and to port, and its
+    symmetric and antisymmetric parts, in residual standard deviations (none without r)."""
     sides = {}
-    if "r" in sig:
-        r = np.concatenate(sig["r"])
-        for c, e in res.items():
-            s, p, spread = e[r > 0], e[r < 0], float(np.std(e)) or 1.0
-            if s.size and p.size:
-                ms, mp = float(np.mean(s)), float(np.mean(p))
-                sides[c] = {"starboard": ms / spread, "port": mp / spread,
-                            "symmetric": 0.5 * (ms + mp) / spread,
-                            "antisymmetric": 0.5 * (ms - mp) / spread}
-    n_total = total.size
-    band = 1.96 / np.sqrt(n_total)
+    if "r" not in sig:
+        return sides
+    r = np.concatenate(sig["r"])
+    for c, e in res.items():
+        s, p, spread = e[r > 0], e[r < 0], float(np.std(e)) or 1.0
+        if s.size and p.size:
+            ms, mp = float(np.mean(s)), float(np.mean(p))
+            sides[c] = {"starboard": ms / spread, "port": mp / spread,
+                        "symmetric": 0.5 * (ms + mp) / spread,
+                        "antisymmetric": 0.5 * (ms - mp) / spread}
+    return sides
+
+
+def _residual_correlations(res, sig, ds, band):
+    """Per channel the largest correlation of its residual with each signal, and the
+    fraction of its autocorrelations outside `band`."""
     ends = np.cumsum([int(n) for n in ds.lengths])[:-1]
     correlations, whiteness = {}, {}
     for c, e in res.items():
         per_record = np.split(e, ends)
         correlations[c] = {k: _largest_correlation(per_record, sig[k], ds) for k in sig}
         whiteness[c] = _outside_band(per_record, band)
-    loads = residual_loads(model, ds, wind=wind, smoothed=smoothed) if vessel else None
-    forces = None if loads is None else {
-        name: _describe_load(loads[name], sig, ds, unit) for name, unit in LOADS}
-    return {"records": records, "windows": windows, "regions": regions, "sides": sides,
-            "correlations": correlations, "band": float(band), "whiteness": whiteness,
-            "regions_defined": {k: REGIONS[k] for k in regions}, "forces": forces}
+    return correlations, whiteness
 
 
 def _describe_load(per_record, sig, ds, unit) -> dict:
