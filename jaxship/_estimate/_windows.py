@@ -11,6 +11,7 @@ are padded to common (windows, steps) shapes with a mask.
 """
 
 import math
+from typing import NamedTuple
 
 import equinox as eqx
 import jax
@@ -208,7 +209,52 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
     measured. `hold`: see `resolve_holds`; `wind`: also replay the measured wind, and
     the apparent wind it makes (`apparent_wind`) for steering models."""
     lengths = window_lengths(ds, horizon)
-    num_exp, num = ds.num_experiments, ds.num_samples
+    index = _window_index(ds, lengths)
+    num_exp, num_w = ds.num_experiments, index.start.shape[1]
+    derived = apparent_wind(ds) if wind else {}
+    samples = _Samples(ds, derived, starts)
+    weights = channel_weights(ds, channels, weights)
+    dt_e = np.asarray(ds.dt, dtype=np.float64)
+    dt = np.broadcast_to(dt_e[:, None], (num_exp, num_w))
+    rud = np.asarray(getattr(ds, rudder), dtype=np.float64)
+    names = ("delta", "u", "v", "n") + (("wind_speed", "wind_dir", *derived) if wind else ())
+    holds = resolve_holds(rudder, hold, names)
+    f = lambda a: jnp.asarray(a, dtype=float)
+    rows = np.arange(num_exp)[:, None, None]
+    records = {name: f(rud[rows, index.record] if name == "delta" else
+                       samples.at(name, index.record, rows)) for name in names}
+    windows = Windows(
+        records=records,
+        dt=f(dt),
+        start=_window_start(samples, rud, dict(holds)["delta"], index.start, names),
+        targets=f(np.stack([samples.at(c, index.target, rows) for c in channels])),
+        mask=jnp.asarray(index.mask),
+        weights=f(weights),
+        channels=tuple(channels),
+        substeps=simulator.steps_per_sample(np.asarray(dt)),
+        simulator=simulator,
+        holds=holds,
+        servo=rudder == "delta_c",
+    )
+    layout = {"target": index.target, "mask": index.mask, "lengths": lengths,
+              "weights": weights}
+    return windows, layout
+
+
+class _WindowIndex(NamedTuple):
+    """NumPy index arrays of the windows: `start` (E, W) first sample, `target` (E, W, L)
+    predicted samples (clipped to the dataset), `mask` (E, W, L) the real ones, `record`
+    (E, W, L + 1) the samples replayed (beyond a record's end its last sample holds)."""
+
+    start: np.ndarray
+    target: np.ndarray
+    mask: np.ndarray
+    record: np.ndarray
+
+
+def _window_index(ds: Dataset, lengths) -> _WindowIndex:
+    """Cut each record into windows of `lengths[e]` samples after a start sample."""
+    num = ds.num_samples
     counts = [len(range(0, n - 1, L)) for n, L in zip(ds.lengths, lengths)]
     num_w, num_l = max(counts), max(lengths)
     w_idx = np.arange(num_w)[None, :, None]
@@ -221,68 +267,61 @@ def build_windows(ds: Dataset, *, horizon, channels, weights, rudder: str = "del
     # the samples replayed in each window: its start and the L after it (clipped to the
     # experiment: beyond its end the last sample holds)
     record_index = np.minimum(start + np.arange(num_l + 1)[None, None, :], valid_len - 1)
-    target_index = np.clip(target, 0, num - 1)
-    start_index = np.clip(start[..., 0], 0, num - 1)  # (E, W)
-    rows = np.arange(num_exp)[:, None, None]
-    rows2 = np.arange(num_exp)[:, None]
+    return _WindowIndex(start=np.clip(start[..., 0], 0, num - 1),
+                        target=np.clip(target, 0, num - 1), mask=mask, record=record_index)
 
-    derived = apparent_wind(ds) if wind else {}
 
-    def at(name, index, r):
-        return np.asarray(derived[name] if name in derived else getattr(ds, name),
-                          dtype=np.float64)[r, index]
+class _Samples(NamedTuple):
+    """The dataset's channels (with the derived apparent wind) and the start values that
+    replace the measured ones (`starts`, or None)."""
 
-    def start_at(name, index, r):
-        if starts is not None and name in starts:
-            return np.asarray(starts[name], dtype=np.float64)[r, index]
-        return at(name, index, r)
+    ds: Dataset
+    derived: dict
+    starts: dict | None
 
-    weights = channel_weights(ds, channels, weights)
+    def at(self, name, index, r):
+        """Samples of channel `name` at rows `r`, columns `index`."""
+        return np.asarray(self.derived[name] if name in self.derived
+                          else getattr(self.ds, name), dtype=np.float64)[r, index]
+
+    def start_at(self, name, index, r):
+        """As `at`, from the given start values where there are any."""
+        if self.starts is not None and name in self.starts:
+            return np.asarray(self.starts[name], dtype=np.float64)[r, index]
+        return self.at(name, index, r)
+
+
+def _window_start(samples: _Samples, rud, rudder_hold, start_index, names) -> WindowStart:
+    """Each window's start: states, rudder, the replayed rudder's integral up to it
+    (trapezoidal for a first-order hold, rectangles for a zero-order hold: exact for
+    either), the first sample's states, elapsed time and track position."""
+    ds = samples.ds
+    num_exp, num_w = start_index.shape
     dt_e = np.asarray(ds.dt, dtype=np.float64)
-    dt = np.broadcast_to(dt_e[:, None], (num_exp, num_w))
-    rud = np.asarray(getattr(ds, rudder), dtype=np.float64)
-    # integral of the replayed rudder from the first sample to sample k (trapezoidal for
-    # a first-order hold, rectangles for a zero-order hold: exact for either)
-    names = ("delta", "u", "v", "n") + (("wind_speed", "wind_dir", *derived) if wind else ())
-    holds = resolve_holds(rudder, hold, names)
-    pieces = dict(holds)["delta"].interval_mean(rud[:, :-1], rud[:, 1:])
+    rows2 = np.arange(num_exp)[:, None]
+    pieces = rudder_hold.interval_mean(rud[:, :-1], rud[:, 1:])
     integral = np.concatenate([np.zeros((num_exp, 1)), np.cumsum(pieces, axis=1)], axis=1)
     integral = integral * dt_e[:, None]
     first = lambda name: np.broadcast_to(
-        start_at(name, np.zeros((1, 1), dtype=int), np.arange(num_exp)[:, None]),
+        samples.start_at(name, np.zeros((1, 1), dtype=int), np.arange(num_exp)[:, None]),
         (num_exp, num_w))
     f = lambda a: jnp.asarray(a, dtype=float)
-    start_values = WindowStart(
-        r=f(start_at("r", start_index, rows2)),
-        psi=f(start_at("psi", start_index, rows2)),
+    at = lambda name: f(samples.at(name, start_index, rows2))
+    start_at = lambda name: f(samples.start_at(name, start_index, rows2))
+    return WindowStart(
+        r=start_at("r"),
+        psi=start_at("psi"),
         delta=f(rud[rows2, start_index]),
         r_first=f(first("r")),
         psi_first=f(first("psi")),
         delta_integral=f(integral[rows2, start_index]),
         elapsed=f(start_index * dt_e[:, None]),
-        aux=AuxInputs(*(f(start_at(c, start_index, rows2)) if c in names else None
+        aux=AuxInputs(*(start_at(c) if c in names else None
                         for c in ("u", "v", "n", "wind_u", "wind_v"))),
-        rudder_angle=f(at("delta", start_index, rows2)),
-        x=f(at("x", start_index, rows2)), y=f(at("y", start_index, rows2)),
+        rudder_angle=at("delta"),
+        x=at("x"), y=at("y"),
         ground=f(np.broadcast_to(ds.over_ground[:, None], (num_exp, num_w))),
     )
-    records = {name: f(rud[rows, record_index] if name == "delta" else
-                       at(name, record_index, rows)) for name in names}
-    windows = Windows(
-        records=records,
-        dt=f(dt),
-        start=start_values,
-        targets=f(np.stack([at(c, target_index, rows) for c in channels])),
-        mask=jnp.asarray(mask),
-        weights=f(weights),
-        channels=tuple(channels),
-        substeps=simulator.steps_per_sample(np.asarray(dt)),
-        simulator=simulator,
-        holds=holds,
-        servo=rudder == "delta_c",
-    )
-    layout = {"target": target_index, "mask": mask, "lengths": lengths, "weights": weights}
-    return windows, layout
 
 
 def to_timeline(values, layout, shape) -> tuple[np.ndarray, np.ndarray]:
