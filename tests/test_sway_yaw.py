@@ -63,7 +63,7 @@ def test_reproduces_published_constants(factory):
     y_v, y_r, n_v, n_r, y_d, n_d = derivatives
     np.testing.assert_allclose([vessel.y_v, vessel.y_r, vessel.n_v, vessel.n_r, vessel.y_delta],
                                [y_v, y_r, n_v, n_r, -y_d], rtol=1e-15)
-    masses, n_delta, res = _derive_mass_terms(*derivatives, *constants)
+    masses, n_delta, res = _derive_mass_terms(derivatives, constants)
     np.testing.assert_allclose(-vessel.n_delta, n_delta, rtol=1e-5)
     np.testing.assert_allclose([vessel.m22, vessel.m23, vessel.m32, vessel.m33], masses,
                                rtol=2e-5)
@@ -83,8 +83,8 @@ def test_exact_derivation_is_exact():
     )
     c = {k: float(v) for k, v in ship.prime_transfer_constants().items()}
     masses, _, res = _derive_mass_terms(
-        ship.y_v, ship.y_r, ship.n_v, ship.n_r, -ship.y_delta, -ship.n_delta,
-        *(-c["K"], c["T1"], c["T2"], c["T3"], -c["Kv"], c["T3v"]),
+        (ship.y_v, ship.y_r, ship.n_v, ship.n_r, -ship.y_delta, -ship.n_delta),
+        (-c["K"], c["T1"], c["T2"], c["T3"], -c["Kv"], c["T3v"]),
     )
     np.testing.assert_allclose(masses, M.ravel(), rtol=1e-9)
     np.testing.assert_allclose(res, 0.0, atol=1e-12)

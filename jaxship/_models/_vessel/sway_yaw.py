@@ -167,8 +167,7 @@ def _transfer_constants(M, A, b):
     )
 
 
-def _derive_mass_terms(y_v, y_r, n_v, n_r, y_delta, n_delta, K, T1, T2, T3, Kv, T3v,
-                       resolution=0.005):
+def _derive_mass_terms(derivatives, constants, resolution=0.005):
     """Mass terms $(m' - Y'_{\\dot v}, m'x'_G - Y'_{\\dot r}, m'x'_G - N'_{\\dot v},
     I'_z - N'_{\\dot r})$ that reproduce published transfer-function constants.
 
@@ -179,9 +178,13 @@ def _derive_mass_terms(y_v, y_r, n_v, n_r, y_delta, n_delta, K, T1, T2, T3, Kv, 
     root with positive diagonal and the smaller coupling is taken), then Gauss-Newton
     refines a least-squares fit of all six constants in units of `resolution` (half the
     last published digit). With `n_delta=None` (missing in Table 3, linear column) it
-    is estimated as a fifth unknown. NumPy only; returns `(mass_terms, n_delta,
-    residuals)` with the residuals (model minus published) of the six constants.
+    is estimated as a fifth unknown. `derivatives`: `(y_v, y_r, n_v, n_r, y_delta,
+    n_delta)`; `constants`: `(K, T1, T2, T3, Kv, T3v)`. NumPy only; returns
+    `(mass_terms, n_delta, residuals)` with the residuals (model minus published) of the
+    six constants.
     """
+    y_v, y_r, n_v, n_r, y_delta, n_delta = derivatives
+    K, T1, T2, T3, Kv, T3v = constants
     A = np.array([[y_v, y_r], [n_v, n_r]], dtype=float)
     (a11, a12), (a21, a22) = A
     b1 = float(y_delta)
