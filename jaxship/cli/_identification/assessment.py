@@ -96,10 +96,13 @@ def _metrics_dict(m, names) -> dict:
     }
 
 
-def assess(kind, horizon, ds, rudder, predictions, mask, num_params, max_lag, notes=None,
+def assess(kind, horizon, ds, rudder, predicted, sizes, notes=None,
            start="measured") -> Assessment:
-    """The `Assessment` of `predictions` on `ds`. A record whose outputs become
+    """The `Assessment` of the `predicted = (predictions, mask)` on `ds`, with `sizes =
+    (num_params, max_lag)` of the residual tests. A record whose outputs become
     non-finite is assessed on the samples before (and a note says so)."""
+    predictions, mask = predicted
+    num_params, max_lag = sizes
     u = np.asarray(getattr(ds, rudder), dtype=np.float64)
     mask = np.array(mask, dtype=bool)
     bad = np.zeros(mask.shape, dtype=bool)

@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 
@@ -139,12 +140,66 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     """
     name, entry = start_entry(model, start) if start is not None else \
         (model_key(model), MODELS[model_key(model)])
-    if rudder not in ("delta", "delta_c"):
-        raise ValueError(f"unknown rudder channel {rudder!r}; choose 'delta' (measured angle) "
-                         "or 'delta_c' (command).")
-    default_channels = channels is None
-    channels = _parse_channels(entry.default_channels if default_channels else channels,
-                               entry.channels)
+    options = _checked_options(name, entry, _Options(
+        horizon, rudder, channels, initial, max_steps, substeps, free,
+        default_channels=channels is None))
+    records = _read_records(train, validate, options.rudder, name, entry, start)
+    notes, caught = same_records(records.train, records.held_out or []), []
+    options = options._replace(channels=_fitted_channels(records, options, notes))
+    report = progress if progress is not None else (lambda event: None)
+    fitting = _Fitting(name, records.train_ds, _estimator(options), report, options.max_steps)
+    context = StartContext(rudder=options.rudder, channels=options.channels,
+                           estimator=fitting.estimator, fit=fitting.run, note=notes.append)
+    fitting.context = context
+    start, method, neutral = _start_values(entry, records.train_ds, context, report, notes)
+    wind = getattr(start, "wind_loads", False) and logs_wind(records.train_ds)
+    if wind:  # replayed where the model feels it, as `jaxship.discover` does
+        fitting.estimator = dataclasses.replace(fitting.estimator, wind=True)
+        notes.append(f"every training record logs the wind (wind_speed, wind_dir): replayed "
+                     f"as loads on {type(start).__name__}.")
+    result, start, method = _fit_or_restart(fitting, entry, options, context,
+                                            (start, method, neutral), notes)
+    caught.extend(_convergence_problems(result, options.max_steps))
+    caught.extend(result.flags)
+    blocks = _assessments(result, entry, records, options, fitting, wind, notes)
+    _frozen_notes(result, notes)
+    return IdentificationResult(
+        model_name=name, description=entry.description, fit=result, start=start,
+        start_method=method, train=blocks[0], train_simulation=blocks[1],
+        validation=blocks[2], options=options.to_json(), notes=tuple(notes),
+        warnings=tuple(caught),
+    )
+
+
+class _Options(NamedTuple):
+    """`identify`'s options (as asked, then as `_checked_options` returns them)."""
+
+    horizon: float | None
+    rudder: str
+    channels: tuple[str, ...]
+    initial: str
+    max_steps: int
+    substeps: int
+    free: tuple[str, ...] | None
+    default_channels: bool  # no channels given: the entry's defaults, which data may thin
+
+    def to_json(self) -> dict:
+        return {"horizon_s": self.horizon, "rudder": self.rudder,
+                "channels": list(self.channels), "initial": self.initial,
+                "max_steps": self.max_steps, "substeps": self.substeps,
+                "free": None if self.free is None else list(self.free)}
+
+
+def _checked_options(name, entry, asked: _Options) -> _Options:
+    """`identify`'s options as asked, checked against the model's entry: channels parsed
+    (the entry's defaults when none is given), `initial="auto"` resolved (`"estimate"` for
+    output error where the entry supports it, else `"measured"`)."""
+    if asked.rudder not in ("delta", "delta_c"):
+        raise ValueError(f"unknown rudder channel {asked.rudder!r}; choose 'delta' (measured "
+                         "angle) or 'delta_c' (command).")
+    channels = _parse_channels(entry.default_channels if asked.default_channels
+                               else asked.channels, entry.channels)
+    horizon, initial = asked.horizon, asked.initial
     if horizon is not None:
         horizon = float(horizon)
         if not (math.isfinite(horizon) and horizon >= 0):
@@ -158,8 +213,24 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     if initial not in entry.initial:
         raise ValueError(f"model {name} supports initial {' or '.join(entry.initial)}, not "
                          f"{initial!r}.")
-    if int(max_steps) < 1:
-        raise ValueError(f"`max_steps` must be a positive integer, got {max_steps}.")
+    if int(asked.max_steps) < 1:
+        raise ValueError(f"`max_steps` must be a positive integer, got {asked.max_steps}.")
+    return asked._replace(horizon=horizon, channels=channels, initial=initial,
+                          max_steps=int(asked.max_steps), substeps=int(asked.substeps))
+
+
+class _Records(NamedTuple):
+    """The training and held-out records, as experiments and as datasets."""
+
+    train: list
+    held_out: list | None
+    train_ds: js.Dataset
+    valid_ds: js.Dataset | None
+
+
+def _read_records(train, validate, rudder, name, entry, start) -> _Records:
+    """Read and check the training and held-out records (columns the model needs, Froude
+    number against the vessel's length where one is known)."""
     train_exps = as_experiments(train, "training")
     check_experiments(train_exps, rudder, "training", name, entry.requires)
     held_out = None
@@ -171,49 +242,83 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     if length is not None:
         check_froude(train_exps, length, "training", name)
         check_froude(held_out or [], length, "validation", name)
-    train_ds = js.Dataset.from_experiments(train_exps)
     valid_ds = None if held_out is None else js.Dataset.from_experiments(held_out)
-    notes, caught = same_records(train_exps, held_out or []), []
-    longest = max(e.duration for e in train_exps)
-    if horizon is not None and horizon >= longest:
-        notes.append(f"the horizon (--horizon {horizon:g} s) is not shorter than any training "
-                     f"record (the longest: {longest:.4g} s): each record is one window, so the "
-                     "fit is output error (--horizon none).")
+    return _Records(train_exps, held_out, js.Dataset.from_experiments(train_exps), valid_ds)
+
+
+def _fitted_channels(records, options, notes) -> tuple[str, ...]:
+    """The fitted output channels: those asked for (or the entry's default, less a default
+    u or v that never varies and a default psi or r every training record derives), with
+    a note on each dropped channel and on a horizon no shorter than the records."""
+    channels, default_channels = options.channels, options.default_channels
+    longest = max(e.duration for e in records.train)
+    if options.horizon is not None and options.horizon >= longest:
+        notes.append(f"the horizon (--horizon {options.horizon:g} s) is not shorter than any "
+                     f"training record (the longest: {longest:.4g} s): each record is one "
+                     "window, so the fit is output error (--horizon none).")
     if default_channels:  # a default u or v that never varies (e.g. no surge dynamics)
         constant = [c for c in channels
-                    if c in ("u", "v") and np.ptp(valid_samples(train_ds, c)) == 0]
+                    if c in ("u", "v") and np.ptp(valid_samples(records.train_ds, c)) == 0]
         if constant and len(constant) < len(channels):
             channels = tuple(c for c in channels if c not in constant)
             notes.append(f"the measured {', '.join(constant)} is constant in the training "
                          f"records: not fitted (channels {', '.join(channels)}).")
-    channels = _derived_notes(train_exps, held_out, channels, default_channels, notes)
+    return _derived_notes(records.train, records.held_out, channels, default_channels, notes)
 
-    report = progress if progress is not None else (lambda event: None)
-    solver = js.LevenbergMarquardt(rtol=1e-9, atol=1e-9)
-    estimator = js.PredictionError(horizon=horizon, channels=channels, rudder=rudder,
-                                simulator=js.Simulator(max_step=math.inf, substeps=int(substeps)),
-                                solver=solver,
-                                max_steps=int(max_steps),
-                                initial={"estimate": js.EstimatedStarts(),
-                                         "measured": js.MeasuredStates()}[initial])
 
-    def run_fit(start_model, *, free=None, stage="fitting", custom=None):
-        relay = lambda event: report(dataclasses.replace(event, message=stage))
+def _estimator(options: _Options) -> js.PredictionError:
+    """The prediction-error estimator of `identify`'s fit."""
+    return js.PredictionError(
+        horizon=options.horizon, channels=options.channels, rudder=options.rudder,
+        simulator=js.Simulator(max_step=math.inf, substeps=options.substeps),
+        solver=js.LevenbergMarquardt(rtol=1e-9, atol=1e-9), max_steps=options.max_steps,
+        initial={"estimate": js.EstimatedStarts(),
+                 "measured": js.MeasuredStates()}[options.initial])
+
+
+@dataclasses.dataclass
+class _Fitting:
+    """A quiet, progress-reporting fit on the training data (`StartContext.fit`): with
+    `estimator` (replaced by its wind-replaying copy once the start is known) or an
+    entry's own estimator (`custom`, called with `context`)."""
+
+    name: str
+    train_ds: js.Dataset
+    estimator: js.PredictionError
+    report: Callable
+    max_steps: int
+    context: StartContext | None = None
+
+    def run(self, start_model, *, free=None, stage="fitting", custom=None):
+        relay = lambda event: self.report(dataclasses.replace(event, message=stage))
         if custom is not None and free is not None:
-            raise ValueError(f"model {name} is fitted by its own estimator: it takes no "
+            raise ValueError(f"model {self.name} is fitted by its own estimator: it takes no "
                              "choice of free parameters.")
         if custom is None:
-            return js.fit(start_model, train_ds, estimator=estimator, free=free,
+            return js.fit(start_model, self.train_ds, estimator=self.estimator, free=free,
                           progress=relay)
-        total = int(max_steps)  # an entry's own estimator (e.g. ARMAX): no steps to show
+        total = self.max_steps  # an entry's own estimator (e.g. ARMAX): no steps to show
         relay(Progress("fit", stage, step=0, total=total))
-        result = custom(start_model, train_ds, context)
+        result = custom(start_model, self.train_ds, self.context)
         relay(Progress("fit", stage, step=int(result.num_steps), total=total,
                        cost=float(result.cost), done=True))
         return result
 
-    context = StartContext(rudder=rudder, channels=channels, estimator=estimator,
-                           fit=run_fit, note=notes.append)
+    def attempt(self, start_model, entry, free):
+        """The fit from `start_model`, or `(None, why)` when its outputs became non-finite."""
+        try:
+            outcome = self.run(start_model, free=entry.free if free is None else free,
+                               stage=f"fitting {self.name}", custom=entry.fit)
+        except np.linalg.LinAlgError as error:  # NaN residuals: the simulation blew up
+            return None, str(error)
+        if not math.isfinite(outcome.cost):
+            return None, f"cost {outcome.cost}"
+        return outcome, ""
+
+
+def _start_values(entry, train_ds, context, report, notes):
+    """The entry's start values, or its neutral fallback (with a note) when the start
+    regression fails. Returns `(start, method, neutral)`."""
     report(Progress("start", "start values"))
     try:
         start = entry.start(train_ds, context)
@@ -224,59 +329,54 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
         notes.append(f"start values: {error} A neutral start was used instead; the fit "
                      "below says whether the data determine the parameters.")
     report(Progress("start", "start values", done=True))
-    wind = getattr(start, "wind_loads", False) and logs_wind(train_ds)
-    if wind:  # replayed where the model feels it, as `jaxship.discover` does
-        estimator = dataclasses.replace(estimator, wind=True)
-        notes.append(f"every training record logs the wind (wind_speed, wind_dir): replayed "
-                     f"as loads on {type(start).__name__}.")
+    return start, method, neutral
 
-    def attempt(start_model):
-        try:
-            outcome = run_fit(start_model, free=entry.free if free is None else free,
-                              stage=f"fitting {name}",
-                              custom=entry.fit)
-        except np.linalg.LinAlgError as error:  # NaN residuals: the simulation blew up
-            return None, str(error)
-        if not math.isfinite(outcome.cost):
-            return None, f"cost {outcome.cost}"
-        return outcome, ""
 
-    outcome, why = attempt(start)
+def _fit_or_restart(fitting, entry, options, context, begun, notes):
+    """The fit from the start values; if it diverges from a regression start, once more
+    from the neutral fallback. Returns `(result, start, method)`; raises
+    `FitDivergedError` when no start gives finite outputs."""
+    start, method, neutral = begun
+    outcome, why = fitting.attempt(start, entry, options.free)
     if outcome is None and not neutral:
         notes.append(f"the fit from the {method} start diverged (non-finite model outputs: "
                      f"{why}); restarted from the neutral fallback start.")
-        start = entry.fallback(train_ds, context)
+        start = entry.fallback(fitting.train_ds, context)
         method = "neutral fallback (the fit from the regression start diverged)"
-        outcome, why = attempt(start)
+        outcome, why = fitting.attempt(start, entry, options.free)
     if outcome is None:
         raise FitDivergedError(
-            f"the fit of {name} diverged: the model's outputs became non-finite ({why}) from "
-            f"the start {_values_text(start)}; try a finite --horizon, --initial measured or "
-            "another model."
+            f"the fit of {fitting.name} diverged: the model's outputs became non-finite "
+            f"({why}) from the start {_values_text(start)}; try a finite --horizon, "
+            "--initial measured or another model."
         )
-    result = outcome
-    problems = _convergence_problems(result, int(max_steps))
-    caught.extend(problems)
-    caught.extend(result.flags)
+    return outcome, start, method
 
+
+def _assessments(result, entry, records, options, fitting, wind, notes):
+    """The fit criterion on the training records, and the output-error simulations of the
+    fitted model on the training and held-out records (None without held-out records)."""
     d = len(result.names)
     simulate = entry.simulate or simulate_records
-    max_lag = int(estimator.max_lag)
+    max_lag = int(fitting.estimator.max_lag)
+    report, rudder, channels = fitting.report, options.rudder, options.channels
     # the criterion's horizon: the estimator's, or the entry's own (ARMAX: one sample)
     criterion = result.horizon
     train_block = assess("prediction" if criterion is not None else "simulation", criterion,
-                          train_ds, rudder, result.predictions, result.predicted,
-                          int(result.metrics[channels[0]].num_params), max_lag,
-                          start="estimated" if initial == "estimate" else "measured")
+                          records.train_ds, rudder, (result.predictions, result.predicted),
+                          (int(result.metrics[channels[0]].num_params), max_lag),
+                          start="estimated" if options.initial == "estimate" else "measured")
     report(Progress("validate", "simulating the training records"))
+
     def measured(ds):  # psi and r always exist (derived if need be); other outputs if measured
         return tuple(c for c in entry.channels if c in ("psi", "r") or c in ds.channels)
 
-    predictions, mask = simulate(result.model, train_ds, rudder, measured(train_ds),
-                                 substeps=int(substeps), wind=wind)
-    train_sim = assess("simulation", None, train_ds, rudder, predictions, mask, d, max_lag,
-                        notes)
-    valid_block = None
+    predictions, mask = simulate(result.model, records.train_ds, rudder,
+                                 measured(records.train_ds), substeps=options.substeps,
+                                 wind=wind)
+    train_sim = assess("simulation", None, records.train_ds, rudder, (predictions, mask),
+                       (d, max_lag), notes)
+    valid_block, valid_ds = None, records.valid_ds
     if valid_ds is not None:
         report(Progress("validate", "simulating the validation records"))
         held_wind = wind and logs_wind(valid_ds)
@@ -284,11 +384,15 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
             notes.append("the validation records do not all log the wind: simulated in calm "
                          "air.")
         predictions, mask = simulate(result.model, valid_ds, rudder, measured(valid_ds),
-                                     substeps=int(substeps), wind=held_wind)
-        valid_block = assess("simulation", None, valid_ds, rudder, predictions, mask, d,
-                              max_lag, notes)
+                                     substeps=options.substeps, wind=held_wind)
+        valid_block = assess("simulation", None, valid_ds, rudder, (predictions, mask),
+                             (d, max_lag), notes)
     report(Progress("validate", "validation", done=True))
+    return train_block, train_sim, valid_block
 
+
+def _frozen_notes(result, notes) -> None:
+    """A note on the parameters the fit froze (a preset's many: only their number)."""
     frozen = list(result.to_dict()["frozen"])
     if len(frozen) > 12:  # a vessel preset: listed in the report's "frozen"
         notes.append(f"{len(frozen)} coefficients of the preset are frozen (not estimated); "
@@ -297,16 +401,6 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
         notes.append("frozen parameters (not estimated): "
                      + ", ".join(f"{n} = {float(getattr(result.model, n)):.6g}" for n in frozen)
                      + ".")
-    out = IdentificationResult(
-        model_name=name, description=entry.description, fit=result, start=start,
-        start_method=method, train=train_block, train_simulation=train_sim,
-        validation=valid_block,
-        options={"horizon_s": horizon, "rudder": rudder, "channels": list(channels),
-                 "initial": initial, "max_steps": int(max_steps), "substeps": int(substeps),
-                 "free": None if free is None else list(free)},
-        notes=tuple(notes), warnings=tuple(caught),
-    )
-    return out
 
 
 def logs_wind(ds: js.Dataset) -> bool:
