@@ -2,6 +2,7 @@
 spirals and the IMO criteria table."""
 
 import textwrap
+from typing import NamedTuple
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -252,6 +253,53 @@ def plot_trajectory(traj, *, length=None, title="", others=(), labels=None, beam
     runs = [traj, *others]
     labels = list(labels) if labels is not None else [f"run {i}" for i in range(len(runs))]
     reference = dict(reference or {})
+    _check_reference(reference, indices)
+    scale, unit = (float(length), "L") if length else (1.0, "m")
+    fig = plt.figure(figsize=(12.5, 9), layout="constrained")
+    axes = _trajectory_axes(fig)
+    t, s, color = _draw_runs(axes, runs, labels, scale)
+    axes.track.plot(s["y"][0] / scale, s["x"][0] / scale, "o", color=color, ms=5,
+                    label="start")
+    if length and outlines:
+        _draw_outlines(axes.track, t, s, count=int(outlines), length=float(length),
+                       beam=float(beam) if beam else float(length) / 6.0, scale=scale,
+                       color=color)
+    marks = dict(length=float(length) if length else None, scale=scale, reference=reference,
+                 reference_label=reference_label)
+    if isinstance(indices, TurningIndices):
+        _turning_marks(axes.track, t, s, indices, **marks)
+    elif isinstance(indices, StoppingIndices):
+        _stopping_marks(axes.track, t, s, indices, **marks)
+    elif isinstance(indices, ZigZagIndices):
+        _zigzag_marks(axes.heading, t, s, indices, reference=reference,
+                      reference_label=reference_label)
+    elif indices is not None:
+        raise ValueError(f"`indices` must be turning, zig-zag or stopping indices, got "
+                         f"{type(indices).__name__}.")
+    _reference_lines(axes, reference, reference_label)
+    _label_axes(axes, length, unit)
+    legend_axes = [*axes, *_propeller_rate(axes.speed, traj)]
+    for ax, span in ((axes.heading, 2.0), (axes.rudder, 2.0), (axes.rate, 0.2),
+                     (axes.speed, 0.1)):
+        _min_span(ax, span)
+    _legend_below(fig, legend_axes)
+    _title(fig, title)
+    return fig
+
+
+class _TrajectoryAxes(NamedTuple):
+    """`plot_trajectory`'s axes: the track on the left, four time histories on the right."""
+
+    track: plt.Axes
+    heading: plt.Axes
+    rudder: plt.Axes
+    rate: plt.Axes
+    speed: plt.Axes
+
+
+def _check_reference(reference, indices) -> None:
+    """Raise for a reference value of an unknown name, or one drawn with indices of a kind
+    the run was not given."""
     known = (*_REFERENCE_TIME, *_REFERENCE_TURNING, *_REFERENCE_ZIGZAG, *_REFERENCE_STOPPING)
     unknown = sorted(set(reference) - set(known))
     if unknown:
@@ -262,84 +310,87 @@ def plot_trajectory(traj, *, length=None, title="", others=(), labels=None, beam
         if set(reference) & set(names) and not isinstance(indices, kind):
             raise ValueError(f"reference values {sorted(set(reference) & set(names))} are "
                              f"drawn with the run's indices: pass a {kind.__name__}.")
-    scale, unit = (float(length), "L") if length else (1.0, "m")
-    fig = plt.figure(figsize=(12.5, 9), layout="constrained")
+
+
+def _trajectory_axes(fig) -> _TrajectoryAxes:
+    """The track (left, full height) and heading, rudder, yaw rate and speed sharing time."""
     grid = fig.add_gridspec(4, 2, width_ratios=[1.1, 1.3])
     track = fig.add_subplot(grid[:, 0])
     heading = fig.add_subplot(grid[0, 1])
     rudder, rate, speed = (fig.add_subplot(grid[i, 1], sharex=heading) for i in (1, 2, 3))
+    return _TrajectoryAxes(track, heading, rudder, rate, speed)
+
+
+def _draw_runs(axes: _TrajectoryAxes, runs, labels, scale):
+    """Each run's track and time histories (the first run's rudder order dashed). Returns
+    the first run's `(t, samples, color)`."""
     first = None
     for k, (run, label) in enumerate(zip(runs, labels)):
         t, s = _run_samples(run)
-        (line,) = track.plot(s["y"] / scale, s["x"] / scale, lw=1.3, label=label)
+        (line,) = axes.track.plot(s["y"] / scale, s["x"] / scale, lw=1.3, label=label)
         color = line.get_color()
-        heading.plot(t, np.rad2deg(s["psi"]), color=color, lw=1.2)
-        rudder.plot(t, np.rad2deg(s["delta"]), color=color, lw=1.2)
+        axes.heading.plot(t, np.rad2deg(s["psi"]), color=color, lw=1.2)
+        axes.rudder.plot(t, np.rad2deg(s["delta"]), color=color, lw=1.2)
         if k == 0 and "order" in s:
-            rudder.step(t, np.rad2deg(s["order"]), where="post", color="0.3", ls="--",
-                        lw=0.9, label="rudder order")
-        rate.plot(t, np.rad2deg(s["r"]), color=color, lw=1.2)
-        speed.plot(t, np.hypot(s["u"], s["v"]), color=color, lw=1.2)
+            axes.rudder.step(t, np.rad2deg(s["order"]), where="post", color="0.3", ls="--",
+                             lw=0.9, label="rudder order")
+        axes.rate.plot(t, np.rad2deg(s["r"]), color=color, lw=1.2)
+        axes.speed.plot(t, np.hypot(s["u"], s["v"]), color=color, lw=1.2)
         if k == 0:
             first = (t, s, color)
-    t, s, color = first
-    track.plot(s["y"][0] / scale, s["x"][0] / scale, "o", color=color, ms=5, label="start")
-    if length and outlines:
-        _draw_outlines(track, t, s, count=int(outlines), length=float(length),
-                       beam=float(beam) if beam else float(length) / 6.0, scale=scale,
-                       color=color)
-    marks = dict(length=float(length) if length else None, scale=scale, reference=reference,
-                 reference_label=reference_label)
-    if isinstance(indices, TurningIndices):
-        _turning_marks(track, t, s, indices, **marks)
-    elif isinstance(indices, StoppingIndices):
-        _stopping_marks(track, t, s, indices, **marks)
-    elif isinstance(indices, ZigZagIndices):
-        _zigzag_marks(heading, t, s, indices, reference=reference,
-                      reference_label=reference_label)
-    elif indices is not None:
-        raise ValueError(f"`indices` must be turning, zig-zag or stopping indices, got "
-                         f"{type(indices).__name__}.")
-    axes = {"heading": heading, "rudder": rudder, "rate": rate, "speed": speed}
+    return first
+
+
+def _reference_lines(axes: _TrajectoryAxes, reference, reference_label) -> None:
+    """Reference heading, rudder, yaw rate or speed: a dashed line for a value, a band for
+    a `(low, high)` range."""
+    by_key = {"heading": axes.heading, "rudder": axes.rudder, "rate": axes.rate,
+              "speed": axes.speed}
     for name, (key, factor, display) in _REFERENCE_TIME.items():
         if name in reference:
             low, high = (factor * v for v in _range(reference[name]))
             text = f"{reference_label}: {name.replace('_', ' ')} " + _range_text(
                 low, high, lambda v: f"{v:.3g} {display}")
             if low == high:
-                axes[key].axhline(low, color=_REFERENCE_COLOR, ls="--", lw=1.3, label=text)
+                by_key[key].axhline(low, color=_REFERENCE_COLOR, ls="--", lw=1.3, label=text)
             else:
-                axes[key].axhspan(low, high, facecolor=_REFERENCE_COLOR, alpha=0.25, lw=0.0,
-                                  label=text)
+                by_key[key].axhspan(low, high, facecolor=_REFERENCE_COLOR, alpha=0.25,
+                                    lw=0.0, label=text)
+
+
+def _label_axes(axes: _TrajectoryAxes, length, unit) -> None:
+    """Axis labels (the track in ship lengths and metres when `length` is given), equal
+    track aspect, time labels on the bottom axes only, grids."""
+    track = axes.track
     track.set(xlabel=f"east [{unit}]", ylabel=f"north [{unit}]", title="track")
     track.set_aspect("equal", adjustable="datalim")
     if length:
         to_m, to_l = (lambda v: v * float(length)), (lambda v: v / float(length))
         track.secondary_xaxis("top", functions=(to_m, to_l)).set_xlabel("east [m]")
         track.secondary_yaxis("right", functions=(to_m, to_l)).set_ylabel("north [m]")
-    heading.set(ylabel="heading [deg]")
-    rudder.set(ylabel="rudder angle [deg]")
-    rate.set(ylabel="yaw rate [deg/s]")
-    speed.set(ylabel="speed U [m/s]", xlabel="time [s]")
-    legend_axes = [track, heading, rudder, rate, speed]
-    n = np.asarray(getattr(traj.state, "n", np.zeros(1)), dtype=np.float64)
-    if n.size == np.size(traj.t) and np.ptp(n) > 1e-6 * max(1.0, np.max(np.abs(n))):
-        shaft = speed.twinx()  # a propeller order (the stop): its rate on the right
-        t0, _ = _run_samples(traj)
-        valid = np.asarray(getattr(traj, "valid", np.ones(n.size, dtype=bool)), dtype=bool)
-        shaft.plot(t0, 60.0 * n[valid], color="0.35", ls="-.", lw=1.0,
-                   label="propeller rate (right axis)")
-        shaft.set_ylabel("propeller [rpm]")
-        legend_axes.append(shaft)
-    for ax, span in ((heading, 2.0), (rudder, 2.0), (rate, 0.2), (speed, 0.1)):
-        _min_span(ax, span)
-    for ax in (heading, rudder, rate):
+    axes.heading.set(ylabel="heading [deg]")
+    axes.rudder.set(ylabel="rudder angle [deg]")
+    axes.rate.set(ylabel="yaw rate [deg/s]")
+    axes.speed.set(ylabel="speed U [m/s]", xlabel="time [s]")
+    for ax in (axes.heading, axes.rudder, axes.rate):
         ax.tick_params(labelbottom=False)
-    for ax in (track, heading, rudder, rate, speed):
+    for ax in axes:
         ax.grid(True, alpha=0.3)
-    _legend_below(fig, legend_axes)
-    _title(fig, title)
-    return fig
+
+
+def _propeller_rate(speed, traj) -> list:
+    """The propeller rate on a right axis of `speed` when it varies (a propeller order,
+    the stop); returns that axis in a list, or an empty list."""
+    n = np.asarray(getattr(traj.state, "n", np.zeros(1)), dtype=np.float64)
+    if not (n.size == np.size(traj.t) and np.ptp(n) > 1e-6 * max(1.0, np.max(np.abs(n)))):
+        return []
+    shaft = speed.twinx()
+    t0, _ = _run_samples(traj)
+    valid = np.asarray(getattr(traj, "valid", np.ones(n.size, dtype=bool)), dtype=bool)
+    shaft.plot(t0, 60.0 * n[valid], color="0.35", ls="-.", lw=1.0,
+               label="propeller rate (right axis)")
+    shaft.set_ylabel("propeller [rpm]")
+    return [shaft]
 
 
 def _min_span(ax, span):
