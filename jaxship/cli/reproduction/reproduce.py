@@ -25,6 +25,7 @@ the reduced design of `QUICK_FAMILIES`, `QUICK_MODELS` and `QUICK_CASES` (CI run
 
 import contextlib
 import ctypes
+import dataclasses
 import json
 import multiprocessing
 import os
@@ -122,90 +123,123 @@ def reproduce(out, *, quick=False, progress=False, identification=True,
     return results
 
 
+@dataclasses.dataclass
+class _Ledger:
+    """What `reproduce`'s stages give: wall and CPU seconds per stage, the JSON results,
+    the report's sections and the CPU time of the second process' jobs."""
+
+    timings: dict = dataclasses.field(default_factory=dict)
+    cpu: dict = dataclasses.field(default_factory=dict)
+    results: dict = dataclasses.field(default_factory=dict)
+    sections: list = dataclasses.field(default_factory=list)
+    second_cpu: float = 0.0
+
+    def done(self, name, clock) -> None:
+        """Stage `name`, begun at `clock` (wall, CPU), has ended."""
+        self.timings[name] = time.perf_counter() - clock[0]
+        self.cpu[name] = time.process_time() - clock[1]
+
+
+def _clock():
+    return time.perf_counter(), time.process_time()
+
+
 def _run(out, quick, progress, identification, closed_loop, discover, parallel) -> dict:
     """`reproduce` into the folder `out`."""
     (out / "trials").mkdir(parents=True, exist_ok=True)
     (out / "figures").mkdir(exist_ok=True)
     load = os.getloadavg()[0] if sys.platform != "win32" else None
-    began, cpu0 = time.perf_counter(), time.process_time()
-    timings, cpu, results, sections = {}, {}, {}, []
+    began, cpu0 = _clock()
+    ledger = _Ledger()
     vessel = js.get_vessel("thesis")
     families = QUICK_FAMILIES if quick else thesis.FAMILIES
-
-    def stage_done(name, clock):
-        timings[name] = time.perf_counter() - clock[0]
-        cpu[name] = time.process_time() - clock[1]
-
     worker = _Worker() if parallel and (discover or identification) else None
     discovery_job = worker.submit(_discovery_job, quick, str(out)) if worker and discover \
         else None
     if discovery_job is not None and progress:
         tqdm.write("discovery: started in a second process")
-    second_cpu = 0.0  # CPU time of the second process' jobs
     try:
-        clock = (time.perf_counter(), time.process_time())
+        clock = _clock()
         design, indices = _trials(vessel, families, out, progress)
-        sections.append(trials_section(indices, out, design))
-        results["indices"] = indices
-        stage_done("trials", clock)
+        ledger.sections.append(trials_section(indices, out, design))
+        ledger.results["indices"] = indices
+        ledger.done("trials", clock)
         study = None
         if identification:
-            clock = (time.perf_counter(), time.process_time())
+            clock = _clock()
             study, experiments, extra = _identification(vessel, design, families, quick,
                                                         progress, worker)
-            second_cpu += extra
-            results["identification"] = _identification_json(study)
-            sections.append(identification_section(study, experiments, out, quick))
-            stage_done("identification", clock)
+            ledger.second_cpu += extra
+            ledger.results["identification"] = _identification_json(study)
+            ledger.sections.append(identification_section(study, experiments, out, quick))
+            ledger.done("identification", clock)
         if identification and closed_loop:
-            clock = (time.perf_counter(), time.process_time())
-            with _Stage("chapter 5: closed loop", 2 * 3 + 1, progress) as stage:
-                evaluation = chapter5.autopilot_study(vessel, identification=study,
-                                                       progress=stage)
-            results["autopilot"] = chapter5.to_json(evaluation)
-            sections.append(autopilot_section(evaluation, study, out, quick))
-            stage_done("autopilot", clock)
+            _autopilot_stage(vessel, study, out, quick, progress, ledger)
         if discover:
-            clock = (time.perf_counter(), time.process_time())
-            with _Stage("discovery", None, progress) as stage:
-                here = lambda: _discovery(quick, out, stage)
-                if discovery_job is not None:
-                    worker.listen("discovery", stage)
-                    data = worker.result(discovery_job, here)
-                    second_cpu += data["case"]["cpu_seconds"]
-                else:
-                    data = here()
-            results["discovery"] = data
-            sections.append(discovery_section(data))
-            stage_done("discovery", clock)
-            if discovery_job is not None:  # its own run, in parallel; and the wait for it
-                timings["waiting for the discovery"] = timings["discovery"]
-                timings["discovery"] = data["case"]["seconds"]
-                cpu["discovery"] = data["case"]["cpu_seconds"]
+            _discovery_stage(quick, out, progress, (worker, discovery_job), ledger)
     except BaseException:  # Ctrl-C or an error: do not wait for the second process' job
         if worker is not None:
             worker.close(wait=False)
         raise
     if worker is not None:
         worker.close()
-
+    results = ledger.results
     results["run"] = {
         "quick": bool(quick), "seconds": time.perf_counter() - began,
-        "cpu_seconds": time.process_time() - cpu0 + second_cpu,
-        "second_process": worker is not None, "stages_seconds": timings,
-        "stages_cpu_seconds": cpu, "cpu_count": os.cpu_count(),
+        "cpu_seconds": time.process_time() - cpu0 + ledger.second_cpu,
+        "second_process": worker is not None, "stages_seconds": ledger.timings,
+        "stages_cpu_seconds": ledger.cpu, "cpu_count": os.cpu_count(),
         "load_average_at_start": load, "jaxship": js.__version__,
         "python": platform.python_version(),
     }
+    _write_results(out, results)
+    stages = [k for k in ("trials", "identification", "autopilot", "discovery")
+              if k in ledger.timings]
+    text = header(results["run"], quick, len(indices) // len(RPMS), stages)
+    text += "\n".join(ledger.sections) + left_out(quick, identification, closed_loop, discover)
+    (out / "report.md").write_text(text)
+    return results
+
+
+def _autopilot_stage(vessel, study, out, quick, progress, ledger: _Ledger) -> None:
+    """Chapter 5: the autopilots designed on the identified models, in closed loop."""
+    clock = _clock()
+    with _Stage("chapter 5: closed loop", 2 * 3 + 1, progress) as stage:
+        evaluation = chapter5.autopilot_study(vessel, identification=study, progress=stage)
+    ledger.results["autopilot"] = chapter5.to_json(evaluation)
+    ledger.sections.append(autopilot_section(evaluation, study, out, quick))
+    ledger.done("autopilot", clock)
+
+
+def _discovery_stage(quick, out, progress, job, ledger: _Ledger) -> None:
+    """The discovery case, here or (`job = (worker, submitted)`, submitted not None) the
+    result of the second process, whose own run time is then the stage's and the wait
+    for it a stage of its own."""
+    worker, discovery_job = job
+    clock = _clock()
+    with _Stage("discovery", None, progress) as stage:
+        here = lambda: _discovery(quick, out, stage)
+        if discovery_job is not None:
+            worker.listen("discovery", stage)
+            data = worker.result(discovery_job, here)
+            ledger.second_cpu += data["case"]["cpu_seconds"]
+        else:
+            data = here()
+    ledger.results["discovery"] = data
+    ledger.sections.append(discovery_section(data))
+    ledger.done("discovery", clock)
+    if discovery_job is not None:  # its own run, in parallel; and the wait for it
+        ledger.timings["waiting for the discovery"] = ledger.timings["discovery"]
+        ledger.timings["discovery"] = data["case"]["seconds"]
+        ledger.cpu["discovery"] = data["case"]["cpu_seconds"]
+
+
+def _write_results(out, results) -> None:
+    """Each stage's JSON file (None for a stage not run: no file)."""
     for name in ("indices", "identification", "autopilot", "discovery", "run"):
         results.setdefault(name, None)
         if results[name] is not None:
             (out / f"{name}.json").write_text(json.dumps(results[name], indent=2) + "\n")
-    stages = [k for k in ("trials", "identification", "autopilot", "discovery") if k in timings]
-    text = header(results["run"], quick, len(indices) // len(RPMS), stages)
-    text += "\n".join(sections) + left_out(quick, identification, closed_loop, discover)
-    (out / "report.md").write_text(text)
-    return results
 
 
 # ----------------------------------------------------------------------------- stages
