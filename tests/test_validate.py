@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from jaxship._foundation._covariance import (
+    RobustErrors,
     bartlett_long_run,
     cluster_from_windows,
     hac_covariance,
@@ -343,15 +344,15 @@ def test_not_white_flag_and_robust_std_in_the_report():
     cov = np.diag([1e-6, 1e-2])
     robust = np.diag([1.44e-4, 4e-2])  # 12x and 2x the plain std
     for white in (None, True):
-        rep = parameter_report(["K", "T"], [0.05, 10.0], cov, robust_covariance=robust,
-                               white=white)
+        rep = parameter_report(["K", "T"], [0.05, 10.0], cov,
+                               robust=RobustErrors(white=white, covariance=robust))
         assert rep.flags == () and rep.identifiable and rep.residuals_white is white
         np.testing.assert_allclose(rep.std_robust, [0.012, 0.2])
     plain = parameter_report(["K", "T"], [0.05, 10.0], cov)
     assert np.isnan(plain.std_robust).all() and "std robust" not in plain.table()
     assert plain.residuals_white is None and plain.hac_lags is None
-    rep = parameter_report(["K", "T"], [0.05, 10.0], cov, robust_covariance=robust,
-                           white=False, hac_lags=25)
+    rep = parameter_report(["K", "T"], [0.05, 10.0], cov,
+                           robust=RobustErrors(white=False, covariance=robust, hac_lags=25))
     assert len(rep.flags) == 1 and rep.uncertainty_flags == rep.flags
     flag = rep.flags[0]
     assert "not white" in flag and "too small by up to 12x (K)" in flag and "25 lags" in flag
@@ -360,12 +361,12 @@ def test_not_white_flag_and_robust_std_in_the_report():
     data = json.loads(json.dumps(rep.to_dict()))
     assert data["std_robust"] == pytest.approx([0.012, 0.2]) and data["hac_lags"] == 25
     # the relative-error check uses the robust std when the residuals are not white
-    rep = parameter_report(["K", "T"], [0.02, 10.0], cov, robust_covariance=robust,
-                           white=False)
+    rep = parameter_report(["K", "T"], [0.02, 10.0], cov,
+                           robust=RobustErrors(white=False, covariance=robust))
     assert any("K = 0.02 is poorly determined: robust" in f for f in rep.flags)
     assert not rep.identifiable
     # not white without robust errors: still flagged
-    rep = parameter_report(["K", "T"], [0.05, 10.0], cov, white=False)
+    rep = parameter_report(["K", "T"], [0.05, 10.0], cov, robust=RobustErrors(white=False))
     assert len(rep.flags) == 1 and "no robust standard errors" in rep.flags[0]
 
 

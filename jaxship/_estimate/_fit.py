@@ -15,6 +15,7 @@ import abc
 import contextlib
 import dataclasses
 import math
+from typing import NamedTuple
 
 import equinox as eqx
 import jax
@@ -24,6 +25,7 @@ import optimistix as optx
 
 from .._foundation._contract import AbstractModel
 from .._foundation._covariance import (
+    RobustErrors,
     cluster_from_windows,
     hac_from_windows,
     least_squares_covariance,
@@ -33,6 +35,7 @@ from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
 from .._foundation._progress import ProgressCallback, reporting_steps, step_hook
 from .._foundation._sharding import sharded_vmap
 from .._models._manoeuvres import FirstOrderHold, ZeroOrderHold
+from .._simulation._data import Dataset
 from .._simulation._integrate import Simulator, integrate, replay_policy
 from ._excitation import excitation_flags
 from ._initial import EstimatedStarts, MeasuredStates
@@ -334,8 +337,8 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
             if needed <= windows.substeps or needed > MAX_SUBSTEPS:
                 break
             windows, z0 = dataclasses.replace(windows, substeps=needed), z
-        out = _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac,
-                      result, num_steps, starts=starts)
+        out = _report(_Problem(model, ds, estimator, specs, transform, windows, layout,
+                               starts), _Optimum(p, pred, jac, result, num_steps))
         finish(out.num_steps, out.cost)
     if offset_scale is not None:
         offsets = _split(z, transform, windows, offset_scale)[1]
@@ -470,10 +473,37 @@ def _verdict(result, specs, p, rows, jac, pred, targets, mask) -> RESULTS:
     return result
 
 
-def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, jac, result,
-            num_steps, *, starts=MeasuredStates()) -> FitResult:
+class _Problem(NamedTuple):
+    """A prediction-error fit as posed: the start model, its data and estimator, the free
+    parameters and their transform, the windows (as last solved) and their layout, the
+    start strategy."""
+
+    model: object
+    ds: Dataset
+    estimator: object
+    specs: list
+    transform: Transform
+    windows: object
+    layout: dict
+    starts: object
+
+
+class _Optimum(NamedTuple):
+    """What `_solve` found: parameters, window predictions, Jacobian, the optimiser's
+    result and its number of steps."""
+
+    p: object
+    pred: object
+    jac: object
+    result: object
+    num_steps: object
+
+
+def _report(problem: _Problem, optimum: _Optimum) -> FitResult:
     """The `FitResult` from the optimum: residuals, covariance, identifiability and
     validation metrics on the host (shared by steering-model and vessel fits)."""
+    model, ds, estimator, specs, transform, windows, layout, starts = problem
+    p, pred, jac, result, num_steps = optimum
     channels = windows.channels
     d = len(specs)
     values = np.asarray(p, dtype=np.float64)
@@ -523,9 +553,9 @@ def _report(model, ds, estimator, specs, transform, windows, layout, p, pred, ja
             method = f"Newey-West HAC, {lags} lags"
         return parameter_report(transform.names, values, covariance,
                                 units=tuple(s.unit for s in specs), null_directions=null,
-                                extra_flags=flags, robust_covariance=robust[:d, :d],
+                                extra_flags=flags,
                                 undetermined_flags=flags if no_excitation else (),
-                                white=white, hac_lags=lags, robust_method=method)
+                                robust=RobustErrors(white, robust[:d, :d], lags, method))
 
     return assemble_result(
         fitted, report, ds, predictions, hit, validation=Validation(

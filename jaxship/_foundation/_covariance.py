@@ -388,11 +388,27 @@ def _combination(names, vector):
     return " ".join(terms).lstrip("+")
 
 
-def parameter_report(names, values, covariance, *, units=(), corr_threshold: float = 0.95,
-                     rel_std_threshold: float = 0.5, null_directions=(),
-                     extra_flags=(), robust_covariance=None, white: bool | None = None,
-                     hac_lags: int | None = None, robust_method: str | None = None,
-                     undetermined_flags=()) -> ParameterReport:
+# identifiability flags: a correlation above this, a relative standard error above this
+CORRELATION_FLAG = 0.95
+RELATIVE_STD_FLAG = 0.5
+
+
+@dataclasses.dataclass(frozen=True)
+class RobustErrors:
+    """What the residuals say about the standard errors: `white`, whether they passed the
+    whiteness test (e.g. `all(m.white for m in metrics)`; None: not tested); `covariance`
+    (d, d), a covariance robust to their correlation (e.g. `hac_covariance` with its
+    `hac_lags`, or `cluster_from_windows`), or None; `method` names it in the flag."""
+
+    white: bool | None = None
+    covariance: np.ndarray | None = None
+    hac_lags: int | None = None
+    method: str | None = None
+
+
+def parameter_report(names, values, covariance, *, units=(), null_directions=(),
+                     extra_flags=(), undetermined_flags=(),
+                     robust: RobustErrors = RobustErrors()) -> ParameterReport:
     """Standard errors, correlation matrix, condition number and identifiability
     flags of estimates `values` with `covariance` (see `ParameterReport`).
 
@@ -400,13 +416,15 @@ def parameter_report(names, values, covariance, *, units=(), corr_threshold: flo
     the data do not determine; `extra_flags` are appended as they are, and those of
     them in `undetermined_flags` (e.g. no excitation) count as undetermined too.
 
-    `robust_covariance` (d, d), e.g. from `hac_covariance` with its `hac_lags` or
-    `cluster_from_windows`, gives `std_robust`; `robust_method` names it in the flag.
-    `white`: the residuals passed the whiteness test (e.g.
-    `all(m.white for m in metrics)`); when False a flag says that the usual standard
-    errors are too small, by how much at most (the largest `std_robust / std`), and
-    the relative-error check uses the larger of `std` and `std_robust`.
+    `robust.covariance` gives `std_robust`. When the residuals are not white
+    (`robust.white` False) a flag says that the usual standard errors are too small, by
+    how much at most (the largest `std_robust / std`), and the relative-error check
+    uses the larger of `std` and `std_robust`. Flags: a correlation above
+    `CORRELATION_FLAG`, a relative standard error above `RELATIVE_STD_FLAG`.
     """
+    corr_threshold, rel_std_threshold = CORRELATION_FLAG, RELATIVE_STD_FLAG
+    robust_covariance, white = robust.covariance, robust.white
+    hac_lags, robust_method = robust.hac_lags, robust.method
     names = tuple(names)
     values = np.asarray(values, dtype=np.float64).reshape(-1)
     cov = np.asarray(covariance, dtype=np.float64)
