@@ -52,6 +52,7 @@ $P_{k|N} = P_{k|k} + G_k(P_{k+1|N} - P_{k+1|k})G_k^T$.
 
 import dataclasses
 import math
+from typing import NamedTuple
 
 import equinox as eqx
 import jax
@@ -242,11 +243,24 @@ def _measure(model, channels, ground):
     return h
 
 
-def _filter(model, inputs, y, mask, dt, z0, P0, Q, q_rudder, R, channels, substeps, holds,
-            ground=0.0):
-    """The EKF over one record (module docstring); `inputs` `{name: (N,)}`, `mask`:
-    (N,); `y`: (N, C); `ground`: 1 where its u, v are over ground. Returns a
-    `KalmanOutput`."""
+class _Noise(NamedTuple):
+    """The filter's noise: process covariance `Q` over the state, the rudder-equivalent
+    disturbance's variance `q_rudder` and the measurement covariance `R`."""
+
+    Q: jax.Array
+    q_rudder: jax.Array
+    R: jax.Array
+
+
+def _filter(model, record, prior, noise: _Noise, rec: "_Records", ground=0.0):
+    """The EKF over one record (module docstring); `record`: `(inputs, y, mask, dt)`
+    with `inputs` `{name: (N,)}`, `y`: (N, C), `mask`: (N,); `prior`: `(z0, P0)` of
+    sample 0; `rec`: the records' channels, substeps and holds; `ground`: 1 where its
+    u, v are over ground. Returns a `KalmanOutput`."""
+    inputs, y, mask, dt = record
+    z0, P0 = prior
+    Q, q_rudder, R = noise
+    channels, substeps, holds = rec.channels, rec.substeps, rec.holds
     F = _interval_map(model, substeps, dict(holds))
     h = _measure(model, channels, ground)
     jac = jax.jacfwd(F, argnums=(0, 1))
@@ -371,8 +385,8 @@ def _batch_filter(model, rec: _Records, Q, q_rudder, R, P0=None):
 
     def one(inputs, y, mask, dt, start):
         z0, p0 = _prior(model, start, rec.channels, R, P0)
-        return _filter(model, inputs, y, mask, dt, z0, p0, Q, q_rudder, R, rec.channels,
-                       rec.substeps, rec.holds, start.ground_scale)
+        return _filter(model, (inputs, y, mask, dt), (z0, p0), _Noise(Q, q_rudder, R), rec,
+                       start.ground_scale)
 
     # plain vmap: reverse mode (the ML Hessian) of a scan inside shard_map fails in
     # jax 0.10 ("context mesh ... should match"); records are few, windows are many
@@ -408,16 +422,29 @@ def _check_inputs(model, data, channels, rudder, substeps, *, vessels=True):
     return ds, channels
 
 
-def _prepare(model, data, channels, rudder, substeps, process_noise, measurement_noise,
-             initial_covariance, hold=None):
-    ds, channels = _check_inputs(model, data, channels, rudder, substeps)
-    Q, q_rudder = process_matrices(model, process_noise)
-    R = measurement_matrix(channels, measurement_noise)
+class _Options(NamedTuple):
+    """The keyword options `ekf` and `smooth_states` share (see `ekf`)."""
+
+    channels: tuple
+    rudder: str
+    substeps: int
+    process_noise: object
+    measurement_noise: object
+    initial_covariance: object
+    hold: object
+
+
+def _prepare(model, data, options: _Options):
+    """`(dataset, records, Q, q_rudder, R, P0)` of the filter after checking the inputs."""
+    ds, channels = _check_inputs(model, data, options.channels, options.rudder,
+                                 options.substeps)
+    Q, q_rudder = process_matrices(model, options.process_noise)
+    R = measurement_matrix(channels, options.measurement_noise)
     P0 = None
-    if initial_covariance is not None:
-        P0 = jnp.asarray(_matrix(initial_covariance, Q.shape[0], "initial_covariance",
+    if options.initial_covariance is not None:
+        P0 = jnp.asarray(_matrix(options.initial_covariance, Q.shape[0], "initial_covariance",
                                  definite=False))
-    rec = _records(ds, channels, rudder, substeps, hold)
+    rec = _records(ds, channels, options.rudder, options.substeps, options.hold)
     return ds, rec, jnp.asarray(Q), jnp.asarray(q_rudder), jnp.asarray(R), P0
 
 
@@ -452,8 +479,9 @@ def ekf(model: AbstractSteeringModel | AbstractVessel, experiment, *, process_no
     if not isinstance(experiment, Experiment):
         raise ValueError(f"`experiment` must be a jaxship Experiment, got "
                          f"{type(experiment).__name__}; use smooth_states for a Dataset.")
-    _, rec, Q, q, R, P0 = _prepare(model, experiment, channels, rudder, substeps,
-                                   process_noise, measurement_noise, initial_covariance, hold)
+    _, rec, Q, q, R, P0 = _prepare(model, experiment, _Options(
+        channels, rudder, substeps, process_noise, measurement_noise, initial_covariance,
+        hold))
     out = _filter_jit(as_arrays(model), rec, Q, q, R, P0)
     out = jax.tree.map(lambda a: a[0], out)
     return dataclasses.replace(out, names=_augmented_names(model))
@@ -498,9 +526,9 @@ def smooth_states(model: AbstractSteeringModel | AbstractVessel, data, *, proces
     """
     # padded to a bucket length: records of nearby lengths share the compiled smoother
     # (padded samples are predicted without update, so the smoothed states are the same)
-    ds, rec, Q, q, R, P0 = _prepare(model, as_dataset(data).bucketed(), channels, rudder,
-                                    substeps, process_noise, measurement_noise,
-                                    initial_covariance, hold)
+    ds, rec, Q, q, R, P0 = _prepare(model, as_dataset(data).bucketed(), _Options(
+        channels, rudder, substeps, process_noise, measurement_noise, initial_covariance,
+        hold))
     _, zs, Ps = _smooth_jit(as_arrays(model), rec, Q, q, R, P0)
     zs, Ps = np.asarray(zs), np.asarray(Ps)
     names = _augmented_names(model)

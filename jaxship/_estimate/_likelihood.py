@@ -136,10 +136,14 @@ def _innovations(z, model, transform, noise, rec):
     return e, rec.y - e
 
 
-def _report(model, ds, channels, rudder, specs, transform, layout, rec, z, cov, loss,
-            result, steps, criterion, max_lag=25) -> FitResult:
+def _report(model, problem: "_Problem", specs, rudder, estimate, criterion,
+            max_lag=25) -> FitResult:
     """The `FitResult` of an innovations fit: the parameter report, the noise, and the
-    one-step-ahead predictions of the filter validated per channel."""
+    one-step-ahead predictions of the filter validated per channel. `estimate`: the
+    criterion's `(z, result, steps, cov, loss)`."""
+    z, result, steps, cov, loss = estimate
+    transform, layout, rec, ds, channels = (problem.transform, problem.layout, problem.rec,
+                                            problem.ds, problem.channels)
     d = len(specs)
     q = np.asarray(_physical(z, d, transform), dtype=np.float64)
     values = q[:d]
@@ -317,9 +321,8 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
     z0 = jnp.asarray(np.concatenate([transform.to_unconstrained([s.start for s in specs]),
                                      z_noise]), dtype=float)
     problem = _Problem(as_arrays(model), transform, layout, rec, ds, channels)
-    z, result, steps, cov, loss = criterion.estimate(problem, z0, solver, int(max_steps))
-    return _report(model, ds, channels, rudder, specs, transform, layout, rec, z, cov, loss,
-                   result, steps, criterion.name)
+    estimate = criterion.estimate(problem, z0, solver, int(max_steps))
+    return _report(model, problem, specs, rudder, estimate, criterion.name)
 
 
 class _Problem(eqx.Module):
