@@ -8,6 +8,7 @@ splits that axis across the devices of a `jax.sharding.Mesh` with `jax.shard_map
 """
 
 from collections.abc import Callable, Sequence
+from typing import NamedTuple
 
 import equinox as eqx
 import jax
@@ -120,9 +121,8 @@ def simulate_batch(
             and size >= WRITTEN_OUT_BATCH:
         simulator = eqx.tree_at(lambda s: s.solver, simulator, RK4(rolled=False))
     steps = simulator.steps_per_sample(manoeuvre.dt)
-    return _batched(
-        b_dyn, s_dyn, b_static, s_static, simulator, steps, output, wind, size, mesh, chunk_size
-    )
+    return _batched(b_dyn, s_dyn, b_static, s_static, _Runs(simulator, steps, output, wind),
+                    _Spread(size, mesh, chunk_size))
 
 
 def _split_batch(in_axes, args):
@@ -165,9 +165,33 @@ def _resolve_axes(prefix, tree, name):
         raise ValueError(f"`in_axes` for {name} is not a prefix of it: {e}") from None
 
 
+class _Runs(NamedTuple):
+    """How each run is simulated: the simulator, its steps per sample, the `output`
+    applied to each trajectory (or None) and whether the wind loads are on."""
+
+    simulator: Simulator
+    steps: int
+    output: Callable | None
+    wind: bool
+
+
+class _Spread(NamedTuple):
+    """How the batch is spread: its `size`, the device `mesh` (None: one device) and the
+    `chunk_size` of `lax.map` (None: all runs of a device vmapped at once)."""
+
+    size: int
+    mesh: object
+    chunk_size: int | None
+
+
 @eqx.filter_jit
-def _batched(b_dyn, s_dyn, b_static, s_static, simulator, steps, output, wind, size, mesh,
-             chunk_size):
+def _batched(b_dyn, s_dyn, b_static, s_static, runs: _Runs, spread: _Spread):
+    """The batched runs (`b_dyn`, `b_static`: the batched leaves' arrays and the rest;
+    `s_dyn`, `s_static`: the shared ones), vmapped or mapped in chunks on each device of
+    the mesh."""
+    simulator, steps, output, wind = runs
+    size, mesh, chunk_size = spread
+
     def one(b, s):
         model, manoeuvre, x0, environment = eqx.combine(b, b_static, s, s_static)
         if isinstance(model, AbstractSteeringModel) and isinstance(manoeuvre, Replay):
