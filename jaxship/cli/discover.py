@@ -2,6 +2,7 @@
 
 import pathlib
 
+from .. import DiscoveryOptions
 from ._common import (
     VELOCITIES,
     ProgressBar,
@@ -46,11 +47,12 @@ def run(args) -> int:
     check_out(args.out, writes=("discovery.json", "report.md", "figures/"),
               inputs=[*args.train, *(args.holdout or [])])
     report = run_discovery(args.train, args.holdout, model=name, start=start, out=args.out,
-                           max_effects=args.max_effects, alpha=args.alpha,
-                           sample_interval=args.sample_interval,
-                           over_ground=VELOCITIES.get(args.velocities),
-                           progress=ProgressBar(not args.quiet),
-                           note=note)
+                           options=DiscoveryOptions(max_effects=args.max_effects,
+                                                    alpha=args.alpha),
+                           reading=dict(sample_interval=args.sample_interval,
+                                        over_ground=VELOCITIES.get(args.velocities),
+                                        note=note),
+                           progress=ProgressBar(not args.quiet))
     print(report.to_markdown())
     print(f"wrote {args.out}/discovery.json, {args.out}/report.md, {args.out}/figures/")
     return 0

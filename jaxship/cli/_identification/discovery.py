@@ -18,31 +18,30 @@ from .workflow import identify, logs_wind
 
 
 def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
-                  max_effects: int = 3, alpha: float = 0.01, sample_interval=None,
-                  over_ground=None, progress=None, note=None, start=None):
-    """Read the records (resampled to `sample_interval` [s] if given, the trial CSVs' u, v
-    over ground if `over_ground`: `read_experiments`),
-    fit `model` (as `jaxship identify` does, for start values), run discovery and write
-    `out/discovery.json`, `out/report.md` and `out/figures/`. Returns the
-    `DiscoveryReport`. `progress` takes the stage reports (`jaxship.Progress`), `note`
-    (default: a stage report) what was done to the records (files skipped,
-    resampling): the command prints notes even when quiet. `start`: a model to start
-    from (`--vessel`), fitted as `model` (`start_entry`)."""
+                  options=None, reading=None, progress=None, start=None):
+    """Read the records (`reading`: `read_experiments`' keywords `sample_interval` [s] to
+    resample to, `over_ground` for the trial CSVs' u, v, and `note`, default a stage
+    report, which hears what was done to the records: files skipped, resampling; the
+    command prints notes even when quiet), fit `model` (as `jaxship identify` does, for
+    start values), run discovery with `options` (a `jaxship.DiscoveryOptions`, default
+    its defaults) and write `out/discovery.json`, `out/report.md` and `out/figures/`.
+    Returns the `DiscoveryReport`. `progress` takes the stage reports
+    (`jaxship.Progress`). `start`: a model to start from (`--vessel`), fitted as `model`
+    (`start_entry`)."""
     say = (lambda message: None) if progress is None else (
         lambda message: progress(js.Progress("discover", message)))
-    note = note or say
+    options = js.DiscoveryOptions() if options is None else options
+    reading = dict(reading or {})
+    reading["note"] = reading.get("note") or say
     name = start_entry(model, start)[0] if start is not None else model_key(model)
-    if max_effects < 1:
-        raise ValueError(f"--max-effects must be at least 1, got {max_effects}.")
-    if not 0 < alpha < 1:
-        raise ValueError(f"--alpha must be between 0 and 1, got {alpha}.")
-    train = read_experiments(train_paths, role="training", note=note,
-                             sample_interval=sample_interval, over_ground=over_ground)
+    if options.max_effects < 1:
+        raise ValueError(f"--max-effects must be at least 1, got {options.max_effects}.")
+    if not 0 < options.alpha < 1:
+        raise ValueError(f"--alpha must be between 0 and 1, got {options.alpha}.")
+    train = read_experiments(train_paths, role="training", **reading)
     # a held-out record named as a training one (two `trial.csv`) is told apart by its folder
-    holdout = read_experiments(holdout_paths, role="held-out", note=note,
-                               taken=[e.name for e in train],
-                               sample_interval=sample_interval,
-                               over_ground=over_ground) if holdout_paths else None
+    holdout = read_experiments(holdout_paths, role="held-out", taken=[e.name for e in train],
+                               **reading) if holdout_paths else None
     check_writes(pathlib.Path(out), tuple(f"figures/{_figure_name(i)}"
                                           for i in range(len(holdout or train))))
     length = float(start.length) if isinstance(start, js.AbstractVessel) else \
@@ -51,8 +50,7 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
         check_froude(holdout, length, "held-out", name)
     say(f"start values: identify {name} on {len(train)} training records")
     start = identify(train, model=name, start=start).fit.model
-    report = js.discover(start, train, holdout, options=js.DiscoveryOptions(
-        max_effects=max_effects, alpha=alpha), progress=progress)
+    report = js.discover(start, train, holdout, options=options, progress=progress)
     with staged_folder(pathlib.Path(out)) as stage:  # all or nothing
         figures = save_discovery_figures(report, train, holdout, stage / "figures")
         text = report.to_markdown()
