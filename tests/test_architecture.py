@@ -623,9 +623,6 @@ OVER_THE_LIMITS = {
     # channels, weights, rudder, simulator, hold, wind) and the smoothed starts; tests
     # build windows without an estimator
     "jaxship/_estimate/_windows.py:build_windows": "the estimator's fields as keywords",
-    # the time loop, diffeqsolve's shape: field, y0, the policy and its state, the sample
-    # grid (t0, dt, num), the solver and its steps per sample, what to record, when
-    "jaxship/_simulation/_integrate.py:integrate": "the time loop's terms, as diffeqsolve",
 }
 
 

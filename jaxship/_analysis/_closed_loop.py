@@ -193,8 +193,8 @@ def _run(plant, autopilot, x0, dt, num, simulator, steps):
             return y[5], psi_d, psi_ref, y[2], r_d, y[6], delta_c
         return y[-1], psi_d, psi_ref, plant.output(y[:-1]), r_d, delta_c, delta_c
 
-    out, result = integrate(field, y0, policy, autopilot.init(x0), 0.0, dt, num, simulator,
-                            steps, observe)
+    out, result = integrate(field, y0, (policy, autopilot.init(x0)), (0.0, dt, num),
+                            simulator, steps, observe)
     return (*out, result)
 
 

@@ -194,7 +194,7 @@ def _predict(model, w: Windows, offsets=None):
             return jnp.stack([model.measure(c, y[i]) for c, i in zip(w.channels, index)])
 
         out, _ = integrate(lambda t, y, a: field(t, y, a[0].at(t - a[1])), y0,
-                           replay_policy(records, dt, holds), None, 0.0, dt, num,
+                           (replay_policy(records, dt, holds), None), (0.0, dt, num),
                            w.simulator, w.substeps, observe, emit="end")
         return out  # (L, C)
 

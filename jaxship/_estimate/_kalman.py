@@ -225,7 +225,7 @@ def _interval_map(model, substeps, holds):
         start = {k: a[0] + (w if k == "delta" else 0.0) for k, a in inputs.items()}
         slope = {k: holds[k].slope(a[0], a[1], dt) for k, a in inputs.items()}
         held = Held(start, slope)
-        out, _ = integrate(field, z, lambda t, y, s, h: (held, s), None, 0.0, dt, 1,
+        out, _ = integrate(field, z, (lambda t, y, s, h: (held, s), None), (0.0, dt, 1),
                            simulator, substeps, lambda y, _: y, emit="end")
         return out[0]
 

@@ -170,9 +170,10 @@ class Simulator(eqx.Module):
         return sol.ys[-1], sol.result
 
 
-def integrate(field, y0, policy, policy_state, t0, dt, num, simulator: Simulator, steps: int,
-              observe=None, *, emit: str = "start"):
-    """The time loop: `num` output samples from `y0` at `t0` every `dt`.
+def integrate(field, y0, control, grid, simulator: Simulator, steps: int, observe=None, *,
+              emit: str = "start"):
+    """The time loop: `grid = (t0, dt, num)`, `num` output samples from `y0` at `t0`
+    every `dt`, under `control = (policy, policy_state)`.
 
     - `field(t, y, (inputs, t_k))`: the vector field, with the inputs held from the
       control step's start `t_k` (evaluate them at `t` with `inputs.at(t - t_k)`).
@@ -189,6 +190,8 @@ def integrate(field, y0, policy, policy_state, t0, dt, num, simulator: Simulator
     `RESULTS` code: the first failed step's (diffrax's code passed through), else
     `simulation_blew_up` when a recorded value is not finite, else `successful`.
     """
+    policy, policy_state = control
+    t0, dt, num = grid
     h = dt / steps
     observe = (lambda y, inputs: (y, inputs)) if observe is None else observe
 

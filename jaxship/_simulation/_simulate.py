@@ -168,8 +168,8 @@ def _simulate(vessel, manoeuvre, x0, environment, simulator, steps, wind=True, p
         return jnp.concatenate([y[:len(STATE_FIELDS)], jnp.stack([delta, n])])
 
     field = vessel_field(vessel, environment, wind=wind, rudder_rate=manoeuvre.rudder_rate)
-    out, result = integrate(field, y0, policy,
-                        manoeuvre.init(x0), t0, dt, num, simulator, steps, observe)
+    out, result = integrate(field, y0, (policy, manoeuvre.init(x0)), (t0, dt, num),
+                            simulator, steps, observe)
     if not per_field:
         out = tuple(out[:, i] for i in range(len(STATE_FIELDS) + 2))
     state, command = ShipState(*out[:-2]), Command(*out[-2:])

@@ -47,8 +47,8 @@ def _propagate(model, state0, psi0, records, dt, holds, simulator, steps):
     y0 = jnp.concatenate([state0, jnp.reshape(psi0, (1,))])
     num = records["delta"].shape[0] - 1
     observe = lambda y, _: (y[-1], model.output(y[:-1]), y[:-1])
-    return integrate(steering_field(model), y0, replay_policy(records, dt, holds), None, 0.0,
-                     dt, num, simulator, steps, observe, emit="end")
+    return integrate(steering_field(model), y0, (replay_policy(records, dt, holds), None),
+                     (0.0, dt, num), simulator, steps, observe, emit="end")
 
 
 def at_rest(dtype=float) -> ShipState:
@@ -168,6 +168,6 @@ def _steer(model, manoeuvre, x0, simulator, steps):
     observe = lambda y, held: (y[-1], model.output(y[:-1]), y[:-1], held.value["delta"],
                                held.value["ordered"])
     (psi, r, states, delta, ordered), result = integrate(
-        steering_field(model), y0, policy, (zero, memory), manoeuvre.start, dt,
-        manoeuvre.num_samples, simulator, steps, observe)
+        steering_field(model), y0, (policy, (zero, memory)),
+        (manoeuvre.start, dt, manoeuvre.num_samples), simulator, steps, observe)
     return steering_trajectory(manoeuvre, psi, r, states, delta, ordered, result)
