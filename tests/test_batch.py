@@ -68,7 +68,8 @@ def test_a_large_batch_takes_rk4s_stages_written_out_with_the_same_numbers(monke
     x0 = js.straight_run(vessel)
     seen = []
     batched = jb._batched
-    monkeypatch.setattr(jb, "_batched", lambda *a: seen.append(a[4].solver) or batched(*a))
+    monkeypatch.setattr(jb, "_batched",
+                        lambda *a: seen.append(a[4].simulator.solver) or batched(*a))
     written = jb.simulate_batch(vessel, manoeuvres, x0, in_axes=(None, 0, None, None))
     rolled = jb.simulate_batch(vessel, manoeuvres, x0, in_axes=(None, 0, None, None),
                                simulator=js.Simulator(solver=js.RK4(rolled=True)))
