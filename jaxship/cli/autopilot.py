@@ -106,13 +106,9 @@ def run(args) -> int:
     evaluation = autopilot_study.evaluate(model, vessel, design=design, tune=args.tune,
                                           progress=progress, steady_turn=args.steady_turn,
                                           **kw)
-    at_step = evaluation.feedforward_at_step
-    if at_step is None:  # the model's own steady turn: the vessel's measured for the report
+    if evaluation.feedforward_at_step is None:  # --steady-turn model: measured for the report
         progress("the vessel's steady turn at the step's peak rate")
-        at_step = autopilot_study.steady_turn_trial(
-            model, vessel, design, evaluation.controllers["pid"],
-            **{"rpm" if by_rpm else "speed": sum(values) / len(values)})
-        del at_step["steady_gain"]
+    at_step = _feedforward_at_step(evaluation, by_rpm, values)
     inverse = autopilot_study.feedforward_gain_text(at_step)
     bar.update(bar.total - bar.n)
     bar.close()
@@ -176,6 +172,18 @@ def run(args) -> int:
         if sentence:
             print(f"jaxship: {sentence}", file=sys.stderr)
     return 3 if failure or unfit else 0
+
+
+def _feedforward_at_step(evaluation, by_rpm, values) -> dict:
+    """The evaluation's `feedforward_at_step` (--steady-turn trial), or with the model's
+    own steady turn the same numbers measured for the report, without a scale."""
+    if evaluation.feedforward_at_step is not None:
+        return evaluation.feedforward_at_step
+    at_step = autopilot_study.steady_turn_trial(
+        evaluation.model, evaluation.plant, evaluation.design, evaluation.controllers["pid"],
+        **{"rpm" if by_rpm else "speed": sum(values) / len(values)})
+    del at_step["steady_gain"]
+    return at_step
 
 
 def gains_table(gains: dict) -> str:

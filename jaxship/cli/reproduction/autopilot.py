@@ -466,7 +466,8 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
         start = controllers["pid+ff"]
         if not float(start.kd) > 0:
             start = design_controllers(model, plant, dataclasses.replace(
-                design, subtract_damping=False), speed=u0, n=n0)["pid+ff"]
+                design, subtract_damping=False), speed=u0, n=n0,
+                steady_gain=start.feedforward.steady_gain)["pid+ff"]
         say("tuning the gains on the vessel")
         tuned = js.tune_autopilot(plant, start, duration=design.duration, dt=design.tune_dt,
                                   rudder_weight=design.rudder_weight,
