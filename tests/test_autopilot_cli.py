@@ -491,3 +491,23 @@ def test_the_steady_turn_trial_on_a_plant_that_is_not_the_design_model():
     assert ratio["trial"] <= 0.7 and overshoot <= 2.0
     at_step = evaluation.feedforward_at_step
     assert 0 < at_step["steady_gain"] < 1.0
+
+
+@pytest.mark.slow  # 16 s: two closed loops and two open ones on the thesis vessel
+def test_the_steady_turn_trial_measures_the_vessels_steady_turn():
+    """`vessel_steady_rudder` (issue 61) against the open loop: the thesis vessel (course-
+    stable) held at the measured rudder, +- it, turns steadily at the step's peak desired
+    yaw rate within 2 %; a trial too short to settle is refused with a sentence."""
+    thesis, design = js.get_vessel("thesis"), study.Design()
+    u0, n0 = study.operating_point(thesis, rpm=400.0)
+    pid = study.design_controllers(js.Nomoto1(K=0.2, T=2.5), thesis, design, speed=u0,
+                                   n=n0)["pid"]
+    rudder = study.vessel_steady_rudder(thesis, pid, design, rpm=400.0)
+    x0 = js.straight_run(thesis, n=400.0 / 60.0)
+    rates = [float(js.simulate(thesis, js.Turn(s * rudder, duration=150.0, dt=0.5),
+                               x0).state.r[-1]) for s in (1, -1)]
+    assert (rates[0] - rates[1]) / 2 == pytest.approx(study.peak_reference_rate(design),
+                                                      rel=0.02)
+    short = study.Design(step_time=1.0, duration=4.0)
+    with pytest.raises(ValueError, match="did not settle on the reverse-spiral trial"):
+        study.vessel_steady_rudder(thesis, pid, short, rpm=400.0)

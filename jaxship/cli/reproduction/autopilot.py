@@ -275,7 +275,9 @@ def vessel_steady_rudder(plant, pid, design: Design, *, rpm=None, speed=None) ->
     at $+r_p$ and $-r_p$ (`YawRateLevels`, each for the design's run length) by the
     gains and limits of the `pid` autopilot (the design's feedback, no feed-forward),
     the mean rudder over the last quarter of each level; half their difference (a
-    rudder offset of the vessel drops out). For a course-unstable vessel at small
+    rudder offset of the vessel drops out). **Raises** `ValueError` where the vessel
+    did not settle on the levels (mean yaw rate of a last quarter more than 10 % off
+    its level, or the run not finite). For a course-unstable vessel at small
     $r_p$ this is a point inside its spiral loop, where zig-zags at 10-20 deg do not
     steer."""
     r_p, hold = peak_reference_rate(design), design.duration
@@ -285,8 +287,16 @@ def vessel_steady_rudder(plant, pid, design: Design, *, rpm=None, speed=None) ->
                                 interval=pid.interval)
     run = js.closed_loop(plant, pilot, duration=2 * hold, dt=design.dt,
                          **({"rpm": [rpm]} if rpm is not None else {"speeds": [speed]}))
-    t, delta = np.asarray(run.t), np.asarray(run.delta)[0, 0]
+    t, delta, r = np.asarray(run.t), np.asarray(run.delta)[0, 0], np.asarray(run.r)[0, 0]
     last = [(t > (k + 0.75) * hold) & (t <= (k + 1) * hold) for k in (0, 1)]
+    rates = [float(np.mean(r[part])) for part in last]
+    # a steady turn: the mean yaw rate of each last quarter within 10 % of its level
+    if not (bool(np.asarray(run.success)[0, 0]) and abs(rates[0] - r_p) <= 0.1 * r_p
+            and abs(rates[1] + r_p) <= 0.1 * r_p):
+        raise ValueError(f"the vessel did not settle on the reverse-spiral trial's yaw rates "
+                         f"+-{math.degrees(r_p):.3g} deg/s (mean "
+                         f"{math.degrees(rates[0]):.3g}, {math.degrees(rates[1]):.3g} deg/s): "
+                         "give --steady-turn model.")
     return float(np.mean(delta[last[0]]) - np.mean(delta[last[1]])) / 2
 
 
