@@ -404,6 +404,12 @@ def test_a_rudder_on_its_limits_is_a_code_and_a_sentence(identified, tmp_path, c
     assert {r["code"] for r in runs} == {"rudder_saturated"}
     assert all(r["time_saturated_s"] > 0.5 * 10.0 for r in runs)  # window 10-20 s
     assert "rudder_saturated" in (out / "report.md").read_text().split("##")[0]
+    # issue 61: no steady turn at the 180 deg step's peak rate; the model's own, said so
+    at_step = written["feedforward_at_step"]
+    assert at_step["vessel_rudder_deg"] is None and at_step["steady_gain"] == 1.0
+    assert written["gains"]["pid+ff"]["ff_steady_gain"] == 1.0
+    assert ("did not settle on the reverse-spiral trial's yaw rates" in at_step["trial_failed"]
+            and "steady-turn part stays the model's" in (out / "report.md").read_text())
     assert "warning: The rudder sat at its limit" in capsys.readouterr().err
 
 

@@ -183,6 +183,7 @@ def _feedforward_at_step(evaluation, by_rpm, values) -> dict:
         evaluation.model, evaluation.plant, evaluation.design, evaluation.controllers["pid"],
         **{"rpm" if by_rpm else "speed": sum(values) / len(values)})
     del at_step["steady_gain"]
+    at_step.pop("trial_failed", None)  # not measured: the report just says nothing of it
     return at_step
 
 

@@ -295,8 +295,8 @@ def vessel_steady_rudder(plant, pid, design: Design, *, rpm=None, speed=None) ->
             and abs(rates[1] + r_p) <= 0.1 * r_p):
         raise ValueError(f"the vessel did not settle on the reverse-spiral trial's yaw rates "
                          f"+-{math.degrees(r_p):.3g} deg/s (mean "
-                         f"{math.degrees(rates[0]):.3g}, {math.degrees(rates[1]):.3g} deg/s): "
-                         "give --steady-turn model.")
+                         f"{math.degrees(rates[0]):.3g}, {math.degrees(rates[1]):.3g} "
+                         "deg/s).")
     return float(np.mean(delta[last[0]]) - np.mean(delta[last[1]])) / 2
 
 
@@ -332,11 +332,17 @@ def steady_turn_trial(model, plant, design: Design, pid, *, rpm=None, speed=None
     where a course-unstable ship is inside its spiral loop (Bech 1966; MSC/Circ.1053
     app. 4); the reverse spiral is the trial that measures the steady turn there. The
     acceleration part ($T\\dot r_d/K$, the yaw inertia per rudder angle) stays the
-    model's."""
+    model's. Where the vessel does not settle on the trial's yaw rates (a step faster than
+    it can turn steadily) "vessel_rudder_deg" is None, "steady_gain" 1 and
+    "trial_failed" says why."""
     key, value = ("rpm", rpm) if rpm is not None else ("speed", speed)
     u, n = operating_point(plant, **{key: value})
     at_step = feedforward_at_step(model, plant, design, speed=u, n=n)
-    vessel = math.degrees(vessel_steady_rudder(plant, pid, design, rpm=rpm, speed=speed))
+    try:
+        vessel = math.degrees(vessel_steady_rudder(plant, pid, design, rpm=rpm, speed=speed))
+    except ValueError as error:  # not measured: the model's own steady turn, said so
+        return at_step | {"vessel_rudder_deg": None, "steady_gain": 1.0,
+                          "trial_failed": str(error)}
     ratio = vessel / at_step["model_rudder_deg"] if at_step["model_rudder_deg"] else 1.0
     return at_step | {"vessel_rudder_deg": vessel,
                       "steady_gain": max(ratio, LEAST_STEADY_GAIN)}
@@ -357,7 +363,10 @@ def feedforward_gain_text(at_step: dict) -> str:
         text += (f" The vessel steered needs {vessel:.3g} deg there (a reverse-spiral point "
                  f"flown in closed loop): the model's steady-turn rudder is "
                  f"{at_step['model_rudder_deg'] / vessel:.3g} times the vessel's.")
-    if "steady_gain" in at_step:
+    if at_step.get("trial_failed"):
+        text += (f" The reverse-spiral trial failed ({at_step['trial_failed']}): the "
+                 "feed-forward's steady-turn part stays the model's.")
+    elif "steady_gain" in at_step:
         text += (f" The feed-forward's steady-turn part is scaled by g_s = "
                  f"{at_step['steady_gain']:.3g} to the vessel's (--steady-turn trial).")
     return text
