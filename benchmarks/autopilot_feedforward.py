@@ -4,7 +4,10 @@ Run as a new user would, through the command line: each vessel's steering model 
 `jaxship identify` on that vessel's zig-zags, then `jaxship autopilot` with its defaults
 (45 deg step) on a vessel preset, PID with feed-forward (pid+ff) against the same PID
 without it (pid). Printed per run: the summed heading error (thesis eq. 3.19, deg at 1 s
-over the window after the step), the overshoot [deg], and the ratio pid+ff / pid.
+over the window after the step), the overshoot [deg], and the ratio pid+ff / pid; and
+the diagnosis of issue 61: at the step's peak desired yaw rate, the steady-turn rudder the
+model's feed-forward orders against the one the vessel itself needs there (a reverse-spiral
+point flown in closed loop by `autopilot`, "feedforward_at_step" in autopilot.json).
 
 - Mariner at 7.7 m/s: zig-zags 10/10 and 20/20 of jaxship's `mariner` preset, which
   is also the plant;
@@ -75,8 +78,9 @@ def main(argv=None) -> int:
                         help="extra options passed to `jaxship autopilot`")
     args = parser.parse_args(argv)
     print("| vessel | model | run | pid+ff sum [deg] | pid sum [deg] | ratio | "
-          "pid+ff overshoot [deg] | pid overshoot [deg] | fit |")
-    print("|---|---|---|---:|---:|---:|---:|---:|---|")
+          "pid+ff overshoot [deg] | pid overshoot [deg] | peak r_d [deg/s] | "
+          "model's steady rudder there [deg] | vessel's [deg] | fit |")
+    print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|")
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
         for name, train, plant, option, values in cases(folder):
@@ -91,9 +95,10 @@ def main(argv=None) -> int:
                             option, *values, "--out", ap, *args.autopilot)
                 except RuntimeError as error:
                     print(f"| {name} | {model} | autopilot failed: "
-                          f"{str(error).splitlines()[-1][:80]} | | | | | | {fitted} |")
+                          f"{str(error).splitlines()[-1][:80]} | | | | | | | | | {fitted} |")
                     continue
-                rows = json.loads((ap / "autopilot.json").read_text())["runs"]
+                written = json.loads((ap / "autopilot.json").read_text())
+                rows, at = written["runs"], written["feedforward_at_step"]
                 by = {(r["controller"], r["rpm"], r["speed"]): r for r in rows}
                 for (controller, rpm, speed), ff in by.items():
                     if controller != "pid+ff":
@@ -104,7 +109,8 @@ def main(argv=None) -> int:
                     ratio = "-" if None in (a, b) else f"{a / b:.2f}"
                     print(f"| {name} | {model} | {run} | {a:.1f} | {b:.1f} | {ratio} | "
                           f"{ff['max_overshoot_deg']:.2f} | {fb['max_overshoot_deg']:.2f} | "
-                          f"{fitted} |", flush=True)
+                          f"{at['peak_rate_deg_s']:.3g} | {at['model_rudder_deg']:.3g} | "
+                          f"{at['vessel_rudder_deg']:.3g} | {fitted} |", flush=True)
     return 0
 
 

@@ -2,6 +2,7 @@
 on a vessel preset."""
 
 import json
+import math
 import pathlib
 import sys
 
@@ -44,6 +45,12 @@ def register(sub) -> None:
                       "model, step "
                       "time and window follow it in the thesis' proportions")
     auto.add_argument("--damping", default="1.0", help="the controller's zeta")
+    auto.add_argument("--steady-turn", choices=("trial", "model"), default="trial",
+                      help="the feed-forward's steady-turn part: trial (default) scales the "
+                      "model's to the rudder the vessel needs at the step's peak yaw rate, "
+                      "measured first by a reverse-spiral point flown in closed loop (zig-zags "
+                      "do not reach those small yaw rates, inside a course-unstable ship's "
+                      "spiral loop); model: the model's own (thesis eq. 5.2/5.6)")
     auto.add_argument("--quiet", action="store_true", help="no progress bar")
     # --tune runs long gradient programs, which XLA's defaults compile to run faster
     auto.set_defaults(run=run, small_programs=lambda args: not args.tune)
@@ -84,12 +91,8 @@ def run(args) -> int:
         omega, basis = autopilot_study.natural_frequency_for(model, vessel, speed=u0, n=n0,
                                                              step=step)
     design = autopilot_study.Design.scaled(omega, step=step, damping=damping, basis=basis)
-    u_mean, n_mean = autopilot_study.operating_point(
-        vessel, **{"rpm" if by_rpm else "speed": sum(values) / len(values)})
-    inverse = autopilot_study.feedforward_gain_text(model, vessel, design, speed=u_mean,
-                                                    n=n_mean)
 
-    bar = tqdm(total=2 + 2 * int(args.tune), desc="autopilot", unit="stage", leave=False,
+    bar = tqdm(total=3 + 2 * int(args.tune), desc="autopilot", unit="stage", leave=False,
                file=sys.stderr, disable=args.quiet)
     started = []
 
@@ -101,7 +104,12 @@ def run(args) -> int:
 
     kw = {"rpm": values} if by_rpm else {"speeds": values}
     evaluation = autopilot_study.evaluate(model, vessel, design=design, tune=args.tune,
-                                          progress=progress, **kw)
+                                          progress=progress, steady_turn=args.steady_turn,
+                                          **kw)
+    if evaluation.feedforward_at_step is None:  # --steady-turn model: measured for the report
+        progress("the vessel's steady turn at the step's peak rate")
+    at_step = _feedforward_at_step(evaluation, by_rpm, values)
+    inverse = autopilot_study.feedforward_gain_text(at_step)
     bar.update(bar.total - bar.n)
     bar.close()
 
@@ -137,6 +145,7 @@ def run(args) -> int:
                       "parameters": {k: float(e["value"] if isinstance(e, dict) else e)
                                      for k, e in report["parameters"].items()}},
             "vessel": args.vessel,
+            "feedforward_at_step": at_step,
             **evaluation.to_dict(),
             "figures": figures,
         }
@@ -163,6 +172,19 @@ def run(args) -> int:
         if sentence:
             print(f"jaxship: {sentence}", file=sys.stderr)
     return 3 if failure or unfit else 0
+
+
+def _feedforward_at_step(evaluation, by_rpm, values) -> dict:
+    """The evaluation's `feedforward_at_step` (--steady-turn trial), or with the model's
+    own steady turn the same numbers measured for the report, without a scale."""
+    if evaluation.feedforward_at_step is not None:
+        return evaluation.feedforward_at_step
+    at_step = autopilot_study.steady_turn_trial(
+        evaluation.model, evaluation.plant, evaluation.design, evaluation.controllers["pid"],
+        **{"rpm" if by_rpm else "speed": sum(values) / len(values)})
+    del at_step["steady_gain"]
+    at_step.pop("trial_failed", None)  # not measured: the report just says nothing of it
+    return at_step
 
 
 def gains_table(gains: dict) -> str:

@@ -134,7 +134,8 @@ class Evaluation:
     ClosedLoop} (axes: 1 autopilot x operating points x samples), the operating points
     `rpm` and `speed` of the runs, the `rows` (one dict per controller and
     operating point, keys `RUN_KEYS` and `success`), the `tuning` summary (or None)
-    and the `design`."""
+    and the `design`; `feedforward_at_step` (`steady_turn_trial`, or None).
+    """
 
     model: object
     plant: object
@@ -147,6 +148,7 @@ class Evaluation:
     speed: list
     rows: list
     tuning: dict | None = None
+    feedforward_at_step: dict | None = None
 
     def gains(self) -> dict:
         """{controller: {kp, ki, kd, feedforward[, ff_gain, ff_steady_gain]}}: kp
@@ -260,31 +262,123 @@ def natural_frequency_for(model, plant, *, speed: float, n: float,
                "the thesis' proportions")
 
 
-def feedforward_gain_text(model, plant, design: Design, *, speed: float, n: float) -> str:
-    """Which model the feed-forward inverts and its steady-turn gain where the step steers:
-    at the reference's peak yaw rate $r_p = A\\omega\\,2e^{-2}$ (the peak of
-    $\\dot\\psi_d$ of eq. 5.7 at damping 1 for a step $A$) the model's steady-turn
-    rudder $\\delta_s$ (`Feedforward.inverse` with $\\dot r_d = 0$) and its gain
-    $r_p/\\delta_s$, against the linear gain $1/d$ of `yaw_inertia` about the straight
-    run (K for Nomoto models), in one sentence."""
+def peak_reference_rate(design: Design) -> float:
+    """The step's peak desired yaw rate $r_p = A\\omega\\,2e^{-2}$ [rad/s]: the peak of
+    $\\dot\\psi_d$ of eq. 5.7 at damping 1 for a step $A$ (`reference_rudder_frequency`)."""
+    return abs(design.step) * DEG * design.reference_frequency * 2 * math.exp(-2)
+
+
+def vessel_steady_rudder(plant, pid, design: Design, *, rpm=None, speed=None) -> float:
+    """The rudder [rad] the vessel `plant` itself needs to turn steadily at the step's
+    peak desired yaw rate $r_p$ (`peak_reference_rate`), at `rpm` or `speed`: two
+    points of Bech's reverse spiral (MSC/Circ.1053, app. 4, 2.2), flown in closed loop
+    at $+r_p$ and $-r_p$ (`YawRateLevels`, each for the design's run length) by the
+    gains and limits of the `pid` autopilot (the design's feedback, no feed-forward),
+    the mean rudder over the last quarter of each level; half their difference (a
+    rudder offset of the vessel drops out). **Raises** `ValueError` where the vessel
+    did not settle on the levels (mean yaw rate of a last quarter more than 10 % off
+    its level, or the run not finite). For a course-unstable vessel at small
+    $r_p$ this is a point inside its spiral loop, where zig-zags at 10-20 deg do not
+    steer."""
+    r_p, hold = peak_reference_rate(design), design.duration
+    pilot = js.HeadingAutopilot(kp=pid.kp, ki=pid.ki, kd=pid.kd, reference=None,
+                                steps=js.YawRateLevels(rates=(r_p, -r_p), hold=hold),
+                                max_angle=pid.max_angle, max_rate=pid.max_rate,
+                                interval=pid.interval)
+    run = js.closed_loop(plant, pilot, duration=2 * hold, dt=design.dt,
+                         **({"rpm": [rpm]} if rpm is not None else {"speeds": [speed]}))
+    t, delta, r = np.asarray(run.t), np.asarray(run.delta)[0, 0], np.asarray(run.r)[0, 0]
+    last = [(t > (k + 0.75) * hold) & (t <= (k + 1) * hold) for k in (0, 1)]
+    rates = [float(np.mean(r[part])) for part in last]
+    # a steady turn: the mean yaw rate of each last quarter within 10 % of its level
+    if not (bool(np.asarray(run.success)[0, 0]) and abs(rates[0] - r_p) <= 0.1 * r_p
+            and abs(rates[1] + r_p) <= 0.1 * r_p):
+        raise ValueError(f"the vessel did not settle on the reverse-spiral trial's yaw rates "
+                         f"+-{math.degrees(r_p):.3g} deg/s (mean "
+                         f"{math.degrees(rates[0]):.3g}, {math.degrees(rates[1]):.3g} "
+                         "deg/s).")
+    return float(np.mean(delta[last[0]]) - np.mean(delta[last[1]])) / 2
+
+
+def feedforward_at_step(model, plant, design: Design, *, speed: float, n: float) -> dict:
+    """Which model the feed-forward inverts and how it steers where the step steers
+    (JSON-ready, degrees and 1/s): at the step's peak desired yaw rate $r_p$
+    (`peak_reference_rate`) the model's steady-turn rudder $\\delta_s$
+    (`Feedforward.inverse` with $\\dot r_d = 0$) and its gain $r_p/\\delta_s$,
+    against the linear gain $1/d$ of `yaw_inertia` about the straight run (K for
+    Nomoto models)."""
     state = js.straight_run(plant, speed=speed)  # the measured u, v, n the inverse uses
-    r_peak = abs(design.step) * DEG * design.reference_frequency * 2 * math.exp(-2)
+    r_peak = peak_reference_rate(design)
     steady = float(js.Feedforward(model).inverse(r_peak, 0.0, state))
-    linear = 1.0 / float(js.yaw_inertia(model, speed=speed, n=n)[1])
-    gain = r_peak / steady if steady != 0 else math.inf
-    return (f"The feed-forward inverts the {type(model).__name__} model. At the step's peak "
-            f"desired yaw rate {math.degrees(r_peak):.3g} deg/s its steady-turn rudder is "
-            f"{math.degrees(steady):.3g} deg: a gain r/delta = {gain:.4g} 1/s where the "
-            f"autopilot steers, against the identified model's linear gain 1/d = "
-            f"{linear:.4g} 1/s at r = 0.")
+    return {"model": type(model).__name__, "peak_rate_deg_s": math.degrees(r_peak),
+            "model_rudder_deg": math.degrees(steady),
+            "model_gain_1_s": r_peak / steady if steady != 0 else None,
+            "linear_gain_1_s": 1.0 / float(js.yaw_inertia(model, speed=speed, n=n)[1])}
+
+
+# the least steady-turn gain a trial sets: a point measured inside a spiral loop can be
+# at or below zero rudder; the feed-forward then orders (almost) no steady rudder, and
+# `tune_autopilot` (log-space gains) can still start from it
+LEAST_STEADY_GAIN = 0.01
+
+
+def steady_turn_trial(model, plant, design: Design, pid, *, rpm=None, speed=None) -> dict:
+    """`feedforward_at_step` at the operating point `rpm` or `speed` with the rudder
+    the vessel `plant` needs there ("vessel_rudder_deg", `vessel_steady_rudder` flown by
+    `pid`) and the feed-forward's steady-turn gain from them, "steady_gain"
+    $g_s = \\delta_{vessel}(r_p)/\\delta_s(r_p)$ (at least `LEAST_STEADY_GAIN`): the
+    model's steady-turn characteristic corrected at the one yaw rate where the step
+    steers. Zig-zags at 10-20 deg do not reach the small yaw rates of a heading step,
+    where a course-unstable ship is inside its spiral loop (Bech 1966; MSC/Circ.1053
+    app. 4); the reverse spiral is the trial that measures the steady turn there. The
+    acceleration part ($T\\dot r_d/K$, the yaw inertia per rudder angle) stays the
+    model's. Where the vessel does not settle on the trial's yaw rates (a step faster than
+    it can turn steadily) "vessel_rudder_deg" is None, "steady_gain" 1 and
+    "trial_failed" says why."""
+    key, value = ("rpm", rpm) if rpm is not None else ("speed", speed)
+    u, n = operating_point(plant, **{key: value})
+    at_step = feedforward_at_step(model, plant, design, speed=u, n=n)
+    try:
+        vessel = math.degrees(vessel_steady_rudder(plant, pid, design, rpm=rpm, speed=speed))
+    except ValueError as error:  # not measured: the model's own steady turn, said so
+        return at_step | {"vessel_rudder_deg": None, "steady_gain": 1.0,
+                          "trial_failed": str(error)}
+    ratio = vessel / at_step["model_rudder_deg"] if at_step["model_rudder_deg"] else 1.0
+    return at_step | {"vessel_rudder_deg": vessel,
+                      "steady_gain": max(ratio, LEAST_STEADY_GAIN)}
+
+
+def feedforward_gain_text(at_step: dict) -> str:
+    """`feedforward_at_step` (with, where measured, the vessel's own rudder
+    "vessel_rudder_deg", `vessel_steady_rudder`) in words."""
+    gain = at_step["model_gain_1_s"]
+    text = (f"The feed-forward inverts the {at_step['model']} model. At the step's peak "
+            f"desired yaw rate {at_step['peak_rate_deg_s']:.3g} deg/s its steady-turn rudder "
+            f"is {at_step['model_rudder_deg']:.3g} deg: a gain r/delta = "
+            f"{math.inf if gain is None else gain:.4g} 1/s where the autopilot steers, "
+            f"against the identified model's linear gain 1/d = "
+            f"{at_step['linear_gain_1_s']:.4g} 1/s at r = 0.")
+    vessel = at_step.get("vessel_rudder_deg")
+    if vessel:  # measured and not zero
+        text += (f" The vessel steered needs {vessel:.3g} deg there (a reverse-spiral point "
+                 f"flown in closed loop): the model's steady-turn rudder is "
+                 f"{at_step['model_rudder_deg'] / vessel:.3g} times the vessel's.")
+    if at_step.get("trial_failed"):
+        text += (f" The reverse-spiral trial failed ({at_step['trial_failed']}): the "
+                 "feed-forward's steady-turn part stays the model's.")
+    elif "steady_gain" in at_step:
+        text += (f" The feed-forward's steady-turn part is scaled by g_s = "
+                 f"{at_step['steady_gain']:.3g} to the vessel's (--steady-turn trial).")
+    return text
 
 
 def design_controllers(model, plant, design: Design = Design(), *, speed: float,
-                       n: float) -> dict:
+                       n: float, steady_gain: float = 1.0) -> dict:
     """{"pid+ff": ..., "pid": ...}: `HeadingAutopilot`s for `model` (a steering model
     or vessel) by pole placement about the straight run at `speed` [m/s] and `n`
     [rev/s], with the reference model and step of `design` and the rudder limits of
-    the vessel `plant`; "pid+ff" inverts `model` for the reference feed-forward."""
+    the vessel `plant`; "pid+ff" inverts `model` for the reference feed-forward, its
+    steady-turn part weighted by `steady_gain` (`Feedforward`; 1: the model's own)."""
     steps = js.HeadingSteps(times=(design.step_time,), headings=(design.step * DEG,))
     reference = js.ReferenceModel(natural_frequency=design.reference_frequency,
                                   damping=design.reference_damping)
@@ -296,7 +390,8 @@ def design_controllers(model, plant, design: Design = Design(), *, speed: float,
     if not m > 0:
         raise ValueError(f"the {type(model).__name__} model turns the ship against its rudder "
                          f"at {speed:.3g} m/s (yaw inertia m = {m:.3g}): no autopilot design.")
-    return {"pid+ff": js.design_autopilot(model, feedforward=True, **kw),
+    inverse = js.Feedforward(model, steady_gain=steady_gain)
+    return {"pid+ff": js.design_autopilot(model, feedforward=inverse, **kw),
             "pid": js.design_autopilot(model, feedforward=False, **kw)}
 
 
@@ -346,13 +441,16 @@ def run_rows(name: str, run, design: Design, rpm, speed, max_angle: float) -> li
 
 
 def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
-             tune: bool = False, progress=None) -> Evaluation:
+             tune: bool = False, progress=None, steady_turn: str = "model") -> Evaluation:
     """Design the autopilots of `model` (`design_controllers`, about the mean operating
     point of the runs) and run each on the vessel `plant` from straight runs at each
     of `rpm` or `speeds` [m/s] (exactly one of them, a sequence). `tune`: also a
     `"tuned"` controller, `tune_autopilot` on `plant` at the same operating points
     from the "pid+ff" gains (if its $K_d \\le 0$, from the thesis' $K_d =
-    2\\zeta\\omega_n m$). `progress`: a callable taking a message, or None."""
+    2\\zeta\\omega_n m$). `progress`: a callable taking a message, or None.
+    `steady_turn`: "model" (the feed-forward inverts the model as it is; the thesis'
+    eq. 5.2/5.6) or "trial" (its steady-turn part scaled to the vessel's own rudder at
+    the step's peak rate, `steady_turn_trial`)."""
     if (rpm is None) == (speeds is None):
         raise ValueError("give exactly one of rpm and speeds.")
     design.check()
@@ -372,13 +470,23 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
         raise ValueError(f"the {type(plant).__name__} has no propeller model (its speed does "
                          "not depend on the rpm): give speeds (--speed) instead.")
     controllers = design_controllers(model, plant, design, speed=u0, n=n0)
+    at_step = None
+    if steady_turn == "trial":
+        say("the vessel's steady turn at the step's peak rate")
+        at_step = steady_turn_trial(model, plant, design, controllers["pid"],
+                                    **{key: mean})
+        controllers = design_controllers(model, plant, design, speed=u0, n=n0,
+                                         steady_gain=at_step["steady_gain"])
+    elif steady_turn != "model":
+        raise ValueError(f"steady_turn is 'trial' or 'model', got {steady_turn!r}.")
     run_kw = {"rpm": values} if key == "rpm" else {"speeds": values}
     tuning = None
     if tune:
         start = controllers["pid+ff"]
         if not float(start.kd) > 0:
             start = design_controllers(model, plant, dataclasses.replace(
-                design, subtract_damping=False), speed=u0, n=n0)["pid+ff"]
+                design, subtract_damping=False), speed=u0, n=n0,
+                steady_gain=start.feedforward.steady_gain)["pid+ff"]
         say("tuning the gains on the vessel")
         tuned = js.tune_autopilot(plant, start, duration=design.duration, dt=design.tune_dt,
                                   rudder_weight=design.rudder_weight,
@@ -398,4 +506,4 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
                          float(plant.rudder.max_angle))
     return Evaluation(model=model, plant=plant, design=design, design_speed=u0,
                       design_rpm=60.0 * n0, controllers=controllers, runs=runs, rpm=rpms,
-                      speed=speeds_, rows=rows, tuning=tuning)
+                      speed=speeds_, rows=rows, tuning=tuning, feedforward_at_step=at_step)
