@@ -16,7 +16,6 @@ from ._analysis._discover._catalogue import (
     DISCOVERY_CATALOGUE as DISCOVERY_CATALOGUE,
     Candidate as Candidate,
 )
-
 from ._models._effects import (
     AbstractEffect as AbstractEffect,
     AbstractLoadEffect as AbstractLoadEffect,

@@ -424,9 +424,9 @@ def cli_private_imports() -> list[str]:
 
 def counts() -> dict:
     """The numbers issue 59 asks to show (`python tests/test_architecture.py` prints them)."""
-    import jaxship as js
-
     import dataclasses
+
+    import jaxship as js
 
     oversized = _oversized()
     codes = {c.__name__: "result" in {f.name for f in dataclasses.fields(c)}

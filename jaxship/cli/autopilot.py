@@ -2,7 +2,6 @@
 on a vessel preset."""
 
 import json
-import math
 import pathlib
 import sys
 
