@@ -20,7 +20,8 @@ LAYERS = {
     "simulate": ["_simulation"],
     "estimate": ["_estimate"],
     "analysis": ["_analysis"],
-    # the public namespaces (effects, indices, strategies, wind_loads) only re-export, as __init__ does
+    # the public namespaces (effects, indices, strategies, wind_loads) only re-export, as
+    # __init__ does
     "application": ["_trials", "cli", "plotting", "__init__", "effects", "indices",
                     "strategies", "wind_loads"],
 }

@@ -25,7 +25,8 @@ def records_of(seeds, num=200):
     rngs = [np.random.default_rng(seed) for seed in seeds]
     delta = np.stack([np.repeat(np.where(rng.random(num // 40) < 0.5, -1.0, 1.0) * 10 * DEG,
                                 40) for rng in rngs])
-    replays = js.stack([js.Replay(d, dt=DT, delta_hold=js.strategies.FirstOrderHold()) for d in delta])
+    replays = js.stack([js.Replay(d, dt=DT, delta_hold=js.strategies.FirstOrderHold())
+                        for d in delta])
     tr = js.simulate_batch(TRUTH, replays,
                            simulator=js.Simulator(substeps=4), in_axes=(None, 0, None, None))
     a = np.exp(-DT / DISTURBANCE.tau)

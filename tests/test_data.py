@@ -45,7 +45,8 @@ def assert_channels_equal(a: Experiment, b: Experiment, rtol=1e-12):
 # --- trial CSV round trip ------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("units", [js.strategies.DisplayUnits(), js.strategies.SIUnits()], ids=["display", "si"])
+@pytest.mark.parametrize("units", [js.strategies.DisplayUnits(), js.strategies.SIUnits()],
+                         ids=["display", "si"])
 def test_round_trip_all_channels(tmp_path, units):
     exp = synthetic_experiment()
     path = tmp_path / "trial.csv"

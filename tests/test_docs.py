@@ -16,7 +16,8 @@ import jaxship.plotting
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 API = ROOT / "docs" / "api"
-NAMESPACES = ("effects", "indices", "plotting", "strategies", "wind_loads")  # public modules with their own names
+# public modules with their own names
+NAMESPACES = ("effects", "indices", "plotting", "strategies", "wind_loads")
 
 
 def public() -> set[str]:

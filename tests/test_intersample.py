@@ -67,7 +67,8 @@ def test_nomoto2_recovered_from_a_rate_limited_rudder_logged_at_2_hz():
     data = logged_zigzags(truth, 5 * DEG, 0.5)
     start = js.Nomoto2(K=0.05, T1=20.0, T2=2.0, T3=3.0)
     res = js.fit(start, data, estimator=js.PredictionError(horizon=20.0))
-    held = js.fit(start, data, estimator=js.PredictionError(horizon=20.0, hold=js.strategies.ZeroOrderHold()))
+    held = js.fit(start, data, estimator=js.PredictionError(
+        horizon=20.0, hold=js.strategies.ZeroOrderHold()))
     assert res.success
     np.testing.assert_allclose(res.values, [0.06, 25.0, 3.0, 5.0], rtol=0.01)
     # the held replay is biased by more than its own reported uncertainty

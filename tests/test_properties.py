@@ -316,13 +316,14 @@ def relabel(columns, old, new, factor=1.0):
 # a column written in another unit than its label: (units written, the change, the label
 # of the column named, the unit it likely holds); r in deg/s labelled rad/s is left to
 # the yaw-rate bound (`_PLAUSIBLE`) when beyond it
+SI, DISPLAY = js.strategies.SIUnits(), js.strategies.DisplayUnits()
 CORRUPTIONS = {
-    "psi in deg labelled rad": (js.strategies.SIUnits(), lambda c: relabel(c, "psi [rad]", "psi [rad]",
-                                                        180 / math.pi), "psi [rad]", "deg"),
-    "psi in rad labelled deg": (js.strategies.DisplayUnits(), lambda c: relabel(c, "psi [deg]", "psi [deg]",
-                                                             math.pi / 180), "psi [deg]", "rad"),
-    "r in rad/s labelled deg/s": (js.strategies.DisplayUnits(), lambda c: relabel(c, "r [deg/s]", "r [deg/s]",
-                                                               math.pi / 180), "r [deg/s]",
+    "psi in deg labelled rad": (SI, lambda c: relabel(c, "psi [rad]", "psi [rad]",
+                                                      180 / math.pi), "psi [rad]", "deg"),
+    "psi in rad labelled deg": (DISPLAY, lambda c: relabel(c, "psi [deg]", "psi [deg]",
+                                                           math.pi / 180), "psi [deg]", "rad"),
+    "r in rad/s labelled deg/s": (DISPLAY, lambda c: relabel(c, "r [deg/s]", "r [deg/s]",
+                                                             math.pi / 180), "r [deg/s]",
                                   "rad/s"),
     "t in ms labelled s": (js.strategies.DisplayUnits(),
                            lambda c: relabel(c, "t [s]", "t [s]", 1000.0), "t [s]", "ms"),

@@ -99,7 +99,8 @@ def test_matches_the_3dof_simulation_of_sea_stratus():
     tr = js.simulate(VESSEL, man, js.straight_run(VESSEL))
     d = np.asarray(tr.state.delta)
     for over, tol in ((1, 2e-6), (10, 2e-4)):
-        st = js.simulate(TRUTH, js.Replay(d[::over], dt=0.1 * over, delta_hold=js.strategies.FirstOrderHold()),
+        st = js.simulate(TRUTH, js.Replay(d[::over], dt=0.1 * over,
+                                          delta_hold=js.strategies.FirstOrderHold()),
                          aux=AuxInputs(u=np.asarray(tr.state.u)[::over]), simulator=per_sample())
         for name, got in (("r", st.state.r), ("v", st.internal[:, 1]), ("psi", st.state.psi)):
             ref = np.asarray(getattr(tr.state, name))[::over]
@@ -170,7 +171,8 @@ def test_gradients_match_finite_differences():
     def loss(values):
         model = eqx.tree_at(lambda m: tuple(getattr(m, k) for k in FREE), TRUTH,
                             tuple(values[i] for i in range(len(FREE))))
-        tr = js.simulate(model, js.Replay(delta, dt=1.0, delta_hold=js.strategies.FirstOrderHold()), aux=aux,
+        tr = js.simulate(model, js.Replay(delta, dt=1.0,
+                                          delta_hold=js.strategies.FirstOrderHold()), aux=aux,
                          simulator=per_sample())
         return jnp.sum(tr.state.r**2) * 1e4 + jnp.sum(tr.internal[:, 1] ** 2)
 

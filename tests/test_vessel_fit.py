@@ -42,7 +42,8 @@ def perturbed(vessel, names, factors):
 def two_trials():
     """A 20/20 zig-zag at 500 rpm (60 s) and a PRBS at 300 rpm (45 s): merged experiments
     of different lengths and propeller rates. The zig-zag reverses the rudder at a control
-    step (`switch_at=js.strategies.SwitchAtNearestStep()`), so that the 0.1 s samples replay it exactly."""
+    step (`switch_at=js.strategies.SwitchAtNearestStep()`), so that the 0.1 s samples replay it
+    exactly."""
     return [
         trial(THESIS, js.ZigZag(20 * DEG, 20 * DEG, duration=60.0, dt=0.1, n=500 / 60,
                                 switch_at=js.strategies.SwitchAtNearestStep()), 500, "zigzag"),

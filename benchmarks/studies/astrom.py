@@ -132,7 +132,8 @@ def _simulate_fit(model, exp: js.Experiment) -> dict:
     """Fit % of the fitted model simulated over the whole record (replayed rudder and
     speed) against the noisy measurements, psi, r and v."""
     x0 = dataclasses.replace(js.straight_state(0.0, psi=exp.psi[0]), r=exp.r[0], v=exp.v[0])
-    tr = js.simulate(model, js.Replay(exp.delta, dt=exp.dt, delta_hold=js.strategies.FirstOrderHold()), x0,
+    tr = js.simulate(model, js.Replay(exp.delta, dt=exp.dt,
+                                              delta_hold=js.strategies.FirstOrderHold()), x0,
                      aux=js.AuxInputs(u=exp.u, v=exp.v, n=exp.n),
                      simulator=js.Simulator(max_step=math.inf))
     return {"psi": js.fit_percent(exp.psi, np.asarray(tr.state.psi)),

@@ -46,7 +46,8 @@ def record(truth, manoeuvre, name, rng, *, disturbance_std=0.0, noise=(0.1, 0.05
     psi, r = np.asarray(out.state.psi), np.asarray(out.state.r)
     if disturbance_std:
         w = disturbance(t, disturbance_std, int(rng.integers(2**31)))
-        replay = js.Replay(delta + w, dt=float(t[1] - t[0]), delta_hold=js.strategies.FirstOrderHold())
+        replay = js.Replay(delta + w, dt=float(t[1] - t[0]),
+                           delta_hold=js.strategies.FirstOrderHold())
         out = js.simulate(truth, replay,
                           simulator=js.Simulator(max_step=math.inf, substeps=25))
         psi, r = np.asarray(out.state.psi), np.asarray(out.state.r)
