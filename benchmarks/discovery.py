@@ -39,6 +39,7 @@ from benchmarks.studies.discovery import (
     run_case,
     run_vessel_case,
     vessel_records,
+    wind_records,
 )
 from jaxship import effects
 
@@ -77,6 +78,19 @@ SCENARIOS = {  # name: (hidden effects, coloured-disturbance std [rad], true val
          effects.YawCubicDamping(beta=300.0)), 0.0,
         {"rudder_offset.delta0": 1.0 * DEG, "yaw_moment_bias.n0": K * 1.0 * DEG,
          "rudder_delay.delay": 1.5, "yaw_cubic_damping.beta": 300.0}),
+}
+# Nomoto 1 truth that feels a logged 15 m/s wind from 60 deg at 7 m/s (`wind_records`: 10/10
+# zig-zags on four headings to train, +-20 deg turns held out)
+WIND_SCENARIOS = {
+    "wind c2 3e-6 + offset 1 deg": ((effects.ApparentWind(c2=3e-6),
+                                     effects.RudderOffset(delta0=1.0 * DEG)),
+                                    {"wind.c2": 3e-6, "rudder_offset.delta0": 1.0 * DEG,
+                                     "yaw_moment_bias.n0": K * 1.0 * DEG}),
+    "wind c2 3e-6 + offset 1 deg + delay 1.5 s": (
+        (effects.ApparentWind(c2=3e-6), effects.RudderOffset(delta0=1.0 * DEG),
+         effects.RudderDelay(delay=1.5)),
+        {"wind.c2": 3e-6, "rudder_offset.delta0": 1.0 * DEG,
+         "yaw_moment_bias.n0": K * 1.0 * DEG, "rudder_delay.delay": 1.5}),
 }
 # Mariner truth, u and v logged over ground (GNSS), 400 s records (`run_vessel_case`)
 VESSEL_SCENARIOS = {
@@ -144,6 +158,9 @@ def main():
     cases = {name: (effects, truth, lambda e, seed, c=colour: run_case(e, 1000 + seed,
                                                                         disturbance_std=c))
              for name, (effects, colour, truth) in SCENARIOS.items()}
+    cases |= {name: (effects, truth, lambda e, seed: run_case(e, 1000 + seed,
+                                                               records=wind_records))
+              for name, (effects, truth) in WIND_SCENARIOS.items()}
     cases |= {name: (effects, truth, lambda e, seed: run_vessel_case(e, 1000 + seed))
               for name, (effects, truth) in VESSEL_SCENARIOS.items()}
     seeds = range(args.first_seed, args.first_seed + args.seeds)

@@ -134,12 +134,16 @@ def wind_records(truth, seed, *, speed=7.0, wind=(15.0, 60.0 * DEG), noise=(0.1,
     return train, holdout
 
 
-def run_case(effects, seed, *, base=None, disturbance_std=0.0, **options):
+def run_case(effects, seed, *, base=None, disturbance_std=0.0, records=None, **options):
     """Discovery on records of `base` (default Nomoto 1, K = 0.06 1/s, T = 25 s) with
-    `effects` hidden; returns `(report, seconds)`."""
+    `effects` hidden, made by `records(truth, seed)` (default `hidden_effect_records`;
+    e.g. `wind_records`); returns `(report, seconds)`."""
     base = js.Nomoto1(K=0.06, T=25.0) if base is None else base
     truth = js.augment(base, *effects) if effects else base
-    train, holdout = hidden_effect_records(truth, seed, disturbance_std=disturbance_std)
+    if records is None:
+        train, holdout = hidden_effect_records(truth, seed, disturbance_std=disturbance_std)
+    else:
+        train, holdout = records(truth, seed)
     start = js.Nomoto1(K=0.05, T=20.0) if isinstance(base, js.Nomoto1) else base
     began = time.perf_counter()
     report = js.discover(start, train, holdout, **options)
