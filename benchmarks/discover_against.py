@@ -10,7 +10,8 @@ then see the same load). Absolute times on a shared machine are noisy: the ratio
 of the medians of the wall time and of the process's CPU time (user + system, which a
 machine's load changes far less) are the result. From each run's `discovery.json` it
 also prints the named effects with their +-3 standard-error intervals and the share of
-the two HSVA 10/10 runs' first-overshoot error closed (summed |predicted - measured| before and after discovery).
+the two HSVA 10/10 runs' first-overshoot error closed (summed |predicted - measured|
+before and after discovery).
 
     git worktree add /tmp/old <commit>
     python benchmarks/discover_against.py --old /tmp/old --pairs 2 [--together]
