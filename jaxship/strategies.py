@@ -35,12 +35,11 @@ from ._estimate._likelihood import (
     HeldNoise as HeldNoise,
     ProcessNoise as ProcessNoise,
 )
+from ._models._holds import FirstOrderHold as FirstOrderHold, ZeroOrderHold as ZeroOrderHold
 from ._models._manoeuvres import (
-    FirstOrderHold as FirstOrderHold,
     SwitchAtCrossing as SwitchAtCrossing,
     SwitchAtNearestStep as SwitchAtNearestStep,
     SwitchAtNextStep as SwitchAtNextStep,
-    ZeroOrderHold as ZeroOrderHold,
 )
 from ._simulation._readers import DisplayUnits as DisplayUnits, SIUnits as SIUnits
 

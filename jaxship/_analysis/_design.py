@@ -23,7 +23,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._foundation._params import as_arrays, rebuild, resolve_free
-from .._models._manoeuvres import AbstractManoeuvre, FirstOrderHold, Replay
+from .._models._holds import FirstOrderHold
+from .._models._manoeuvres import AbstractManoeuvre, Replay
 from .._models._steering._base import AbstractSteeringModel
 from .._simulation._integrate import Simulator
 from .._simulation._simulate import simulate

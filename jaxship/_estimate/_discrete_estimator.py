@@ -19,7 +19,7 @@ import optimistix as optx
 from .._foundation._covariance import parameter_report
 from .._foundation._params import parameter_fields
 from .._models._effects import AugmentedSteering, YawCubicDamping
-from .._models._manoeuvres import ZeroOrderHold
+from .._models._holds import ZeroOrderHold
 from .._models._steering.nomoto import Nomoto1, Nomoto2, NonlinearNomoto
 from .._simulation._data import Experiment
 from ._discrete import (

@@ -34,7 +34,7 @@ from .._foundation._covariance import (
 from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
 from .._foundation._progress import ProgressCallback, reporting_steps, step_hook
 from .._foundation._sharding import sharded_vmap
-from .._models._manoeuvres import FirstOrderHold, ZeroOrderHold
+from .._models._holds import FirstOrderHold, ZeroOrderHold
 from .._simulation._data import Dataset
 from .._simulation._integrate import Simulator, integrate, replay_policy
 from ._excitation import excitation_flags

@@ -13,7 +13,7 @@ import optimistix as optx
 
 from .._foundation._covariance import least_squares_covariance, parameter_report
 from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
-from .._models._manoeuvres import FirstOrderHold, ZeroOrderHold
+from .._models._holds import FirstOrderHold, ZeroOrderHold
 from .._models._steering._base import AbstractSteeringModel
 from ._fit import AbstractEstimator, FitResult
 from ._kalman import (

@@ -25,7 +25,7 @@ import equinox as eqx
 import numpy as np
 
 from .._foundation._params import resolve_free
-from .._models._manoeuvres import FirstOrderHold, ZeroOrderHold
+from .._models._holds import FirstOrderHold, ZeroOrderHold
 from .._models._steering._base import AuxInputs
 from .._models._steering.nomoto import Nomoto1, NonlinearNomoto
 from .._models._steering.ross import HULL_TERMS, RUDDER_TERMS, RossAutopilot

@@ -18,7 +18,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._models._manoeuvres import HOLDS, FirstOrderHold, ZeroOrderHold, check_hold
+from .._models._holds import HOLDS, FirstOrderHold, ZeroOrderHold, check_hold
 from .._models._steering._base import AuxInputs, WindowStart
 from .._simulation._data import Dataset, Experiment, check_uniform
 from .._simulation._integrate import Simulator

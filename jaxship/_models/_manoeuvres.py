@@ -19,6 +19,7 @@ from jaxtyping import ArrayLike
 
 from .._foundation._state import Command, Switched
 from ._control import AbstractController, HeadingAutopilot, HeadingSteps, YawRateLevels
+from ._holds import FirstOrderHold, ZeroOrderHold, check_hold
 
 
 class AbstractManoeuvre(AbstractController):
@@ -170,10 +171,9 @@ class SwitchAtCrossing(eqx.Module):
         return 0.0 * r
 
 
-class SwitchAtNearestStep(eqx.Module):
-    """`ZigZag(switch_at=SwitchAtNearestStep())`: the rudder is reversed at the control step
-    nearest to the crossing (within half a step): the heading change half a step ahead,
-    $\\Delta\\psi + r h/2$, is compared with the switch angle."""
+class _SwitchAtAStep(eqx.Module):
+    """A rule that reverses the rudder at a control step: the memory is the side, the
+    command the trial's per-step one; `lookahead` says which step."""
 
     def memory(self, side, x0):
         return side
@@ -184,26 +184,22 @@ class SwitchAtNearestStep(eqx.Module):
     def command(self, zigzag, sampled, t, state, memory, h):
         """The trial's per-step command `sampled()`."""
         return sampled()
+
+
+class SwitchAtNearestStep(_SwitchAtAStep):
+    """`ZigZag(switch_at=SwitchAtNearestStep())`: the rudder is reversed at the control step
+    nearest to the crossing (within half a step): the heading change half a step ahead,
+    $\\Delta\\psi + r h/2$, is compared with the switch angle."""
 
     def lookahead(self, h, r):
         """The heading change half a control step ahead."""
         return 0.5 * h * r
 
 
-class SwitchAtNextStep(eqx.Module):
+class SwitchAtNextStep(_SwitchAtAStep):
     """`ZigZag(switch_at=SwitchAtNextStep())`: the rudder is reversed at the first control
     step after the crossing (as MSS `zigzag.m` and sampled-logic implementations do, late
     by up to one step)."""
-
-    def memory(self, side, x0):
-        return side
-
-    def sampled(self):
-        return self
-
-    def command(self, zigzag, sampled, t, state, memory, h):
-        """The trial's per-step command `sampled()`."""
-        return sampled()
 
     def lookahead(self, h, r):
         return 0.0 * r
@@ -487,75 +483,6 @@ def heading_perturbations(amplitude, period, kp, ki, kd, duration, *, dt=0.1,
                              steps=HeadingSteps(tuple(times), tuple(headings)),
                              max_angle=max_angle)
     return Controlled(pilot, duration=duration, dt=dt)
-
-
-def _sample_at(record, dt, tau):
-    """`(record, k)`: the record as an array and the index of its sample at or before
-    `tau` seconds after its first sample (the last beyond the end)."""
-    record = jnp.asarray(record)
-    position = tau / dt
-    return record, jnp.clip(jnp.floor(position + 1e-9).astype(int), 0, record.shape[0] - 1)
-
-
-class ZeroOrderHold(eqx.Module):
-    """A recorded signal held from each sample to the next (MATLAB's `InterSample='zoh'`):
-    right for a commanded, piecewise-constant signal."""
-
-    def interpolate(self, record, dt, tau):
-        """Value and slope (zero) of `record`, sampled every `dt`, at `tau` seconds after
-        its first sample; the last sample holds beyond the end."""
-        record, k = _sample_at(record, dt, tau)
-        return record[k], jnp.zeros_like(record[k])
-
-    def slope(self, first, second, dt):
-        """The slope over one sample interval from `first` to `second`: zero."""
-        return 0.0 * first
-
-    def interval_mean(self, first, second):
-        """The signal's mean over the interval from sample `first` to `second`."""
-        return first
-
-    def interval_samples(self, first, second) -> list:
-        """The samples the signal over the interval depends on."""
-        return [first]
-
-
-class FirstOrderHold(eqx.Module):
-    """A recorded signal interpolated linearly between samples (MATLAB's
-    `InterSample='foh'`): right for a measured, continuous signal such as a logged rudder
-    angle or shaft speed."""
-
-    def interpolate(self, record, dt, tau):
-        """Value and slope of `record`, sampled every `dt`, at `tau` seconds after its first
-        sample, linear between samples; the last sample holds beyond the end."""
-        record, k = _sample_at(record, dt, tau)
-        k1 = jnp.minimum(k + 1, record.shape[0] - 1)
-        slope = (record[k1] - record[k]) / dt
-        return record[k] + slope * jnp.clip(tau - k * dt, 0.0, None), slope
-
-    def slope(self, first, second, dt):
-        """The slope over one sample interval from `first` to `second`."""
-        return (second - first) / dt
-
-    def interval_mean(self, first, second):
-        """The signal's mean over the interval from sample `first` to `second`."""
-        return 0.5 * (first + second)
-
-    def interval_samples(self, first, second) -> list:
-        """The samples the signal over the interval depends on."""
-        return [first, second]
-
-
-HOLDS = (ZeroOrderHold, FirstOrderHold)
-
-
-def check_hold(hold, name: str):
-    """`hold` if it is a `ZeroOrderHold()` or `FirstOrderHold()`; `ValueError` naming
-    `name` otherwise."""
-    if not isinstance(hold, HOLDS):
-        raise ValueError(f"`{name}` must be ZeroOrderHold() or FirstOrderHold(), got "
-                         f"{hold!r}.")
-    return hold
 
 
 def interpolate(record, dt, tau, hold):

@@ -253,12 +253,17 @@ def straight_run(vessel: AbstractVessel, *, speed=None, n=None, psi=0.0) -> Ship
     reference = max(abs(float(speed)), float(vessel.nominal_speed))  # at rest too
     scale = float(_surge_mass(vessel)) * reference**2 / float(vessel.length)
     if not abs(residual) <= 1e-3 * scale:
-        raise ValueError(
-            f"{type(vessel).__name__} has no straight run at u = {float(speed):.4g} m/s, n = "
-            f"{float(n):.4g} rev/s: a surge force of {residual:.4g} N is left (its surge "
-            f"equation balances at {float(vessel.nominal_speed):.4g} m/s"
-            + (" only: it has no propeller term)." if not _has_propeller(vessel) else ")."))
+        raise _no_straight_run(vessel, speed, n, f"a surge force of {residual:.4g} N is left")
     return straight_state(speed, n, psi)
+
+
+def _no_straight_run(vessel, u, n, left: str) -> ValueError:
+    """The error of `straight_run` where the surge force does not balance at u, n."""
+    return ValueError(
+        f"{type(vessel).__name__} has no straight run at u = {float(u):.4g} m/s, n = "
+        f"{float(n):.4g} rev/s: {left} (its surge equation balances at "
+        f"{float(vessel.nominal_speed):.4g} m/s"
+        + (" only: it has no propeller term)." if not _has_propeller(vessel) else ")."))
 
 
 def _straight_runs(vessel, speed, n, psi) -> ShipState:
@@ -277,11 +282,8 @@ def _straight_runs(vessel, speed, n, psi) -> ShipState:
     if bad.any():
         i = np.flatnonzero(bad.ravel())[0]
         u_bad, n_bad = (float(np.ravel(np.asarray(x))[i]) for x in np.broadcast_arrays(speed, n))
-        raise ValueError(
-            f"{type(vessel).__name__} has no straight run at u = {u_bad:.4g} m/s, n = "
-            f"{n_bad:.4g} rev/s ({int(bad.sum())} of {bad.size} values): a surge force is "
-            f"left (its surge equation balances at {float(vessel.nominal_speed):.4g} m/s"
-            + (" only: it has no propeller term)." if not _has_propeller(vessel) else ")."))
+        raise _no_straight_run(vessel, u_bad, n_bad,
+                               f"({int(bad.sum())} of {bad.size} values) a surge force is left")
     return straight_state(speed, n, psi)
 
 
