@@ -457,23 +457,33 @@ def test_identify_not_converged_exit_3_plain_sentence(record, tmp_path, capsys):
     assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "result.json"]  # no temporary files
 
 
+def _identify_nomoto1_on_noise(tmp_path, name, rudder, capsys):
+    """`jaxship identify --model nomoto1` on 300 s at 1 s of heading and yaw-rate noise
+    (seed 0) with the rudder `rudder` (an array, or `rudder(rng, size)` drawn first):
+    the output folder, the exit code and the captured output."""
+    rng = np.random.default_rng(0)
+    t = np.arange(0.0, 300.0, 1.0)
+    delta = rudder(rng, t.size) if callable(rudder) else rudder
+    rows = np.column_stack([t, delta, rng.normal(0.0, 3.0, t.size),
+                            rng.normal(0.0, 0.6, t.size)])
+    path = tmp_path / f"{name}.csv"
+    np.savetxt(path, rows, delimiter=",", header="t [s],delta [deg],psi [deg],r [deg/s]",
+               comments="")
+    out = tmp_path / "fit"
+    code = main(["identify", str(path), "--model", "nomoto1", "--out", str(out),
+                 "--no-figures", "--quiet"])
+    return out, code, capsys.readouterr()
+
+
 def test_identify_of_pure_noise_is_not_converged(tmp_path, capsys):
     """The trust audit's case: Nomoto 1 on 300 s of pure noise at 1 s samples said
     "converged in 30 steps" with a cost of 9.2e122 (one RK4 step per sample under a
     start T of 0.31 s); now it is not converged (here the optimiser, chasing the noise,
     reaches its step limit; a start that blows up says so): exit 3, the reason on
     stderr."""
-    rng = np.random.default_rng(0)
     t = np.arange(0.0, 300.0, 1.0)
-    rows = np.column_stack([t, np.where((t // 30) % 2 == 0, 10.0, -10.0),
-                            rng.normal(0.0, 3.0, t.size), rng.normal(0.0, 0.6, t.size)])
-    path = tmp_path / "noise.csv"
-    np.savetxt(path, rows, delimiter=",", header="t [s],delta [deg],psi [deg],r [deg/s]",
-               comments="")
-    out = tmp_path / "fit"
-    code = main(["identify", str(path), "--model", "nomoto1", "--out", str(out),
-                 "--no-figures", "--quiet"])
-    captured = capsys.readouterr()
+    out, code, captured = _identify_nomoto1_on_noise(
+        tmp_path, "noise", np.where((t // 30) % 2 == 0, 10.0, -10.0), capsys)
     assert code == 3, captured.out + captured.err
     assert "NOT converged" in captured.out and "not a converged estimate" in captured.err
     result = json.loads((out / "result.json").read_text())
@@ -486,17 +496,8 @@ def test_identify_of_white_noise_is_undetermined_exit_3(fitted, tmp_path, capsys
     is `undetermined` (no channel's fit reaches 5 % and T's 95 % interval includes zero):
     exit 3, one sentence on stderr, the flag naming T. A record the model explains still
     exits 0 (the `fitted` fixture)."""
-    rng = np.random.default_rng(0)
-    t = np.arange(0.0, 300.0, 1.0)
-    rows = np.column_stack([t, rng.normal(0.0, 10.0, t.size), rng.normal(0.0, 3.0, t.size),
-                            rng.normal(0.0, 0.6, t.size)])
-    path = tmp_path / "white.csv"
-    np.savetxt(path, rows, delimiter=",", header="t [s],delta [deg],psi [deg],r [deg/s]",
-               comments="")
-    out = tmp_path / "fit"
-    code = main(["identify", str(path), "--model", "nomoto1", "--out", str(out),
-                 "--no-figures", "--quiet"])
-    captured = capsys.readouterr()
+    out, code, captured = _identify_nomoto1_on_noise(
+        tmp_path, "white", lambda rng, size: rng.normal(0.0, 10.0, size), capsys)
     assert code == 3, captured.out + captured.err
     assert ("the fit explains almost nothing and leaves parameters undetermined "
             "(undetermined:") in captured.err
