@@ -51,28 +51,32 @@ def discrete_zigzag(fit, angle, switch, dt, num, *, rudder_rate=None):
     a starboard-first zig-zag `angle`/`switch` [rad] from rest: the rudder order
     reverses when the heading change passes `switch` (as `ZigZag`), the actual
     rudder follows at `rudder_rate` [rad/s] and is held over each interval; heading
-    by the trapezoid rule. Returns `(t, psi, delta)` of `num` samples."""
+    by the trapezoid rule. Returns `(t, psi, delta)` of `num` samples; a fitted model
+    that diverges (its cubic term outgrowing its damping) gives non-finite samples from
+    there on, and its overshoots are then NaN in the tables (`_overshoots`), not a
+    warning."""
     c, s = fit.coefficients, fit.structure
     r = np.zeros(num + 2)  # r[k + 1] is sample k; r[0] the rest before sample 0
     d = np.zeros(num + 1)  # d[k + 1] is held from sample k; d[0] = 0 before
     psi = np.zeros(num)
     side, step = 1.0, np.inf if rudder_rate is None else rudder_rate * dt
-    for k in range(num):
-        if k:
-            psi[k] = psi[k - 1] + 0.5 * dt * (r[k] + r[k + 1])
-        if side > 0 and psi[k] >= switch:
-            side = -1.0
-        elif side < 0 and psi[k] <= -switch:
-            side = 1.0
-        d[k + 1] = d[k] + np.clip(side * angle - d[k], -step, step)
-        if s in ("linear1", "nonlinear1"):
-            nl = c["a2"] * r[k + 1] ** 3 if s == "nonlinear1" else 0.0
-            lin = c["a3" if s == "nonlinear1" else "a2"] * d[k + 1]
-            r[k + 2] = c["a1"] * r[k + 1] + nl + lin + c["b0"]
-        else:
-            nl = c["c1"] * r[k + 1] ** 3 if s == "nonlinear2" else 0.0
-            r[k + 2] = (c["a1"] * r[k + 1] + c["a2"] * r[k] + c["b1"] * d[k + 1]
-                        + c["b2"] * d[k] + nl + c["c0"])
+    with np.errstate(over="ignore", invalid="ignore"):  # a diverging fit: inf, NaN
+        for k in range(num):
+            if k:
+                psi[k] = psi[k - 1] + 0.5 * dt * (r[k] + r[k + 1])
+            if side > 0 and psi[k] >= switch:
+                side = -1.0
+            elif side < 0 and psi[k] <= -switch:
+                side = 1.0
+            d[k + 1] = d[k] + np.clip(side * angle - d[k], -step, step)
+            if s in ("linear1", "nonlinear1"):
+                nl = c["a2"] * r[k + 1] ** 3 if s == "nonlinear1" else 0.0
+                lin = c["a3" if s == "nonlinear1" else "a2"] * d[k + 1]
+                r[k + 2] = c["a1"] * r[k + 1] + nl + lin + c["b0"]
+            else:
+                nl = c["c1"] * r[k + 1] ** 3 if s == "nonlinear2" else 0.0
+                r[k + 2] = (c["a1"] * r[k + 1] + c["a2"] * r[k] + c["b1"] * d[k + 1]
+                            + c["b2"] * d[k] + nl + c["c0"])
     return dt * np.arange(num), psi, d[1:]
 
 
