@@ -831,8 +831,8 @@ def main(argv=None):
     context = multiprocessing.get_context("spawn")
     child = context.Process(target=slow_to_start.job, args=(context.Queue(),))
     child.start()
-    print(child.pid, flush=True)
-    try:
+    try:  # the pid inside: a signal during print's return would land outside the try
+        print(child.pid, flush=True)
         time.sleep(60)
     except KeyboardInterrupt:  # as the commands do
         print("jaxship: interrupted.", file=sys.stderr)
@@ -843,12 +843,33 @@ cli.main = main
 cli.run()
 """
 
+CHILD_STARTING_UNCAUGHT = """
+import multiprocessing, time
+from jaxship import cli
+import slow_to_start
 
-def test_ctrl_c_while_a_worker_starts_leaves_no_worker_and_no_traceback(tmp_path):
+def main(argv=None):  # a Ctrl-C before the command's own handler (while parsing)
+    context = multiprocessing.get_context("spawn")
+    child = context.Process(target=slow_to_start.job, args=(context.Queue(),))
+    child.start()
+    print(child.pid, flush=True)
+    time.sleep(60)
+    return 0
+
+cli.main = main
+cli.run()
+"""
+
+
+@pytest.mark.parametrize("script", [CHILD_STARTING, CHILD_STARTING_UNCAUGHT],
+                         ids=["caught by the command", "escaping main"])
+def test_ctrl_c_while_a_worker_starts_leaves_no_worker_and_no_traceback(tmp_path, script):
     """`reproduce`'s Ctrl-C test on a loaded machine (CI of 2026-11-28): a spawned worker
     still importing when the command ended outlived it, found the semaphores of its
     arguments unlinked and printed a FileNotFoundError traceback after "jaxship:
-    interrupted.". The command now kills its child processes as it ends."""
+    interrupted.". The command now kills its child processes as it ends. And a Ctrl-C
+    that escapes `main` (CI of 2026-11-29: it came while `print` returned, before the
+    `try`) ends alike, not with a KeyboardInterrupt traceback and status -2."""
     import signal
     import subprocess
     import sys
@@ -856,7 +877,7 @@ def test_ctrl_c_while_a_worker_starts_leaves_no_worker_and_no_traceback(tmp_path
 
     (tmp_path / "slow_to_start.py").write_text(SLOW_TO_START)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path), *sys.path]))
-    process = subprocess.Popen([sys.executable, "-c", CHILD_STARTING], stdout=subprocess.PIPE,
+    process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, env=env)
     child = int(process.stdout.readline())
     process.send_signal(signal.SIGINT)

@@ -129,7 +129,11 @@ def run() -> None:
     _listen_for_interrupts()
     for signum in ENDINGS:
         signal.signal(signum, _interrupt)
-    status = main()
+    try:
+        status = main()
+    except KeyboardInterrupt:  # raised before `main` reached its own handler (parsing)
+        _say(_SIGNAL[0])
+        status = 128 + _SIGNAL[0]
     _RETURNED.set()
     if _INTERRUPTED.is_set():
         _end(128 + _SIGNAL[0])
