@@ -4,6 +4,8 @@ source tree.
 - The executed notebooks of `notebooks/` (outside `docs/`) become pages at
   `notebooks/NAME/`: their files are added to the build as they are, and mkdocs-jupyter
   renders them with the outputs CI stored (`execute: false`).
+- The API pages (`docs/api/*.md`) get their entries, generated from the `__all__` lists
+  (`api_pages.py`), where their `API_MARKER` stands.
 - The home page (`docs/index.md`) takes the README below its first heading, its links
   into `docs/` made relative to the site, the notebooks' link to the first notebook's page
   and the benchmarks' README named as a file of the project.
@@ -11,9 +13,14 @@ source tree.
 
 import pathlib
 import re
+import sys
 
 from mkdocs.plugins import event_priority
 from mkdocs.structure.files import File
+
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # api_pages beside this
+import api_pages  # noqa: E402
 
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -29,6 +36,9 @@ def on_files(files, config):
 
 
 def on_page_markdown(markdown, page, config, files):
+    if page.file.src_uri.startswith("api/"):
+        page_name = page.file.src_uri[len("api/"):-len(".md")]
+        return markdown.replace(api_pages.API_MARKER, api_pages.page_entries(page_name))
     if page.file.src_uri != "index.md":
         return markdown
     readme = (ROOT / "README.md").read_text(encoding="utf-8")

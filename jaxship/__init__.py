@@ -137,6 +137,7 @@ from ._simulation._data import Dataset as Dataset, Experiment as Experiment
 from ._simulation._froude import froude_scale as froude_scale
 from ._simulation._integrate import RK4 as RK4, Simulator as Simulator
 from ._simulation._measured import (
+    measurement_files as measurement_files,
     read_measured as read_measured,
     shared_data_dir as shared_data_dir,
 )
@@ -157,38 +158,53 @@ from . import (
 )
 
 
+# The public names, grouped by layer as in docs/architecture.md (`# -- layer`); a
+# `# page: section` line puts the names after it in that section of docs/api/<page>.md
+# (docs/api_pages.py generates the entries of the API pages from every `__all__`).
 __all__ = [
-    # foundation
+    # -- foundation: the model contract, state, validation, progress, the cache
+    # steering: The model contract
     "AbstractModel",
     "Free",
     "param",
     "default_free",
-    "Progress",
+    # simulation: State
     "ShipState",
     "Command",
     "Trajectory",
     "straight_state",
+    # estimation: Validation
     "validate",
     "fit_percent",
+    # utilities: Progress
+    "Progress",
+    # utilities: Compilation cache
     "enable_compilation_cache",
+    # strategies: Strategy objects
     "strategies",
-    # models: vessels
+    # -- models: vessels, steering models, effects, manoeuvres and controllers
+    # vessels: Presets
+    "VESSELS",
+    "get_vessel",
+    # vessels: Vessel files
+    "load_vessel",
+    "save_vessel",
+    # vessels: Vessels
     "AbstractVessel",
     "MMGVessel",
     "RossVessel",
-    "VESSELS",
-    "get_vessel",
-    "load_vessel",
-    "save_vessel",
     "straight_run",
     "state_derivative",
+    # vessels: Actuators
     "RudderServo",
     "Shaft",
+    # vessels: Environment
     "Environment",
     "Current",
     "Wind",
+    # vessels: Wind loads
     "wind_loads",
-    # models: steering models
+    # steering: Steering models
     "AbstractSteeringModel",
     "AuxInputs",
     "Nomoto1",
@@ -199,10 +215,10 @@ __all__ = [
     "LinearSwayYaw",
     "LowSpeedSwayYaw",
     "ARMAXModel",
-    # models: effects (the classes in jaxship.effects)
+    # effects: Augmenting a model
     "effects",
     "augment",
-    # models: manoeuvres and controllers
+    # manoeuvres: Manoeuvres
     "Turn",
     "ZigZag",
     "Stop",
@@ -213,7 +229,9 @@ __all__ = [
     "prbs",
     "multi_step_3211",
     "thesis_manoeuvre",
+    "heading_perturbations",
     "Replay",
+    # manoeuvres: Controllers
     "AbstractController",
     "Controlled",
     "HeadingAutopilot",
@@ -221,26 +239,34 @@ __all__ = [
     "ReferenceModel",
     "HeadingSteps",
     "YawRateLevels",
-    "heading_perturbations",
-    # simulate
+    # -- simulate: the simulator, batches, records and their files
+    # simulation: Simulating
     "simulate",
     "Simulator",
     "RK4",
+    # simulation: Batches
     "simulate_batch",
     "stack",
+    # simulation: Scaling
     "froude_scale",
+    # data: Records
     "Experiment",
     "Dataset",
+    # data: Trial CSV
     "read_trial_csv",
     "write_trial_csv",
+    # data: Measured data
     "read_measured",
+    "measurement_files",
     "shared_data_dir",
-    # estimate
+    # -- estimate: fit and predict, the estimator strategies, bands, the Kalman filter
+    # estimation: Fitting and predicting
     "fit",
     "predict",
     "FitResult",
     "FitError",
     "RESULTS",
+    # estimation: Estimators
     "AbstractEstimator",
     "PredictionError",
     "Innovations",
@@ -255,13 +281,17 @@ __all__ = [
     "MeasuredStates",
     "EstimatedStarts",
     "LevenbergMarquardt",
+    # estimation: Prediction bands
     "prediction_bands",
     "calibrate_disturbance",
     "Disturbance",
+    # estimation: Kalman filter
     "ekf",
     "smooth_states",
-    # analysis
+    # -- analysis: indices, autopilot design and closed loops, experiment design, discovery
+    # analysis: Manoeuvre indices
     "indices",
+    # analysis: Autopilot
     "design_autopilot",
     "tune_autopilot",
     "yaw_inertia",
@@ -269,8 +299,10 @@ __all__ = [
     "ClosedLoop",
     "closed_loop_metrics",
     "YawDisturbance",
+    # analysis: Experiment design
     "fisher_information",
     "excitation_order",
+    # analysis: Discovery
     "discover",
     "DiscoveryOptions",
     "DiscoveryReport",

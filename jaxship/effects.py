@@ -54,7 +54,7 @@ from ._models._hydro_effects import (
 
 
 __all__ = [
-    # the seam: the base class, the places an effect acts on, the augmented models
+    # effects: Augmenting a model
     "AbstractEffect",
     "AbstractRudderEffect",
     "AbstractLoadEffect",
@@ -63,33 +63,34 @@ __all__ = [
     "AbstractSensorEffect",
     "AugmentedVessel",
     "AugmentedSteering",
-    # rudder and sensors
+    # effects: Rudder and sensors
     "RudderOffset",
     "RudderLag",
     "RudderDelay",
     "RudderRateLimit",
+    "RudderStall",
     "HeadingSensorBias",
     "YawRateSensorBias",
-    # loads and yaw terms
+    # effects: Loads and yaw terms
     "YawMomentBias",
     "SwayForceBias",
     "YawCubicDamping",
     "YawQuadraticDamping",
-    "nonlinear_nomoto2",
     "SpeedDependentDamping",
     "SpeedDependentRudder",
-    "RudderStall",
     "PropellerRace",
     "PropellerAsymmetry",
     "CrossflowDrag",
     "SurgeTurnResistance",
     "AddedMassError",
-    # environment
+    # steering: Steering models
+    "nonlinear_nomoto2",
+    # effects: Environment
     "UniformCurrent",
     "ApparentWind",
     "Windage",
     "RecordedDisturbance",
-    # what discover tries
+    # analysis: Discovery
     "Candidate",
     "DISCOVERY_CATALOGUE",
 ]

@@ -25,7 +25,10 @@ from ._simulation._batch import batch_turning_indices as batch_turning_indices
 
 
 __all__ = [
+    # analysis: Manoeuvre indices
     "turning_indices",
+    "SteadyFromRate",
+    "SteadyFromCircle",
     "initial_turning_indices",
     "zigzag_indices",
     "pull_out_indices",
@@ -34,7 +37,6 @@ __all__ = [
     "stopping_indices",
     "imo_criteria",
     "format_table",
+    # simulation: Batches
     "batch_turning_indices",
-    "SteadyFromRate",
-    "SteadyFromCircle",
 ]

@@ -45,19 +45,25 @@ from ._simulation._readers import DisplayUnits as DisplayUnits, SIUnits as SIUni
 
 
 __all__ = [
+    # strategies: Holding a sampled input between samples
     "ZeroOrderHold",
     "FirstOrderHold",
+    # strategies: When a zig-zag's rudder switches
     "SwitchAtCrossing",
     "SwitchAtNearestStep",
     "SwitchAtNextStep",
+    # strategies: The covariance of a fit's residuals
     "RobustCovariance",
     "WhiteCovariance",
     "GivenCovariance",
+    # strategies: The innovations model's process noise
     "ProcessNoise",
     "EstimatedNoise",
     "HeldNoise",
+    # strategies: Discrete to continuous response models
     "ExactDiscretisation",
     "EulerDiscretisation",
+    # strategies: The units of a written trial file
     "DisplayUnits",
     "SIUnits",
 ]

@@ -16,4 +16,9 @@ from ._models._environment import (
 from ._models._fujiwara_wind import FujiwaraWindLoads as FujiwaraWindLoads
 
 
-__all__ = ["AbstractWindLoads", "FossenWindLoads", "FujiwaraWindLoads"]
+__all__ = [
+    # vessels: Wind loads
+    "FossenWindLoads",
+    "FujiwaraWindLoads",
+    "AbstractWindLoads",
+]

@@ -12,7 +12,8 @@ import pytest
 from helpers import assert_equal_to_rounding, per_sample
 
 import jaxship as js
-from jaxship._foundation._params import default_free, get_path, rebuild
+from jaxship._foundation._contract import get_path, rebuild
+from jaxship._foundation._params import default_free
 from jaxship._models._steering._base import WindowStart
 
 

@@ -741,3 +741,30 @@ def test_decimate_keeps_measured_channels_and_extra_signals():
     np.testing.assert_allclose(d.extra["setting"], [1.0, 2.0])
     with pytest.raises(ValueError, match="positive integer"):
         e.decimate(0)
+
+
+def test_a_record_renamed_restated_and_checked(tmp_path):
+    """`Experiment.renamed`, `with_velocities` (either way) and `check_uniform`, and
+    `measurement_files` of a folder: the doors the command line reads records through."""
+    t = np.arange(5) * 0.5
+    e = js.Experiment(t, np.zeros(5), psi=np.zeros(5), u=np.ones(5), name="a",
+                      metadata={"file": "a.csv"})
+    assert e.renamed("b").name == "b" and e.renamed("b").meta["file"] == "a.csv"
+    ground = e.with_velocities(over_ground=True)
+    assert ground.over_ground and not e.over_ground
+    assert not ground.with_velocities(over_ground=False).over_ground
+    np.testing.assert_array_equal(ground.u, e.u)
+    e.check_uniform()
+    uneven = js.Experiment(np.array([0.0, 0.5, 1.0, 2.0]), np.zeros(4), psi=np.zeros(4),
+                           name="uneven")
+    with pytest.raises(ValueError, match=r"^where: .*interpolate first"):
+        uneven.check_uniform("interpolate first", where="where")
+    with pytest.raises(ValueError, match=r"^Experiment 'uneven'"):
+        uneven.check_uniform()
+    write_trial_csv(tmp_path / "run.csv", e)
+    (tmp_path / "open_water.csv").write_text("J,KT,KQ\n0.1,0.3,0.04\n")
+    (tmp_path / "README.md").write_text("not a record")
+    (tmp_path / "semicolons.csv").write_text("t [s];delta [deg]\n0;0\n")
+    records, skipped = js.measurement_files(tmp_path)
+    assert [p.name for p in records] == ["run.csv", "semicolons.csv"]
+    assert [p.name for p in skipped] == ["open_water.csv"]

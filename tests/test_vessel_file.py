@@ -243,3 +243,33 @@ def test_a_wind_model_round_trips_in_its_table(tmp_path):
         path.write_text(text.replace(old, new, 1))
         with pytest.raises(ValueError, match=re.escape(message)):
             js.load_vessel(path)
+
+
+def test_the_vessel_file_as_text_and_as_a_dict_reads_back_bit_for_bit():
+    """The public doors of the vessel file (issue 59: the command line goes through
+    them): `save_vessel(vessel)` with no path gives the file's text, `load_vessel` reads
+    its parsed content (a dict) as it reads the file."""
+    import tomllib
+
+    vessel = js.get_vessel("kvlcc2")
+    text = js.save_vessel(vessel, source="a test")
+    assert text.splitlines()[3] == "# a test" and 'model = "MMGVessel"' in text
+    back = js.load_vessel(tomllib.loads(text))
+    assert all(np.float64(a).tobytes() == np.float64(b).tobytes()
+               for a, b in zip(jax.tree.leaves(vessel), jax.tree.leaves(back)))
+    with pytest.raises(ValueError, match="field 'model': unknown vessel class 'Tug'"):
+        js.load_vessel(tomllib.loads(text.replace('model = "MMGVessel"', 'model = "Tug"')))
+
+
+def test_parameters_by_name_on_every_model():
+    """`parameter_names`, `get_parameter` and `with_parameters` address a vessel's, a
+    steering model's and an effect's parameters alike (`"<effect id>.<field>"`)."""
+    model = js.augment(js.Nomoto1(K=0.1, T=20.0), js.effects.RudderOffset(delta0=0.01))
+    assert model.parameter_names() == ("K", "T", "delta0", "rudder_offset.delta0")
+    changed = model.with_parameters({"T": 25.0, "rudder_offset.delta0": -0.02})
+    assert changed.get_parameter("T") == 25.0 and model.get_parameter("T") == 20.0
+    assert changed.get_parameter("rudder_offset.delta0") == -0.02
+    assert model.with_parameters({}) is model
+    vessel = js.get_vessel("mariner")
+    assert "length" in vessel.parameter_names()
+    assert float(vessel.with_parameters({"length": 200.0}).get_parameter("length")) == 200.0

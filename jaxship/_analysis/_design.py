@@ -22,7 +22,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._foundation._params import as_arrays, rebuild, resolve_free
+from .._foundation._contract import rebuild
+from .._foundation._params import as_arrays, resolve_free
 from .._models._holds import FirstOrderHold
 from .._models._manoeuvres import AbstractManoeuvre, Replay
 from .._models._steering._base import AbstractSteeringModel

@@ -30,7 +30,8 @@ import jax.numpy as jnp
 import numpy as np
 import scipy  # scipy.signal loads on first use (an import-time saving)
 
-from .._foundation._params import as_arrays, rebuild
+from .._foundation._contract import rebuild
+from .._foundation._params import as_arrays
 from .._simulation._data import Dataset
 from ._fit import PredictionError, _predict, _predict_jit, _prepare
 from ._result import FitResult

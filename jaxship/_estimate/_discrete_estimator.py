@@ -16,8 +16,8 @@ import equinox as eqx
 import numpy as np
 import optimistix as optx
 
+from .._foundation._contract import parameter_fields
 from .._foundation._covariance import parameter_report
-from .._foundation._params import parameter_fields
 from .._models._effects import AugmentedSteering, YawCubicDamping
 from .._models._holds import ZeroOrderHold
 from .._models._steering.nomoto import Nomoto1, Nomoto2, NonlinearNomoto

@@ -23,7 +23,7 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
-from .._foundation._contract import AbstractModel
+from .._foundation._contract import AbstractModel, rebuild
 from .._foundation._covariance import (
     RobustErrors,
     cluster_from_windows,
@@ -31,7 +31,7 @@ from .._foundation._covariance import (
     least_squares_covariance,
     parameter_report,
 )
-from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
+from .._foundation._params import Transform, as_arrays, resolve_free
 from .._foundation._progress import ProgressCallback, reporting_steps, step_hook
 from .._foundation._sharding import sharded_vmap
 from .._models._holds import FirstOrderHold, ZeroOrderHold

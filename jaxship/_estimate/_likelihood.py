@@ -11,8 +11,9 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
+from .._foundation._contract import rebuild
 from .._foundation._covariance import least_squares_covariance, parameter_report
-from .._foundation._params import Transform, as_arrays, rebuild, resolve_free
+from .._foundation._params import Transform, as_arrays, resolve_free
 from .._models._holds import FirstOrderHold, ZeroOrderHold
 from .._models._steering._base import AbstractSteeringModel
 from ._fit import AbstractEstimator, FitResult

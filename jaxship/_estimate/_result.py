@@ -9,9 +9,9 @@ import statistics
 import equinox as eqx
 import numpy as np
 
+from .._foundation._contract import get_path, parameter_fields
 from .._foundation._covariance import ParameterReport
 from .._foundation._frames import fit_to_dataframe
-from .._foundation._params import get_path, parameter_fields
 from .._foundation._validate import ValidationReport, _to_plain, validate
 from ._lm import RESULTS, SolverOutcome
 
@@ -123,9 +123,12 @@ class FitResult(SolverOutcome):
         """JSON-ready summary: model name, parameters (value, std, unit), frozen
         values, metrics per channel, correlation, condition number, flags, result."""
         fields = {n: get_path(self.model, n) for n in _field_names(self.model)}
+        report = self.parameters
         params = {
-            n: {"value": float(v), "std": _to_plain(float(s)), "unit": u}
-            for n, v, s, u in zip(self.names, self.values, self.std, self.parameters.units)
+            n: {"value": float(v), "std": _to_plain(float(s)), "unit": u,
+                "relative_std": _to_plain(float(rel))}
+            for n, v, s, u, rel in zip(self.names, self.values, self.std, report.units,
+                                       report.relative_std)
         }
         return {
             "model": type(self.model).__name__,
@@ -133,7 +136,7 @@ class FitResult(SolverOutcome):
             "frozen": {n: _to_plain(float(v)) for n, v in fields.items() if n not in params},
             "train": {c: m.to_dict() for c, m in self.metrics.items()},
             "correlation": _to_plain(self.correlation),
-            "condition_number": _to_plain(self.parameters.condition_number),
+            "condition_number": _to_plain(report.condition_number),
             "flags": list(self.flags),
             "result": self.message,
             "code": self.code_name,

@@ -15,7 +15,7 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
-from .._foundation._params import get_path, rebuild
+from .._foundation._contract import get_path, rebuild
 from .._simulation._simulate import _as_arrays as as_arrays
 from ._fit import _prepare, _residuals
 from ._lm import blockwise_jacfwd, value_and_jacfwd

@@ -30,10 +30,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._contract import AbstractComposite, AbstractModel
+from ._contract import PARAMETER_KEY as _KEY, get_path, parameter_fields
 
-
-_KEY = "jaxship_parameter"
 
 UNBOUNDED, LOWER, UPPER, BOX = 0, 1, 2, 3
 
@@ -79,19 +77,6 @@ class Free:
     lower: float | None = None
     upper: float | None = None
     scale: float | None = None
-
-
-def parameter_fields(model) -> dict[str, ParameterInfo]:
-    """The estimable fields of `model` with their metadata, in field order: the fields
-    declared with `param` (vessels, steering models and effects alike); for a model with
-    effects, the base's and each effect's as `"<effect id>.<field>"` (the model contract,
-    `_contract.AbstractModel`)."""
-    if isinstance(model, AbstractComposite):  # the base's and "<id>.<field>"
-        out = dict(parameter_fields(model.base))
-        for effect in model.effects:
-            out.update({f"{effect.id}.{k}": v for k, v in parameter_fields(effect).items()})
-        return out
-    return {f.name: f.metadata[_KEY] for f in dataclasses.fields(model) if _KEY in f.metadata}
 
 
 def default_free(model) -> tuple[str, ...]:
@@ -259,21 +244,6 @@ class Transform(eqx.Module):
                 q = (p[i] - lower[i]) / (upper[i] - lower[i])
                 z[i] = np.log(q) - np.log1p(-q)
         return z
-
-
-def get_path(model, name: str):
-    """The parameter `name` of `model`: a field, or `"<effect id>.<field>"`."""
-    for part in name.split("."):
-        model = model.lookup(part) if isinstance(model, AbstractModel) else getattr(model, part)
-    return model
-
-
-def rebuild(model, names, values):
-    """`model` with the parameters `names` replaced by the entries of `values` (traced)."""
-    return eqx.tree_at(
-        lambda m: tuple(get_path(m, n) for n in names), model,
-        tuple(values[i] for i in range(len(names))),
-    )
 
 
 def as_arrays(tree):

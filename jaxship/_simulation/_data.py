@@ -210,6 +210,12 @@ class Experiment(eqx.Module):
         """True when `channel` was measured (not derived or zero-filled); `t` always."""
         return channel == "t" or channel in self.channels
 
+    def check_uniform(self, advice: str | None = None, *, where: str | None = None) -> None:
+        """A one-line `ValueError` naming the record (or `where`), the first sample
+        interval off `dt` and `advice`, when the record is not uniformly sampled
+        (`is_uniform`), or when JAX's float type cannot resolve its time stamps."""
+        check_uniform(self.t, where or f"Experiment {self.name!r}", advice or "")
+
     # -- construction ----------------------------------------------------------------
 
     @classmethod
@@ -254,6 +260,21 @@ class Experiment(eqx.Module):
         if isinstance(factor, bool) or not isinstance(factor, (int, np.integer)) or factor < 1:
             raise ValueError(f"`factor` must be a positive integer, got {factor!r}.")
         return self._kept(slice(None, None, int(factor)))
+
+    def renamed(self, name: str) -> "Experiment":
+        """The same record under another `name`."""
+        return self._relabelled(name, self.metadata)
+
+    def with_velocities(self, *, over_ground: bool) -> "Experiment":
+        """The same record with its `u`, `v` stated over ground (`over_ground=True`:
+        GNSS, a basin's carriage) or through the water (the metadata `"velocities"`)."""
+        metadata = {k: v for k, v in self.metadata if k != OVER_GROUND[0]}
+        return self._relabelled(self.name, metadata | (dict([OVER_GROUND]) if over_ground
+                                                       else {}))
+
+    def _relabelled(self, name: str, metadata) -> "Experiment":
+        return Experiment(self.t, name=name, metadata=metadata, extra=self.extra,
+                          **self._measured())
 
     def _kept(self, keep) -> "Experiment":
         """The samples `keep` (a mask or slice) of the measured channels and of the

@@ -19,8 +19,7 @@ import re
 import equinox as eqx
 import numpy as np
 
-from .._foundation._contract import AbstractComposite
-from .._foundation._params import parameter_fields
+from .._foundation._contract import AbstractComposite, parameter_fields
 from .._foundation._state import STATE_FIELDS, Command, ShipState, Trajectory
 from .._models._actuators import RudderServo, Shaft
 from .._models._effects import family_unit

@@ -7,6 +7,7 @@ import csv
 import itertools
 import math
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -267,6 +268,44 @@ def header_names(line: str) -> list[str]:
     except csv.Error:  # not a CSV line (a stray carriage return): no names
         return []
     return [_HEADER.match(f).group(1) if _HEADER.match(f) else f.strip() for f in fields]
+
+
+# file suffixes of measurement files in a folder (others, e.g. README.md, are not read)
+DATA_SUFFIXES = (".csv", ".dat", ".txt")
+
+
+def measurement_files(folder) -> tuple[list[Path], list[Path]]:
+    """`(records, skipped)`: the files of `folder` (not its subfolders), in name order,
+    with a `.csv`, `.dat` or `.txt` suffix, split into those whose first line
+    `read_measured` recognises and the others (another format, such as a propeller
+    open-water table; or not a regular file: a FIFO, a device, a broken link, never
+    opened). A header of `name [unit]` fields separated by semicolons or tabs counts
+    as a record, so that `read_measured` names its CSV dialect rather than a folder
+    skipping it in silence. **Raises** `ValueError` for a file that cannot be read."""
+    listed = [item for item in sorted(Path(folder).iterdir())
+              if item.suffix.lower() in DATA_SUFFIXES and not item.is_dir()]
+    records = [item for item in listed if item.is_file() and _recognised(item)]
+    return records, [item for item in listed if item not in records]
+
+
+def _recognised(path: Path) -> bool:
+    """Whether the first line of `path` is one `read_measured` reads (or names the
+    reason it cannot: UTF-16, a semicolon or tab dialect)."""
+    try:
+        with open(path, "rb") as f:
+            raw = f.readline(4096)
+    except OSError as error:
+        raise ValueError(f"{path}: cannot read the file ({error.strerror or error}).") from None
+    if raw.startswith(UTF16_MARKS) or b"\x00" in raw:
+        return True
+    first = raw.decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
+    if first.startswith(("MARIN", "HSVA")):
+        return True
+    if path.suffix.lower() == ".csv" or ("[" in first and "," in first):
+        if set(header_names(first)) & {"t", "psi_hat", "delta_rudder"}:
+            return True
+    fields = re.split(r"[;\t]", first)
+    return len(fields) > 1 and "," not in first and any(_HEADER.match(f) for f in fields)
 
 
 def read_measured(path, **kwargs) -> Experiment:

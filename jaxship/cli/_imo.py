@@ -10,7 +10,6 @@ import numpy as np
 
 import jaxship as js
 
-from .._foundation._params import rebuild
 from ._common import surge_force
 from ._trials import (
     TrialSpec,
@@ -136,7 +135,7 @@ def check_imo(vessel, *, report=None, speed=None, rpm=None) -> ImoCheck:
 def _drawn_criteria(vessel, names, draws, runs, *, speed, rpm):
     """`({criterion: (values, met or not)}, how many)` of the draws that ran every trial:
     each trial of `runs` simulated at once for every parameter draw (`simulate_batch`)."""
-    vessels = [rebuild(vessel, names, row) for row in draws]
+    vessels = [vessel.with_parameters(dict(zip(names, row))) for row in draws]
     nominal = initial_state(vessel, speed=speed, rpm=rpm)
     starts, ran = [], np.ones(len(vessels), bool)
     for k, v in enumerate(vessels):  # a draw with no straight run is left out

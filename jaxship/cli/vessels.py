@@ -1,8 +1,7 @@
 """`jaxship vessels`: the vessel presets with their size, speed, rpm and source; with
 `--show NAME`, a preset as a vessel file (TOML) to start one's own ship from."""
 
-from .. import VESSELS, get_vessel
-from .._models._vessel.file import vessel_text
+from .. import VESSELS, get_vessel, save_vessel
 
 
 def register(sub) -> None:
@@ -18,7 +17,7 @@ def run(args) -> int:
     if args.show is not None:
         vessel = get_vessel(args.show)
         key = args.show.strip().lower().replace("-", "_")
-        print(vessel_text(vessel, source=f"the preset {key}: {VESSELS[key].description}"),
+        print(save_vessel(vessel, source=f"the preset {key}: {VESSELS[key].description}"),
               end="")
         return 0
     width = max(map(len, VESSELS))

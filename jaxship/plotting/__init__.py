@@ -30,3 +30,23 @@ from ._tracks import (
     plot_spiral as plot_spiral,
     plot_trajectory as plot_trajectory,
 )
+
+# the figures by page section of the API reference (docs/api_pages.py)
+__all__ = [
+    # plotting: Trials
+    "plot_trajectory",
+    "plot_spiral",
+    "plot_imo_criteria",
+    # plotting: Fits
+    "plot_comparison",
+    "plot_residuals",
+    "plot_parameter_correlation",
+    "save_identification_figures",
+    "identification_figure_names",
+    # plotting: Autopilot
+    "plot_autopilot",
+    # plotting: The figures of `jaxship reproduce`
+    "plot_trial_vs_thesis",
+    "plot_model_outputs",
+    "plot_heading_tracking",
+]

@@ -9,7 +9,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..._estimate._windows import apparent_wind
-from ..._foundation._params import parameter_fields, rebuild
+from ..._foundation._contract import parameter_fields, rebuild
 from ..._models._steering._base import AbstractSteeringModel, AuxInputs
 
 

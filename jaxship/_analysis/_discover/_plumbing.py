@@ -4,8 +4,7 @@ an estimate's size."""
 
 import math
 
-from ..._foundation._contract import AbstractComposite
-from ..._foundation._params import parameter_fields, rebuild
+from ..._foundation._contract import AbstractComposite, parameter_fields, rebuild
 from ..._models._effects import family_unit
 from ._plausible import rudder_equivalent
 from ._report import EffectParameter

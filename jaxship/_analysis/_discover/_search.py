@@ -48,7 +48,7 @@ import scipy  # scipy.stats loads on first use (an import-time saving)
 from ..._estimate._fit import fit
 from ..._estimate._lm import RESULTS, LevenbergMarquardt
 from ..._estimate._sensitivity import sensitivities
-from ..._foundation._params import parameter_fields
+from ..._foundation._contract import parameter_fields
 from ..._foundation._validate import NonFiniteError
 from ..._models._effects import augment
 from ._catalogue import applicable

@@ -7,7 +7,8 @@ tables `[rudder]` and `[shaft]`, and a wind-load model other than the default
 (`FossenWindLoads`) the table `[wind_model]` (`model = "FujiwaraWindLoads"` and its
 geometry). Floats are written with `repr`, so that a vessel
 reads back bit for bit. `vessel_to_dict` / `vessel_from_dict` are the same content as
-a dict (what `jaxship identify` stores in its result).
+a dict; `save_vessel(vessel)` (no path) gives the text, `load_vessel(dict)` reads the
+dict (what `jaxship identify` stores in its result).
 """
 
 import dataclasses
@@ -17,7 +18,7 @@ import pathlib
 import re
 import tomllib
 
-from ..._foundation._params import parameter_fields
+from ..._foundation._contract import parameter_fields
 from .._actuators import RudderServo, Shaft
 from .._environment import FossenWindLoads
 from .._fujiwara_wind import FujiwaraWindLoads
@@ -238,18 +239,26 @@ def vessel_text(vessel: AbstractVessel, *, source: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
-def save_vessel(vessel: AbstractVessel, path, *, source: str = "") -> pathlib.Path:
-    """Write `vessel` as a vessel file (TOML, `vessel_text`) at `path`; returns the path."""
+def save_vessel(vessel: AbstractVessel, path=None, *, source: str = ""):
+    """Write `vessel` as a vessel file (TOML, `vessel_text`) at `path` and return the
+    path; with `path=None`, return the file's text instead (`tomllib.loads` of it is the
+    dict `load_vessel` also reads)."""
+    text = vessel_text(vessel, source=source)
+    if path is None:
+        return text
     path = pathlib.Path(path)
-    path.write_text(vessel_text(vessel, source=source), encoding="utf-8")
+    path.write_text(text, encoding="utf-8")
     return path
 
 
-def load_vessel(path) -> AbstractVessel:
-    """The vessel of the vessel file at `path` (see `save_vessel`). **Raises**
+def load_vessel(source) -> AbstractVessel:
+    """The vessel of the vessel file at `source` (a path; see `save_vessel`), or of a
+    vessel file's content already parsed (a dict, as `tomllib` reads it). **Raises**
     `ValueError`, one line naming the file and the field: not TOML, an unknown or
     missing field, a wrong unit, a value out of its physical range."""
-    path = pathlib.Path(path)
+    if isinstance(source, dict):
+        return vessel_from_dict(source)
+    path = pathlib.Path(source)
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except OSError as error:

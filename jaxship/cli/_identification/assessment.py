@@ -10,8 +10,6 @@ import numpy as np
 
 import jaxship as js
 
-from ..._foundation._validate import _to_plain
-
 
 CHANNEL_UNITS = {"psi": "rad", "r": "rad/s", "u": "m/s", "v": "m/s"}
 
@@ -65,32 +63,27 @@ class Assessment:
 def _test_dict(corr) -> dict | None:
     if corr is None:
         return None
+    test = corr.to_dict()
     return {
-        "passed": bool(corr.passed),
-        "statistic": _to_plain(corr.statistic),
-        "threshold_99": _to_plain(corr.threshold),
-        "band_99": _to_plain(corr.band),
+        "passed": test["passed"],
+        "statistic": test["statistic"],
+        "threshold_99": test["threshold"],
+        "band_99": test["band"],
         "max_lag": int(np.max(np.abs(corr.lags))),
-        "lags_outside_band": int(corr.num_outside),
+        "lags_outside_band": test["num_outside"],
     }
 
 
 def _metrics_dict(m, names) -> dict:
     unit = CHANNEL_UNITS.get(m.channel, "")
+    plain = m.to_dict()
     return {
         "unit": unit,
-        "loss": _to_plain(m.loss),
+        "loss": plain["loss"],
         "loss_unit": f"({unit})^2" if unit else "",
-        "fpe": _to_plain(m.fpe),
-        "aic": _to_plain(m.aic),
-        "bic": _to_plain(m.bic),
-        "fit_percent": _to_plain(m.fit_percent),
-        "fit_percent_per_experiment": {n: _to_plain(v) for n, v in
-                                       zip(names, m.fit_per_experiment)},
-        "rms": _to_plain(m.rms),
-        "mean": _to_plain(m.mean),
-        "num_samples": int(m.num_samples),
-        "num_params": int(m.num_params),
+        **{k: plain[k] for k in ("fpe", "aic", "bic", "fit_percent")},
+        "fit_percent_per_experiment": dict(zip(names, plain["fit_per_experiment"])),
+        **{k: plain[k] for k in ("rms", "mean", "num_samples", "num_params")},
         "whiteness": _test_dict(m.autocorrelation),
         "input_independence": _test_dict(m.cross_correlation),
     }

@@ -4,21 +4,12 @@
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 import jaxship as js
-from jaxship._simulation._data import OVER_GROUND, check_uniform
-from jaxship._simulation._measured import header_names
-from jaxship._simulation._readers import UTF16_MARKS
-
-
-# file suffixes read from a folder (others, e.g. README.md, are skipped)
-DATA_SUFFIXES = (".csv", ".dat", ".txt")
-_HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*\[([^\]]*)\]\s*$")  # `name [unit]`
 
 
 def valid_samples(ds: js.Dataset, name: str) -> np.ndarray:
@@ -43,37 +34,6 @@ def source(e: js.Experiment) -> str:
     return str(e.meta.get("file", e.name))
 
 
-def is_measurement_file(path: Path) -> bool:
-    """Whether `read_measured` recognises the format of `path` (the same test of the
-    first line: MARIN or HSVA .dat, Esso Osaka CSV, trial CSV with a `t` column), so
-    that a folder scan skips other files without reading them; a header of
-    `name [unit]` columns separated by semicolons or tabs counts too, so that
-    `read_measured` rejects it with the reason."""
-    try:
-        with open(path, "rb") as f:
-            raw = f.readline(4096)
-    except OSError as error:
-        raise ValueError(f"{path}: cannot read the file ({error.strerror or error}).") from None
-    if raw.startswith(UTF16_MARKS) or b"\x00" in raw:  # read: `read_measured` names UTF-16
-        return True
-    first = raw.decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").strip()
-    if first.startswith(("MARIN", "HSVA")):
-        return True
-    if path.suffix.lower() == ".csv" or ("[" in first and "," in first):
-        if set(header_names(first)) & {"t", "psi_hat", "delta_rudder"}:
-            return True
-    # a header of `name [unit]` columns separated by semicolons or tabs: a record in the
-    # wrong CSV dialect, read so that `read_measured` says so (not skipped in silence)
-    fields = re.split(r"[;\t]", first)
-    return len(fields) > 1 and "," not in first and any(_HEADER.match(f) for f in fields)
-
-
-def _renamed(e: js.Experiment, name: str, metadata=None) -> js.Experiment:
-    measured = {k: getattr(e, k) for k in e.channels}
-    return js.Experiment(e.t, name=name, metadata=e.metadata if metadata is None else metadata,
-                         extra=e.extra, **measured)
-
-
 def _with_velocities(e: js.Experiment, over_ground: bool | None) -> js.Experiment:
     """`e` with the reference of its u, v stated by the user (`--velocities`): a trial
     CSV's as given; a measured data set's reader states its own (over ground), and a
@@ -84,7 +44,7 @@ def _with_velocities(e: js.Experiment, over_ground: bool | None) -> js.Experimen
         raise ValueError(f"{source(e)}: its reader states that u, v are "
                          f"{'over ground' if e.over_ground else 'through the water'}; "
                          "--velocities applies to trial CSV files only.")
-    return _renamed(e, e.name, dict(e.metadata) | dict([OVER_GROUND]))  # read through the water
+    return e.with_velocities(over_ground=over_ground)
 
 
 def read_experiments(paths, *, role: str = "training", note=None, taken=(),
@@ -120,12 +80,9 @@ def read_experiments(paths, *, role: str = "training", note=None, taken=(),
     for path in paths:
         path = Path(path)
         if path.is_dir():
-            listed = [item for item in sorted(path.iterdir())
-                      if item.suffix.lower() in DATA_SUFFIXES and not item.is_dir()]
-            candidates = [item for item in listed if item.is_file()]
-            found = [item for item in candidates if is_measurement_file(item)]
-            skipped = [item.name for item in candidates if item not in found]
-            special = [item.name for item in listed if not item.is_file()]  # never opened
+            found, others = js.measurement_files(path)
+            skipped = [item.name for item in others if item.is_file()]
+            special = [item.name for item in others if not item.is_file()]  # never opened
             if skipped and note is not None:
                 note(f"{path}: skipped {len(skipped)} file(s) whose format is not a "
                      f"measurement record: {', '.join(skipped)}.")
@@ -146,12 +103,12 @@ def read_experiments(paths, *, role: str = "training", note=None, taken=(),
     out = []
     for e in experiments:
         if names.count(e.name) > 1:
-            e = _renamed(e, f"{Path(source(e)).parent.name}/{e.name}")
+            e = e.renamed(f"{Path(source(e)).parent.name}/{e.name}")
         out.append(e)
     names = [e.name for e in out] + list(taken)
     for i, e in enumerate(out):  # still equal (same folder name): number them
         if names.count(e.name) > 1:
-            out[i] = _renamed(e, f"{e.name}#{i}")
+            out[i] = e.renamed(f"{e.name}#{i}")
     return out if sample_interval is None else _resampled(out, sample_interval, role, note)
 
 
@@ -256,6 +213,6 @@ def check_experiments(experiments, rudder: str, role: str, model: str = "",
                 "them or a Nomoto model.")
         if e.num_samples < 3:
             raise ValueError(f"{where}: needs at least 3 samples, has {e.num_samples}.")
-        check_uniform(e.t, where, "interpolate the record onto a uniform time grid first "
-                      "(--sample-interval keeps every k-th sample: it does not make the "
-                      "intervals equal).")
+        e.check_uniform("interpolate the record onto a uniform time grid first "
+                        "(--sample-interval keeps every k-th sample: it does not make the "
+                        "intervals equal).", where=where)

@@ -9,16 +9,13 @@ import json
 import math
 import pathlib
 import re
+import tomllib
 
 import jax
 import numpy as np
 
 import jaxship as js
 
-from ..._foundation._contract import AbstractComposite
-from ..._foundation._params import get_path, parameter_fields, rebuild
-from ..._foundation._validate import _to_plain
-from ..._models._vessel.file import vessel_from_dict, vessel_to_dict
 from .assessment import Assessment
 from .registry import model_key
 
@@ -83,12 +80,9 @@ class IdentificationResult:
         """JSON-ready report (schema in the `identify` docstring)."""
         fitted = self.fit.to_dict()
         report = self.fit.parameters
-        start = {n: _to_plain(float(get_path(self.start, n))) for n in report.names}
-        parameters = {}
-        for name, entry in fitted["parameters"].items():
-            rel = report.relative_std[report.names.index(name)]
-            parameters[name] = {**entry, "relative_std": _to_plain(float(rel)),
-                                "start": start[name]}
+        start = {n: float(self.start.get_parameter(n)) for n in report.names}
+        parameters = {name: {**entry, "start": start[name]}
+                      for name, entry in fitted["parameters"].items()}
 
         def records(block):
             if block is None:
@@ -103,11 +97,11 @@ class IdentificationResult:
                      "velocities": "over ground" if ds.over_ground[i] else "through the water"}
                     for i in range(ds.num_experiments)]
 
-        return {
+        return _json_floats({
             "model": self.model_name,
             "model_class": type(self.model).__name__,
             "description": self.description,
-            "options": _to_plain(self.options),
+            "options": self.options,
             "data": {"train": records(self.train), "validation": records(self.validation)},
             "start": {"method": self.start_method, "parameters": start},
             "parameters": parameters,
@@ -120,15 +114,15 @@ class IdentificationResult:
             "train_simulation": self.train_simulation.to_dict(),
             "validation": None if self.validation is None else self.validation.to_dict(),
             "correlation": {"names": list(report.names),
-                            "matrix": _to_plain(np.asarray(report.correlation))},
+                            "matrix": fitted["correlation"]},
             "identifiability": {
                 "identifiable": self.identifiable,
-                "condition_number": _to_plain(report.condition_number),
+                "condition_number": fitted["condition_number"],
                 "flags": list(self.flags),
             },
             "notes": list(self.notes),
             "warnings": list(self.warnings),
-        }
+        })
 
     def to_json(self, indent: int | None = 2) -> str:
         """`to_dict` as JSON text (non-finite numbers as "inf"/"-inf"/null)."""
@@ -141,27 +135,29 @@ def _constants(model) -> dict:
     draught): with `parameters` and `frozen` they rebuild the model."""
     if not isinstance(model, js.AbstractSteeringModel):
         return {}
-    names = parameter_fields(model)
+    names = model.parameter_names()
     out = {}
     for field in dataclasses.fields(model):
         value = getattr(model, field.name, None)
         if field.name in names or isinstance(value, bool) or np.ndim(value) != 0:
             continue
         if isinstance(value, (int, float, np.number, np.ndarray, jax.Array)):
-            out[field.name] = _to_plain(float(value))
+            out[field.name] = float(value)
     return out
 
 
 def _structure(model) -> dict:
     """What rebuilds the model beside its values: `effects`, the class names of its
     effects in order (a model with effects), and `vessel`, the fitted vessel in the
-    vessel file's form (`vessel_to_dict`), so that a vessel of one's own file comes back."""
-    base = model.base if isinstance(model, AbstractComposite) else model
+    vessel file's content (`save_vessel`'s text read as TOML), so that a vessel of one's own
+    file comes back."""
+    augmented = isinstance(model, (js.effects.AugmentedSteering, js.effects.AugmentedVessel))
+    base = model.base if augmented else model
     out = {}
-    if isinstance(model, AbstractComposite):
+    if augmented:
         out["effects"] = [type(effect).__name__ for effect in model.effects]
     if isinstance(base, js.AbstractVessel):
-        out["vessel"] = _to_plain(vessel_to_dict(base))
+        out["vessel"] = tomllib.loads(js.save_vessel(base))  # the vessel file's content
     return out
 
 
@@ -235,7 +231,7 @@ def model_from_report(report: dict):
         raise ValueError(f"the {name} result has effect parameters "
                          f"({', '.join(k for k in values if '.' in k)}) but no 'effects'.")
     if own_vessel or name in js.VESSELS:
-        base = vessel_from_dict(_finite(report["vessel"])) if own_vessel else js.get_vessel(name)
+        base = js.load_vessel(_finite(report["vessel"])) if own_vessel else js.get_vessel(name)
         return _set_values(_with_effects(base, effects), values, name)
     cls = getattr(js, str(report.get("model_class", "")), None)
     if not (isinstance(cls, type) and issubclass(cls, js.AbstractSteeringModel)):
@@ -261,11 +257,22 @@ def model_from_report(report: dict):
 
 def _set_values(model, values: dict, name: str):
     """`model` with the parameters `values` (`{name or "<effect id>.<field>": value}`)."""
-    known = parameter_fields(model)
-    unknown = [k for k in values if k not in known]
+    unknown = [k for k in values if k not in model.parameter_names()]
     if unknown:
         raise ValueError(f"the {name} model has no coefficient {unknown[0]!r}.")
-    return rebuild(model, tuple(values), tuple(values.values())) if values else model
+    return model.with_parameters(values)
+
+
+def _json_floats(data):
+    """`data` with its non-finite floats as JSON can hold them: "inf", "-inf", null
+    (`_finite` reads them back)."""
+    if isinstance(data, dict):
+        return {k: _json_floats(v) for k, v in data.items()}
+    if isinstance(data, list):
+        return [_json_floats(v) for v in data]
+    if isinstance(data, float) and not math.isfinite(data):
+        return None if math.isnan(data) else ("inf" if data > 0 else "-inf")
+    return data
 
 
 def _finite(data):

@@ -25,7 +25,6 @@ import numpy as np
 import jaxship as js
 
 from ... import Progress
-from ..._foundation._params import parameter_fields
 from .assessment import assess
 from .data import (
     as_experiments,
@@ -47,10 +46,10 @@ class FitDivergedError(ValueError):
 
 
 def _values_text(model) -> str:
-    names = tuple(parameter_fields(model))
-    if not names:  # a vessel: its default free coefficients
-        names = js.default_free(model)
-    return ", ".join(f"{n} = {float(getattr(model, n)):.4g}" for n in names)
+    """The start's values: a vessel's default free coefficients, a steering model's all."""
+    names = (js.default_free(model) if isinstance(model, js.AbstractVessel)
+             else model.parameter_names())
+    return ", ".join(f"{n} = {float(model.get_parameter(n)):.4g}" for n in names)
 
 
 def _parse_channels(channels, allowed) -> tuple[str, ...]:
