@@ -116,7 +116,7 @@ def test_turning_indices_of_a_perfect_circle(side):
                       "steady_turning_diameter_m", "speed_loss_percent", "time_to_90_s",
                       "time_to_180_s"}
     np.testing.assert_allclose(d["speed_loss_percent"], 100 * (1 - u1 / u0), rtol=1e-5)
-    assert ind.to_dict(units="si")["speed_loss"] == pytest.approx(ind.speed_loss)
+    assert ind.to_dict(units=js.strategies.SIUnits())["speed_loss"] == pytest.approx(ind.speed_loss)
 
 
 def test_turning_interpolates_between_coarse_samples():

@@ -394,8 +394,9 @@ def _check_plausible(path, header, key, unit, si, lines):
 
 
 class DisplayUnits(eqx.Module):
-    """`write_trial_csv(units=DisplayUnits())` (the default): angles in degrees, rates in
-    deg/s, shaft speed in rpm (times in s, lengths in m, speeds in m/s)."""
+    """`write_trial_csv(units=DisplayUnits())` and the manoeuvre indices' `to_dict` (the
+    default of both): angles in degrees, rates in deg/s, shaft speed in rpm (times in s,
+    lengths in m, speeds in m/s; the indices' speed loss in percent)."""
 
     def unit(self, si: str) -> str:
         """The unit a quantity measured in the SI unit `si` is written in."""
@@ -403,8 +404,8 @@ class DisplayUnits(eqx.Module):
 
 
 class SIUnits(eqx.Module):
-    """`write_trial_csv(units=SIUnits())`: every quantity in its SI unit (rad, rad/s,
-    rev/s, s, m, m/s)."""
+    """`write_trial_csv(units=SIUnits())`, `to_dict(units=SIUnits())` of the manoeuvre
+    indices: every quantity in its SI unit (rad, rad/s, rev/s, s, m, m/s)."""
 
     def unit(self, si: str) -> str:
         """The unit a quantity measured in the SI unit `si` is written in: `si`."""

@@ -31,6 +31,7 @@ from ._tracks import (
     plot_trajectory as plot_trajectory,
 )
 
+
 # the figures by page section of the API reference (docs/api_pages.py)
 __all__ = [
     # plotting: Trials

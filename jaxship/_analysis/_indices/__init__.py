@@ -6,7 +6,7 @@ by keyword (`t, x, y, psi, u, v, r, delta, n`). Events between samples (heading
 passing 90 deg, the ship stopping, ...) are located by linear interpolation, never by
 rounding to whole degrees or samples. Results are small frozen dataclasses in SI units
 (m, s, rad, rad/s); `to_dict()` gives display units (m, s, deg, deg/s, percent) with the
-unit in each name, `to_dict(units="si")` the SI values.
+unit in each name, `to_dict(units=jaxship.strategies.SIUnits())` the SI values.
 
 Definitions follow IMO MSC.137(76) sec. 4.2 and 5.3, MSC/Circ.1053 and ITTC 7.5-04-02-01;
 positions are those of the vessel's reference point (midship for every catalogue vessel),

@@ -4,6 +4,8 @@ import dataclasses
 
 import numpy as np
 
+from ..._simulation._readers import DisplayUnits, SIUnits
+
 
 _DEG = 180.0 / np.pi
 _TOL = 1e-9  # deadband on commands [rad, rev/s] when detecting orders
@@ -202,13 +204,14 @@ def _course_frame(s: _Series, t_e):
 
 
 def _check_units(units):
-    if units not in ("display", "si"):
-        raise ValueError(f"`units` must be 'display' or 'si', got {units!r}.")
+    if not isinstance(units, (DisplayUnits, SIUnits)):
+        raise ValueError("`units` must be `jaxship.strategies.DisplayUnits()` or `SIUnits()`, "
+                         f"got {units!r}.")
 
 
 def _convert(value, unit, units):
     """SI `value` of a quantity in `unit` ('m', 's', 'rad', 'rad_s', '1') to display."""
-    if units == "si":
+    if isinstance(units, SIUnits):
         return value, {"rad_s": "rad_s", "1": ""}.get(unit, unit)
     factor, name = {
         "m": (1.0, "m"), "s": (1.0, "s"), "rad": (_DEG, "deg"), "rad_s": (_DEG, "deg_s"),

@@ -4,6 +4,7 @@ import dataclasses
 
 import numpy as np
 
+from ..._simulation._readers import DisplayUnits
 from ._series import (
     _TOL,
     _course_frame,
@@ -41,7 +42,7 @@ class SpiralCurve:
             return self.kind == "direct"
         return _is_direct(self.delta)
 
-    def to_dict(self, units="display") -> dict:
+    def to_dict(self, units=DisplayUnits()) -> dict:
         return _named([("delta", self.delta, "rad"), ("r", self.r, "rad_s")], units)
 
     @property
@@ -91,7 +92,7 @@ class SpiralLoop:
     inside: tuple[float, ...] = ()  # [rad] direct spiral: the levels with two branches
     edges: tuple[float, float] = (float("nan"), float("nan"))  # [rad] estimated rudder range
 
-    def to_dict(self, units="display") -> dict:
+    def to_dict(self, units=DisplayUnits()) -> dict:
         return _named([
             ("loop_width", self.width, "rad"), ("loop_width_min", self.width_low, "rad"),
             ("loop_width_max", self.width_high, "rad"),
@@ -280,7 +281,7 @@ class PullOutIndices:
     release_rate_port: float
     residual_rate_port: float
 
-    def to_dict(self, units="display") -> dict:
+    def to_dict(self, units=DisplayUnits()) -> dict:
         return _named([
             ("release_rate_starboard", self.release_rate_starboard, "rad_s"),
             ("residual_rate_starboard", self.residual_rate_starboard, "rad_s"),
@@ -346,7 +347,7 @@ class StoppingIndices:
     time_to_stop: float  # [s]
     execute_time: float  # [s] time of the astern order
 
-    def to_dict(self, units="display") -> dict:
+    def to_dict(self, units=DisplayUnits()) -> dict:
         return _named([
             ("head_reach", self.head_reach, "m"), ("track_reach", self.track_reach, "m"),
             ("lateral_deviation", self.lateral_deviation, "m"),

@@ -5,6 +5,7 @@ import dataclasses
 import equinox as eqx
 import numpy as np
 
+from ..._simulation._readers import DisplayUnits
 from ._series import (
     _DEG,
     _TOL,
@@ -42,7 +43,7 @@ class TurningIndices:
     side: int  # +1 starboard turn, -1 port turn
     steady_method: str = "rate"
 
-    def to_dict(self, units="display") -> dict:
+    def to_dict(self, units=DisplayUnits()) -> dict:
         return _named([
             ("advance", self.advance, "m"), ("transfer", self.transfer, "m"),
             ("tactical_diameter", self.tactical_diameter, "m"),
@@ -171,7 +172,7 @@ class ZigZagIndices:
     period: float  # [s], NaN with fewer than three switches
     side: int  # +1 starboard first, -1 port first
 
-    def to_dict(self, units="display") -> dict:
+    def to_dict(self, units=DisplayUnits()) -> dict:
         items = [(f"overshoot_{k + 1}", o, "rad") for k, o in enumerate(self.overshoots)]
         items += [
             ("initial_turning_time", self.initial_turning_time, "s"),
@@ -297,7 +298,7 @@ class InitialTurningIndices:
     distance: float  # [m] along the path of the reference point (the IMO "travelled")
     advance: float  # [m] along the original course
 
-    def to_dict(self, units="display") -> dict:
+    def to_dict(self, units=DisplayUnits()) -> dict:
         return _named([
             ("heading_change", self.heading_change, "rad"), ("time", self.time, "s"),
             ("distance", self.distance, "m"), ("advance", self.advance, "m"),
