@@ -477,8 +477,9 @@ def test_the_command_line_imports_only_public_names():
     Issue 59: 46 import statements (55 names) before it; the last 15 names (the parameter
     helpers of identify's result.json, the vessel file's dict and text, the record checks
     of identify's reader) went through public doors (`AbstractModel.parameter_names`,
-    `get_parameter`, `with_parameters`; `AbstractVessel.to_dict`, `from_dict`, `to_toml`;
-    `Experiment.renamed`, `with_velocities`, `check_uniform`; `measurement_files`)."""
+    `get_parameter`, `with_parameters`; `save_vessel(vessel)`'s text, `load_vessel` of a
+    parsed dict; `Experiment.renamed`, `with_velocities`, `check_uniform`;
+    `measurement_files`)."""
     found = cli_private_imports()
     assert not found, f"{len(found)} private imports:\n" + "\n".join(found)
 
@@ -582,10 +583,6 @@ OVER_THE_LIMITS = {
     "jaxship/_analysis/_autopilot.py:design_autopilot": "reshaped by issue 60/61",
     "jaxship/_analysis/_autopilot.py:tune_autopilot": "reshaped by issue 60/61",
     "jaxship/cli/autopilot.py:run": "issue 61 rewrites the autopilot command (109 lines)",
-    # joint_null's one caller is the search (`_search.py`, issue 60's): the search state it
-    # shares with `forward_path` (v, gram, blocks, equivalent, lower, top, enter) and the
-    # draws and seed of the null law; a bundle of that state belongs to that rewrite
-    "jaxship/_analysis/_discover/_score.py:joint_null": "the search's state, issue 60",
     # the data record's constructor: one keyword per measured channel (t, delta and the
     # 13 optional channels a trial logs), as the CSV's columns
     "jaxship/_simulation/_data.py:__init__": "one keyword per measured channel",

@@ -200,13 +200,18 @@ def joint_scores(sens, fitted, candidates):
     return jt.T @ sens.residuals, v, jt.T @ jt, blocks
 
 
-def joint_null(v, gram, blocks, equivalent, lower, top, draws=100_000, seed=0,
-               enter=0.05):
-    """The null law of the robust joint score of `forward_path`'s picks (module text),
-    sorted, from `draws` draws of $g \\sim N(0, V)$; 0 where it picks fewer than two."""
+def null_scores(v, draws=100_000, seed=0):
+    """`draws` draws (rows) of the score vector under the null, $g \\sim N(0, V)$."""
     w, u = np.linalg.eigh(v)
     g = np.random.default_rng(seed).standard_normal((draws, v.shape[0]))
-    g = g @ (u * np.sqrt(np.clip(w, 0.0, None))).T
+    return g @ (u * np.sqrt(np.clip(w, 0.0, None))).T
+
+
+def joint_null(g, v, gram, blocks, equivalent, lower, top, enter=0.05):
+    """The null law of the robust joint score of `forward_path`'s picks (module text),
+    sorted, from the null score draws `g` (`null_scores`); 0 where it picks fewer than
+    two."""
+    draws = g.shape[0]
     chosen = forward_path(g, v, gram, blocks, equivalent, lower, top, enter)
     joint = np.zeros(draws)
     sets, label = np.unique(chosen, axis=0, return_inverse=True)

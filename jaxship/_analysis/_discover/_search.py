@@ -63,7 +63,14 @@ from ._plumbing import (
     split,
 )
 from ._report import CandidateOutcome, CandidateScore, Equivalent
-from ._score import canonical_correlation, forward_path, joint_null, joint_scores, score_tests
+from ._score import (
+    canonical_correlation,
+    forward_path,
+    joint_null,
+    joint_scores,
+    null_scores,
+    score_tests,
+)
 
 
 # warm-started refits converged in 12-57 LM steps on the Monte-Carlo, KVLCC2 and Esso data;
@@ -351,7 +358,7 @@ class Search:
         union = tuple(keys[i] for i in np.flatnonzero(picks))
         if len(union) < 2:
             return []
-        null = joint_null(v, gram, blocks, equivalent, lower, size)
+        null = joint_null(null_scores(v), v, gram, blocks, equivalent, lower, size)
         s = next(iter(score_tests(sc.sens, sc.theta, {"+".join(union): sum(
             (sc.names[k] for k in union), ())}).values()))
         limit = float(np.quantile(null, 1 - sc.level))

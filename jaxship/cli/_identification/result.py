@@ -80,7 +80,9 @@ class IdentificationResult:
         """JSON-ready report (schema in the `identify` docstring)."""
         fitted = self.fit.to_dict()
         report = self.fit.parameters
-        start = {n: float(self.start.get_parameter(n)) for n in report.names}
+        value = (self.start.get_parameter if isinstance(self.start, js.AbstractModel)
+                 else lambda n: getattr(self.start, n))  # ARMAX: its polynomials' fields
+        start = {n: float(value(n)) for n in report.names}
         parameters = {name: {**entry, "start": start[name]}
                       for name, entry in fitted["parameters"].items()}
 
