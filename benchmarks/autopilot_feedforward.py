@@ -17,13 +17,13 @@ point flown in closed loop by `autopilot`, "feedforward_at_step" in autopilot.js
 - the thesis vessel at 300 and 400 rpm: zig-zags 10/10 and 20/20 of the `thesis`
   preset at each rate, merged.
 
-With `--autopilot --tune` (issue 61 point 2) a second table follows: per run the summed
+With `--tune` (issue 61 point 2) a second table follows: per run the summed
 error against the ordered heading (the step) of pid+ff (untuned) and of the tuned
 design (gains, then the reference model's bandwidth, `autopilot --tune`), the error of
 each against its own reference, and the bandwidth before and after with its bound.
 
     python benchmarks/autopilot_feedforward.py [--models nomoto1 nomoto1-norrbin]
-        [--autopilot --tune]
+        [--tune]
 """
 
 import argparse
@@ -82,6 +82,8 @@ def main(argv=None) -> int:
     parser.add_argument("--models", nargs="+", default=["nomoto1", "nomoto1-norrbin"])
     parser.add_argument("--autopilot", nargs="*", default=[],
                         help="extra options passed to `jaxship autopilot`")
+    parser.add_argument("--tune", action="store_true",
+                        help="run `jaxship autopilot --tune` (the second table)")
     args = parser.parse_args(argv)
     print("| vessel | model | run | pid+ff sum [deg] | pid sum [deg] | ratio | "
           "pid+ff overshoot [deg] | pid overshoot [deg] | peak r_d [deg/s] | "
@@ -99,7 +101,8 @@ def main(argv=None) -> int:
                 ap = folder / f"{plant}_{model}_ap"
                 try:
                     jaxship("autopilot", "--model", fit / "result.json", "--vessel", plant,
-                            option, *values, "--out", ap, *args.autopilot)
+                            option, *values, "--out", ap, *args.autopilot,
+                            *(["--tune"] if args.tune else []))
                 except RuntimeError as error:
                     print(f"| {name} | {model} | autopilot failed: "
                           f"{str(error).splitlines()[-1][:80]} | | | | | | | | | {fitted} |")
