@@ -500,7 +500,7 @@ def test_help_lists_every_model(capsys):
     out = capsys.readouterr().out
     listed = [line.split()[0] for line in out.split("models (--model):")[1].splitlines()
               if line.strip()]
-    assert listed == [*STEERING_MODELS, *js.VESSELS]
+    assert listed == [*STEERING_MODELS, *js.VESSELS, "auto"]
 
 
 def test_a_speed_beyond_froude_1_for_the_preset_is_refused(tmp_path, capsys):

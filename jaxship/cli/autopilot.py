@@ -112,22 +112,13 @@ def run(args) -> int:
     if evaluation.feedforward_at_step is None:  # --steady-turn model: measured for the report
         progress("the vessel's steady turn at the step's peak rate")
     at_step = _feedforward_at_step(evaluation, by_rpm, values)
-    inverse = autopilot_study.feedforward_gain_text(at_step)
+    inverse = autopilot_study.feedforward_gain_text(at_step) + _chosen_text(report)
     bar.update(bar.total - bar.n)
     bar.close()
 
     names = list(evaluation.runs)
     loops = [evaluation.runs[n] for n in names]
-    failed = [f"{row['controller']} at {row['rpm']:.4g} rpm, {row['speed']:.3g} m/s"
-              for row in evaluation.rows if not row["success"]]
-    failure = (f"The closed loop blew up (not finite) for {'; '.join(failed)}: those runs "
-               "have no metrics and say nothing about the autopilot." if failed else "")
-    pinned = [f"{row['controller']} at {row['rpm']:.4g} rpm, {row['speed']:.3g} m/s"
-              for row in evaluation.rows if row["code"] == "rudder_saturated"]
-    saturation = (f"The rudder sat at its limit for more than half the window in "
-                  f"{'; '.join(pinned)} (code rudder_saturated): the comparison there says "
-                  "little about the controllers; try a lower --natural-frequency."
-                  if pinned else "")
+    failure, saturation = _problems(evaluation.rows)
     with staged_folder(args.out) as stage:  # the whole set appears, or none of it
         (stage / "figures").mkdir()
         figures = []
@@ -145,6 +136,7 @@ def run(args) -> int:
         result = {
             "model": {"file": str(args.model), "name": report["model"],
                       "class": type(model).__name__, "fit_code": code,
+                      "selection": report.get("selection"),  # identify --model auto
                       "parameters": {k: float(e["value"] if isinstance(e, dict) else e)
                                      for k, e in report["parameters"].items()}},
             "vessel": args.vessel,
@@ -176,6 +168,34 @@ def run(args) -> int:
         if sentence:
             print(f"jaxship: {sentence}", file=sys.stderr)
     return 3 if failure or unfit else 0
+
+
+def _chosen_text(report: dict) -> str:
+    """How `identify --model auto` chose the model of the result `report`; "" for a
+    model named by hand."""
+    selection = report.get("selection")
+    if not isinstance(selection, dict) or "candidates" not in selection:
+        return ""
+    number = lambda x: f"{x:.6g}" if isinstance(x, (int, float)) else str(x)  # "inf"
+    scores = "; ".join(f"{name} {number(c['bic'])}" if "bic" in c else f"{name} not fitted"
+                       for name, c in selection["candidates"].items())
+    return (f" `identify --model auto` chose {selection.get('chosen')} by the least BIC on "
+            f"its training records ({scores}).")
+
+
+def _problems(rows) -> tuple[str, str]:
+    """`(failure, saturation)`: the sentences on runs that blew up and on runs whose
+    rudder sat on its limit (code rudder_saturated) among `rows`; "" where none."""
+    where = lambda row: f"{row['controller']} at {row['rpm']:.4g} rpm, {row['speed']:.3g} m/s"
+    failed = [where(row) for row in rows if not row["success"]]
+    failure = (f"The closed loop blew up (not finite) for {'; '.join(failed)}: those runs "
+               "have no metrics and say nothing about the autopilot." if failed else "")
+    pinned = [where(row) for row in rows if row["code"] == "rudder_saturated"]
+    saturation = (f"The rudder sat at its limit for more than half the window in "
+                  f"{'; '.join(pinned)} (code rudder_saturated): the comparison there says "
+                  "little about the controllers; try a lower --natural-frequency."
+                  if pinned else "")
+    return failure, saturation
 
 
 def _feedforward_at_step(evaluation, by_rpm, values) -> dict:

@@ -24,7 +24,7 @@ from ._common import (
 )
 from ._files import staged_folder
 from ._identification import MODELS, get_model_entry, identify, read_experiments
-from ._identification.selection import AUTO, CANDIDATES, CRITERION, is_auto
+from ._identification.selection import AUTO, CANDIDATES, is_auto
 from ._vessel import VESSEL_HELP, read_vessel_option
 
 
@@ -75,9 +75,11 @@ def register(sub) -> None:
                        and args.model not in VESSELS)
 
 
-AUTO_HELP = (f"each of {', '.join(CANDIDATES)} fitted, the one with the least {CRITERION} "
-             "chosen (held-out records never enter the choice); result.json's selection and "
-             "the printed note give each candidate's BIC and FPE")
+AUTO_HELP = (f"a steering model chosen among {', '.join(CANDIDATES)}: each fitted, the one "
+             "with the least BIC of its fit criterion on the training records kept (N log "
+             "det of the channels' losses + d log N, d estimated parameters, N samples per "
+             "channel; held-out records never enter the choice); result.json's selection "
+             "and the printed note give each candidate's BIC and Akaike's FPE")
 
 
 def _horizon(text):
