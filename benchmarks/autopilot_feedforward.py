@@ -22,7 +22,10 @@ error against the ordered heading (the step) of pid+ff (untuned) and of the tune
 design (gains, then the reference model's bandwidth, `autopilot --tune`), the error of
 each against its own reference, and the bandwidth before and after with its bound.
 
-    python benchmarks/autopilot_feedforward.py [--models nomoto1 nomoto1-norrbin]
+`--models auto` fits with `identify --model auto` (issue 61 point 1: the model chosen by
+its BIC on the training records); the fit column says which.
+
+    python benchmarks/autopilot_feedforward.py [--models nomoto1 nomoto1-norrbin auto]
         [--tune]
 """
 
@@ -98,6 +101,9 @@ def main(argv=None) -> int:
                 done = jaxship("identify", *train, "--model", model, "--out", fit,
                                "--no-figures")
                 fitted = "converged" if done.returncode == 0 else "NOT converged"
+                if model == "auto":  # identify --model auto: the model it chose
+                    chosen = json.loads((fit / "result.json").read_text())["model"]
+                    fitted += f"; auto chose {chosen}"
                 ap = folder / f"{plant}_{model}_ap"
                 try:
                     jaxship("autopilot", "--model", fit / "result.json", "--vessel", plant,
