@@ -130,8 +130,8 @@ def tune_reference(plant, autopilot, demand: RudderDemand, *, duration: float, d
     the largest $g_a$ up to the autopilot's own within the limits (`gain_bound`). The
     candidates: a log grid of `GRID_POINTS` from `LOWEST_SHARE` times the smaller of its own
     bandwidth and the bound with its own $g_a$ up to the bound with $g_a$ at most 1 (the
-    model's own inverse; `frequency_bound`), its own bandwidth added; all in one batched
-    closed loop. `summary`: the bandwidth before and after, the bounds, the acceleration
+    model's own inverse; `frequency_bound`), its own bandwidth added (compared, and chosen
+    only where within the limits); all in one batched closed loop. `summary`: the bandwidth before and after, the bounds, the acceleration
     gain after, the objective at both (before: its own bandwidth, its gains where within
     the limits)."""
     ff = autopilot.feedforward
@@ -149,11 +149,16 @@ def tune_reference(plant, autopilot, demand: RudderDemand, *, duration: float, d
     objective = ordered_objective(runs, rudder_weight)
     ok = np.asarray(runs.success).all(axis=1) & np.isfinite(objective)
     at_own = int(np.flatnonzero(grid == own)[0])
-    best = int(np.argmin(np.where(ok, objective, np.inf))) if ok.any() else at_own
+    # its own bandwidth may lie beyond the limits even without acceleration gain (a
+    # --natural-frequency given by hand): compared, never chosen
+    within = np.array([demand(c.feedforward, w) <= 1.0 + 1e-9
+                       for c, w in zip(candidates, grid)])
+    best = (int(np.argmin(np.where(ok & within, objective, np.inf)))
+            if (ok & within).any() else at_own)
     return candidates[best], {
         "reference_frequency_before": own, "reference_frequency_after": float(grid[best]),
         "reference_frequency_bound": float(bound), "reference_frequency_top": float(top),
         "ff_gain_before_reference": g_own, "ff_gain_after_reference": float(gains[best]),
         "ordered_objective_before": float(objective[at_own]) if ok[at_own] else None,
-        "ordered_objective_after": float(objective[best]) if ok.any() else None,
+        "ordered_objective_after": float(objective[best]) if ok[best] else None,
         "reference_candidates": len(grid)}
