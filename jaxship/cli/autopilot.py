@@ -23,7 +23,9 @@ def register(sub) -> None:
         description="Design a PID heading autopilot with reference feed-forward from the model "
         "of an `identify` result (pole placement, thesis eq. 5.1-5.7), run it on a vessel "
         "preset from straight runs at each --rpm or --speed with feed-forward (pid+ff), "
-        "without (pid) and, with --tune, with gains tuned on the vessel (tuned); writes "
+        "without (pid) and, with --tune, with the gains and the reference model's bandwidth "
+        "tuned on the vessel (tuned); a --model from `identify --model auto` is the model "
+        "it chose; writes "
         "autopilot.json, report.md and figures/ into --out.")
     auto.add_argument("--model", required=True, type=pathlib.Path,
                       help="result.json written by `jaxship identify`")
