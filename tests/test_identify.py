@@ -563,3 +563,22 @@ def test_auto_chooses_the_nonlinear_model_only_where_the_steady_turn_is_nonlinea
     assert figures["nomoto1"]["bic"] < figures["nomoto1-norrbin"]["bic"]
     with pytest.raises(ValueError, match="--free does not go with --model auto"):
         identify(train, model="auto", free=("K",))
+
+
+def test_cli_auto_writes_the_choice_and_refuses_a_vessel(files, tmp_path, capsys):
+    """`jaxship identify --model auto` on the noisy linear Nomoto 1 records: Nomoto 1
+    chosen (parsimony), the note on stdout names each candidate's BIC and FPE, result.json
+    has `selection` and the chosen model's own report; `--model auto` with `--vessel` is a
+    one-line error (exit 2, nothing written)."""
+    out = tmp_path / "auto"
+    code, stdout, _ = run([files["train"], "--model", "auto", "--validate", files["test"],
+                           "--out", str(out), "--no-figures", "--quiet"], capsys)
+    assert code == 0
+    report = json.loads((out / "result.json").read_text())
+    assert report["model"] == report["selection"]["chosen"] == "nomoto1"
+    assert set(report["selection"]["candidates"]) == {"nomoto1", "nomoto1-norrbin"}
+    note = next(line for line in stdout.splitlines() if line.startswith("note: model chosen"))
+    assert "nomoto1-norrbin: BIC" in note and "FPE" in note
+    code, _, err = run([files["train"], "--model", "auto", "--vessel", "thesis", "--out",
+                        str(tmp_path / "no")], capsys)
+    assert code == 2 and "give --model" in err and not (tmp_path / "no").exists()

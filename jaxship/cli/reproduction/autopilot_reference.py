@@ -131,9 +131,9 @@ def tune_reference(plant, autopilot, demand: RudderDemand, *, duration: float, d
     candidates: a log grid of `GRID_POINTS` from `LOWEST_SHARE` times the smaller of its own
     bandwidth and the bound with its own $g_a$ up to the bound with $g_a$ at most 1 (the
     model's own inverse; `frequency_bound`), its own bandwidth added (compared, and chosen
-    only where within the limits); all in one batched closed loop. `summary`: the bandwidth before and after, the bounds, the acceleration
-    gain after, the objective at both (before: its own bandwidth, its gains where within
-    the limits)."""
+    only where within the limits); all in one batched closed loop. `summary`: the
+    bandwidth before and after, the bounds, the acceleration gain after, the objective at
+    both (before: its own bandwidth, its gains where within the limits)."""
     ff = autopilot.feedforward
     own, g_own = float(autopilot.reference.natural_frequency), float(ff.gain)
     bound = demand.frequency_bound(ff)
