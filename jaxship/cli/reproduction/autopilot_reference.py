@@ -26,7 +26,6 @@ import numpy as np
 import jaxship as js
 
 
-DEG = math.pi / 180.0
 # the grid of the bandwidth search: log-spaced from the lower end to the rudder's bound
 GRID_POINTS = 17
 LOWEST_SHARE = 0.5  # the grid's lower end: half the untuned bandwidth (or the bound)
