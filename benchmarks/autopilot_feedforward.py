@@ -17,7 +17,16 @@ point flown in closed loop by `autopilot`, "feedforward_at_step" in autopilot.js
 - the thesis vessel at 300 and 400 rpm: zig-zags 10/10 and 20/20 of the `thesis`
   preset at each rate, merged.
 
-    python benchmarks/autopilot_feedforward.py [--models nomoto1 nomoto1-norrbin]
+With `--tune` (issue 61 point 2) a second table follows: per run the summed
+error against the ordered heading (the step) of pid+ff (untuned) and of the tuned
+design (gains, then the reference model's bandwidth, `autopilot --tune`), the error of
+each against its own reference, and the bandwidth before and after with its bound.
+
+`--models auto` fits with `identify --model auto` (issue 61 point 1: the model chosen by
+its BIC on the training records); the fit column says which.
+
+    python benchmarks/autopilot_feedforward.py [--models nomoto1 nomoto1-norrbin auto]
+        [--tune]
 """
 
 import argparse
@@ -76,11 +85,14 @@ def main(argv=None) -> int:
     parser.add_argument("--models", nargs="+", default=["nomoto1", "nomoto1-norrbin"])
     parser.add_argument("--autopilot", nargs="*", default=[],
                         help="extra options passed to `jaxship autopilot`")
+    parser.add_argument("--tune", action="store_true",
+                        help="run `jaxship autopilot --tune` (the second table)")
     args = parser.parse_args(argv)
     print("| vessel | model | run | pid+ff sum [deg] | pid sum [deg] | ratio | "
           "pid+ff overshoot [deg] | pid overshoot [deg] | peak r_d [deg/s] | "
           "model's steady rudder there [deg] | vessel's [deg] | fit |")
     print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+    tuned_rows = []
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
         for name, train, plant, option, values in cases(folder):
@@ -89,10 +101,14 @@ def main(argv=None) -> int:
                 done = jaxship("identify", *train, "--model", model, "--out", fit,
                                "--no-figures")
                 fitted = "converged" if done.returncode == 0 else "NOT converged"
+                if model == "auto":  # identify --model auto: the model it chose
+                    chosen = json.loads((fit / "result.json").read_text())["model"]
+                    fitted += f"; auto chose {chosen}"
                 ap = folder / f"{plant}_{model}_ap"
                 try:
                     jaxship("autopilot", "--model", fit / "result.json", "--vessel", plant,
-                            option, *values, "--out", ap, *args.autopilot)
+                            option, *values, "--out", ap, *args.autopilot,
+                            *(["--tune"] if args.tune else []))
                 except RuntimeError as error:
                     print(f"| {name} | {model} | autopilot failed: "
                           f"{str(error).splitlines()[-1][:80]} | | | | | | | | | {fitted} |")
@@ -111,7 +127,30 @@ def main(argv=None) -> int:
                           f"{ff['max_overshoot_deg']:.2f} | {fb['max_overshoot_deg']:.2f} | "
                           f"{at['peak_rate_deg_s']:.3g} | {at['model_rudder_deg']:.3g} | "
                           f"{at['vessel_rudder_deg']:.3g} | {fitted} |", flush=True)
+                    if "tuned" in written["gains"]:
+                        tuned_rows.append(_tuned_row(name, model, run, written, rpm, speed))
+    if tuned_rows:
+        print("\n| vessel | model | run | pid+ff vs ordered [deg] | tuned vs ordered [deg] | "
+              "ratio | pid+ff vs its reference [deg] | tuned vs its reference [deg] | "
+              "omega before -> after [rad/s] | bound at tuned g_a [rad/s] | g_a after | "
+              "tuned overshoot [deg] |")
+        print("|---|---|---|---:|---:|---:|---:|---:|---|---:|---:|---:|")
+        print("\n".join(tuned_rows))
     return 0
+
+
+def _tuned_row(name, model, run, written, rpm, speed) -> str:
+    """One row of the `--tune` table (module text)."""
+    by = {(r["controller"], r["rpm"], r["speed"]): r for r in written["runs"]}
+    ff, tuned = by[("pid+ff", rpm, speed)], by[("tuned", rpm, speed)]
+    g = written["gains"]["tuned"]
+    a, b = ff["sum_abs_error_ordered_deg"], tuned["sum_abs_error_ordered_deg"]
+    ratio = "-" if None in (a, b) else f"{b / a:.2f}"
+    return (f"| {name} | {model} | {run} | {a:.1f} | {b:.1f} | {ratio} | "
+            f"{ff['sum_abs_error_deg']:.1f} | {tuned['sum_abs_error_deg']:.1f} | "
+            f"{g['reference_frequency_before']:.4g} -> {g['reference_frequency_after']:.4g} | "
+            f"{g['reference_frequency_bound']:.4g} | {g['ff_gain_after_reference']:.3g} | "
+            f"{tuned['max_overshoot_deg']:.2f} |")
 
 
 if __name__ == "__main__":

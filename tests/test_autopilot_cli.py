@@ -19,6 +19,11 @@ import jaxship as js
 from jaxship.cli import main
 from jaxship.cli._identification import model_from_report, read_result
 from jaxship.cli.reproduction import autopilot as study
+from jaxship.cli.reproduction.autopilot_reference import (
+    RudderDemand,
+    ordered_error_deg,
+    tune_reference,
+)
 from jaxship.plotting import plot_autopilot
 
 
@@ -341,6 +346,15 @@ def test_tune_adds_a_tuned_controller_that_tracks_better(identified, tmp_path):
     assert tuned["objective_after"] < tuned["objective_before"]
     by = {(r["controller"], r["rpm"]): r["rms_error_deg"] for r in result["runs"]}
     assert all(by["tuned", rpm] < by["pid+ff", rpm] for rpm in (300.0, 500.0))
+    # issue 61 point 2: the reference bandwidth, tuned against the ordered heading within
+    # the rudder's limits, and the error against the step not worse than the untuned's
+    assert tuned["reference_frequency"] == tuned["reference_frequency_after"]
+    assert tuned["reference_frequency_after"] <= tuned["reference_frequency_top"]
+    assert tuned["ordered_objective_after"] <= tuned["ordered_objective_before"]
+    ordered = {(r["controller"], r["rpm"]): r["sum_abs_error_ordered_deg"]
+               for r in result["runs"]}
+    assert all(ordered["tuned", rpm] <= ordered["pid+ff", rpm] for rpm in (300.0, 500.0))
+    assert "reference model's bandwidth omega" in (out / "report.md").read_text()
 
 
 def test_the_default_design_follows_the_models_time_constant():
@@ -517,3 +531,37 @@ def test_the_steady_turn_trial_measures_the_vessels_steady_turn():
     short = study.Design(step_time=1.0, duration=4.0)
     with pytest.raises(ValueError, match="did not settle on the reverse-spiral trial"):
         study.vessel_steady_rudder(thesis, pid, short, rpm=400.0)
+
+
+def test_the_tuned_reference_bandwidth_stays_within_the_rudder_and_tracks_the_step_better():
+    """Issue 61 point 2 (`autopilot --tune`): the reference model's bandwidth tuned against
+    the ordered heading on a plant that is not the design model (a Norrbin ship with a
+    cubic yaw damping, steered from a Nomoto 1 with its linear gain and time constant),
+    the rudder 35 deg and 5 deg/s. The tuned feed-forward of the 45 deg step, stepped
+    through `ReferenceModel` and the Nomoto inverse m a_d + d r_d (not the tuner's own
+    bisection), stays within half of both limits and touches one of them (the faster
+    reference pays against the step until the rudder stops it); its summed error against
+    the step is below the untuned design's, whose reference is slower."""
+    plant = js.NonlinearNomoto(K=0.1, T=10.0, n3=400.0)  # H(r) = r + 400 r^3
+    model = js.Nomoto1(K=0.1, T=10.0)
+    limits = (np.radians(35.0), np.radians(5.0))
+    step = js.HeadingSteps(times=(50.0,), headings=(np.radians(45.0),))
+    start = js.design_autopilot(model, natural_frequency=0.125, speed=5.0,
+                                reference=js.ReferenceModel(natural_frequency=0.05),
+                                steps=step, max_angle=limits[0], max_rate=limits[1])
+    state = js.ShipState(u=5.0, v=0.0, r=0.0, x=0.0, y=0.0, psi=0.0, delta=0.0, n=0.0)
+    demand = RudderDemand(state, np.radians(45.0), *limits)
+    tuned, summary = tune_reference(plant, start, demand, duration=400.0, dt=1.0,
+                                    rudder_weight=0.1, run_kw={"speeds": [5.0]})
+    w, g = float(tuned.reference.natural_frequency), float(tuned.feedforward.gain)
+    assert w == summary["reference_frequency_after"] and w > 0.05
+    reference, h = js.ReferenceModel(natural_frequency=w), 0.01 / w
+    scan = lambda s, _: (reference.step(s, np.radians(45.0), h),) * 2
+    _, r_d, a_d = np.vstack([np.zeros(3), jax.lax.scan(scan, jnp.zeros(3), length=3000)[1]]).T
+    rudder = g * model.T / model.K * a_d + r_d / model.K  # g_s = 1
+    shares = (np.max(np.abs(rudder)) / limits[0],
+              np.max(np.abs(np.diff(rudder) / h)) / limits[1])
+    assert max(shares) == pytest.approx(0.5, rel=1e-3)
+    runs = js.closed_loop(plant, [start, tuned], speeds=[5.0], duration=400.0, dt=0.1)
+    before, after = ordered_error_deg(runs, 1.0, (50.0, 400.0))[:, 0]
+    assert after < before, summary

@@ -28,6 +28,7 @@ from jaxship.cli._identification import (
     IdentificationResult,
     Progress,
     identify,
+    model_from_report,
     read_experiments,
 )
 
@@ -499,7 +500,7 @@ def test_help_lists_every_model(capsys):
     out = capsys.readouterr().out
     listed = [line.split()[0] for line in out.split("models (--model):")[1].splitlines()
               if line.strip()]
-    assert listed == [*STEERING_MODELS, *js.VESSELS]
+    assert listed == [*STEERING_MODELS, *js.VESSELS, "auto"]
 
 
 def test_a_speed_beyond_froude_1_for_the_preset_is_refused(tmp_path, capsys):
@@ -528,3 +529,56 @@ def test_a_speed_beyond_froude_1_for_the_preset_is_refused(tmp_path, capsys):
         err = capsys.readouterr().err
         assert code == 2 and expected.search(err), err
         assert len(err.strip().splitlines()) == 1 and not out.exists()
+
+
+def test_auto_chooses_the_nonlinear_model_only_where_the_steady_turn_is_nonlinear():
+    """Issue 61 point 1 (`identify --model auto`): Nomoto 1 and Norrbin's nonlinear Nomoto 1
+    fitted to the same training records, the one with the least BIC on them chosen. On a
+    vessel with cubic yaw damping (H(r) = r + 300 r^3, steps of 5-30 deg: the steady turn
+    bends) it is the Norrbin model; on a linear Nomoto 1 truth (the same rudder and
+    noise) the extra n3 buys less than BIC's log N and Nomoto 1 is chosen (6 of 6 noise
+    draws, seed 1 the closest: 3.2 apart; Akaike's FPE took n3 there). The held-out
+    record never enters the choice: the choice and its figures are the same without it;
+    the result carries each candidate's BIC and FPE (result.json, the printed note)."""
+    steps = rudder_sequence(5, amplitudes=(5.0, 15.0, 30.0))
+    cubic = NonlinearNomoto(K=0.06, T=25.0, n3=300.0)
+    train = record(cubic, steps, name="a", noise=0.05, seed=1)
+    held_out = record(TRUTH, rudder_sequence(2), name="held-out", noise=0.05, seed=3)
+    chosen = identify(train, model="auto", validate=held_out)
+    assert chosen.model_name == "nomoto1-norrbin" and isinstance(chosen.model, NonlinearNomoto)
+    figures = chosen.selection["candidates"]
+    assert chosen.selection["chosen"] == "nomoto1-norrbin"
+    assert figures["nomoto1-norrbin"]["bic"] < figures["nomoto1"]["bic"]
+    assert (figures["nomoto1"]["num_params"], figures["nomoto1-norrbin"]["num_params"]) == (2, 3)
+    assert identify(train, model="auto").selection == chosen.selection
+    report = json.loads(chosen.to_json())
+    assert report["selection"]["chosen"] == report["model"] == "nomoto1-norrbin"
+    assert any(n.startswith("model chosen: nomoto1-norrbin") for n in report["notes"])
+    # `autopilot --model result.json` inverts the chosen model, as any other result's
+    rebuilt = model_from_report(report)
+    assert isinstance(rebuilt, NonlinearNomoto) and float(rebuilt.n3) == float(chosen.model.n3)
+    linear = identify(record(TRUTH, steps, name="b", noise=0.05, seed=1), model="auto")
+    assert linear.model_name == "nomoto1" and isinstance(linear.model, Nomoto1)
+    figures = linear.selection["candidates"]
+    assert figures["nomoto1"]["bic"] < figures["nomoto1-norrbin"]["bic"]
+    with pytest.raises(ValueError, match="--free does not go with --model auto"):
+        identify(train, model="auto", free=("K",))
+
+
+def test_cli_auto_writes_the_choice_and_refuses_a_vessel(files, tmp_path, capsys):
+    """`jaxship identify --model auto` on the noisy linear Nomoto 1 records: Nomoto 1
+    chosen (parsimony), the note on stdout names each candidate's BIC and FPE, result.json
+    has `selection` and the chosen model's own report; `--model auto` with `--vessel` is a
+    one-line error (exit 2, nothing written)."""
+    out = tmp_path / "auto"
+    code, stdout, _ = run([files["train"], "--model", "auto", "--validate", files["test"],
+                           "--out", str(out), "--no-figures", "--quiet"], capsys)
+    assert code == 0
+    report = json.loads((out / "result.json").read_text())
+    assert report["model"] == report["selection"]["chosen"] == "nomoto1"
+    assert set(report["selection"]["candidates"]) == {"nomoto1", "nomoto1-norrbin"}
+    note = next(line for line in stdout.splitlines() if line.startswith("note: model chosen"))
+    assert "nomoto1-norrbin: BIC" in note and "FPE" in note
+    code, _, err = run([files["train"], "--model", "auto", "--vessel", "thesis", "--out",
+                        str(tmp_path / "no")], capsys)
+    assert code == 2 and "give --model" in err and not (tmp_path / "no").exists()

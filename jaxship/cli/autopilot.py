@@ -23,7 +23,9 @@ def register(sub) -> None:
         description="Design a PID heading autopilot with reference feed-forward from the model "
         "of an `identify` result (pole placement, thesis eq. 5.1-5.7), run it on a vessel "
         "preset from straight runs at each --rpm or --speed with feed-forward (pid+ff), "
-        "without (pid) and, with --tune, with gains tuned on the vessel (tuned); writes "
+        "without (pid) and, with --tune, with the gains and the reference model's bandwidth "
+        "tuned on the vessel (tuned); a --model from `identify --model auto` is the model "
+        "it chose; writes "
         "autopilot.json, report.md and figures/ into --out.")
     auto.add_argument("--model", required=True, type=pathlib.Path,
                       help="result.json written by `jaxship identify`")
@@ -34,8 +36,12 @@ def register(sub) -> None:
     auto.add_argument("--step", default="45", help="heading step [deg], at 50 / omega_n "
                       "s (100 s for 0.5 rad/s)")
     auto.add_argument("--tune", action="store_true",
-                      help="also tune the gains on the vessel at the given rpm/speeds: the "
-                      "PID's and the feed-forward's (its acceleration and steady-turn parts)")
+                      help="also tune on the vessel at the given rpm/speeds (controller "
+                      "tuned): the gains, the PID's and the feed-forward's (its acceleration "
+                      "and steady-turn parts), against the reference model's heading; then "
+                      "the reference model's bandwidth omega (eq. 5.7) against the ordered "
+                      "heading (the step), at most what keeps the tuned feed-forward of the "
+                      "step within half the rudder's angle and rate limits")
     auto.add_argument("--natural-frequency", default="auto",
                       help="the controller's omega_n [rad/s]; auto: 1.25 / T from "
                       "the model's yaw time constant T, at most half the rudder servo's "
@@ -91,7 +97,7 @@ def run(args) -> int:
                                                              step=step)
     design = autopilot_study.Design.scaled(omega, step=step, damping=damping, basis=basis)
 
-    bar = tqdm(total=3 + 2 * int(args.tune), desc="autopilot", unit="stage", leave=False,
+    bar = tqdm(total=3 + 3 * int(args.tune), desc="autopilot", unit="stage", leave=False,
                file=sys.stderr, disable=args.quiet)
     started = []
 
@@ -108,22 +114,13 @@ def run(args) -> int:
     if evaluation.feedforward_at_step is None:  # --steady-turn model: measured for the report
         progress("the vessel's steady turn at the step's peak rate")
     at_step = _feedforward_at_step(evaluation, by_rpm, values)
-    inverse = autopilot_study.feedforward_gain_text(at_step)
+    inverse = autopilot_study.feedforward_gain_text(at_step) + _chosen_text(report)
     bar.update(bar.total - bar.n)
     bar.close()
 
     names = list(evaluation.runs)
     loops = [evaluation.runs[n] for n in names]
-    failed = [f"{row['controller']} at {row['rpm']:.4g} rpm, {row['speed']:.3g} m/s"
-              for row in evaluation.rows if not row["success"]]
-    failure = (f"The closed loop blew up (not finite) for {'; '.join(failed)}: those runs "
-               "have no metrics and say nothing about the autopilot." if failed else "")
-    pinned = [f"{row['controller']} at {row['rpm']:.4g} rpm, {row['speed']:.3g} m/s"
-              for row in evaluation.rows if row["code"] == "rudder_saturated"]
-    saturation = (f"The rudder sat at its limit for more than half the window in "
-                  f"{'; '.join(pinned)} (code rudder_saturated): the comparison there says "
-                  "little about the controllers; try a lower --natural-frequency."
-                  if pinned else "")
+    failure, saturation = _problems(evaluation.rows)
     with staged_folder(args.out) as stage:  # the whole set appears, or none of it
         (stage / "figures").mkdir()
         figures = []
@@ -141,6 +138,7 @@ def run(args) -> int:
         result = {
             "model": {"file": str(args.model), "name": report["model"],
                       "class": type(model).__name__, "fit_code": code,
+                      "selection": report.get("selection"),  # identify --model auto
                       "parameters": {k: float(e["value"] if isinstance(e, dict) else e)
                                      for k, e in report["parameters"].items()}},
             "vessel": args.vessel,
@@ -160,9 +158,10 @@ def run(args) -> int:
                 title, _, rest = page.partition("\n")
                 page = f"{title}\n\n**{sentence}**\n{rest}"
         (stage / "report.md").write_text(page)
-    print(gains_table(evaluation.gains()))
-    print(runs_table(evaluation.rows))
-    print(inverse)
+    for text in (gains_table(evaluation.gains()), runs_table(evaluation.rows), inverse,
+                 tuning_text(evaluation.tuning)):
+        if text:
+            print(text)
     print(f"wrote {args.out}/autopilot.json, {args.out}/report.md, {args.out}/figures/ "
           f"({len(figures)} figures)")
     if saturation:
@@ -171,6 +170,34 @@ def run(args) -> int:
         if sentence:
             print(f"jaxship: {sentence}", file=sys.stderr)
     return 3 if failure or unfit else 0
+
+
+def _chosen_text(report: dict) -> str:
+    """How `identify --model auto` chose the model of the result `report`; "" for a
+    model named by hand."""
+    selection = report.get("selection")
+    if not isinstance(selection, dict) or "candidates" not in selection:
+        return ""
+    number = lambda x: f"{x:.6g}" if isinstance(x, (int, float)) else str(x)  # "inf"
+    scores = "; ".join(f"{name} {number(c['bic'])}" if "bic" in c else f"{name} not fitted"
+                       for name, c in selection["candidates"].items())
+    return (f" `identify --model auto` chose {selection.get('chosen')} by the least BIC on "
+            f"its training records ({scores}).")
+
+
+def _problems(rows) -> tuple[str, str]:
+    """`(failure, saturation)`: the sentences on runs that blew up and on runs whose
+    rudder sat on its limit (code rudder_saturated) among `rows`; "" where none."""
+    where = lambda row: f"{row['controller']} at {row['rpm']:.4g} rpm, {row['speed']:.3g} m/s"
+    failed = [where(row) for row in rows if not row["success"]]
+    failure = (f"The closed loop blew up (not finite) for {'; '.join(failed)}: those runs "
+               "have no metrics and say nothing about the autopilot." if failed else "")
+    pinned = [where(row) for row in rows if row["code"] == "rudder_saturated"]
+    saturation = (f"The rudder sat at its limit for more than half the window in "
+                  f"{'; '.join(pinned)} (code rudder_saturated): the comparison there says "
+                  "little about the controllers; try a lower --natural-frequency."
+                  if pinned else "")
+    return failure, saturation
 
 
 def _feedforward_at_step(evaluation, by_rpm, values) -> dict:
@@ -188,29 +215,55 @@ def _feedforward_at_step(evaluation, by_rpm, values) -> dict:
 
 def gains_table(gains: dict) -> str:
     """Markdown table of `Evaluation.gains()`."""
-    lines = ["| controller | K_p [-] | K_i [1/s] | K_d [s] | feed-forward | its gains "
-             "(acceleration, steady turn) |", "|---|---|---|---|---|---|"]
+    lines = ["| controller | K_p [-] | K_i [1/s] | K_d [s] | reference omega [rad/s] | "
+             "feed-forward | its gains (acceleration, steady turn) |",
+             "|---|---|---|---|---|---|---|"]
     for name, g in gains.items():
         ff = g["feedforward"]
         weights = "-" if ff is None else f"{g['ff_gain']:.3g}, {g['ff_steady_gain']:.3g}"
         lines.append(f"| {name} | {g['kp']:.4g} | {g['ki']:.4g} | {g['kd']:.4g} | "
-                     f"{ff or 'none'} | {weights} |")
+                     f"{g['reference_frequency']:.4g} | {ff or 'none'} | {weights} |")
     return "\n".join(lines) + "\n"
 
 
 def runs_table(rows: list[dict]) -> str:
     """Markdown table of run rows (`RUN_KEYS`)."""
-    lines = ["| controller | rpm | speed [m/s] | sum abs error [deg] | RMS error [deg] | "
-             "overshoot [deg] | settling [s] | mean abs rudder [deg] | rudder travel [deg] | "
-             "rate-limited [s] |", "|---" * 10 + "|"]
+    lines = ["| controller | rpm | speed [m/s] | sum abs error [deg] | against the ordered "
+             "heading [deg] | RMS error [deg] | overshoot [deg] | settling [s] | mean abs "
+             "rudder [deg] | rudder travel [deg] | rate-limited [s] |", "|---" * 11 + "|"]
     for r in rows:
         settle = "never" if r["settling_time_s"] is None else f"{r['settling_time_s']:.1f}"
         lines.append(f"| {r['controller']} | {r['rpm']:.0f} | {r['speed']:.3f} | "
-                     f"{cell(r['sum_abs_error_deg'])} | {cell(r['rms_error_deg'], 3)} | "
+                     f"{cell(r['sum_abs_error_deg'])} | "
+                     f"{cell(r.get('sum_abs_error_ordered_deg'))} | "
+                     f"{cell(r['rms_error_deg'], 3)} | "
                      f"{cell(r['max_overshoot_deg'])} | {settle} | "
                      f"{cell(r['mean_abs_rudder_deg'])} | {cell(r['rudder_travel_deg'], 1)} | "
                      f"{cell(r['time_rate_limited_s'], 1)} |")
     return "\n".join(lines) + "\n"
+
+
+def tuning_text(tuning: dict | None) -> str:
+    """`Evaluation.tuning` (`--tune`) in words; "" without it."""
+    if tuning is None:
+        return ""
+    before = tuning["ordered_objective_before"]
+    after = tuning["ordered_objective_after"]
+    versus = ("" if None in (before, after) else
+              f", objective against the ordered heading {before:.4g} -> {after:.4g} rad^2 "
+              "(with the tuned gains)")
+    return (f"Tuned (--tune): the gains by tune_autopilot against the reference model's "
+            f"heading, objective {tuning['objective_before']:.4g} -> "
+            f"{tuning['objective_after']:.4g} rad^2 in {tuning['steps']} steps ("
+            f"{'converged' if tuning['converged'] else 'NOT converged'}); then the reference "
+            f"model's bandwidth omega {tuning['reference_frequency_before']:.4g} -> "
+            f"{tuning['reference_frequency_after']:.4g} rad/s against the ordered heading, the "
+            f"best of {tuning['reference_candidates']} on a log grid up to "
+            f"{tuning['reference_frequency_top']:.4g} rad/s, each with the feed-forward of "
+            f"the step within half the rudder's angle and rate limits (with the tuned "
+            f"acceleration gain {tuning['ff_gain_before_reference']:.3g} up to "
+            f"{tuning['reference_frequency_bound']:.4g} rad/s; at the chosen bandwidth "
+            f"{tuning['ff_gain_after_reference']:.3g}){versus}.")
 
 
 def feedforward_text(rows: list[dict]) -> str:
@@ -265,9 +318,9 @@ def evaluation_report(evaluation: autopilot_study.Evaluation, *, title: str = "H
         f"deg/s; the controller updates every {d.interval:g} s. Chosen: {d.basis}.\n")
     text.append("## Gains\n\n" + gains_table(evaluation.gains()))
     text.append("## Closed-loop runs\n\n" + runs_table(evaluation.rows))
-    verdict = feedforward_text(evaluation.rows)
-    if verdict:
-        text.append(verdict + "\n")
+    for verdict in (feedforward_text(evaluation.rows), tuning_text(evaluation.tuning)):
+        if verdict:
+            text.append(verdict + "\n")
     text.append(autopilot_study.METRICS_TEXT.format(dt=d.sample_interval, start=d.window[0],
                                     end=d.window[1]) + "\n")
     if figures:

@@ -24,6 +24,7 @@ from ._common import (
 )
 from ._files import staged_folder
 from ._identification import MODELS, get_model_entry, identify, read_experiments
+from ._identification.selection import AUTO, CANDIDATES, is_auto
 from ._vessel import VESSEL_HELP, read_vessel_option
 
 
@@ -34,14 +35,16 @@ def register(sub) -> None:
         "measurement files or folders of them) and validate it; writes result.json and "
         "figures into --out.",
         epilog="models (--model):\n" + "\n".join(
-            f"  {name:<24} {entry.description}" for name, entry in MODELS.items()),
+            f"  {name:<24} {entry.description}" for name, entry in MODELS.items())
+        + f"\n  {AUTO:<24} " + AUTO_HELP,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     ident.add_argument("train", nargs="+", type=pathlib.Path,
                        help="training records: trial CSV or measurement files, or folders")
     ident.add_argument("--model", default=None,
                        help="a registered model (listed below): a steering model, armax or a "
-                       "vessel preset name (this or --vessel)")
+                       "vessel preset name, or auto: the steering model chosen by its BIC on "
+                       "the training records (this or --vessel)")
     ident.add_argument("--vessel", default=None,
                        help="the model to start from, in place of --model: " + VESSEL_HELP)
     ident.add_argument("--horizon", default=None,
@@ -70,6 +73,13 @@ def register(sub) -> None:
     # a vessel's fit runs long programs, which XLA's defaults compile to run faster
     ident.set_defaults(run=run, small_programs=lambda args: args.vessel is None
                        and args.model not in VESSELS)
+
+
+AUTO_HELP = (f"a steering model chosen among {', '.join(CANDIDATES)}: each fitted, the one "
+             "with the least BIC of its fit criterion on the training records kept (N log "
+             "det of the channels' losses + d log N, d estimated parameters, N samples per "
+             "channel; held-out records never enter the choice); result.json's selection "
+             "and the printed note give each candidate's BIC and Akaike's FPE")
 
 
 def _horizon(text):
@@ -136,7 +146,8 @@ def start_model(model, vessel):
         raise ValueError("give --model (a registered model) or --vessel (a preset, a vessel "
                          "file or a result.json to start from), one of them.")
     if vessel is None:
-        get_model_entry(model)
+        if not is_auto(model):
+            get_model_entry(model)
         return model, None
     chosen = read_vessel_option(vessel)
     return chosen.name, chosen.model

@@ -31,7 +31,9 @@ class IdentificationResult:
     - `train`: `Assessment` of the fit criterion on the training records;
     - `train_simulation`: output-error `Assessment` on the training records;
     - `validation`: output-error `Assessment` on the held-out records, or None;
-    - `options`: horizon [s], rudder, channels; `notes`, `warnings`: texts.
+    - `options`: horizon [s], rudder, channels; `notes`, `warnings`: texts;
+    - `selection`: with `--model auto`, how the model was chosen (`selection.choose`:
+      the criterion, the chosen name, each candidate's figures); None otherwise.
     """
 
     model_name: str
@@ -45,6 +47,7 @@ class IdentificationResult:
     options: dict
     notes: tuple[str, ...] = ()
     warnings: tuple[str, ...] = ()
+    selection: dict | None = None
 
     @property
     def model(self) -> js.AbstractSteeringModel:
@@ -124,6 +127,7 @@ class IdentificationResult:
             },
             "notes": list(self.notes),
             "warnings": list(self.warnings),
+            **({} if self.selection is None else {"selection": self.selection}),
         })
 
     def to_json(self, indent: int | None = 2) -> str:

@@ -36,6 +36,7 @@ from .data import (
 )
 from .registry import MODELS, model_key, start_entry
 from .result import IdentificationResult
+from .selection import CANDIDATES, choose, is_auto, with_selection
 from .simulation import simulate_records
 from .starts import StartContext
 
@@ -77,7 +78,9 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
 
     - `train`: the training records: an `Experiment`, a list of them, a `Dataset`,
       or file/folder paths (see `read_experiments`).
-    - `model`: a name in `MODELS`: `nomoto1`, `nomoto2`, `nomoto1-nonlinear`,
+    - `model`: `"auto"` (each steering model of `selection.CANDIDATES` fitted, the one
+      with the least BIC on the training records returned, with its `selection`) or a
+      name in `MODELS`: `nomoto1`, `nomoto2`, `nomoto1-nonlinear`,
       `ross-autopilot`, `linear-sway-yaw`, `norrbin-crossflow`, `low-speed-sway-yaw`,
       `armax` or a vessel preset of `jaxship.VESSELS` (its `default_free`
       coefficients are estimated from the preset's values; records need u and v).
@@ -137,6 +140,10 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     from r, r differenced from psi); a note says so, and with the default `channels`
     such a channel is not fitted when every training record lacks it.
     """
+    if start is None and is_auto(model):  # each candidate fitted, one chosen (`selection`)
+        return _chosen(train, horizon=horizon, validate=validate, rudder=rudder,
+                       channels=channels, initial=initial, max_steps=max_steps,
+                       substeps=substeps, progress=progress, free=free)
     name, entry = start_entry(model, start) if start is not None else \
         (model_key(model), MODELS[model_key(model)])
     options = _checked_options(name, entry, _Options(
@@ -168,6 +175,23 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
         validation=blocks[2], options=options.to_json(), notes=tuple(notes),
         warnings=tuple(caught),
     )
+
+
+def _chosen(train, *, free=None, **options) -> IdentificationResult:
+    """`identify` of each model of `CANDIDATES` on `train` with the same `options`, the one
+    chosen by `selection.choose` (the training records' fit criterion only) returned with
+    its `selection`."""
+    if free is not None:
+        raise ValueError("--free does not go with --model auto: the candidates estimate "
+                         "different parameters; choose a model to set them.")
+    results, failed = {}, {}
+    for name in CANDIDATES:
+        try:
+            results[name] = identify(train, model=name, **options)
+        except FitDivergedError as error:
+            failed[name] = str(error)
+    name, selection = choose(results, failed)
+    return with_selection(results[name], selection)
 
 
 class _Options(NamedTuple):

@@ -33,6 +33,8 @@ import numpy as np
 
 import jaxship as js
 
+from .autopilot_reference import RudderDemand, ordered_error_deg, tune_reference
+
 
 DEG = math.pi / 180.0
 # the thesis design's proportions (Table 5.1 with omega_n = 0.5 rad/s): reference model
@@ -151,13 +153,15 @@ class Evaluation:
     feedforward_at_step: dict | None = None
 
     def gains(self) -> dict:
-        """{controller: {kp, ki, kd, feedforward[, ff_gain, ff_steady_gain]}}: kp
-        [rad/rad], ki [1/s], kd [s], the class of the inverted model (None: feedback
-        only) and the feed-forward's gains."""
+        """{controller: {kp, ki, kd, reference_frequency, feedforward[, ff_gain,
+        ff_steady_gain]}}: kp [rad/rad], ki [1/s], kd [s], the reference model's bandwidth
+        [rad/s], the class of the inverted model (None: feedback only) and the
+        feed-forward's gains; "tuned" also has the tuning summary (`tune_on_vessel`)."""
         out = {}
         for name, a in self.controllers.items():
             ff = a.feedforward
             out[name] = {"kp": float(a.kp), "ki": float(a.ki), "kd": float(a.kd),
+                         "reference_frequency": float(a.reference.natural_frequency),
                          "feedforward": None if ff is None else type(ff.model).__name__}
             if ff is not None:  # its acceleration and steady-turn gains (`Feedforward`)
                 out[name] |= {"ff_gain": float(ff.gain),
@@ -187,9 +191,11 @@ class Evaluation:
 
 METRICS_TEXT = (
     "sum_abs_error_deg: thesis eq. 3.19, the sum of |psi_d - psi| [deg] sampled every {dt:g} s "
-    "over {start:g}-{end:g} s (psi_d: the reference model's output); rms_error_deg: the RMS "
-    "of the same samples; max_overshoot_deg: the heading past the ordered heading after the "
-    "step; settling_time_s: from the step until the heading stays within 2 % of the step "
+    "over {start:g}-{end:g} s (psi_d: the reference model's output); "
+    "sum_abs_error_ordered_deg: the same sum against the ordered heading psi_ref (the step) in "
+    "place of psi_d, which compares designs with different reference models; rms_error_deg: "
+    "the RMS of the psi_d samples; max_overshoot_deg: the heading past the ordered heading "
+    "after the step; settling_time_s: from the step until the heading stays within 2 % of the step "
     "(null: never); mean_abs_rudder_deg, rudder_travel_deg: mean |delta| and sum |d delta| "
     "of the actual rudder over the window; time_rate_limited_s: time the command moved at "
     "the rudder rate limit.")
@@ -416,6 +422,7 @@ def run_rows(name: str, run, design: Design, rpm, speed, max_angle: float) -> li
     controller `name` at the operating points `rpm`, `speed`."""
     metrics = js.closed_loop_metrics(run, design.sample_interval, window=design.window)
     m = metrics.to_dict_deg()
+    ordered = ordered_error_deg(run, design.sample_interval, design.window)
     t = np.asarray(run.t)
     inside = (t >= design.window[0]) & (t <= design.window[1])
     at_limit = np.abs(np.asarray(run.delta_c)[0]) >= 0.99 * max_angle  # the command
@@ -428,6 +435,7 @@ def run_rows(name: str, run, design: Design, rpm, speed, max_angle: float) -> li
         rows.append({
             "controller": name, "rpm": float(rpm[j]), "speed": float(speed[j]),
             "sum_abs_error_deg": _finite(m["residual_sum_deg"][0][j]),
+            "sum_abs_error_ordered_deg": _finite(ordered[0, j]),
             "rms_error_deg": _finite(m["rms_error_deg"][0][j]),
             "max_overshoot_deg": _finite(m["overshoot_deg"][0][j]),
             "settling_time_s": _finite(m["settling_time_s"][0][j]),
@@ -440,14 +448,44 @@ def run_rows(name: str, run, design: Design, rpm, speed, max_angle: float) -> li
     return rows
 
 
+def tune_on_vessel(model, plant, design: Design, controllers: dict, *, speed: float,
+                   n: float, run_kw: dict, say) -> tuple:
+    """`(tuned autopilot, summary)`: `tune_autopilot` on `plant` at the operating points
+    `run_kw` from the "pid+ff" gains of `controllers` (if its $K_d \\le 0$, from the
+    thesis' $K_d = 2\\zeta\\omega_n m$, designed about `speed`, `n`), then the reference
+    model's bandwidth with those PID gains (`tune_reference`), against the ordered heading,
+    the tuned feed-forward of the step within `RUDDER_SHARE` of the rudder's limits at the
+    straight run at `speed` (`RudderDemand`). `say`: the
+    progress callable."""
+    start = controllers["pid+ff"]
+    if not float(start.kd) > 0:
+        start = design_controllers(model, plant, dataclasses.replace(
+            design, subtract_damping=False), speed=speed, n=n,
+            steady_gain=start.feedforward.steady_gain)["pid+ff"]
+    say("tuning the gains on the vessel")
+    tuned = js.tune_autopilot(plant, start, duration=design.duration, dt=design.tune_dt,
+                              rudder_weight=design.rudder_weight,
+                              max_steps=design.tune_steps, **run_kw)
+    say("tuning the reference model's bandwidth on the vessel")
+    demand = RudderDemand(js.straight_run(plant, speed=speed), design.step * DEG,
+                          float(plant.rudder.max_angle), float(plant.rudder.max_rate),
+                          damping=design.reference_damping, share=RUDDER_SHARE)
+    autopilot, reference = tune_reference(plant, tuned.autopilot, demand,
+                                          duration=design.duration, dt=design.tune_dt,
+                                          rudder_weight=design.rudder_weight, run_kw=run_kw)
+    return autopilot, {"objective_before": float(tuned.objective_before),
+                       "objective_after": float(tuned.objective_after),
+                       "steps": int(tuned.num_steps), "converged": bool(tuned.success),
+                       **reference}
+
+
 def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
              tune: bool = False, progress=None, steady_turn: str = "model") -> Evaluation:
     """Design the autopilots of `model` (`design_controllers`, about the mean operating
     point of the runs) and run each on the vessel `plant` from straight runs at each
     of `rpm` or `speeds` [m/s] (exactly one of them, a sequence). `tune`: also a
-    `"tuned"` controller, `tune_autopilot` on `plant` at the same operating points
-    from the "pid+ff" gains (if its $K_d \\le 0$, from the thesis' $K_d =
-    2\\zeta\\omega_n m$). `progress`: a callable taking a message, or None.
+    `"tuned"` controller, its gains and reference bandwidth tuned on `plant` at the same
+    operating points (`tune_on_vessel`). `progress`: a callable taking a message, or None.
     `steady_turn`: "model" (the feed-forward inverts the model as it is; the thesis'
     eq. 5.2/5.6) or "trial" (its steady-turn part scaled to the vessel's own rudder at
     the step's peak rate, `steady_turn_trial`)."""
@@ -482,19 +520,8 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
     run_kw = {"rpm": values} if key == "rpm" else {"speeds": values}
     tuning = None
     if tune:
-        start = controllers["pid+ff"]
-        if not float(start.kd) > 0:
-            start = design_controllers(model, plant, dataclasses.replace(
-                design, subtract_damping=False), speed=u0, n=n0,
-                steady_gain=start.feedforward.steady_gain)["pid+ff"]
-        say("tuning the gains on the vessel")
-        tuned = js.tune_autopilot(plant, start, duration=design.duration, dt=design.tune_dt,
-                                  rudder_weight=design.rudder_weight,
-                                  max_steps=design.tune_steps, **run_kw)
-        controllers["tuned"] = tuned.autopilot
-        tuning = {"objective_before": float(tuned.objective_before),
-                  "objective_after": float(tuned.objective_after),
-                  "steps": int(tuned.num_steps), "converged": bool(tuned.success)}
+        controllers["tuned"], tuning = tune_on_vessel(model, plant, design, controllers,
+                                                      speed=u0, n=n0, run_kw=run_kw, say=say)
     runs, rows = {}, []
     rpms = values if key == "rpm" else [60.0 * n for _, n in points]
     speeds_ = values if key == "speed" else [u for u, _ in points]

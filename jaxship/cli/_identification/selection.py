@@ -1,0 +1,92 @@
+"""`identify --model auto`: the steering model chosen from the training records alone.
+
+Each candidate of `CANDIDATES` (the first-order steering models the autopilot's feed-forward
+inverts: Nomoto 1 and Norrbin's nonlinear Nomoto 1 of either course stability, issue 61) is
+fitted to the training records as `identify` fits it, and the one with the least Bayesian
+information criterion of its fit criterion on those records is chosen:
+
+$$\\mathrm{BIC} = N\\log\\det\\hat\\Lambda + d\\log N,$$
+
+$\\hat\\Lambda$ the residual covariance of the fitted channels (its diagonal here: the
+channels' losses $V_c$), $d$ the number of estimated parameters and $N$ the samples per
+channel (Schwarz 1978; Ljung 1999, sec. 16.4). Akaike's FPE, $\\det\\hat\\Lambda\\,(1 +
+d/N)/(1 - d/N)$ (thesis eq. 3.21 for one channel), is reported beside it but does not
+choose: it charges an extra parameter about $2/N$ of the loss, and the output-error
+residuals of a steering fit are correlated in time (fewer independent samples than $N$),
+so on a linear Nomoto 1 truth it took Norrbin's cubic term on one of three noise draws
+(loss 0.5 % lower, penalty 0.3 %; issue 61). BIC's $\\log N$ per parameter keeps the
+simpler model unless the extra term buys more than that (parsimony; consistent as $N$
+grows). Held-out records (`--validate`) are assessed for every candidate but never enter
+the choice.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+
+CANDIDATES = ("nomoto1", "nomoto1-norrbin")
+AUTO = "auto"  # the `--model` that chooses among `CANDIDATES`
+CRITERION = ("BIC of the fit criterion on the training records: N times the sum of the log "
+             "losses of the fitted channels plus d log N, d estimated parameters, N samples "
+             "per channel (Schwarz 1978; Ljung 1999, sec. 16.4); Akaike's FPE (the product "
+             "of the losses times (1 + d/N) / (1 - d/N)) reported beside it")
+
+
+def is_auto(model) -> bool:
+    """Whether `model` (a `--model` text) asks for the choice."""
+    return isinstance(model, str) and model.strip().lower() == AUTO
+
+
+def criterion(result) -> dict:
+    """The choice's figures of one candidate's `IdentificationResult`, from its
+    `train` assessment only (the fit criterion on the training records): `bic` and `fpe`
+    (module text; inf for a fit that did not converge, or non-positive or non-finite
+    losses), `losses` per channel, `num_params` d, `num_samples` N, `fit_code`."""
+    metrics = result.train.metrics
+    losses = {c: float(m.loss) for c, m in metrics.items()}
+    d = len(result.fit.names)
+    n = min(int(m.num_samples) for m in metrics.values())
+    usable = (bool(result.fit.success) and d < n
+              and all(math.isfinite(v) and v > 0 for v in losses.values()))
+    if not usable:
+        return {"bic": math.inf, "fpe": math.inf, "losses": losses, "num_params": d,
+                "num_samples": n, "fit_code": result.fit.code_name}
+    log_det = sum(math.log(v) for v in losses.values())
+    return {"bic": n * log_det + d * math.log(n),
+            "fpe": math.exp(log_det) * (1 + d / n) / (1 - d / n), "losses": losses,
+            "num_params": d, "num_samples": n, "fit_code": result.fit.code_name}
+
+
+def choose(results: dict, failed: dict) -> tuple[str, dict]:
+    """`(name, selection)`: the candidate of `results` {name: IdentificationResult} with the
+    least BIC (`criterion`; the first listed on a tie: the simpler); `failed` {name: why} are
+    the candidates whose fit diverged. `selection` (JSON-ready): `criterion` (in words),
+    `chosen`, `candidates` {name: `criterion`, or {"failed": why}}."""
+    if not results:
+        raise ValueError("--model auto: no candidate could be fitted ("
+                         + "; ".join(f"{n}: {why}" for n, why in failed.items()) + ").")
+    figures = {name: criterion(r) for name, r in results.items()}
+    name = min(figures, key=lambda n: (figures[n]["bic"], list(figures).index(n)))
+    candidates = {n: figures.get(n) or {"failed": failed[n]} for n in (*results, *failed)}
+    return name, {"criterion": CRITERION, "chosen": name, "candidates": candidates}
+
+
+def selection_text(selection: dict) -> str:
+    """The choice in one paragraph (the printed report and `summary`)."""
+    parts = []
+    for name, c in selection["candidates"].items():
+        if "failed" in c:
+            parts.append(f"{name}: not fitted ({c['failed']})")
+        else:
+            parts.append(f"{name}: BIC {c['bic']:.6g}, FPE {c['fpe']:.6g} (d = "
+                         f"{c['num_params']}, N = {c['num_samples']}, {c['fit_code']})")
+    return (f"model chosen: {selection['chosen']}, the least BIC on the training records "
+            f"({'; '.join(parts)})")
+
+
+def with_selection(result, selection: dict):
+    """`result` (the chosen candidate's) carrying `selection`, with a note saying so."""
+    return dataclasses.replace(result, selection=selection,
+                               notes=result.notes + (selection_text(selection) + ".",))
