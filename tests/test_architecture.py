@@ -579,10 +579,14 @@ def test_every_outcome_carries_a_result_code():
 MAX_LINES, MAX_PARAMETERS = 80, 8
 # functions over the limits, each with the case for it; the rest of the package holds them
 OVER_THE_LIMITS = {
-    # reshaped by issue 60/61 (the discovery and autopilot helpers rewrite them)
-    "jaxship/_analysis/_autopilot.py:design_autopilot": "reshaped by issue 60/61",
-    "jaxship/_analysis/_autopilot.py:tune_autopilot": "reshaped by issue 60/61",
-    "jaxship/cli/autopilot.py:run": "issue 61 rewrites the autopilot command (109 lines)",
+    # the pole placement's keywords (bandwidth or natural_frequency, damping,
+    # subtract_damping, the operating point speed and n, feedforward) and those of the
+    # `HeadingAutopilot` it returns (reference, steps, limits, interval, anti-windup, wave
+    # filter), each with a default: one call, as diffrax.diffeqsolve takes its options
+    "jaxship/_analysis/_autopilot.py:design_autopilot": "keyword options of one call",
+    # the runs tuned on (speeds or rpm, duration, dt, a disturbance), the objective's
+    # rudder weight and the solver's options (max_steps, rtol, atol, simulator, throw)
+    "jaxship/_analysis/_autopilot.py:tune_autopilot": "keyword options of one call",
     # the data record's constructor: one keyword per measured channel (t, delta and the
     # 13 optional channels a trial logs), as the CSV's columns
     "jaxship/_simulation/_data.py:__init__": "one keyword per measured channel",

@@ -66,8 +66,9 @@ def _figure_name(value, by_rpm) -> str:
     return f"heading_{value:g}{'rpm' if by_rpm else 'mps'}.png"
 
 
-def run(args) -> int:
-    # every check before the long work; nothing is written until the runs are done
+def _numbers(args):
+    """`(by_rpm, values, auto, step, damping, omega)` of the options, checked: the run
+    values (rpm or speeds), whether the natural frequency is `auto` (0.5 until chosen)."""
     if (args.rpm is None) == (args.speed is None):
         raise ValueError("give --rpm or --speed (one of them).")
     by_rpm = args.rpm is not None
@@ -80,6 +81,28 @@ def run(args) -> int:
         raise ValueError("--step, --natural-frequency (or auto) and --damping take "
                          "numbers.") from None
     autopilot_study.Design.scaled(omega, step=step, damping=damping).check()
+    return by_rpm, values, auto, step, damping, omega
+
+
+def _stage_bar(args):
+    """`(bar, progress)`: the stages' progress bar (none with --quiet) and the callable
+    that says a stage starts (the one before it is done)."""
+    bar = tqdm(total=3 + 3 * int(args.tune), desc="autopilot", unit="stage", leave=False,
+               file=sys.stderr, disable=args.quiet)
+    started = []
+
+    def progress(message):
+        if started:
+            bar.update()
+        started.append(message)
+        bar.set_postfix_str(message)
+
+    return bar, progress
+
+
+def run(args) -> int:
+    # every check before the long work; nothing is written until the runs are done
+    by_rpm, values, auto, step, damping, omega = _numbers(args)
     vessel = read_vessel_option(args.vessel, vessel_only=True).model
     check_operating_point(vessel, args.vessel, [] if by_rpm else values,
                           values if by_rpm else [])
@@ -97,16 +120,7 @@ def run(args) -> int:
                                                              step=step)
     design = autopilot_study.Design.scaled(omega, step=step, damping=damping, basis=basis)
 
-    bar = tqdm(total=3 + 3 * int(args.tune), desc="autopilot", unit="stage", leave=False,
-               file=sys.stderr, disable=args.quiet)
-    started = []
-
-    def progress(message):  # a stage starts: the one before it is done
-        if started:
-            bar.update()
-        started.append(message)
-        bar.set_postfix_str(message)
-
+    bar, progress = _stage_bar(args)
     kw = {"rpm": values} if by_rpm else {"speeds": values}
     evaluation = autopilot_study.evaluate(model, vessel, design=design, tune=args.tune,
                                           progress=progress, steady_turn=args.steady_turn,
@@ -158,18 +172,24 @@ def run(args) -> int:
                 title, _, rest = page.partition("\n")
                 page = f"{title}\n\n**{sentence}**\n{rest}"
         (stage / "report.md").write_text(page)
-    for text in (gains_table(evaluation.gains()), runs_table(evaluation.rows), inverse,
-                 tuning_text(evaluation.tuning)):
-        if text:
-            print(text)
-    print(f"wrote {args.out}/autopilot.json, {args.out}/report.md, {args.out}/figures/ "
-          f"({len(figures)} figures)")
-    if saturation:
-        print(f"jaxship: warning: {saturation}", file=sys.stderr)
+    _print_summary(evaluation, inverse, f"{args.out}/autopilot.json, {args.out}/report.md, "
+                   f"{args.out}/figures/ ({len(figures)} figures)", saturation)
     for sentence in (failure, unfit):
         if sentence:
             print(f"jaxship: {sentence}", file=sys.stderr)
     return 3 if failure or unfit else 0
+
+
+def _print_summary(evaluation, inverse: str, written: str, saturation: str) -> None:
+    """The gains, the runs, the inverse's sentence and the tuning on stdout, what was
+    `written`, and a rudder that saturated as a warning on stderr."""
+    for text in (gains_table(evaluation.gains()), runs_table(evaluation.rows), inverse,
+                 tuning_text(evaluation.tuning)):
+        if text:
+            print(text)
+    print(f"wrote {written}")
+    if saturation:
+        print(f"jaxship: warning: {saturation}", file=sys.stderr)
 
 
 def _chosen_text(report: dict) -> str:
