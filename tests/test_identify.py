@@ -28,6 +28,7 @@ from jaxship.cli._identification import (
     IdentificationResult,
     Progress,
     identify,
+    linear_candidate,
     model_from_report,
     read_experiments,
 )
@@ -557,10 +558,18 @@ def test_auto_chooses_the_nonlinear_model_only_where_the_steady_turn_is_nonlinea
     # `autopilot --model result.json` inverts the chosen model, as any other result's
     rebuilt = model_from_report(report)
     assert isinstance(rebuilt, NonlinearNomoto) and float(rebuilt.n3) == float(chosen.model.n3)
+    # ... and places the PID's poles on the linear candidate, kept in the selection: the
+    # same fit as `identify --model nomoto1`
+    feedback = model_from_report(linear_candidate(report["selection"]))
+    alone = identify(train, model="nomoto1", validate=held_out).model
+    assert isinstance(feedback, Nomoto1)
+    assert (float(feedback.K), float(feedback.T)) == pytest.approx(
+        (float(alone.K), float(alone.T)), rel=1e-12)
     linear = identify(record(TRUTH, steps, name="b", noise=0.05, seed=1), model="auto")
     assert linear.model_name == "nomoto1" and isinstance(linear.model, Nomoto1)
     figures = linear.selection["candidates"]
     assert figures["nomoto1"]["bic"] < figures["nomoto1-norrbin"]["bic"]
+    assert linear_candidate(linear.selection) is None  # the poles on the chosen model
     with pytest.raises(ValueError, match="--free does not go with --model auto"):
         identify(train, model="auto", free=("K",))
 

@@ -11,7 +11,12 @@ from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without i
 from ..plotting import plot_autopilot
 from ._common import check_operating_point, check_out, numbers
 from ._files import staged_folder
-from ._identification import read_result, unconverged_fit
+from ._identification import (
+    linear_candidate,
+    model_from_report,
+    read_result,
+    unconverged_fit,
+)
 from ._vessel import VESSEL_HELP, read_vessel_option
 from .reproduction import autopilot as autopilot_study
 from .reproduction.autopilot import cell
@@ -107,6 +112,7 @@ def run(args) -> int:
     check_operating_point(vessel, args.vessel, [] if by_rpm else values,
                           values if by_rpm else [])
     model, report = read_result(args.model)
+    linear, design_models = _design_models(model, report, args.model)
     fit = report.get("fit")  # none: parameters written by hand
     code = fit.get("code") if isinstance(fit, dict) else None
     unfit = unconverged_fit(report, args.model)
@@ -116,15 +122,14 @@ def run(args) -> int:
     if auto:  # from the model's yaw time constant at the mean operating point of the runs
         u0, n0 = autopilot_study.operating_point(
             vessel, **{"rpm" if by_rpm else "speed": sum(values) / len(values)})
-        omega, basis = autopilot_study.natural_frequency_for(model, vessel, speed=u0, n=n0,
-                                                             step=step)
+        omega, basis = autopilot_study.natural_frequency_for(design_models.feedback, vessel,
+                                                             speed=u0, n=n0, step=step)
     design = autopilot_study.Design.scaled(omega, step=step, damping=damping, basis=basis)
 
     bar, progress = _stage_bar(args)
     kw = {"rpm": values} if by_rpm else {"speeds": values}
-    evaluation = autopilot_study.evaluate(model, vessel, design=design, tune=args.tune,
-                                          progress=progress, steady_turn=args.steady_turn,
-                                          **kw)
+    evaluation = autopilot_study.evaluate(design_models, vessel, design=design, tune=args.tune,
+                                          progress=progress, steady_turn=args.steady_turn, **kw)
     if evaluation.feedforward_at_step is None:  # --steady-turn model: measured for the report
         progress("the vessel's steady turn at the step's peak rate")
     at_step = _feedforward_at_step(evaluation, by_rpm, values)
@@ -153,6 +158,7 @@ def run(args) -> int:
             "model": {"file": str(args.model), "name": report["model"],
                       "class": type(model).__name__, "fit_code": code,
                       "selection": report.get("selection"),  # identify --model auto
+                      "feedback": report["model"] if linear is None else linear["model"],
                       "parameters": {k: float(e["value"] if isinstance(e, dict) else e)
                                      for k, e in report["parameters"].items()}},
             "vessel": args.vessel,
@@ -180,6 +186,19 @@ def run(args) -> int:
     return 3 if failure or unfit else 0
 
 
+def _design_models(model, report: dict, path) -> tuple:
+    """`(linear, models)`: the linear candidate of the report's `selection` (its
+    report form, or None) and the `DesignModels` pair `evaluate` designs on: the
+    feed-forward inverts `model`, the poles are placed on the candidate (none: `model`)."""
+    linear = linear_candidate(report.get("selection"))
+    if linear is None:
+        return None, autopilot_study.DesignModels(model, model)
+    try:
+        return linear, autopilot_study.DesignModels(model, model_from_report(linear))
+    except ValueError as error:
+        raise ValueError(f"{path}: the linear candidate of its selection: {error}") from None
+
+
 def _print_summary(evaluation, inverse: str, written: str, saturation: str) -> None:
     """The gains, the runs, the inverse's sentence and the tuning on stdout, what was
     `written`, and a rudder that saturated as a warning on stderr."""
@@ -201,8 +220,17 @@ def _chosen_text(report: dict) -> str:
     number = lambda x: f"{x:.6g}" if isinstance(x, (int, float)) else str(x)  # "inf"
     scores = "; ".join(f"{name} {number(c['bic'])}" if "bic" in c else f"{name} not fitted"
                        for name, c in selection["candidates"].items())
-    return (f" `identify --model auto` chose {selection.get('chosen')} by the least BIC on "
+    text = (f" `identify --model auto` chose {selection.get('chosen')} by the least BIC on "
             f"its training records ({scores}).")
+    linear = linear_candidate(selection)
+    if linear is not None:
+        values = ", ".join(f"{k} = {float(e['value']):.4g}"
+                           for k, e in linear["parameters"].items())
+        text += (f" The PID's poles are placed on its linear candidate {linear['model']} "
+                 f"({values}), fitted to the same records: pole placement needs a linear "
+                 "yaw equation, and this one holds over the records' yaw rates, where the "
+                 "chosen model's tangent at r = 0 extrapolates.")
+    return text
 
 
 def _problems(rows) -> tuple[str, str]:

@@ -19,6 +19,7 @@ from .result import (
     read_result as read_result,
     unconverged_fit as unconverged_fit,
 )
+from .selection import linear_candidate as linear_candidate
 from .simulation import (
     simulate_armax_records as simulate_armax_records,
     simulate_records as simulate_records,

@@ -18,6 +18,13 @@ so on a linear Nomoto 1 truth it took Norrbin's cubic term on one of three noise
 simpler model unless the extra term buys more than that (parsimony; consistent as $N$
 grows). Held-out records (`--validate`) are assessed for every candidate but never enter
 the choice.
+
+Every candidate's fitted model is kept in the selection (`fitted`). Where the choice is
+Norrbin's model, `autopilot` inverts it in the feed-forward but places the PID's poles on
+the linear Nomoto 1 fitted to the same records (`linear_candidate`): pole placement needs
+a linear yaw equation, and the least-squares linear model of the records is a better one
+than the cubic's tangent at r = 0, an extrapolation into a spiral loop the 10-20 deg
+zig-zags do not steer in (issue 61).
 """
 
 from __future__ import annotations
@@ -27,6 +34,7 @@ import math
 
 
 CANDIDATES = ("nomoto1", "nomoto1-norrbin")
+LINEAR = "nomoto1"  # the linear candidate: the autopilot's feedback design model
 AUTO = "auto"  # the `--model` that chooses among `CANDIDATES`
 CRITERION = ("BIC of the fit criterion on the training records: N times the sum of the log "
              "losses of the fitted channels plus d log N, d estimated parameters, N samples "
@@ -67,10 +75,29 @@ def choose(results: dict, failed: dict) -> tuple[str, dict]:
     if not results:
         raise ValueError("--model auto: no candidate could be fitted ("
                          + "; ".join(f"{n}: {why}" for n, why in failed.items()) + ").")
-    figures = {name: criterion(r) for name, r in results.items()}
+    figures = {name: criterion(r) | {"fitted": fitted(r)} for name, r in results.items()}
     name = min(figures, key=lambda n: (figures[n]["bic"], list(figures).index(n)))
     candidates = {n: figures.get(n) or {"failed": failed[n]} for n in (*results, *failed)}
     return name, {"criterion": CRITERION, "chosen": name, "candidates": candidates}
+
+
+def fitted(result) -> dict:
+    """The fitted model of a candidate's `IdentificationResult` in the report's own form
+    (`model`, `model_class`, `parameters`, `frozen`, `constants`: what `model_from_report`
+    rebuilds), so that `autopilot` can design its feedback on the linear candidate."""
+    report = result.to_dict()
+    return {k: report[k] for k in ("model", "model_class", "parameters", "frozen", "constants")
+            if k in report}
+
+
+def linear_candidate(selection) -> dict | None:
+    """The fitted linear Nomoto 1 (`fitted`) of a `selection` (a report's, or None) whose
+    chosen model is another candidate: the model `autopilot` designs its feedback on.
+    None where the choice was the linear model, it was not fitted, or there is no choice."""
+    if not isinstance(selection, dict) or selection.get("chosen") == LINEAR:
+        return None
+    entry = (selection.get("candidates") or {}).get(LINEAR)
+    return entry.get("fitted") if isinstance(entry, dict) else None
 
 
 def selection_text(selection: dict) -> str:

@@ -28,6 +28,7 @@ runs, and kept for every run; the feed-forward uses the simulated vessel's $u$, 
 
 import dataclasses
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -136,7 +137,8 @@ class Evaluation:
     ClosedLoop} (axes: 1 autopilot x operating points x samples), the operating points
     `rpm` and `speed` of the runs, the `rows` (one dict per controller and
     operating point, keys `RUN_KEYS` and `success`), the `tuning` summary (or None)
-    and the `design`; `feedforward_at_step` (`steady_turn_trial`, or None).
+    and the `design`; `feedforward_at_step` (`steady_turn_trial`, or None); `feedback`:
+    the model the PID's poles were placed on where it is not `model` (None: `model`).
     """
 
     model: object
@@ -151,17 +153,20 @@ class Evaluation:
     rows: list
     tuning: dict | None = None
     feedforward_at_step: dict | None = None
+    feedback: object = None
 
     def gains(self) -> dict:
         """{controller: {kp, ki, kd, reference_frequency, feedforward[, ff_gain,
         ff_steady_gain]}}: kp [rad/rad], ki [1/s], kd [s], the reference model's bandwidth
-        [rad/s], the class of the inverted model (None: feedback only) and the
+        [rad/s], the class of the model the poles were placed on ("feedback"), of the
+        inverted model ("feedforward"; None: feedback only) and the
         feed-forward's gains; "tuned" also has the tuning summary (`tune_on_vessel`)."""
         out = {}
         for name, a in self.controllers.items():
             ff = a.feedforward
             out[name] = {"kp": float(a.kp), "ki": float(a.ki), "kd": float(a.kd),
                          "reference_frequency": float(a.reference.natural_frequency),
+                         "feedback": type(self.feedback or self.model).__name__,
                          "feedforward": None if ff is None else type(ff.model).__name__}
             if ff is not None:  # its acceleration and steady-turn gains (`Feedforward`)
                 out[name] |= {"ff_gain": float(ff.gain),
@@ -322,9 +327,9 @@ def feedforward_at_step(model, plant, design: Design, *, speed: float, n: float)
             "linear_gain_1_s": 1.0 / float(js.yaw_inertia(model, speed=speed, n=n)[1])}
 
 
-# the least steady-turn gain a trial sets: a point measured inside a spiral loop can be
-# at or below zero rudder; the feed-forward then orders (almost) no steady rudder, and
-# `tune_autopilot` (log-space gains) can still start from it
+# the least magnitude of the steady-turn gain a trial sets (its sign kept): a vessel
+# that turns steadily at zero rudder there gives 0, from which `tune_autopilot` (the
+# gains' magnitudes in log space) could not start
 LEAST_STEADY_GAIN = 0.01
 
 
@@ -332,11 +337,14 @@ def steady_turn_trial(model, plant, design: Design, pid, *, rpm=None, speed=None
     """`feedforward_at_step` at the operating point `rpm` or `speed` with the rudder
     the vessel `plant` needs there ("vessel_rudder_deg", `vessel_steady_rudder` flown by
     `pid`) and the feed-forward's steady-turn gain from them, "steady_gain"
-    $g_s = \\delta_{vessel}(r_p)/\\delta_s(r_p)$ (at least `LEAST_STEADY_GAIN`): the
-    model's steady-turn characteristic corrected at the one yaw rate where the step
-    steers. Zig-zags at 10-20 deg do not reach the small yaw rates of a heading step,
-    where a course-unstable ship is inside its spiral loop (Bech 1966; MSC/Circ.1053
-    app. 4); the reverse spiral is the trial that measures the steady turn there. The
+    $g_s = \\delta_{vessel}(r_p)/\\delta_s(r_p)$ (in magnitude at least
+    `LEAST_STEADY_GAIN`): the model's steady-turn characteristic corrected at the one yaw
+    rate where the step steers. Zig-zags at 10-20 deg do not reach the small yaw rates of a
+    heading step, where a course-unstable ship is inside its spiral loop (Bech 1966;
+    MSC/Circ.1053 app. 4); the reverse spiral is the trial that measures the steady turn
+    there. $g_s$ is negative where the model and the vessel turn steadily there with
+    rudders of opposite signs (the Norrbin model of the KVLCC2's zig-zags orders -0.73 deg
+    at 0.33 deg/s, inside its loop, where the `kvlcc2` preset needs +0.03 deg). The
     acceleration part ($T\\dot r_d/K$, the yaw inertia per rudder angle) stays the
     model's. Where the vessel does not settle on the trial's yaw rates (a step faster than
     it can turn steadily) "vessel_rudder_deg" is None, "steady_gain" 1 and
@@ -351,7 +359,7 @@ def steady_turn_trial(model, plant, design: Design, pid, *, rpm=None, speed=None
                           "trial_failed": str(error)}
     ratio = vessel / at_step["model_rudder_deg"] if at_step["model_rudder_deg"] else 1.0
     return at_step | {"vessel_rudder_deg": vessel,
-                      "steady_gain": max(ratio, LEAST_STEADY_GAIN)}
+                      "steady_gain": math.copysign(max(abs(ratio), LEAST_STEADY_GAIN), ratio)}
 
 
 def feedforward_gain_text(at_step: dict) -> str:
@@ -374,17 +382,31 @@ def feedforward_gain_text(at_step: dict) -> str:
                  "feed-forward's steady-turn part stays the model's.")
     elif "steady_gain" in at_step:
         text += (f" The feed-forward's steady-turn part is scaled by g_s = "
-                 f"{at_step['steady_gain']:.3g} to the vessel's (--steady-turn trial).")
+                 f"{at_step['steady_gain']:.3g} to the vessel's (--steady-turn trial"
+                 + ("; negative: the model turns steadily there with a rudder of the other "
+                    "sign" if at_step["steady_gain"] < 0 else "") + ").")
     return text
 
 
+class DesignModels(NamedTuple):
+    """`evaluate`'s two models where they differ: the one the feed-forward inverts and the
+    one the PID's poles are placed on (a chosen Norrbin model and the linear candidate of
+    `identify --model auto`, `selection.linear_candidate`)."""
+
+    feedforward: object
+    feedback: object
+
+
 def design_controllers(model, plant, design: Design = Design(), *, speed: float,
-                       n: float, steady_gain: float = 1.0) -> dict:
+                       n: float, steady_gain: float = 1.0, feedback=None) -> dict:
     """{"pid+ff": ..., "pid": ...}: `HeadingAutopilot`s for `model` (a steering model
     or vessel) by pole placement about the straight run at `speed` [m/s] and `n`
     [rev/s], with the reference model and step of `design` and the rudder limits of
     the vessel `plant`; "pid+ff" inverts `model` for the reference feed-forward, its
-    steady-turn part weighted by `steady_gain` (`Feedforward`; 1: the model's own)."""
+    steady-turn part weighted by `steady_gain` (`Feedforward`; 1: the model's own).
+    `feedback`: the model the poles are placed on, when not `model` (the linear Nomoto 1
+    beside a chosen Norrbin model, `selection.linear_candidate`)."""
+    feedback = model if feedback is None else feedback
     steps = js.HeadingSteps(times=(design.step_time,), headings=(design.step * DEG,))
     reference = js.ReferenceModel(natural_frequency=design.reference_frequency,
                                   damping=design.reference_damping)
@@ -392,13 +414,15 @@ def design_controllers(model, plant, design: Design = Design(), *, speed: float,
               reference=reference, steps=steps, max_angle=float(plant.rudder.max_angle),
               max_rate=float(plant.rudder.max_rate), interval=design.interval, speed=speed,
               n=n, subtract_damping=design.subtract_damping)
-    m = float(js.yaw_inertia(model, speed=speed, n=n)[0])
-    if not m > 0:
-        raise ValueError(f"the {type(model).__name__} model turns the ship against its rudder "
-                         f"at {speed:.3g} m/s (yaw inertia m = {m:.3g}): no autopilot design.")
+    for each in {id(model): model, id(feedback): feedback}.values():
+        m = float(js.yaw_inertia(each, speed=speed, n=n)[0])
+        if not m > 0:
+            raise ValueError(f"the {type(each).__name__} model turns the ship against its "
+                             f"rudder at {speed:.3g} m/s (yaw inertia m = {m:.3g}): no "
+                             "autopilot design.")
     inverse = js.Feedforward(model, steady_gain=steady_gain)
-    return {"pid+ff": js.design_autopilot(model, feedforward=inverse, **kw),
-            "pid": js.design_autopilot(model, feedforward=False, **kw)}
+    return {"pid+ff": js.design_autopilot(feedback, feedforward=inverse, **kw),
+            "pid": js.design_autopilot(feedback, feedforward=False, **kw)}
 
 
 def cell(x, digits=2) -> str:  # a table cell: "-" for None
@@ -456,12 +480,13 @@ def tune_on_vessel(model, plant, design: Design, controllers: dict, *, speed: fl
     model's bandwidth with those PID gains (`tune_reference`), against the ordered heading,
     the tuned feed-forward of the step within `RUDDER_SHARE` of the rudder's limits at the
     straight run at `speed` (`RudderDemand`). `say`: the
-    progress callable."""
+    progress callable. `model`: the one the poles are placed on (`design_controllers`'
+    `feedback`); the feed-forward keeps its own."""
     start = controllers["pid+ff"]
     if not float(start.kd) > 0:
-        start = design_controllers(model, plant, dataclasses.replace(
+        start = design_controllers(start.feedforward.model, plant, dataclasses.replace(
             design, subtract_damping=False), speed=speed, n=n,
-            steady_gain=start.feedforward.steady_gain)["pid+ff"]
+            steady_gain=start.feedforward.steady_gain, feedback=model)["pid+ff"]
     say("tuning the gains on the vessel")
     tuned = js.tune_autopilot(plant, start, duration=design.duration, dt=design.tune_dt,
                               rudder_weight=design.rudder_weight,
@@ -488,7 +513,9 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
     operating points (`tune_on_vessel`). `progress`: a callable taking a message, or None.
     `steady_turn`: "model" (the feed-forward inverts the model as it is; the thesis'
     eq. 5.2/5.6) or "trial" (its steady-turn part scaled to the vessel's own rudder at
-    the step's peak rate, `steady_turn_trial`)."""
+    the step's peak rate, `steady_turn_trial`). `model` may be a `DesignModels` pair: the
+    feed-forward inverts one, the PID's poles are placed on the other."""
+    model, feedback = model if isinstance(model, DesignModels) else (model, None)
     if (rpm is None) == (speeds is None):
         raise ValueError("give exactly one of rpm and speeds.")
     design.check()
@@ -507,21 +534,23 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
     if key == "rpm" and operating_point(plant, rpm=1.25 * mean)[0] == u0:
         raise ValueError(f"the {type(plant).__name__} has no propeller model (its speed does "
                          "not depend on the rpm): give speeds (--speed) instead.")
-    controllers = design_controllers(model, plant, design, speed=u0, n=n0)
+    controllers = design_controllers(model, plant, design, speed=u0, n=n0, feedback=feedback)
     at_step = None
     if steady_turn == "trial":
         say("the vessel's steady turn at the step's peak rate")
         at_step = steady_turn_trial(model, plant, design, controllers["pid"],
                                     **{key: mean})
         controllers = design_controllers(model, plant, design, speed=u0, n=n0,
-                                         steady_gain=at_step["steady_gain"])
+                                         steady_gain=at_step["steady_gain"], feedback=feedback)
     elif steady_turn != "model":
         raise ValueError(f"steady_turn is 'trial' or 'model', got {steady_turn!r}.")
     run_kw = {"rpm": values} if key == "rpm" else {"speeds": values}
     tuning = None
     if tune:
-        controllers["tuned"], tuning = tune_on_vessel(model, plant, design, controllers,
-                                                      speed=u0, n=n0, run_kw=run_kw, say=say)
+        controllers["tuned"], tuning = tune_on_vessel(model if feedback is None else feedback,
+                                                      plant, design,
+                                                      controllers, speed=u0, n=n0,
+                                                      run_kw=run_kw, say=say)
     runs, rows = {}, []
     rpms = values if key == "rpm" else [60.0 * n for _, n in points]
     speeds_ = values if key == "speed" else [u for u, _ in points]
@@ -533,4 +562,5 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
                          float(plant.rudder.max_angle))
     return Evaluation(model=model, plant=plant, design=design, design_speed=u0,
                       design_rpm=60.0 * n0, controllers=controllers, runs=runs, rpm=rpms,
-                      speed=speeds_, rows=rows, tuning=tuning, feedforward_at_step=at_step)
+                      speed=speeds_, rows=rows, tuning=tuning, feedforward_at_step=at_step,
+                      feedback=feedback)
