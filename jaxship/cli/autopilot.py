@@ -228,8 +228,8 @@ def _chosen_text(report: dict) -> str:
                            for k, e in linear["parameters"].items())
         text += (f" The PID's poles are placed on its linear candidate {linear['model']} "
                  f"({values}), fitted to the same records: pole placement needs a linear "
-                 "yaw equation, and this one holds over the records' yaw rates, where the "
-                 "chosen model's tangent at r = 0 extrapolates.")
+                 "yaw equation; this one is fitted over the records' yaw rates, while the "
+                 "chosen model's tangent at r = 0 is an extrapolation.")
     return text
 
 

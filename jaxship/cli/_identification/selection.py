@@ -23,8 +23,8 @@ Every candidate's fitted model is kept in the selection (`fitted`). Where the ch
 Norrbin's model, `autopilot` inverts it in the feed-forward but places the PID's poles on
 the linear Nomoto 1 fitted to the same records (`linear_candidate`): pole placement needs
 a linear yaw equation, and the least-squares linear model of the records is a better one
-than the cubic's tangent at r = 0, an extrapolation into a spiral loop the 10-20 deg
-zig-zags do not steer in (issue 61).
+than the cubic's tangent at r = 0, an extrapolation into a spiral loop where the 10-20 deg
+zig-zags never turn steadily (issue 61).
 """
 
 from __future__ import annotations
