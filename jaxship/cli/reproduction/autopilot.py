@@ -138,7 +138,7 @@ class Evaluation:
     `rpm` and `speed` of the runs, the `rows` (one dict per controller and
     operating point, keys `RUN_KEYS` and `success`), the `tuning` summary (or None)
     and the `design`; `feedforward_at_step` (`steady_turn_trial`, or None); `feedback`:
-    the model the PID's poles were placed on where it is not `model` (None: `model`).
+    the model the PID's poles were placed on (None: `model`).
     """
 
     model: object
@@ -166,7 +166,8 @@ class Evaluation:
             ff = a.feedforward
             out[name] = {"kp": float(a.kp), "ki": float(a.ki), "kd": float(a.kd),
                          "reference_frequency": float(a.reference.natural_frequency),
-                         "feedback": type(self.feedback or self.model).__name__,
+                         "feedback": type(self.model if self.feedback is None
+                                          else self.feedback).__name__,
                          "feedforward": None if ff is None else type(ff.model).__name__}
             if ff is not None:  # its acceleration and steady-turn gains (`Feedforward`)
                 out[name] |= {"ff_gain": float(ff.gain),
@@ -414,7 +415,7 @@ def design_controllers(model, plant, design: Design = Design(), *, speed: float,
               reference=reference, steps=steps, max_angle=float(plant.rudder.max_angle),
               max_rate=float(plant.rudder.max_rate), interval=design.interval, speed=speed,
               n=n, subtract_damping=design.subtract_damping)
-    for each in {id(model): model, id(feedback): feedback}.values():
+    for each in (model, feedback):
         m = float(js.yaw_inertia(each, speed=speed, n=n)[0])
         if not m > 0:
             raise ValueError(f"the {type(each).__name__} model turns the ship against its "
@@ -515,7 +516,7 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
     eq. 5.2/5.6) or "trial" (its steady-turn part scaled to the vessel's own rudder at
     the step's peak rate, `steady_turn_trial`). `model` may be a `DesignModels` pair: the
     feed-forward inverts one, the PID's poles are placed on the other."""
-    model, feedback = model if isinstance(model, DesignModels) else (model, None)
+    model, feedback = model if isinstance(model, DesignModels) else (model, model)
     if (rpm is None) == (speeds is None):
         raise ValueError("give exactly one of rpm and speeds.")
     design.check()
@@ -547,10 +548,8 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
     run_kw = {"rpm": values} if key == "rpm" else {"speeds": values}
     tuning = None
     if tune:
-        controllers["tuned"], tuning = tune_on_vessel(model if feedback is None else feedback,
-                                                      plant, design,
-                                                      controllers, speed=u0, n=n0,
-                                                      run_kw=run_kw, say=say)
+        controllers["tuned"], tuning = tune_on_vessel(feedback, plant, design, controllers,
+                                                      speed=u0, n=n0, run_kw=run_kw, say=say)
     runs, rows = {}, []
     rpms = values if key == "rpm" else [60.0 * n for _, n in points]
     speeds_ = values if key == "speed" else [u for u, _ in points]
