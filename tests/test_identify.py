@@ -565,6 +565,10 @@ def test_auto_chooses_the_nonlinear_model_only_where_the_steady_turn_is_nonlinea
     assert isinstance(feedback, Nomoto1)
     assert (float(feedback.K), float(feedback.T)) == pytest.approx(
         (float(alone.K), float(alone.T)), rel=1e-12)
+    for code in ("poorly_determined", "nonlinear_max_steps_reached"):  # T, K may be anything
+        unusable = json.loads(json.dumps(report["selection"]))
+        unusable["candidates"]["nomoto1"]["fit_code"] = code
+        assert linear_candidate(unusable) is None
     linear = identify(record(TRUTH, steps, name="b", noise=0.05, seed=1), model="auto")
     assert linear.model_name == "nomoto1" and isinstance(linear.model, Nomoto1)
     figures = linear.selection["candidates"]

@@ -138,8 +138,8 @@ def _tuned_values(autopilot):
     return lambda a: (a.kp, a.ki, a.kd, a.feedforward.gain, a.feedforward.steady_gain)
 
 
-def _with_gains(autopilot, log_gains, signs):
-    gains = tuple(signs * jnp.exp(log_gains))
+def _with_gains(autopilot, log_gains):
+    gains = tuple(jnp.exp(log_gains))
     return eqx.tree_at(_tuned_values(autopilot), autopilot, gains)
 
 
@@ -157,9 +157,7 @@ def tune_autopilot(plant, autopilot: HeadingAutopilot, *, speeds=None, rpm=None,
 
     Levenberg-Marquardt (optimistix) on the residuals $\\tilde\\psi_k/\\sqrt N$,
     $\\sqrt w\\,\\delta_{c,k}/\\sqrt N$, whose sum of squares is the objective, with the
-    gains' magnitudes in log space (each keeps the sign it starts with; the PID's gains
-    must start positive, the feed-forward's non-zero: a steady-turn gain measured inside a
-    spiral loop can be negative, `Feedforward`) and the
+    gains in log space (they stay positive; the start must be positive) and the
     Jacobian by forward mode through the simulation. One gain set for all speeds (no
     gain schedule). The reference model, the feed-forward's model and the limits stay
     as they are.
@@ -168,16 +166,14 @@ def tune_autopilot(plant, autopilot: HeadingAutopilot, *, speeds=None, rpm=None,
     """
     gains = np.array([np.asarray(g) for g in _tuned_values(autopilot)(autopilot)],
                      dtype=float)
-    if gains.ndim != 1 or not (np.all(gains[:3] > 0) and np.all(gains != 0)):
-        raise ValueError(f"tune one autopilot with positive PID gains and non-zero "
-                         f"feed-forward gains, got {gains}.")
-    signs = jnp.asarray(np.sign(gains))
+    if gains.ndim != 1 or not np.all(gains > 0):
+        raise ValueError(f"tune one autopilot with positive gains, got {gains}.")
     plant, x0, dt_, num, simulator, steps = _setup(plant, speeds, rpm, duration, dt,
                                                    disturbance, simulator)
     autopilot = _as_arrays(autopilot)
 
     def run(log_gains):
-        batch = stack([_with_gains(autopilot, log_gains, signs)])
+        batch = stack([_with_gains(autopilot, log_gains)])
         return _closed_loop(plant, batch, x0, dt_, num, simulator, steps)
 
     def residuals(log_gains, args):
@@ -188,11 +184,11 @@ def tune_autopilot(plant, autopilot: HeadingAutopilot, *, speeds=None, rpm=None,
         return jnp.concatenate([error, effort])
 
     objective = lambda y: tracking_objective(run(y), rudder_weight)
-    start = jnp.log(jnp.abs(jnp.asarray(gains)))
+    start = jnp.log(jnp.asarray(gains))
     solution = optx.least_squares(residuals, optx.LevenbergMarquardt(rtol=rtol, atol=atol),
                                   start, max_steps=max_steps, throw=throw)
     return TunedAutopilot(
-        autopilot=_with_gains(autopilot, solution.value, signs),
+        autopilot=_with_gains(autopilot, solution.value),
         objective_before=objective(start),
         objective_after=objective(solution.value),
         num_steps=solution.stats["num_steps"],

@@ -188,8 +188,8 @@ def run(args) -> int:
 
 def _design_models(model, report: dict, path) -> tuple:
     """`(linear, models)`: the linear candidate of the report's `selection` (its
-    report form, or None) and the `DesignModels` pair `evaluate` designs on: the
-    feed-forward inverts `model`, the poles are placed on the candidate (none: `model`)."""
+    report form, or None) and the `DesignModels` pair `evaluate` designs on: `model`
+    and the candidate, the poles placed on the candidate (none: `model` twice)."""
     linear = linear_candidate(report.get("selection"))
     if linear is None:
         return None, autopilot_study.DesignModels(model, model)

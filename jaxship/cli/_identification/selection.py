@@ -20,11 +20,12 @@ grows). Held-out records (`--validate`) are assessed for every candidate but nev
 the choice.
 
 Every candidate's fitted model is kept in the selection (`fitted`). Where the choice is
-Norrbin's model, `autopilot` inverts it in the feed-forward but places the PID's poles on
-the linear Nomoto 1 fitted to the same records (`linear_candidate`): pole placement needs
-a linear yaw equation, and the least-squares linear model of the records is a better one
-than the cubic's tangent at r = 0, an extrapolation into a spiral loop where the 10-20 deg
-zig-zags never turn steadily (issue 61).
+Norrbin's model, `autopilot` places the PID's poles on the linear Nomoto 1 fitted to the
+same records (`linear_candidate`): pole placement needs a linear yaw equation, and the
+least-squares linear model of the records is a better one than the cubic's tangent at
+r = 0, an extrapolation into a spiral loop where the 10-20 deg zig-zags never turn
+steadily. Its feed-forward inverts whichever of the two turns steadily nearer the vessel
+at the step's yaw rate (issue 61).
 """
 
 from __future__ import annotations
@@ -93,11 +94,15 @@ def fitted(result) -> dict:
 def linear_candidate(selection) -> dict | None:
     """The fitted linear Nomoto 1 (`fitted`) of a `selection` (a report's, or None) whose
     chosen model is another candidate: the model `autopilot` designs its feedback on.
-    None where the choice was the linear model, it was not fitted, or there is no choice."""
+    None where the choice was the linear model, there is no choice, or the linear fit
+    did not succeed (not fitted, or a code other than successful: its T and K may be
+    anything)."""
     if not isinstance(selection, dict) or selection.get("chosen") == LINEAR:
         return None
     entry = (selection.get("candidates") or {}).get(LINEAR)
-    return entry.get("fitted") if isinstance(entry, dict) else None
+    if not isinstance(entry, dict) or entry.get("fit_code") != "successful":
+        return None
+    return entry.get("fitted")
 
 
 def selection_text(selection: dict) -> str:

@@ -54,6 +54,12 @@ RUN_KEYS = ("controller", "rpm", "speed", "sum_abs_error_deg", "rms_error_deg",
             "rudder_travel_deg", "time_rate_limited_s")
 
 
+# the most output samples of one closed-loop run (`Design.check`): 10^6 at 0.1 s is 28 h;
+# a model with a yaw time constant of years (a fit the data did not determine) would
+# otherwise ask for petabytes
+MAX_SAMPLES = 1e6
+
+
 @dataclasses.dataclass(frozen=True)
 class Design:
     """Numbers of the autopilot design and of the closed-loop runs.
@@ -123,6 +129,12 @@ class Design:
         if not 0 <= self.step_time < self.duration:
             raise ValueError(f"the step time ({self.step_time} s) must lie within the run "
                              f"(0 to {self.duration} s).")
+        if self.duration / self.dt > MAX_SAMPLES:
+            raise ValueError(f"the run would be {self.duration:.3g} s long, "
+                             f"{self.duration / self.dt:.3g} samples of {self.dt:g} s (at "
+                             f"most {MAX_SAMPLES:.0e}): omega_n = {self.natural_frequency:.3g} "
+                             "rad/s is too slow; a model with so long a yaw time constant "
+                             "barely steers (give --natural-frequency).")
         every = self.sample_interval / self.dt
         if abs(every - round(every)) > 1e-9 * every:
             raise ValueError(f"the sample interval ({self.sample_interval} s) must be a "
@@ -328,9 +340,9 @@ def feedforward_at_step(model, plant, design: Design, *, speed: float, n: float)
             "linear_gain_1_s": 1.0 / float(js.yaw_inertia(model, speed=speed, n=n)[1])}
 
 
-# the least magnitude of the steady-turn gain a trial sets (its sign kept): a vessel
-# that turns steadily at zero rudder there gives 0, from which `tune_autopilot` (the
-# gains' magnitudes in log space) could not start
+# the least steady-turn gain a trial sets: a point measured inside a spiral loop can be
+# at or below zero rudder; the feed-forward then orders (almost) no steady rudder, and
+# `tune_autopilot` (log-space gains) can still start from it
 LEAST_STEADY_GAIN = 0.01
 
 
@@ -338,14 +350,11 @@ def steady_turn_trial(model, plant, design: Design, pid, *, rpm=None, speed=None
     """`feedforward_at_step` at the operating point `rpm` or `speed` with the rudder
     the vessel `plant` needs there ("vessel_rudder_deg", `vessel_steady_rudder` flown by
     `pid`) and the feed-forward's steady-turn gain from them, "steady_gain"
-    $g_s = \\delta_{vessel}(r_p)/\\delta_s(r_p)$ (in magnitude at least
-    `LEAST_STEADY_GAIN`): the model's steady-turn characteristic corrected at the one yaw
-    rate where the step steers. Zig-zags at 10-20 deg do not reach the small yaw rates of a
-    heading step, where a course-unstable ship is inside its spiral loop (Bech 1966;
-    MSC/Circ.1053 app. 4); the reverse spiral is the trial that measures the steady turn
-    there. $g_s$ is negative where the model and the vessel turn steadily there with
-    rudders of opposite signs (the Norrbin model of the KVLCC2's zig-zags orders -0.73 deg
-    at 0.33 deg/s, inside its loop, where the `kvlcc2` preset needs +0.03 deg). The
+    $g_s = \\delta_{vessel}(r_p)/\\delta_s(r_p)$ (at least `LEAST_STEADY_GAIN`): the
+    model's steady-turn characteristic corrected at the one yaw rate where the step
+    steers. Zig-zags at 10-20 deg do not reach the small yaw rates of a heading step,
+    where a course-unstable ship is inside its spiral loop (Bech 1966; MSC/Circ.1053
+    app. 4); the reverse spiral is the trial that measures the steady turn there. The
     acceleration part ($T\\dot r_d/K$, the yaw inertia per rudder angle) stays the
     model's. Where the vessel does not settle on the trial's yaw rates (a step faster than
     it can turn steadily) "vessel_rudder_deg" is None, "steady_gain" 1 and
@@ -358,9 +367,43 @@ def steady_turn_trial(model, plant, design: Design, pid, *, rpm=None, speed=None
     except ValueError as error:  # not measured: the model's own steady turn, said so
         return at_step | {"vessel_rudder_deg": None, "steady_gain": 1.0,
                           "trial_failed": str(error)}
+    return _scaled(at_step, vessel)
+
+
+def _scaled(at_step: dict, vessel: float) -> dict:
+    """`at_step` (`feedforward_at_step`) with the vessel's rudder [deg] there and the
+    steady-turn gain to it (`steady_turn_trial`)."""
     ratio = vessel / at_step["model_rudder_deg"] if at_step["model_rudder_deg"] else 1.0
     return at_step | {"vessel_rudder_deg": vessel,
-                      "steady_gain": math.copysign(max(abs(ratio), LEAST_STEADY_GAIN), ratio)}
+                      "steady_gain": max(ratio, LEAST_STEADY_GAIN)}
+
+
+def nearest_steady_turn(models, plant, design: Design, pid, *, rpm=None,
+                        speed=None) -> tuple:
+    """`(model, trial)`: of `models` (a `DesignModels` pair), the one whose steady-turn
+    rudder at the step's peak desired yaw rate is nearest the one the vessel `plant` needs
+    there, and its `steady_turn_trial`: the least $|\\log(\\delta_s/\\delta_{vessel})|$,
+    a rudder of the other sign (or zero) never nearer, the first model on a tie or where
+    none is near (or the trial failed). The trial then also has "candidates" {class:
+    steady-turn rudder [deg]}. The model that fits the step it steers (issue 61): the
+    Norrbin model of the KVLCC2's zig-zags turns steadily there, inside its spiral loop,
+    with -0.73 deg where the `kvlcc2` preset needs +0.03 deg; the linear Nomoto 1 of the
+    same records, +1.31 deg."""
+    first = steady_turn_trial(models[0], plant, design, pid, rpm=rpm, speed=speed)
+    vessel = first["vessel_rudder_deg"]
+    if not vessel or models[1] is models[0]:
+        return models[0], first
+    u, n = operating_point(plant, **({"rpm": rpm} if rpm is not None else {"speed": speed}))
+    trials = [first, _scaled(feedforward_at_step(models[1], plant, design, speed=u, n=n),
+                             vessel)]
+
+    def distance(trial):
+        steady = trial["model_rudder_deg"]
+        return abs(math.log(steady / vessel)) if steady * vessel > 0 else math.inf
+
+    k = min((0, 1), key=lambda i: distance(trials[i]))
+    return models[k], trials[k] | {"candidates": {type(m).__name__: t["model_rudder_deg"]
+                                                  for m, t in zip(models, trials)}}
 
 
 def feedforward_gain_text(at_step: dict) -> str:
@@ -378,21 +421,26 @@ def feedforward_gain_text(at_step: dict) -> str:
         text += (f" The vessel steered needs {vessel:.3g} deg there (a reverse-spiral point "
                  f"flown in closed loop): the model's steady-turn rudder is "
                  f"{at_step['model_rudder_deg'] / vessel:.3g} times the vessel's.")
+    if "candidates" in at_step:  # `nearest_steady_turn`
+        rudders = ", ".join(f"{name} {x:.3g} deg" for name, x in at_step["candidates"].items())
+        text += (f" Of the candidates' steady-turn rudders there ({rudders}) the "
+                 f"{at_step['model']}'s is the nearest to the vessel's (a rudder of the other "
+                 "sign is never near), so the feed-forward inverts it.")
     if at_step.get("trial_failed"):
         text += (f" The reverse-spiral trial failed ({at_step['trial_failed']}): the "
                  "feed-forward's steady-turn part stays the model's.")
     elif "steady_gain" in at_step:
         text += (f" The feed-forward's steady-turn part is scaled by g_s = "
-                 f"{at_step['steady_gain']:.3g} to the vessel's (--steady-turn trial"
-                 + ("; negative: the model turns steadily there with a rudder of the other "
-                    "sign" if at_step["steady_gain"] < 0 else "") + ").")
+                 f"{at_step['steady_gain']:.3g} to the vessel's (--steady-turn trial).")
     return text
 
 
 class DesignModels(NamedTuple):
-    """`evaluate`'s two models where they differ: the one the feed-forward inverts and the
-    one the PID's poles are placed on (a chosen Norrbin model and the linear candidate of
-    `identify --model auto`, `selection.linear_candidate`)."""
+    """`evaluate`'s two models where they differ (a chosen Norrbin model and the linear
+    candidate of `identify --model auto`, `selection.linear_candidate`): the one the
+    feed-forward inverts and the one the PID's poles are placed on. With the steady-turn
+    trial the feed-forward inverts whichever turns steadily nearer the vessel at the
+    step's peak rate (`nearest_steady_turn`)."""
 
     feedforward: object
     feedback: object
@@ -515,7 +563,8 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
     `steady_turn`: "model" (the feed-forward inverts the model as it is; the thesis'
     eq. 5.2/5.6) or "trial" (its steady-turn part scaled to the vessel's own rudder at
     the step's peak rate, `steady_turn_trial`). `model` may be a `DesignModels` pair: the
-    feed-forward inverts one, the PID's poles are placed on the other."""
+    PID's poles are placed on its `feedback`, the feed-forward inverts its `feedforward`
+    (with the trial: the nearer of the two, `nearest_steady_turn`)."""
     model, feedback = model if isinstance(model, DesignModels) else (model, model)
     if (rpm is None) == (speeds is None):
         raise ValueError("give exactly one of rpm and speeds.")
@@ -539,8 +588,8 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
     at_step = None
     if steady_turn == "trial":
         say("the vessel's steady turn at the step's peak rate")
-        at_step = steady_turn_trial(model, plant, design, controllers["pid"],
-                                    **{key: mean})
+        model, at_step = nearest_steady_turn((model, feedback), plant, design,
+                                             controllers["pid"], **{key: mean})
         controllers = design_controllers(model, plant, design, speed=u0, n=n0,
                                          steady_gain=at_step["steady_gain"], feedback=feedback)
     elif steady_turn != "model":
