@@ -25,8 +25,15 @@ each against its own reference, and the bandwidth before and after with its boun
 `--models auto` fits with `identify --model auto` (issue 61 point 1: the model chosen by
 its BIC on the training records); the fit column says which.
 
+`--vessels` chooses the cases: by default the issue's three vessels above; `more` are
+checks on vessels the issue's design never looked at: the Esso Osaka 3 m model (its four
+zig-zags at 12 rps, measured, /work/shared/data; the plant the `esso_osaka` preset at 600
+and 720 rpm) and the presets `sea_stratus_nonlinear`, `compass_island_nonlinear`,
+`sea_swift` and `sea_scout` (zig-zags 10/10 and 20/20 of each at its nominal speed, the
+plant the preset itself).
+
     python benchmarks/autopilot_feedforward.py [--models nomoto1 nomoto1-norrbin auto]
-        [--tune]
+        [--tune] [--vessels issue more]
 """
 
 import argparse
@@ -41,6 +48,9 @@ import jaxship as js
 
 HSVA = ("HSVA_CPMC_KVLCC2_Z_10_05", "HSVA_CPMC_KVLCC2_Z_20_05",
         "HSVA_CPMC_KVLCC2_Z_10_10_P", "HSVA_CPMC_KVLCC2_Z_20_10_P")
+ESSO = ("zigzag_31-Jul-2020_13_29_19", "zigzag_31-Jul-2020_13_50_28",
+        "zigzag_31-Jul-2020_14_03_39", "zigzag_31-Jul-2020_14_10_05")  # the 12 rps runs
+PRESETS = ("sea_stratus_nonlinear", "compass_island_nonlinear", "sea_swift", "sea_scout")
 
 
 def jaxship(*args) -> subprocess.CompletedProcess:
@@ -66,17 +76,33 @@ def zigzags(vessel: str, folder: pathlib.Path, **point) -> list:
     return paths
 
 
-def cases(folder: pathlib.Path) -> list:
-    """(name, training records, plant preset, run option, values) of the five runs."""
+def measured(folder: str, names, suffix: str) -> list:
+    """The paths of measured records in ../shared/data (empty where absent, said)."""
     data = js.shared_data_dir()
-    hsva = [] if data is None else [data / "kvlcc2_simman2008_hsva" / f"{n}.dat" for n in HSVA]
-    out = [("Mariner", zigzags("mariner", folder, speed=[7.7]), "mariner", "--speed", [7.7])]
-    if hsva and all(p.is_file() for p in hsva):
-        out.append(("KVLCC2 (HSVA)", hsva, "kvlcc2", "--rpm", [600, 711]))
-    else:
-        print("KVLCC2: HSVA data not found (set $JAXSHIP_DATA); skipped", file=sys.stderr)
-    out.append(("thesis", zigzags("thesis", folder, rpm=[300, 400]), "thesis", "--rpm",
-                [300, 400]))
+    paths = [] if data is None else [data / folder / f"{n}{suffix}" for n in names]
+    if not paths or not all(p.is_file() for p in paths):
+        print(f"{folder}: data not found (set $JAXSHIP_DATA); skipped", file=sys.stderr)
+        return []
+    return paths
+
+
+def cases(folder: pathlib.Path, which=("issue",)) -> list:
+    """(name, training records, plant preset, run option, values) of the issue's five runs
+    and (`more`) the checks on other vessels (module text)."""
+    out = []
+    if "issue" in which:
+        out.append(("Mariner", zigzags("mariner", folder, speed=[7.7]), "mariner", "--speed",
+                    [7.7]))
+        if hsva := measured("kvlcc2_simman2008_hsva", HSVA, ".dat"):
+            out.append(("KVLCC2 (HSVA)", hsva, "kvlcc2", "--rpm", [600, 711]))
+        out.append(("thesis", zigzags("thesis", folder, rpm=[300, 400]), "thesis", "--rpm",
+                    [300, 400]))
+    if "more" in which:
+        if esso := measured("esso_osaka_frt/zigzag", ESSO, ".csv"):
+            out.append(("Esso Osaka (12 rps)", esso, "esso_osaka", "--rpm", [600, 720]))
+        for name in PRESETS:
+            speed = float(js.get_vessel(name).nominal_speed)
+            out.append((name, zigzags(name, folder, speed=[speed]), name, "--speed", [speed]))
     return out
 
 
@@ -87,6 +113,8 @@ def main(argv=None) -> int:
                         help="extra options passed to `jaxship autopilot`")
     parser.add_argument("--tune", action="store_true",
                         help="run `jaxship autopilot --tune` (the second table)")
+    parser.add_argument("--vessels", nargs="+", choices=("issue", "more"), default=["issue"],
+                        help="the issue's vessels, and/or more (module text)")
     args = parser.parse_args(argv)
     print("| vessel | model | run | pid+ff sum [deg] | pid sum [deg] | ratio | "
           "pid+ff overshoot [deg] | pid overshoot [deg] | peak r_d [deg/s] | "
@@ -95,7 +123,7 @@ def main(argv=None) -> int:
     tuned_rows = []
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
-        for name, train, plant, option, values in cases(folder):
+        for name, train, plant, option, values in cases(folder, args.vessels):
             for model in args.models:
                 fit = folder / f"{plant}_{model}"
                 done = jaxship("identify", *train, "--model", model, "--out", fit,
@@ -115,6 +143,9 @@ def main(argv=None) -> int:
                     continue
                 written = json.loads((ap / "autopilot.json").read_text())
                 rows, at = written["runs"], written["feedforward_at_step"]
+                if "candidates" in at:  # from auto: the two designed on, say which does what
+                    fitted += (f"; poles on {written['gains']['pid']['feedback']}, "
+                               f"feed-forward inverts {at['model']}")
                 by = {(r["controller"], r["rpm"], r["speed"]): r for r in rows}
                 for (controller, rpm, speed), ff in by.items():
                     if controller != "pid+ff":
@@ -123,10 +154,11 @@ def main(argv=None) -> int:
                     run = f"{speed:.3g} m/s" if option == "--speed" else f"{rpm:.0f} rpm"
                     a, b = ff["sum_abs_error_deg"], fb["sum_abs_error_deg"]
                     ratio = "-" if None in (a, b) else f"{a / b:.2f}"
-                    print(f"| {name} | {model} | {run} | {a:.1f} | {b:.1f} | {ratio} | "
-                          f"{ff['max_overshoot_deg']:.2f} | {fb['max_overshoot_deg']:.2f} | "
+                    print(f"| {name} | {model} | {run} | {_cell(a, '.1f')} | {_cell(b, '.1f')} | "
+                          f"{ratio} | {_cell(ff['max_overshoot_deg'], '.2f')} | "
+                          f"{_cell(fb['max_overshoot_deg'], '.2f')} | "
                           f"{at['peak_rate_deg_s']:.3g} | {at['model_rudder_deg']:.3g} | "
-                          f"{at['vessel_rudder_deg']:.3g} | {fitted} |", flush=True)
+                          f"{_cell(at['vessel_rudder_deg'])} | {fitted} |", flush=True)
                     if "tuned" in written["gains"]:
                         tuned_rows.append(_tuned_row(name, model, run, written, rpm, speed))
     if tuned_rows:
@@ -137,6 +169,12 @@ def main(argv=None) -> int:
         print("|---|---|---|---:|---:|---:|---:|---:|---|---:|---:|---:|")
         print("\n".join(tuned_rows))
     return 0
+
+
+def _cell(x, spec: str = ".3g") -> str:
+    """A number in format `spec`; "-" where none was measured (a trial that failed, a run
+    that blew up)."""
+    return "-" if x is None else format(x, spec)
 
 
 def _tuned_row(name, model, run, written, rpm, speed) -> str:
