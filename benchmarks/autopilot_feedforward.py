@@ -26,7 +26,7 @@ each against its own reference, and the bandwidth before and after with its boun
 its BIC on the training records); the fit column says which.
 
 `--vessels` chooses the cases: by default the issue's three vessels above; `more` are
-checks on vessels the issue's design never looked at: the Esso Osaka 3 m model (its four
+checks on other vessels: the Esso Osaka 3 m model (its four
 zig-zags at 12 rps, measured, /work/shared/data; the plant the `esso_osaka` preset at 600
 and 720 rpm) and the presets `sea_stratus_nonlinear`, `compass_island_nonlinear`,
 `sea_swift` and `sea_scout` (zig-zags 10/10 and 20/20 of each at its nominal speed, the

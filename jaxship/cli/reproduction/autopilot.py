@@ -380,9 +380,9 @@ def _scaled(at_step: dict, vessel: float) -> dict:
 
 def nearest_steady_turn(models, plant, design: Design, pid, *, rpm=None,
                         speed=None) -> tuple:
-    """`(model, trial)`: of `models` (a `DesignModels` pair), the one whose steady-turn
-    rudder at the step's peak desired yaw rate is nearest the one the vessel `plant` needs
-    there, and its `steady_turn_trial`: the least $|\\log(\\delta_s/\\delta_{vessel})|$,
+    """`(model, trial)`: of `models` (the feed-forward's model, then the poles' one), the
+    one whose steady-turn rudder at the step's peak desired yaw rate is nearest the one
+    the vessel `plant` needs there, and its `steady_turn_trial`: the least $|\\log(\\delta_s/\\delta_{vessel})|$,
     a rudder of the other sign (or zero) never nearer, the first model on a tie or where
     none is near (or the trial failed). The trial then also has "candidates" {class:
     steady-turn rudder [deg]}. The model that fits the step it steers (issue 61): the
