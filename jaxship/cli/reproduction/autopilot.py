@@ -382,13 +382,13 @@ def nearest_steady_turn(models, plant, design: Design, pid, *, rpm=None,
                         speed=None) -> tuple:
     """`(model, trial)`: of `models` (the feed-forward's model, then the poles' one), the
     one whose steady-turn rudder at the step's peak desired yaw rate is nearest the one
-    the vessel `plant` needs there, and its `steady_turn_trial`: the least $|\\log(\\delta_s/\\delta_{vessel})|$,
-    a rudder of the other sign (or zero) never nearer, the first model on a tie or where
-    none is near (or the trial failed). The trial then also has "candidates" {class:
-    steady-turn rudder [deg]}. The model that fits the step it steers (issue 61): the
-    Norrbin model of the KVLCC2's zig-zags turns steadily there, inside its spiral loop,
-    with -0.73 deg where the `kvlcc2` preset needs +0.03 deg; the linear Nomoto 1 of the
-    same records, +1.31 deg."""
+    the vessel `plant` needs there, and its `steady_turn_trial`: the least
+    $|\\log(\\delta_s/\\delta_{vessel})|$, a rudder of the other sign (or zero) never
+    nearer, the first model on a tie or where none is near (or the trial failed). The
+    trial then also has "candidates" {class: steady-turn rudder [deg]}. The model that
+    fits the step it steers (issue 61): the Norrbin model of the KVLCC2's zig-zags turns
+    steadily there, inside its spiral loop, with -0.73 deg where the `kvlcc2` preset
+    needs +0.03 deg; the linear Nomoto 1 of the same records, +1.31 deg."""
     first = steady_turn_trial(models[0], plant, design, pid, rpm=rpm, speed=speed)
     vessel = first["vessel_rudder_deg"]
     if not vessel or models[1] is models[0]:
