@@ -22,7 +22,7 @@ LAYERS = {
     "analysis": ["_analysis"],
     # the public namespaces (effects, indices, strategies, wind_loads) only re-export, as
     # __init__ does
-    "application": ["_trials", "cli", "plotting", "__init__", "effects", "indices",
+    "application": ["_workflow", "thesis", "cli", "plotting", "__init__", "effects", "indices",
                     "strategies", "wind_loads"],
 }
 RANK = {name: i for i, names in enumerate(LAYERS.values()) for name in names}

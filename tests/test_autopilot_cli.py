@@ -16,14 +16,14 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship.cli import main
-from jaxship.cli._identification import model_from_report, read_result
-from jaxship.cli.reproduction import autopilot as study
-from jaxship.cli.reproduction.autopilot_reference import (
+from jaxship._workflow import _autopilot as study
+from jaxship._workflow._autopilot_reference import (
     RudderDemand,
     ordered_error_deg,
     tune_reference,
 )
+from jaxship._workflow._identify import model_from_report, read_result
+from jaxship.cli import main
 from jaxship.plotting import plot_autopilot
 
 

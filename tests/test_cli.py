@@ -14,9 +14,9 @@ from helpers import per_sample
 import jaxship as js
 import jaxship.cli as cli
 from jaxship._foundation._params import parameter_fields, resolve_free
+from jaxship._workflow._identify.workflow import FitDivergedError
 from jaxship.cli import main
 from jaxship.cli._files import MANIFEST, staged_folder
-from jaxship.cli._identification.workflow import FitDivergedError
 
 
 def test_vessels_lists_every_preset_with_source(capsys):
@@ -366,7 +366,7 @@ def test_discover_names_the_files_it_skips_even_when_quiet(record, tmp_path, cap
     def stop(*args, **kwargs):
         raise ValueError("stopped after reading")
 
-    monkeypatch.setattr("jaxship.cli._identification.discovery.identify", stop)
+    monkeypatch.setattr("jaxship.cli._discovery.identify", stop)
     assert main(["discover", str(folder), "--model", "nomoto1", "--sample-interval", "1",
                  "--quiet", "--out", str(tmp_path / "d")]) == 2
     err = capsys.readouterr().err

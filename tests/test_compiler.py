@@ -1,4 +1,4 @@
-"""XLA's compiler flags (`jaxship.cli._compiler`, issue 56): set only on the CPU and only
+"""XLA's compiler flags (`jaxship._workflow._compiler`, issue 56): set only on the CPU and only
 where the installed jaxlib knows them, so that no version of XLA ends the process on an
 unknown flag; the user's own $XLA_FLAGS kept."""
 
@@ -8,8 +8,8 @@ import sys
 
 import pytest
 
-from jaxship.cli import _compiler
-from jaxship.cli._compiler import FLAG_VERSIONS, SMALL_PROGRAMS, compile_for_small_programs
+from jaxship._workflow import _compiler
+from jaxship._workflow._compiler import FLAG_VERSIONS, SMALL_PROGRAMS, compile_for_small_programs
 
 
 @pytest.fixture

@@ -679,7 +679,7 @@ def test_the_discover_command_refuses_an_output_file(tmp_path, capsys):
 def test_an_interrupted_discover_command_leaves_the_earlier_results(tmp_path, capsys,
                                                                       monkeypatch):
     # issue 13: results are written to a temporary folder and renamed, never half
-    import jaxship.cli._identification.discovery as command
+    import jaxship.cli._discovery as command
 
     record = tmp_path / "a.csv"
     js.write_trial_csv(record, hidden_effect_records(js.Nomoto1(K=K, T=25.0), 0)[0][0])

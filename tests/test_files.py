@@ -219,7 +219,7 @@ def test_a_file_of_the_users_among_the_figures_is_refused_before_the_work(tmp_pa
         raise AssertionError("the work started")
 
     monkeypatch.setattr("jaxship.cli.identify.identify", never)
-    monkeypatch.setattr("jaxship.cli._identification.discovery.identify", never)
+    monkeypatch.setattr("jaxship.cli._discovery.identify", never)
     monkeypatch.setattr("jaxship.cli.autopilot.autopilot_study.evaluate", never)
     record = tmp_path / "zz.csv"
     t = np.arange(200) * 0.5

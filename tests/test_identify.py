@@ -22,8 +22,7 @@ from jaxship import (
     NorrbinCrossFlow,
     RossAutopilot,
 )
-from jaxship.cli import main
-from jaxship.cli._identification import (
+from jaxship._workflow._identify import (
     MODELS,
     IdentificationResult,
     Progress,
@@ -32,6 +31,7 @@ from jaxship.cli._identification import (
     model_from_report,
     read_experiments,
 )
+from jaxship.cli import main
 
 
 FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples

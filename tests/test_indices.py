@@ -16,7 +16,7 @@ from jaxship._analysis._indices import (
     imo_overshoot_limits_deg,
     loop_width,
 )
-from jaxship.cli._trials import run_spec, trial_indices
+from jaxship._workflow._trials import run_spec, trial_indices
 from jaxship.indices import (
     format_table,
     imo_criteria,

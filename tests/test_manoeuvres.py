@@ -9,7 +9,7 @@ from helpers import linear_test_vessel
 
 import jaxship as js
 from jaxship._analysis._indices import reverse_spiral_curve
-from jaxship.cli._trials import linear_yaw, run_spec, trial_indices, yaw_rate_gains
+from jaxship._workflow._trials import linear_yaw, run_spec, trial_indices, yaw_rate_gains
 
 
 AT_SAMPLES = js.Simulator(max_step=math.inf)  # controllers act at the output samples

@@ -16,7 +16,7 @@ from matplotlib.patches import Polygon  # noqa: E402
 
 import jaxship as js  # noqa: E402
 from jaxship._analysis._indices import SpiralCurve, StoppingIndices  # noqa: E402
-from jaxship.cli._trials import simulate_to_folder  # noqa: E402
+from jaxship.cli._trial_files import simulate_to_folder  # noqa: E402
 from jaxship.plotting import (  # noqa: E402
     plot_comparison,
     plot_imo_criteria,

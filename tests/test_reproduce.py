@@ -14,12 +14,8 @@ import time
 import pytest
 
 from jaxship.cli import main
-from jaxship.cli.reproduction import (
-    autopilot_thesis as chapter5,
-    reproduce as rp,
-    reproduce_report,
-    thesis,
-)
+from jaxship.cli.reproduction import reproduce as rp, reproduce_report
+from jaxship.thesis import autopilot as chapter5, identification as thesis
 
 
 def test_quick_trials_match_thesis_ranges_and_open_the_report(tmp_path):
@@ -281,7 +277,7 @@ def test_the_discovery_case_records_are_the_discovery_tests_records():
 
     import jaxship as js
     from benchmarks.studies.discovery import hidden_effect_records as tests_records
-    from jaxship.cli.reproduction.discovery_case import hidden_effect_records
+    from jaxship.thesis.discovery_case import hidden_effect_records
 
     truth = js.augment(js.Nomoto1(K=0.06, T=25.0), js.effects.YawCubicDamping(beta=300.0))
     mine, theirs = hidden_effect_records(truth, 3), tests_records(truth, 3)

@@ -11,13 +11,10 @@ import numpy as np
 import pytest
 import scipy.stats
 
-from jaxship.cli.reproduction import (
-    autopilot,
-    autopilot_thesis as chapter5,
-    reproduce_report,
-    thesis,
-)
+from jaxship._workflow import _autopilot as autopilot
+from jaxship.cli.reproduction import reproduce_report
 from jaxship.plotting import plot_model_outputs
+from jaxship.thesis import autopilot as chapter5, identification as thesis
 
 
 KEYS = [(m, f) for m in ("nomoto", "ross") for f in chapter5.FAMILIES]

@@ -21,7 +21,7 @@ from jaxship import (
 from jaxship._estimate._linear import initial_estimate
 from jaxship._foundation._params import parameter_fields
 from jaxship._models._steering.ross import HULL_TERMS, ROSS_FREE, SPEED_RUDDER
-from jaxship.cli.reproduction import thesis as ti
+from jaxship.thesis import identification as ti
 
 
 FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples

@@ -16,11 +16,11 @@ import jax
 import matplotlib
 
 from .. import FitError, __version__, enable_compilation_cache  # noqa: E402
+from .._workflow._compiler import SMALL_PROGRAMS, compile_for_small_programs  # noqa: E402, F401
+from .._workflow._identify.workflow import FitDivergedError  # noqa: E402
 from . import autopilot, discover, identify, reproduce, simulate, vessels  # noqa: E402
 from ._common import one_line  # noqa: E402
-from ._compiler import SMALL_PROGRAMS, compile_for_small_programs  # noqa: E402, F401
 from ._files import discard_open_stages  # noqa: E402
-from ._identification.workflow import FitDivergedError  # noqa: E402
 
 
 EXIT_STATUS = """exit status: 0 done; 2 bad input (arguments, records, an --out that cannot be

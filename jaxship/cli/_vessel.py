@@ -6,7 +6,7 @@ import dataclasses
 import pathlib
 
 from .. import VESSELS, AbstractVessel, get_vessel, load_vessel
-from ._identification import read_result
+from .._workflow._identify import read_result
 
 
 VESSEL_HELP = ("a preset (see `jaxship vessels`), a vessel file (TOML; `jaxship vessels "

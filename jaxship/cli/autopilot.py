@@ -8,18 +8,18 @@ import sys
 import matplotlib.pyplot as plt
 from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
 
-from ..plotting import plot_autopilot
-from ._common import check_operating_point, check_out, numbers
-from ._files import staged_folder
-from ._identification import (
+from .._workflow import _autopilot as autopilot_study
+from .._workflow._autopilot import cell
+from .._workflow._identify import (
     linear_candidate,
     model_from_report,
     read_result,
     unconverged_fit,
 )
+from ..plotting import plot_autopilot
+from ._common import check_operating_point, check_out, numbers
+from ._files import staged_folder
 from ._vessel import VESSEL_HELP, read_vessel_option
-from .reproduction import autopilot as autopilot_study
-from .reproduction.autopilot import cell
 
 
 def register(sub) -> None:

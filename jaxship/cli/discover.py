@@ -11,7 +11,7 @@ from ._common import (
     check_out,
     note,
 )
-from ._identification.discovery import run_discovery
+from ._discovery import run_discovery
 from ._vessel import VESSEL_HELP
 from .identify import start_model
 

@@ -11,6 +11,8 @@ import equinox as eqx
 import jaxship as js
 
 from .. import VESSELS
+from .._workflow._identify import MODELS, get_model_entry, identify, read_experiments
+from .._workflow._identify.selection import AUTO, CANDIDATES, is_auto
 from ..plotting import identification_figure_names, save_identification_figures
 from ._common import (
     VELOCITIES,
@@ -23,8 +25,6 @@ from ._common import (
     one_line,
 )
 from ._files import staged_folder
-from ._identification import MODELS, get_model_entry, identify, read_experiments
-from ._identification.selection import AUTO, CANDIDATES, is_auto
 from ._vessel import VESSEL_HELP, read_vessel_option
 
 

@@ -9,12 +9,13 @@ import sys
 import matplotlib.pyplot as plt
 
 from .. import AbstractVessel, froude_scale
+from .._workflow._identify import unconverged_fit
+from .._workflow._imo import check_imo, imo_specs
+from .._workflow._trials import TrialSpec
 from ..plotting import plot_imo_criteria, plot_trajectory
 from ._common import check_operating_point, check_out, note, positive
 from ._files import staged_folder
-from ._identification import unconverged_fit
-from ._imo import check_imo, imo_specs
-from ._trials import TrialSpec, simulate_steering_to_folder, simulate_to_folder
+from ._trial_files import simulate_steering_to_folder, simulate_to_folder
 from ._vessel import VESSEL_HELP, read_vessel_option
 
 

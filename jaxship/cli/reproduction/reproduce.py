@@ -43,11 +43,11 @@ import numpy as np
 from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
 
 import jaxship as js
-from jaxship.cli._trials import trial_indices
+from jaxship._workflow._trials import trial_indices
 
+from ...thesis import autopilot as chapter5, identification as thesis
+from ...thesis.discovery_case import hidden_effect_records
 from .._files import staged_folder
-from . import autopilot_thesis as chapter5, thesis
-from .discovery_case import hidden_effect_records
 from .reproduce_report import (
     DISCOVERY_HIDDEN,
     DISCOVERY_SEED,

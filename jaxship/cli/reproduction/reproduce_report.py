@@ -13,7 +13,8 @@ from jaxship.plotting import (
     plot_trial_vs_thesis,
 )
 
-from . import autopilot, autopilot_thesis as chapter5, thesis
+from ..._workflow import _autopilot as autopilot
+from ...thesis import autopilot as chapter5, identification as thesis
 
 
 DISCOVERY_HIDDEN = 300.0  # beta of the hidden cubic yaw damping [s/rad^2]

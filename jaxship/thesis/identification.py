@@ -33,7 +33,8 @@ import math
 import numpy as np
 
 import jaxship as js
-from jaxship.cli._trials import initial_state
+
+from .._workflow._trials import initial_state
 
 
 DEG = math.pi / 180.0

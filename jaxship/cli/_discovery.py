@@ -10,11 +10,11 @@ import numpy as np
 
 import jaxship as js
 
-from .._common import check_writes
-from .._files import staged_folder
-from .data import check_froude, preset_length, read_experiments
-from .registry import model_key, start_entry
-from .workflow import identify, logs_wind
+from .._workflow._identify.data import check_froude, preset_length, read_experiments
+from .._workflow._identify.registry import model_key, start_entry
+from .._workflow._identify.workflow import identify, logs_wind
+from ._common import check_writes
+from ._files import staged_folder
 
 
 def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,

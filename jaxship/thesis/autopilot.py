@@ -12,8 +12,8 @@ import scipy  # scipy.stats loads on first use (an import-time saving)
 
 import jaxship as js
 
-from . import thesis
-from .autopilot import CONTROLLERS, Design, _finite, cell, evaluate
+from .._workflow._autopilot import CONTROLLERS, Design, _finite, cell, evaluate
+from . import identification as thesis
 
 
 RPMS = (300.0, 400.0)  # thesis sec. 5.4: simulated at 300 and 400 rpm

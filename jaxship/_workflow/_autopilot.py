@@ -34,8 +34,8 @@ import numpy as np
 
 import jaxship as js
 
-from .autopilot_reference import RudderDemand, ordered_error_deg, tune_reference
-from .autopilot_steady_turn import (
+from ._autopilot_reference import RudderDemand, ordered_error_deg, tune_reference
+from ._autopilot_steady_turn import (
     feedforward_at_step as feedforward_at_step,
     feedforward_gain_text as feedforward_gain_text,
     nearest_steady_turn as nearest_steady_turn,

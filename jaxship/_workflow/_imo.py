@@ -10,14 +10,14 @@ import numpy as np
 
 import jaxship as js
 
-from ._common import surge_force
+from .._models._vessel._base import surge_force
 from ._trials import (
     TrialSpec,
-    _spec_text,
-    _trial_marks,
     initial_state,
     run_spec,
+    spec_text,
     trial_criteria,
+    trial_marks,
 )
 
 
@@ -114,7 +114,7 @@ def check_imo(vessel, *, report=None, speed=None, rpm=None) -> ImoCheck:
         manoeuvre, traj = run_spec(vessel, spec, speed=speed, rpm=rpm)
         if not bool(traj.success):
             raise ValueError(f"the {spec.kind} trial failed (non-finite state).")
-        marks = _trial_marks(spec, manoeuvre, traj)
+        marks = trial_marks(spec, manoeuvre, traj)
         runs[spec] = (manoeuvre, traj, marks)
         rows += trial_criteria(spec, vessel, traj, marks)
     names, draws, how = parameter_draws(report, np.random.default_rng(SEED))
@@ -129,7 +129,7 @@ def check_imo(vessel, *, report=None, speed=None, rpm=None) -> ImoCheck:
             passed[criterion] = float(np.mean(met))
     info = {"draws": DRAWS if names else 0, "used": used, "level": LEVEL, "from": how,
             "parameters": list(names), "seed": SEED}
-    return ImoCheck(rows, {_spec_text(s): r for s, r in runs.items()}, bands, passed, info)
+    return ImoCheck(rows, {spec_text(s): r for s, r in runs.items()}, bands, passed, info)
 
 
 def _drawn_criteria(vessel, names, draws, runs, *, speed, rpm):
@@ -150,7 +150,7 @@ def _drawn_criteria(vessel, names, draws, runs, *, speed, rpm):
             batch, manoeuvre, x0, in_axes=(0, None, 0, None), simulator=SIMULATOR))
         for k, v in enumerate(vessels):
             traj = jax.tree.map(lambda a, k=k: a[k], trajs)
-            marks = _trial_marks(spec, manoeuvre, traj) if traj.success else None
+            marks = trial_marks(spec, manoeuvre, traj) if traj.success else None
             rows = trial_criteria(spec, v, traj, marks)
             ran[k] &= bool(rows)
             for row in rows:

@@ -1,26 +1,20 @@
 """Trial specifications such as `turn:35` or `zigzag:-10/10`, and running them.
 
-This is the application's (`jaxship simulate`), not the library's: specs are strings
-in degrees, vessels go by name. A library user builds the manoeuvre (`jaxship.Turn`,
-`jaxship.ZigZag`, ...) and calls `jaxship.simulate`.
-Durations default to multiples of the vessel's time scale L/U so that the same
+Specs are strings in degrees, as written on the command line (`jaxship simulate
+--manoeuvre`). Durations default to multiples of the vessel's time scale L/U so that the same
 spec suits a 4 m model and a 160 m ship.
 """
 
 import dataclasses
-import json
-import pathlib
 
 import jax
 import jax.numpy as jnp
-import matplotlib.pyplot as plt
 import numpy as np
 
 import jaxship as js
 
-from .. import Experiment, Simulator, simulate, straight_run, straight_state, write_trial_csv
-from ..plotting import plot_imo_criteria, plot_spiral, plot_trajectory
-from ._common import surge_force
+from .. import Simulator, simulate, straight_run, straight_state
+from .._models._vessel._base import surge_force
 
 
 SPEC_HELP = (
@@ -343,14 +337,14 @@ def _reverse_curve(manoeuvre, traj):
     return js.indices.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
 
 
-def _spiral_curve(spec, manoeuvre, traj):
+def spiral_curve(spec, manoeuvre, traj):
     if spec.kind == "spiral":
         hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
         return js.indices.spiral_curve(traj, hold=hold)
     return _reverse_curve(manoeuvre, traj)
 
 
-def _trial_marks(spec, manoeuvre, traj):
+def trial_marks(spec, manoeuvre, traj):
     """The indices drawn on the trial figure: turning, zig-zag or stopping."""
     try:
         if spec.kind == "turn" and spec.values[0] != 0:
@@ -388,90 +382,15 @@ def trial_criteria(spec, vessel, traj, marks) -> list:
     return js.indices.imo_criteria(float(vessel.length), speed, **kwargs)
 
 
-def simulate_to_folder(
-    vessel, spec, out, *, speed=None, rpm=None, duration=None, dt=None, title=""
-) -> dict:
-    """Run `spec` on `vessel` and write `trial.csv`, `indices.json` and `trial.png` to `out`,
-    with `spiral.png` (the r-delta curve) for a spiral and `imo_criteria.png` (and the
-    rows under "imo_criteria" in `indices.json`) for a trial that an IMO criterion
-    checks."""
-    spec = TrialSpec.parse(spec) if isinstance(spec, str) else spec
-    manoeuvre, traj = run_spec(vessel, spec, speed=speed, rpm=rpm, duration=duration, dt=dt)
-    if not bool(traj.success):
-        raise ValueError(
-            f"the simulation of {spec!r} failed (non-finite state); try a smaller --dt."
-        )
-    out = pathlib.Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    record = Experiment.from_trajectory(traj)
-    if not np.any(record.n):  # a vessel without a propeller model: no column of zeros
-        record = Experiment(record.t, record.delta, name=record.name, **{
-            c: getattr(record, c) for c in record.channels if c not in ("delta", "n")})
-    write_trial_csv(out / "trial.csv", record)
-    indices = {
-        k: (None if isinstance(v, float) and not np.isfinite(v) else v)
-        for k, v in trial_indices(spec, manoeuvre, traj).items()
-    }
-    marks = _trial_marks(spec, manoeuvre, traj)
-    criteria = trial_criteria(spec, vessel, traj, marks)
-    if criteria:
-        indices["imo_criteria"] = [row.to_dict() for row in criteria]
-    (out / "indices.json").write_text(json.dumps(indices, indent=2) + "\n")
-    name = title or _spec_text(spec)
-    fig = plot_trajectory(traj, length=float(vessel.length), title=name, labels=[name],
-                          indices=marks)
-    fig.savefig(out / "trial.png", dpi=110)
-    plt.close(fig)
-    if spec.kind in ("spiral", "reverse-spiral"):
-        curve = _spiral_curve(spec, manoeuvre, traj)
-        ordered = manoeuvre.rates if spec.kind == "reverse-spiral" else None
-        fig = plot_spiral(curve, title=f"{name}: steady yaw rate against rudder angle",
-                          ordered=ordered)
-        fig.savefig(out / "spiral.png", dpi=110)
-        plt.close(fig)
-    if criteria:
-        fig = plot_imo_criteria(criteria, title=f"{name}: IMO MSC.137(76) criteria")
-        fig.savefig(out / "imo_criteria.png", dpi=110)
-        plt.close(fig)
-    return indices
-
-
-def simulate_steering_to_folder(model, spec, out, *, dt, duration, title="") -> dict:
-    """Run `spec` on the steering `model` from rest (`jaxship.simulate`'s closed loop on
-    its heading and yaw rate), its time scale `duration / 35` (a zig-zag's 35 L/U),
-    and write `trial.csv` (t, delta, r, psi), `indices.json` and `trial.png` to `out`."""
-    tau = duration / 35
-    vessel = _TimeScale(length=tau, nominal_speed=1.0)
-    manoeuvre = build_manoeuvre(spec, vessel, straight_state(0.0, 0.0), duration=duration,
-                                dt=dt)
-    traj = simulate(model, manoeuvre, simulator=Simulator(substeps=2))
-    if not bool(traj.success):
-        raise ValueError(f"the simulation of {_spec_text(spec)} failed (non-finite state); "
-                         "try a smaller --dt.")
-    record = Experiment.from_trajectory(traj)
-    record = Experiment(record.t, record.delta, name=record.name, r=record.r, psi=record.psi)
-    write_trial_csv(pathlib.Path(out) / "trial.csv", record)
-    indices = {k: (None if isinstance(v, float) and not np.isfinite(v) else v)
-               for k, v in trial_indices(spec, manoeuvre, traj).items()
-               if k != "min_speed_m_s" and k != "max_speed_m_s"}
-    (pathlib.Path(out) / "indices.json").write_text(json.dumps(indices, indent=2) + "\n")
-    name = title or _spec_text(spec)
-    fig = plot_trajectory(traj, title=name, labels=[name],
-                          indices=_trial_marks(spec, manoeuvre, traj))
-    fig.savefig(pathlib.Path(out) / "trial.png", dpi=110)
-    plt.close(fig)
-    return indices
-
-
 @dataclasses.dataclass(frozen=True)
-class _TimeScale:
+class TimeScale:
     """What `build_manoeuvre` reads of a vessel, for a steering model: L/U = `length`."""
 
     length: float
     nominal_speed: float
 
 
-def _spec_text(spec) -> str:
+def spec_text(spec) -> str:
     """The spec as written: `turn:35`, `zigzag:10/10`, `spiral`."""
     values = "/".join(f"{v:g}" for v in spec.values)
     return f"{spec.kind}:{values}" if values else spec.kind
