@@ -24,7 +24,7 @@ own: the first run compiles (the README's time), the second reads the cache. It 
 table's time column with the date and the number of CPU cores.
 
 `--flags` times the first run (empty cache) of every example of the table twice, with the
-command's own XLA compiler setting (`jaxship.cli.SMALL_PROGRAMS`: the loop emitters
+command's own XLA compiler setting (`jaxship.compile_for_small_programs()`: the loop emitters
 instead of the MLIR fusion emitters) and with XLA's defaults (set in `$XLA_FLAGS`, which
 the command then leaves as they are), and prints the ratio default / own.
 
@@ -36,6 +36,7 @@ row's: `--only esso` times both).
 """
 
 import argparse
+import importlib.metadata
 import os
 import statistics
 import subprocess
@@ -45,13 +46,24 @@ import time
 from pathlib import Path
 
 import jaxship as js
-from jaxship.cli._compiler import SMALL_PROGRAMS, jaxlib_version, known_flags
 
 
 # what `jaxship simulate` imports besides jaxship itself
 DEPENDENCIES = "import jax, equinox, diffrax, optimistix, matplotlib.pyplot"
-# XLA's own values of the flags `SMALL_PROGRAMS` sets
+# XLA's own values of the flags `js.compile_for_small_programs()` sets
 XLA_DEFAULTS = {"--xla_backend_optimization_level": "3", "--xla_cpu_use_fusion_emitters": "true"}
+
+
+def command_flags() -> tuple[str, ...]:
+    """The flags the command adds on this machine: `js.compile_for_small_programs()` with
+    $XLA_FLAGS empty (this process starts no computation; $XLA_FLAGS is restored)."""
+    given = os.environ.pop("XLA_FLAGS", None)
+    try:
+        return js.compile_for_small_programs()
+    finally:
+        os.environ.pop("XLA_FLAGS", None)
+        if given is not None:
+            os.environ["XLA_FLAGS"] = given
 
 
 def timed(command, env, out):
@@ -132,10 +144,12 @@ def table(repeats: int, tmp: Path, only: str | None = None) -> None:
 def flags(repeats: int, tmp: Path) -> None:
     """Each table command's first run with XLA's defaults and with the command's setting."""
     default = " ".join(f.split("=")[0] + "=" + XLA_DEFAULTS[f.split("=")[0]]
-                       for f in known_flags(SMALL_PROGRAMS))  # none this jaxlib lacks
+                       for f in command_flags())  # none this jaxlib lacks
     if not default:
-        sys.exit(f"--flags: jaxlib {'.'.join(map(str, jaxlib_version()))} knows none of "
-                 f"{SMALL_PROGRAMS}, so the command adds no flag and there is nothing to compare.")
+        sys.exit(f"--flags: here the command adds none of "
+                 f"{js.compile_for_small_programs.SMALL_PROGRAMS} (jaxlib "
+                 f"{importlib.metadata.version('jaxlib')}, or not the CPU), so there is "
+                 "nothing to compare.")
     print(f"{time.strftime('%Y-%m-%d')}, first runs (empty cache), each in a new process")
     print("| command | XLA's defaults | jaxship's setting | ratio |")
     print("|---|---:|---:|---:|")

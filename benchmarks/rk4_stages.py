@@ -7,7 +7,7 @@ its final heading with respect to the sway derivative y_v (`jax.jvp`), and a bat
 64 turning circles (5-35 deg rudder, `simulate_batch`); each timed on its first call
 (compiling and running) and as the median of `--repeat` later calls, both ways in one
 process, under the compiler setting of the `jaxship` command and the tests
-(`jaxship.cli.SMALL_PROGRAMS`; `--xla-defaults` for XLA's own). Run:
+(`jaxship.compile_for_small_programs()`; `--xla-defaults` for XLA's own). Run:
 `python benchmarks/rk4_stages.py [--repeat 5] [--xla-defaults]`.
 """
 
@@ -23,7 +23,6 @@ jax.config.update("jax_enable_x64", True)
 import numpy as np  # noqa: E402
 
 import jaxship as js  # noqa: E402
-from jaxship.cli import compile_for_small_programs  # noqa: E402
 
 
 DEG = np.pi / 180
@@ -65,7 +64,7 @@ def main():
                         help="XLA's own compiler setting instead of the command's")
     args = parser.parse_args()
     if not args.xla_defaults:
-        compile_for_small_programs()
+        js.compile_for_small_programs()
     print(f"compiler setting: {'XLA defaults' if args.xla_defaults else 'SMALL_PROGRAMS'}; "
           f"median of {args.repeat} after the first call")
     print("| vessel | computation | first call, rolled | written out | ratio | "

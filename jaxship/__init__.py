@@ -68,6 +68,7 @@ from ._estimate._lm import RESULTS as RESULTS, LevenbergMarquardt as LevenbergMa
 from ._estimate._predict import predict as predict
 from ._estimate._result import FitError as FitError, FitResult as FitResult
 from ._foundation._cache import enable_compilation_cache as enable_compilation_cache
+from ._foundation._compiler import compile_for_small_programs as compile_for_small_programs
 from ._foundation._contract import AbstractModel as AbstractModel
 from ._foundation._params import Free as Free, default_free as default_free, param as param
 from ._foundation._progress import Progress as Progress
@@ -180,6 +181,7 @@ __all__ = [
     "Progress",
     # utilities: Compilation cache
     "enable_compilation_cache",
+    "compile_for_small_programs",
     # strategies: Strategy objects
     "strategies",
     # -- models: vessels, steering models, effects, manoeuvres and controllers

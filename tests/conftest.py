@@ -6,7 +6,6 @@ import jax
 import pytest
 
 import jaxship as js
-from jaxship.cli import SMALL_PROGRAMS, compile_for_small_programs
 
 
 jax.config.update("jax_enable_x64", True)
@@ -31,12 +30,14 @@ FAST_TIER = ("--xla_backend_optimization_level=1",)
 def pytest_configure(config):
     """XLA's CPU compiler set for many small programs, before JAX starts its backend
     (`jaxship` subprocesses and notebook kernels inherit it): the loop emitters instead
-    of the MLIR fusion emitters, as the `jaxship` command's `SMALL_PROGRAMS`, and in the
+    of the MLIR fusion emitters, as the `jaxship` command's
+    (`jaxship.compile_for_small_programs.SMALL_PROGRAMS`), and in the
     fast tier (`-m 'not slow'`, the default) `FAST_TIER` as well. Most of a test's time
     is compiling. The numbers are the same to rounding
     (`helpers.assert_equal_to_rounding`)."""
     fast = "not slow" in (config.getoption("markexpr", "") or "")
-    compile_for_small_programs(SMALL_PROGRAMS + (FAST_TIER if fast else ()))
+    js.compile_for_small_programs(js.compile_for_small_programs.SMALL_PROGRAMS
+                                  + (FAST_TIER if fast else ()))
 
 
 def pytest_sessionstart(session):

@@ -1,5 +1,5 @@
-"""XLA's compiler flags (`jaxship._workflow._compiler`, issue 56): set only on the CPU and only
-where the installed jaxlib knows them, so that no version of XLA ends the process on an
+"""XLA's compiler flags (`jaxship.compile_for_small_programs`, issue 56): set only on the
+CPU and only where the installed jaxlib knows them, so that no version of XLA ends the process on an
 unknown flag; the user's own $XLA_FLAGS kept."""
 
 import os
@@ -8,8 +8,9 @@ import sys
 
 import pytest
 
-from jaxship._workflow import _compiler
-from jaxship._workflow._compiler import FLAG_VERSIONS, SMALL_PROGRAMS, compile_for_small_programs
+from jaxship import compile_for_small_programs
+from jaxship._foundation import _compiler
+from jaxship._foundation._compiler import FLAG_VERSIONS, SMALL_PROGRAMS
 
 
 @pytest.fixture
@@ -19,6 +20,19 @@ def cpu_jaxlib(monkeypatch):
     monkeypatch.setattr(_compiler, "requested_platforms", lambda: [])
     monkeypatch.setattr(_compiler, "accelerator_plugins", lambda: [])
     monkeypatch.delenv("XLA_FLAGS", raising=False)
+
+
+def test_the_public_default_is_the_commands_setting():
+    """`js.compile_for_small_programs()` adds its documented attribute `SMALL_PROGRAMS`,
+    the loop emitters instead of the MLIR fusion emitters."""
+    import inspect
+
+    import jaxship as js
+
+    assert js.compile_for_small_programs is compile_for_small_programs
+    default = inspect.signature(compile_for_small_programs).parameters["flags"].default
+    assert default == compile_for_small_programs.SMALL_PROGRAMS == SMALL_PROGRAMS == (
+        "--xla_cpu_use_fusion_emitters=false",)
 
 
 def test_the_users_xla_flags_are_kept(cpu_jaxlib, monkeypatch):

@@ -15,8 +15,12 @@ import warnings
 import jax
 import matplotlib
 
-from .. import FitError, __version__, enable_compilation_cache  # noqa: E402
-from .._workflow._compiler import SMALL_PROGRAMS, compile_for_small_programs  # noqa: E402, F401
+from .. import (  # noqa: E402
+    FitError,
+    __version__,
+    compile_for_small_programs,
+    enable_compilation_cache,
+)
 from .._workflow._identify.workflow import FitDivergedError  # noqa: E402
 from . import autopilot, discover, identify, reproduce, simulate, vessels  # noqa: E402
 from ._common import one_line  # noqa: E402
