@@ -23,7 +23,7 @@ jax.config.update("jax_enable_x64", True)
 import numpy as np  # noqa: E402
 
 import jaxship as js  # noqa: E402
-from benchmarks.studies.real_data import esso_osaka_split  # noqa: E402
+from jaxship.studies.real_data import esso_osaka_split  # noqa: E402
 
 
 def main():

@@ -3,7 +3,7 @@
 For every scenario (an effect at a size, two or three effects at once, the white null
 and the coloured null with a slowly varying yaw moment; and Mariner records with two or
 three effects, u and v logged over ground) it runs discovery on `--seeds` independent data
-sets (`benchmarks/studies/discovery.py`: Nomoto 1 truth integrated finely, rate-limited
+sets (`jaxship/studies/discovery.py`: Nomoto 1 truth integrated finely, rate-limited
 rudder logged at 2 Hz, 4 training zig-zags, 2 held-out turning circles) and prints:
 
 - detection: the hidden effect (or each of two) named or in a named class, nothing
@@ -33,7 +33,8 @@ import jax
 import numpy as np
 
 import jaxship as js
-from benchmarks.studies.discovery import (
+from jaxship import effects
+from jaxship.studies.discovery import (
     covered,
     outcome,
     run_case,
@@ -41,7 +42,6 @@ from benchmarks.studies.discovery import (
     vessel_records,
     wind_records,
 )
-from jaxship import effects
 
 
 DEG = np.pi / 180

@@ -33,6 +33,8 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))  # benchmarks.*
 
+from jaxship.cli._identification import identify  # noqa: E402
+
 import jaxship as js  # noqa: E402
 from benchmarks.kvlcc2_simman import (  # noqa: E402 (enables float64)
     DT,
@@ -41,8 +43,7 @@ from benchmarks.kvlcc2_simman import (  # noqa: E402 (enables float64)
     measured_zigzag,
     simulate_zigzag,
 )
-from benchmarks.studies.real_data import kvlcc2_discovery_split  # noqa: E402
-from jaxship.cli._identification import identify  # noqa: E402
+from jaxship.studies.real_data import kvlcc2_discovery_split  # noqa: E402
 
 
 BASIN_SPECIFIC = ("rudder_offset", "heading_sensor_bias", "yaw_rate_sensor_bias", "current")

@@ -41,12 +41,12 @@ import numpy as np
 import optimistix as optx
 
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))  # benchmarks.studies
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))  # benchmarks.*
 
 import jaxship as js  # noqa: E402
 from benchmarks.published_splits import RESULTS, bands_table, write  # noqa: E402
-from benchmarks.studies.published_splits import SPLITS, read_runs  # noqa: E402
-from benchmarks.studies.real_data import kvlcc2_discovery_split  # noqa: E402
+from jaxship.studies.published_splits import SPLITS, read_runs  # noqa: E402
+from jaxship.studies.real_data import kvlcc2_discovery_split  # noqa: E402
 
 
 LEVEL = 0.9

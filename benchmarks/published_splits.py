@@ -44,11 +44,10 @@ import numpy as np
 
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))  # benchmarks.studies
 
 import jaxship as js  # noqa: E402
 import jaxship.cli  # noqa: E402
-from benchmarks.studies.published_splits import (  # noqa: E402
+from jaxship.studies.published_splits import (  # noqa: E402
     SPLITS,
     free_run_score,
     lab_as_published,

@@ -42,7 +42,6 @@ from ._estimate._bands import (
     calibrate_disturbance as calibrate_disturbance,
     prediction_bands as prediction_bands,
 )
-from ._estimate._discrete import fit_discrete_response as fit_discrete_response
 from ._estimate._discrete_estimator import (
     DiscreteResponse as DiscreteResponse,
     LeastSquaresRegression as LeastSquaresRegression,
@@ -278,7 +277,6 @@ __all__ = [
     "DiscreteResponse",
     "LeastSquaresRegression",
     "SupportVectorRegression",
-    "fit_discrete_response",
     "LinearStart",
     "MeasuredStates",
     "EstimatedStarts",

@@ -13,7 +13,7 @@ nb.cells = [
         "# Astrom & Kallstrom (1979): Sea Stratus, prediction error against output error\n\n"
         "Reproduction 2 of issue 3. The Norrbin cross-flow model of Sea Stratus (their Table 3, "
         "nonlinear column, C = 0.63) is simulated through 5/5 and 20/20 zig-zags with a random "
-        "yaw moment (process noise) and measurement noise (`benchmarks/studies/astrom.py`). The six "
+        "yaw moment (process noise) and measurement noise (`jaxship/studies/astrom.py`). The six "
         "derivatives and C are identified from Table 3's initial estimates by output error and "
         "by prediction error with a 60 s horizon, on each zig-zag and on both. Their finding: "
         "under process noise a horizon of tens of seconds is essential, output error drifts.\n\n"
@@ -23,9 +23,7 @@ nb.cells = [
         "import jax\njax.config.update('jax_enable_x64', True)\n"
         "import matplotlib.pyplot as plt\nimport numpy as np\n"
         "from IPython.display import Markdown, display\n"
-        "import pathlib\nimport sys\n\n"
-        "sys.path.insert(0, str(pathlib.Path.cwd().parent))  # the project root: benchmarks.studies\n"
-        "from benchmarks.studies import astrom\n\n"
+        "from jaxship.studies import astrom\n\n"
         "study = astrom.astrom_kallstrom()\ndisplay(Markdown(astrom.table(study)))"),
     nbf.v4.new_markdown_cell("## The records"),
     nbf.v4.new_code_cell(

@@ -8,7 +8,7 @@ The notebook reproduces the heading-autopilot study of the thesis (Odegard 2009,
 turning circles, zig-zags and the thesis manoeuvre) each give a PID with reference
 feed-forward that steers the true vessel at 300 and 400 rpm; the residuals next to the
 thesis' Tables 5.2-5.7 and the closed-loop figures (thesis figs. 5.1-5.6). The pipeline
-is `jaxship/cli/reproduction/autopilot_thesis.py` (the runs: `autopilot.py`).
+is `jaxship/thesis/autopilot.py` (`jaxship.thesis.autopilot`).
 """
 
 import pathlib
@@ -37,7 +37,7 @@ used for the fits.
 
 Here the same chain runs on `js.get_vessel("thesis")` (the true vessel steered, rudder 45 deg and
 15 deg/s through its servo; not the thesis' own coefficients, which are unpublished), with the
-models of `jaxship/cli/reproduction/thesis.py` (the chapter-4 pipeline).
+models of `jaxship/thesis/identification.py` (the chapter-4 pipeline).
 
 * **Controller frequency.** The thesis gives the reference model's $\\omega$ and $\\zeta$ but
   not the controller's. We use $\\omega_n$ = 0.5 rad/s and $\\zeta$ = 1: faster than the
@@ -59,7 +59,7 @@ from IPython.display import Markdown, display
 
 import jaxship as js
 from jaxship.plotting import plot_autopilot
-from jaxship.cli.reproduction import autopilot_thesis as ap
+from jaxship.thesis import autopilot as ap
 
 
 jax.config.update("jax_enable_x64", True)

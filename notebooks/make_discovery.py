@@ -8,8 +8,6 @@ import nbformat as nbf
 
 HERE = pathlib.Path(__file__).parent
 SETUP = """import os
-import pathlib
-import sys
 import time
 
 import jax
@@ -18,11 +16,8 @@ import numpy as np
 from IPython.display import Markdown, display
 
 import jaxship as js
-
-
-sys.path.insert(0, str(pathlib.Path.cwd().parent))  # the project root: benchmarks.studies
-from benchmarks.studies.discovery import hidden_effect_records, outcome, vessel_records  # noqa: E402
-from benchmarks.studies.real_data import (  # noqa: E402
+from jaxship.studies.discovery import hidden_effect_records, outcome, vessel_records
+from jaxship.studies.real_data import (
     esso_osaka_low_speed_discovery,
     esso_osaka_low_speed_steering,
     esso_osaka_low_speed_sway_yaw,

@@ -2,7 +2,7 @@
 
 The notebook identifies the Esso Osaka 3-DOF model and Nomoto models on the FRT-DS-ESSO
 random runs and validates them on held-out runs, then Nomoto models on the HSVA KVLCC2
-zig-zags; the pipeline is `benchmarks/studies/real_data.py`. Every cell after the first skips when
+zig-zags; the pipeline is `jaxship/studies/real_data.py`. Every cell after the first skips when
 the measured data are absent.
 """
 
@@ -35,8 +35,6 @@ the cells below do nothing when it is absent).
 
 The records are decimated to 2 Hz (every 5th sample) to keep the notebook fast."""),
     new_code_cell("""import os
-import pathlib
-import sys
 import time
 
 import jax
@@ -48,8 +46,7 @@ import jaxship as js
 
 
 jax.config.update("jax_enable_x64", True)
-sys.path.insert(0, str(pathlib.Path.cwd().parent))  # the project root: benchmarks.studies
-from benchmarks.studies.real_data import identify_esso_osaka, identify_kvlcc2_hsva  # noqa: E402
+from jaxship.studies.real_data import identify_esso_osaka, identify_kvlcc2_hsva
 
 
 data = js.shared_data_dir()
@@ -118,7 +115,7 @@ def add_measured(axes, runs, channels):
     axes[0, 0].legend(fontsize=7)
 
 if HAVE_ESSO:
-    from benchmarks.studies.real_data import esso_osaka_split
+    from jaxship.studies.real_data import esso_osaka_split
     _, test = esso_osaka_split()
     fig, axes = plot_runs(esso, "3-DOF esso_osaka", ("psi", "r", "u", "v"),
                           ("T_p = 20 s", "simulation"))
@@ -139,7 +136,7 @@ validated by simulating the starboard-first 10/10 and 20/10 and the 10/5 and 20/
     for m in kv.models:
         print(m.result.summary(), end="\\n\\n")
     display(Markdown(kv.table()))
-    from benchmarks.studies.real_data import hsva_split
+    from jaxship.studies.real_data import hsva_split
     _, kv_test = hsva_split()
     fig, axes = plot_runs(kv, "Nomoto2", ("psi", "r"), ("simulation",))
     add_measured(axes, kv_test, ("psi", "r"))

@@ -30,7 +30,7 @@ the lab that recorded it:
 * **Wakita et al. 2022** (*J. Mar. Sci. Technol.* 27:772-785, recurrent network): test runs
   random `16_24_25_3`, turn `15_06_53`, zig-zag `13_42_53` and three berthing runs.
 
-The lists live in one place, `benchmarks/studies/published_splits.py` (`SPLITS`).
+The lists live in one place, `jaxship/studies/published_splits.py` (`SPLITS`).
 
 * **The lab's simulator,** two ways: as published (`lab (Fujiwara wind)`: the lab's MMG
   coefficients, `reference/MMG_params_EssoOsaka3m.csv`, with Fujiwara et al.'s wind loads),
@@ -65,7 +65,7 @@ jax.config.update("jax_enable_x64", True)
 plt.rcParams["figure.dpi"] = 80  # eight wide figures: the notebook stays under 1 MB
 sys.path.insert(0, str(pathlib.Path.cwd().parent))  # the project root: benchmarks
 from benchmarks import published_splits as protocol  # noqa: E402
-from benchmarks.studies.published_splits import SPLITS, free_run, run_score  # noqa: E402
+from jaxship.studies.published_splits import SPLITS, free_run, run_score  # noqa: E402
 
 
 data = js.shared_data_dir()

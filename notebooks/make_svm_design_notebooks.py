@@ -7,18 +7,17 @@ import nbformat as nbf
 
 
 HERE = pathlib.Path(__file__).parent
-SETUP = "import pathlib\nimport sys\n\nimport jax\njax.config.update('jax_enable_x64', True)\nimport numpy as np\n"
+SETUP = "import jax\njax.config.update('jax_enable_x64', True)\nimport numpy as np\n"
 
 svm = nbf.v4.new_notebook()
 svm.cells = [
     nbf.v4.new_markdown_cell(
         "# Lu & Zhao (2008): four discrete response models, LS and SVR\n\n"
         "The four models of their eqs. 7-10 (continuous eqs. 1-4) fitted to a simulated "
-        "20/20 zig-zag of the Mariner (`svm_response_study` in `benchmarks/studies/svm.py`); overshoots "
+        "20/20 zig-zag of the Mariner (`svm_response_study` in `jaxship/studies/svm.py`); overshoots "
         "in the form of their Table 1, indices in the form of Tables 2-4, and prediction of "
         "an untrained 10/10 zig-zag and a 20 deg turning circle (sec. 3.2)."),
-    nbf.v4.new_code_cell(SETUP + "sys.path.insert(0, str(pathlib.Path.cwd().parent))  # the project root\n"
-                         "from benchmarks.studies.svm import svm_response_study\n"
+    nbf.v4.new_code_cell(SETUP + "from jaxship.studies.svm import svm_response_study\n"
                          "study = svm_response_study('mariner', dt=0.5)"),
     nbf.v4.new_markdown_cell("## Table 1: first and second overshoot [deg]"),
     nbf.v4.new_code_cell("for name, o1, o2 in study['table1']:\n"
@@ -45,9 +44,8 @@ design.cells = [
         "Nomoto 1 and 2 models of the thesis vessel at 500 rpm (least-squares fits to a "
         "noise-free simulation), a rate gyro with 0.05 deg/s white noise, every manoeuvre "
         "run for the same duration as the thesis manoeuvre (thesis sec. 3.3.2). "
-        "`design_study` in `benchmarks/studies/svm.py`, `jaxship.fisher_information`."),
-    nbf.v4.new_code_cell(SETUP + "sys.path.insert(0, str(pathlib.Path.cwd().parent))  # the project root\n"
-                         "from benchmarks.studies.svm import design_study\n"
+        "`design_study` in `jaxship/studies/svm.py`, `jaxship.fisher_information`."),
+    nbf.v4.new_code_cell(SETUP + "from jaxship.studies.svm import design_study\n"
                          "from jaxship import excitation_order\n"
                          "d = design_study('thesis', rpm=500.0)\nprint(d['nominal'])\n"
                          "print('duration', d['duration'], 's')"),

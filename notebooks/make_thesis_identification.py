@@ -5,7 +5,7 @@ Run: python notebooks/make_thesis_identification.py.
 The notebook reproduces the identification study of the thesis (Odegard 2009, chapter 4)
 on the built-in thesis vessel: Nomoto and Ross' autopilot model identified from single
 and merged experiments, fit % next to the thesis' numbers. The pipeline is
-`jaxship/cli/reproduction/thesis.py`.
+`jaxship/thesis/identification.py` (`jaxship.thesis.identification`).
 """
 
 import pathlib
@@ -49,7 +49,7 @@ import numpy as np
 import matplotlib.pyplot as plt
 from IPython.display import Markdown, display
 import jaxship as js
-from jaxship.cli.reproduction import thesis as ti
+from jaxship.thesis import identification as ti
 
 DEG = np.pi / 180
 vessel = js.get_vessel("thesis")

@@ -635,8 +635,8 @@ def test_ctrl_c_ends_the_command_with_130_at_once_every_time(tmp_path):
     import threading
     import time
 
-    from benchmarks.studies.discovery import hidden_effect_records
     from jaxship.cli import GRACE
+    from jaxship.studies.discovery import hidden_effect_records
 
     train, held = hidden_effect_records(js.Nomoto1(K=0.06, T=25.0), 0)
     paths = []

@@ -14,18 +14,6 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from benchmarks.studies.discovery import (
-    condition_records,
-    covered,
-    hidden_effect_records,
-    outcome,
-    race_records,
-    record,
-    run_case,
-    run_vessel_case,
-    vessel_records,
-    wind_records,
-)
 from jaxship import effects
 from jaxship._analysis._discover import _search as discover_search
 from jaxship._analysis._discover._holdout import cost_rise, record_indices
@@ -37,6 +25,18 @@ from jaxship._estimate._sensitivity import sensitivities
 from jaxship._estimate._windows import as_dataset
 from jaxship.cli import main
 from jaxship.cli._files import MANIFEST, staged_folder
+from jaxship.studies.discovery import (
+    condition_records,
+    covered,
+    hidden_effect_records,
+    outcome,
+    race_records,
+    record,
+    run_case,
+    run_vessel_case,
+    vessel_records,
+    wind_records,
+)
 
 
 DEG = np.pi / 180

@@ -454,7 +454,7 @@ def test_fit_recovers_the_wind_a_steering_model_feels_from_logged_wind():
     four headings): the wind's c2 and c1 (truth 0) within 3 robust standard errors; K
     and T within 2 % (1.2 and 1.4 % low here, with or without the wind: the noise's
     doing, as noiseless records give them to 1e-8)."""
-    from benchmarks.studies.discovery import wind_records
+    from jaxship.studies.discovery import wind_records
 
     truth = js.augment(js.Nomoto1(K=K, T=T), js.effects.ApparentWind(c2=3e-6))
     train, _ = wind_records(truth, 0)

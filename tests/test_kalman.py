@@ -271,7 +271,7 @@ def test_a_vessels_smoother_recovers_the_unlogged_drift_and_a_fit_needs_no_logge
     missing."""
     import equinox as eqx
 
-    from benchmarks.studies.discovery import vessel_records
+    from jaxship.studies.discovery import vessel_records
 
     mariner = js.get_vessel("mariner")
     logged, _ = vessel_records(mariner, 0)

@@ -9,14 +9,14 @@ import pytest
 
 import jaxship as js
 from benchmarks import published_splits as protocol
-from benchmarks.studies.published_splits import (
+from jaxship.studies.published_splits import (
     MIYAUCHI_2022,
     WAKITA_2022,
     free_run_score,
     lab_as_published,
     read_runs,
 )
-from benchmarks.studies.real_data import ESSO_TEST
+from jaxship.studies.real_data import ESSO_TEST
 
 
 DATA = js.shared_data_dir()

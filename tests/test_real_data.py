@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from benchmarks.studies.real_data import (
+from jaxship.studies.real_data import (
     ESSO_TEST,
     esso_osaka_split,
     hsva_split,
@@ -65,8 +65,8 @@ def test_the_kvlcc2_drift_is_recovered_from_the_track_without_a_logged_v():
     matches the logged v within 10 % of its spread (RMS difference 0.0004-0.0005 m/s
     on HSVA, whose v is derived from the track; 0.004 m/s on MARIN, v spreading
     0.08-0.13 m/s)."""
-    from benchmarks.studies.real_data import kvlcc2_discovery_split
     from jaxship._analysis._discover._forces import smoothed_vessel_states
+    from jaxship.studies.real_data import kvlcc2_discovery_split
 
     _, holdout = kvlcc2_discovery_split(DATA)
     records = [js.Experiment(e.t, e.delta, psi=e.psi, r=e.r, u=e.u, x=e.x, y=e.y, n=e.n,

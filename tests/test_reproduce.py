@@ -272,11 +272,11 @@ def test_ctrl_c_on_reproduce_ends_it_with_130_and_leaves_nothing_behind(tmp_path
 def test_the_discovery_case_records_are_the_discovery_tests_records():
     """`reproduce` draws its discovery case's records with its own copy of the generator
     (the package never imports benchmarks/): the same records, sample for sample, as the
-    discovery tests' `benchmarks.studies.discovery.hidden_effect_records` for one seed."""
+    discovery tests' `jaxship.studies.discovery.hidden_effect_records` for one seed."""
     import numpy as np
 
     import jaxship as js
-    from benchmarks.studies.discovery import hidden_effect_records as tests_records
+    from jaxship.studies.discovery import hidden_effect_records as tests_records
     from jaxship.thesis.discovery_case import hidden_effect_records
 
     truth = js.augment(js.Nomoto1(K=0.06, T=25.0), js.effects.YawCubicDamping(beta=300.0))

@@ -12,13 +12,6 @@ import pytest
 from helpers import per_sample
 
 import jaxship as js
-from benchmarks.studies.astrom import (
-    FREE,
-    TABLE3_START,
-    NoiseLevels,
-    simulate_disturbed,
-    zigzag_trial,
-)
 from jaxship import (
     AuxInputs,
     LinearSwayYaw,
@@ -29,6 +22,13 @@ from jaxship import (
 from jaxship._models._steering import WindowStart
 from jaxship._models._vessel._base import state_derivative
 from jaxship._models._vessel.sway_yaw import sea_stratus_linear, sea_stratus_nonlinear
+from jaxship.studies.astrom import (
+    FREE,
+    TABLE3_START,
+    NoiseLevels,
+    simulate_disturbed,
+    zigzag_trial,
+)
 
 
 DEG = np.pi / 180

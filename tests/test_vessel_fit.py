@@ -182,7 +182,7 @@ def test_fitting_the_positions_recovers_a_current():
     """x, y as outputs (GNSS positions, 1 m noise): the Mariner's zig-zags in a current
     of (0.3, -0.2) m/s north, east give it within 3 robust standard errors; through-water
     u, v, r, psi alone do not see it (the fit does not move from zero)."""
-    from benchmarks.studies.discovery import vessel_records
+    from jaxship.studies.discovery import vessel_records
 
     truth = js.augment(js.get_vessel("mariner"), js.effects.UniformCurrent(north=0.3, east=-0.2))
     train, _ = vessel_records(truth, 0, duration=400.0)
@@ -210,7 +210,7 @@ def test_over_ground_velocities_recover_a_current():
     give the current within 3 robust standard errors, with the positions and from u, v
     alone; the same numbers read as through the water give it 30 standard errors off
     with the positions (the hull fitted to unlike things) and nothing without them."""
-    from benchmarks.studies.discovery import vessel_records
+    from jaxship.studies.discovery import vessel_records
 
     current = np.array([-0.5, 0.35])
     truth = js.augment(js.get_vessel("mariner"), js.effects.UniformCurrent(*current))

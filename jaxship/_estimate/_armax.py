@@ -84,7 +84,7 @@ class ARMAXResult:
         """The continuous model whose zero-order-hold sampling this is, where the orders
         allow it (y = r, u = delta, nk = 1, needs `dt`): $n_a = n_b = 1$ gives Nomoto's
         first-order `K` [1/s], `T` [s]; $n_a = n_b = 2$ the second-order `K`, `T1`,
-        `T2`, `T3` (and `T` = T1 + T2 - T3), as `fit_discrete_response`'s
+        `T2`, `T3` (and `T` = T1 + T2 - T3), as `DiscreteResponse.regress`'s
         `continuous_parameters`. None for other orders or without `dt`; NaN entries
         where the poles have no real continuous counterpart."""
         if self.dt is None or self.nk != 1:

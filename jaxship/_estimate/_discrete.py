@@ -392,7 +392,7 @@ def _svr(x, y, C, epsilon, tol, max_iter):
 
 @dataclasses.dataclass(frozen=True)
 class DiscreteResponseFit:
-    """Result of `fit_discrete_response`: the discrete coefficients (Lu & Zhao eqs.
+    """Result of `DiscreteResponse.regress`: the discrete coefficients (Lu & Zhao eqs.
     7-10), the continuous indices (`continuous_parameters`), the sample interval `dt`
     [s], the estimation `method` (`LeastSquaresRegression` or `SupportVectorRegression`),
     whether the solver `converged`,
@@ -458,13 +458,13 @@ class DiscreteResponseFit:
                                  beta1=p["beta1"], delta0=p["delta_r"])
 
 
-def fit_discrete_response(structure: str, data, *,
-                          method: LeastSquaresRegression | SupportVectorRegression = (
-                              LeastSquaresRegression()),
-                          discretisation: Discretisation | None = None, rudder: str = "delta",
-                          alpha1: float = 1.0) -> DiscreteResponseFit:
-    """Fit one of Lu & Zhao's discrete response models (eqs. 7-10) to measured yaw
-    rate and rudder and convert it to the continuous indices (eqs. 1-4).
+def regress(structure: str, data, *,
+            method: LeastSquaresRegression | SupportVectorRegression = LeastSquaresRegression(),
+            discretisation: Discretisation | None = None, rudder: str = "delta",
+            alpha1: float = 1.0) -> DiscreteResponseFit:
+    """Regress one of Lu & Zhao's discrete response models (eqs. 7-10) on measured yaw
+    rate and rudder and convert it to the continuous indices (eqs. 1-4): the step of
+    `DiscreteResponse` (`jaxship.fit`'s estimator, and its `regress` method).
 
     **Arguments:**
 

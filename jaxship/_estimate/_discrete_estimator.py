@@ -4,7 +4,7 @@
 The model says which structure is fitted: `Nomoto1` the linear first-order model
 (Lu & Zhao 2008, eq. 7), `NonlinearNomoto` the nonlinear one (eq. 8), `Nomoto2` the
 linear second-order (eq. 9) and `nonlinear_nomoto2` the nonlinear second-order
-(eq. 10). The estimate is the equation-error fit of `fit_discrete_response` (least
+(eq. 10). The estimate is the equation-error fit of `DiscreteResponse.regress` (least
 squares or epsilon-SVR), converted to the continuous model's parameters; their
 covariance is the least-squares covariance of the discrete coefficients,
 $\\hat\\sigma^2(X^TX)^{-1}$ with $\\hat\\sigma^2 = \\mathrm{RSS}/(N - p)$, carried to the
@@ -30,7 +30,7 @@ from ._discrete import (
     LeastSquaresRegression,
     SupportVectorRegression,
     continuous_parameters,
-    fit_discrete_response,
+    regress,
     regressors,
 )
 from ._fit import AbstractEstimator, PredictionError
@@ -89,8 +89,8 @@ class DiscreteResponse(AbstractEstimator):
         ds = as_dataset(dataset)
         check_data(ds, self.rudder, ("r",))
         records = [_experiment(ds, i, self.rudder) for i in range(ds.num_experiments)]
-        res = fit_discrete_response(structure, records, method=self.method,
-                                    discretisation=self.discretisation, rudder="delta")
+        res = regress(structure, records, method=self.method,
+                      discretisation=self.discretisation, rudder="delta")
         fitted = res.to_steering()
         values = _PARAMETERS[structure](res.parameters)
         names = tuple(values)
@@ -112,6 +112,27 @@ class DiscreteResponse(AbstractEstimator):
             cost=0.5 * float(np.sum(((r - line) * mask) ** 2)), weights={"r": 1.0},
             window_samples=(1,), horizon=res.dt,
             criterion=f"equation error ({self.method.name}, Lu & Zhao {structure})")
+
+    def regress(self, structure, data, *, alpha1: float = 1.0) -> DiscreteResponseFit:
+        """Lu & Zhao's discrete model itself, the step `fit` converts to a model: the
+        equation-error regression (eqs. 7-10) of `structure` (`"linear1"`,
+        `"nonlinear1"`, `"linear2"`, `"nonlinear2"`, or a steering model of one of them,
+        as `fit` takes) on `data` (an `Experiment` or a list of them, one sample
+        interval; regressions never reach across records), with this estimator's
+        `method`, `discretisation` and `rudder`, `alpha1` the fixed linear coefficient
+        of `nonlinear2` (1 as in Lu & Zhao). Returns the discrete coefficients with their
+        continuous indices, Lu & Zhao's own quantities (`alpha1`, `alpha2`, `beta1`,
+        `delta_r`, `S_over_P`, ...), the equation-error RMS and whether the solver
+        converged; its `simulate` runs the difference equation and `to_steering` gives the
+        model `fit` returns. Use it for the discrete model (which exists also where the
+        second-order time constants are complex and `fit` has no model to return); fit
+        models with `jaxship.fit(model, data, estimator=DiscreteResponse(...))`.
+        **Raises** `ValueError` for bad arguments or data that do not excite the
+        coefficients (singular regression)."""
+        if not isinstance(structure, str):
+            structure = structure_of(structure)
+        return regress(structure, data, method=self.method, discretisation=self.discretisation,
+                       rudder=self.rudder, alpha1=alpha1)
 
     def predict(self, model, dataset) -> Prediction:
         """One-step-ahead predictions of r by the continuous `model` over each sample

@@ -106,7 +106,7 @@ class LevenbergMarquardt(optx.AbstractGaussNewton):
     place of `NielsenDamping`, whose gain ratio leaves the acceleration out of the
     prediction, turns it off): it pays where a fit walks a long curved valley
     (`benchmarks/fit.py`: 34 -> 20 steps, about 9 -> 6 s without compilation) and costs
-    where it does not (the KVLCC2 `identify` of `benchmarks/studies/real_data.py`: 87 ->
+    where it does not (the KVLCC2 `identify` of `jaxship/studies/real_data.py`: 87 ->
     85 steps, 25 -> 30 s, most of it compiling the extra residual evaluation).
 
     `damping` is the first step's $\\lambda$ in the fit's internal coordinates (the

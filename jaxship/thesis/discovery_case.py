@@ -4,7 +4,7 @@ a rudder rate limit of 2.3 deg/s, integrated more finely than any fit (0.02 s co
 steps against one RK4 step per 0.5 s sample), the rudder logged at the sample rate.
 Measurement noise: heading 0.1 deg, yaw rate 0.05 deg/s.
 
-The same records as the discovery tests' generator (`benchmarks/studies/discovery.py`,
+The same records as the discovery tests' generator (`jaxship/studies/discovery.py`,
 `hidden_effect_records` without a disturbance), which lives outside the package;
 tests/test_reproduce.py checks that the two agree sample for sample.
 """

@@ -19,7 +19,6 @@ import equinox as eqx
 import numpy as np
 
 import jaxship as js
-from jaxship import fit_discrete_response
 
 
 DEG = np.pi / 180.0
@@ -47,7 +46,7 @@ def _overshoots(t, psi, delta, switch):
 
 
 def discrete_zigzag(fit, angle, switch, dt, num, *, rudder_rate=None):
-    """The discrete model `fit` (a `DiscreteResponseFit`, sample interval `dt`) through
+    """The discrete model `fit` (`DiscreteResponse.regress`'s, sample interval `dt`) through
     a starboard-first zig-zag `angle`/`switch` [rad] from rest: the rudder order
     reverses when the heading change passes `switch` (as `ZigZag`), the actual
     rudder follows at `rudder_rate` [rad/s] and is held over each interval; heading
@@ -88,9 +87,10 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
     **Arguments:** `vessel` (name or vessel), `rpm` (None: nominal approach),
     sample interval `dt` [s], record length in units of L/U, white noise `noise_r`
     [rad/s] added to the training yaw rate, `methods`, `svr_options` (keywords of
-    `fit_discrete_response`).
+    `SupportVectorRegression`).
 
-    **Returns** a dict: `"fits"` {(structure, method): DiscreteResponseFit},
+    **Returns** a dict: `"fits"` {(structure, method): the discrete model,
+    `DiscreteResponse(method=...).regress(structure, record)`},
     `"table1"` rows (name, o1 [deg], o2 [deg]) for the test and each model (the
     continuous model simulated through the closed-loop zig-zag with the vessel's
     rudder rate; NaN where the fit has no real positive time constants),
@@ -120,7 +120,7 @@ def svm_response_study(vessel="mariner", *, rpm=None, dt=0.5, duration_lengths=4
         strategy = (js.SupportVectorRegression(**(svr_options or {})) if method == "svr"
                     else js.LeastSquaresRegression())
         for s in STRUCTURES:
-            fits[(s, method)] = fit_discrete_response(s, train, method=strategy)
+            fits[(s, method)] = js.DiscreteResponse(method=strategy).regress(s, train)
     test = records["zigzag 20/20"]
     table1 = [("test",) + _overshoots(test.t, test.psi, test.delta, 20 * DEG)]
     table1_discrete = []
@@ -173,8 +173,8 @@ def design_study(vessel="thesis", *, rpm=500.0, dt=0.5, noise_r=0.05 * DEG, dura
     rate = float(v.rudder.max_rate)
     rec = [_run(v, js.ZigZag(20 * DEG, 20 * DEG, duration=600.0, dt=dt), x0),
            _run(v, thesis, x0)]
-    n1 = fit_discrete_response("linear1", rec).to_steering()
-    n2 = fit_discrete_response("linear2", rec).to_steering()
+    n1 = js.DiscreteResponse().regress("linear1", rec).to_steering()
+    n2 = js.DiscreteResponse().regress("linear2", rec).to_steering()
     n1 = eqx.tree_at(lambda m: m.delta0, n1, 0.0)
     n2 = eqx.tree_at(lambda m: m.delta0, n2, 0.0)
     manoeuvres = {
