@@ -145,7 +145,6 @@ PENDING_CONVERSION = {
     # moves to jaxship.studies.published_splits once it calls js.identify
     "notebooks/published_splits.ipynb",
     "notebooks/make_published_splits.py",
-    "notebooks/kvlcc2_simman.ipynb",  # imports benchmarks/kvlcc2_simman.py via sys.path
 }
 COMMAND_NAMES = {"vessels", "simulate", "reproduce", "identify", "autopilot", "discover"}
 
