@@ -4,7 +4,8 @@ must stay the same (issue 68: the command a shell over the library, same numbers
 
 Written at commit 91cbe21 (before the trials moved into the library) with
 `python tests/golden/simulate_cases.py tests/golden/simulate.json`, run from a checkout
-of that commit (`git worktree add /tmp/base 91cbe21`; this file copied there);
+of that commit (`git worktree add /tmp/base 91cbe21`; this file copied there; the
+temporary folder in the heading of the band case's `criteria.md` then written `TMP`);
 `tests/test_simulate_golden.py` reruns the cases and compares.
 """
 
@@ -76,5 +77,8 @@ if __name__ == "__main__":
 
     commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
                             check=True).stdout.strip()
-    golden = {"how": __doc__.strip(), "commit": commit, "cases": run_all()}
+    import importlib.metadata
+
+    golden = {"how": __doc__.strip(), "commit": commit,
+              "jaxlib": importlib.metadata.version("jaxlib"), "cases": run_all()}
     pathlib.Path(sys.argv[1]).write_text(json.dumps(golden, indent=1) + "\n")
