@@ -158,6 +158,11 @@ from . import (
 )
 
 
+# isort: split
+# the workflow's verbs, last: their modules `import jaxship as js` at module level
+from ._workflow._trials import StandardTrial as StandardTrial
+
+
 # The public names, grouped by layer as in docs/architecture.md (`# -- layer`); a
 # `# page: section` line puts the names after it in that section of docs/api/<page>.md
 # (docs/api_pages.py generates the entries of the API pages from every `__all__`).
@@ -232,6 +237,8 @@ __all__ = [
     "thesis_manoeuvre",
     "heading_perturbations",
     "Replay",
+    # manoeuvres: Standard trials
+    "StandardTrial",
     # manoeuvres: Controllers
     "AbstractController",
     "Controlled",

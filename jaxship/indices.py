@@ -5,7 +5,9 @@ measured `Trajectory`, in SI units and radians:
     traj = js.simulate(js.get_vessel("mariner"), js.Turn(0.61, duration=600.0, dt=0.5))
     js.indices.turning_indices(traj).tactical_diameter
 
-`batch_turning_indices` is the jittable form for `simulate_batch(..., output=)`.
+`check_imo` runs a vessel's IMO trials and checks the criteria, with the band of an
+identification's standard errors. `batch_turning_indices` is the jittable form for
+`simulate_batch(..., output=)`.
 """
 
 from ._analysis._indices import (
@@ -22,6 +24,7 @@ from ._analysis._indices import (
     zigzag_indices as zigzag_indices,
 )
 from ._simulation._batch import batch_turning_indices as batch_turning_indices
+from ._workflow._imo import ImoCheck as ImoCheck, check_imo as check_imo
 
 
 __all__ = [
@@ -37,6 +40,9 @@ __all__ = [
     "stopping_indices",
     "imo_criteria",
     "format_table",
+    # analysis: The IMO check
+    "check_imo",
+    "ImoCheck",
     # simulation: Batches
     "batch_turning_indices",
 ]

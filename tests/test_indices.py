@@ -16,7 +16,6 @@ from jaxship._analysis._indices import (
     imo_overshoot_limits_deg,
     loop_width,
 )
-from jaxship._workflow._trials import run_spec, trial_indices
 from jaxship.indices import (
     format_table,
     imo_criteria,
@@ -413,8 +412,10 @@ def test_kvlcc2_direct_spiral_shows_its_loop():
     # the simulated trial (`jaxship simulate --manoeuvre spiral`): finer steps near
     # midships; the loop of this MMG model lies between about 0 and 0.5 deg of rudder
     vessel = js.get_vessel("kvlcc2")
-    manoeuvre, traj = run_spec(vessel, "spiral")
-    indices = trial_indices("spiral", manoeuvre, traj)
+    trial = js.StandardTrial.parse("spiral")
+    manoeuvre, x0 = trial.sized(vessel)
+    traj = js.simulate(vessel, manoeuvre, x0, simulator=trial.simulator)
+    indices = trial.indices(manoeuvre, traj)
     hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
     curve = spiral_curve(traj, hold=hold)
     assert curve.r.size == 29 and len(indices["r_deg_s"]) == 29  # every level
@@ -604,7 +605,7 @@ def test_stop_and_pull_out_of_a_simulated_stable_ship(toy):
 
 def test_direct_spiral_of_a_stable_ship_has_no_loop(toy):
     x0 = js.straight_run(toy)
-    traj = js.simulate(toy, js.spiral(10 * DEG, 2 * DEG, hold=400.0, dt=1.0), x0)
+    traj = js.simulate(toy, js.spiral(400.0, levels=np.arange(10, 0, -2) * DEG, dt=1.0), x0)
     curve = spiral_curve(traj, hold=400.0)
     levels = np.concatenate([np.arange(10, -11, -2), np.arange(-8, 11, 2)]) * DEG
     np.testing.assert_allclose(curve.delta, levels, atol=1e-12)

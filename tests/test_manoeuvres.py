@@ -9,7 +9,7 @@ from helpers import linear_test_vessel
 
 import jaxship as js
 from jaxship._analysis._indices import reverse_spiral_curve
-from jaxship._workflow._trials import linear_yaw, run_spec, trial_indices, yaw_rate_gains
+from jaxship._workflow._trials import linear_yaw, yaw_rate_gains
 
 
 AT_SAMPLES = js.Simulator(max_step=math.inf)  # controllers act at the output samples
@@ -60,7 +60,7 @@ def test_turn_orders_the_rudder_at_execute(vessel, x0):
 
 
 def test_spiral_staircase():
-    m = js.spiral(10 * DEG, 5 * DEG, hold=50.0, dt=1.0)
+    m = js.spiral(50.0, levels=np.array([10, 5]) * DEG, dt=1.0)
     levels = np.array([10, 5, 0, -5, -10, -5, 0, 5, 10]) * DEG
     assert m.duration == 9 * 50.0 and m.num_samples == 451
     tau = np.arange(m.num_samples) * 1.0
@@ -328,7 +328,7 @@ def test_reverse_spiral_trial_reaches_every_level_across_the_direct_range(name):
     # for the KVLCC2, against +-0.6 and +-3 in the direct spiral) and the last one was
     # dropped (7 of 8 reported)
     vessel = js.get_vessel(name)
-    manoeuvre, traj = run_spec(vessel, "reverse-spiral")  # the CLI's trial spec
+    manoeuvre, traj = run_trial(vessel, "reverse-spiral")  # the CLI's trial spec
     assert isinstance(manoeuvre, js.ReverseSpiral)
     curve = js.indices.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
     ordered = np.asarray(manoeuvre.rates)
@@ -340,12 +340,19 @@ def test_reverse_spiral_trial_reaches_every_level_across_the_direct_range(name):
     r_port_max, r_stbd_max = _direct_range(vessel, x0, tau, float(manoeuvre.dt))
     assert np.ptp(curve.r) >= 0.5 * (r_port_max - r_stbd_max)
     assert np.all(np.abs(np.asarray(traj.command.delta)) <= vessel.rudder.max_angle + 1e-12)
-    indices = trial_indices("reverse-spiral", manoeuvre, traj)
+    indices = js.StandardTrial.parse("reverse-spiral").indices(manoeuvre, traj)
     assert len(indices["r_deg_s"]) == 12
     if name == "kvlcc2":  # course-unstable: the S-curve has a loop between its branches
         assert curve.loop.width > np.deg2rad(0.1) and curve.loop.height > np.deg2rad(0.5)
     else:
         assert curve.loop.width == 0.0
+
+
+def run_trial(vessel, spec):
+    """`(manoeuvre, trajectory)` of `jaxship simulate --manoeuvre spec` on `vessel`."""
+    trial = js.StandardTrial.parse(spec)
+    manoeuvre, x0 = trial.sized(vessel)
+    return manoeuvre, js.simulate(vessel, manoeuvre, x0, simulator=trial.simulator)
 
 
 def test_linear_yaw_and_gains_place_the_poles():
@@ -367,7 +374,7 @@ def test_crash_stop_trial_ends_when_the_ship_has_stopped():
     # issue 13: the KVLCC2 kept going full astern after it had stopped and spun at
     # -4 deg/s to a heading of -1534 deg
     vessel = js.get_vessel("kvlcc2")
-    manoeuvre, traj = run_spec(vessel, "stop")  # the CLI's trial spec
+    manoeuvre, traj = run_trial(vessel, "stop")  # the CLI's trial spec, ended at the stop
     ind = js.indices.stopping_indices(traj)
     t = np.asarray(traj.t)
     assert t[-1] <= ind.execute_time + 1.1 * ind.time_to_stop + 3 * float(manoeuvre.dt)
@@ -376,8 +383,10 @@ def test_crash_stop_trial_ends_when_the_ship_has_stopped():
     assert np.max(np.abs(np.asarray(traj.state.r))) < 0.05 * DEG
     assert np.max(np.abs(np.asarray(traj.state.psi))) < 1.0 * DEG
     np.testing.assert_array_equal(np.asarray(traj.command.n)[after][1:], 0.0)
-    # run for the whole default duration: it stays stopped (no astern run, no spin)
-    long = js.simulate(vessel, manoeuvre, js.straight_run(vessel))
+    assert manoeuvre.num_samples == t.size  # the sized trial ends where the run does
+    # run on for long after: it stays stopped (no astern run, no spin)
+    longer = js.Stop(manoeuvre.astern_n, duration=10 * ind.time_to_stop, dt=manoeuvre.dt)
+    long = js.simulate(vessel, longer, js.straight_run(vessel))
     t, u = np.asarray(long.t), np.asarray(long.state.u)
     stopped = t >= ind.execute_time + ind.time_to_stop
     assert t[-1] > 5 * ind.time_to_stop

@@ -13,10 +13,10 @@ import sys
 
 import pytest
 
+import jaxship as js
 import jaxship.cli as cli
 from jaxship._models._vessel.catalogue import get_vessel
 from jaxship._workflow._identify import MODELS
-from jaxship._workflow._trials import TrialSpec
 from jaxship.cli import main
 
 
@@ -114,7 +114,7 @@ def test_every_table_example_parses(argv, monkeypatch):
     if getattr(args, "vessel", None) and not args.vessel.endswith(("result.json", ".toml")):
         get_vessel(args.vessel)
     if getattr(args, "manoeuvre", None) and args.manoeuvre != "imo":
-        TrialSpec.parse(args.manoeuvre)
+        js.StandardTrial.parse(args.manoeuvre)
     if args.command in ("identify", "discover"):
         assert args.model in MODELS, args.model
 
@@ -124,7 +124,7 @@ def test_the_manoeuvres_the_readme_names_parse():
     forms = re.findall(r"`([a-z0-9-]+(?::[-0-9/]+)?)`", sentence)
     assert len(forms) >= 5, sentence
     for form in forms:
-        TrialSpec.parse(form)
+        js.StandardTrial.parse(form)
 
 
 def test_the_cheap_examples_run(tmp_path, capsys):

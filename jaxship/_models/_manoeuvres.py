@@ -303,14 +303,24 @@ def _staircase(levels, durations):
     return np.repeat(edges, 2)[1:-1], np.repeat(levels, 2)
 
 
-def spiral(max_angle=np.deg2rad(25), step=np.deg2rad(5), hold=300.0, *, dt=0.1, n=None):
-    """Direct (Dieudonne) spiral: `max_angle` down to `-max_angle` and back in `step`s,
-    each held `hold` s (MSC/Circ.1053 app. 4; steady yaw rate read at the end of each)."""
-    k = int(round(max_angle / step))
-    down = np.arange(k, -k - 1, -1) * step
-    levels = np.concatenate([down, down[::-1][1:]])
-    times, angles = _staircase(levels, hold)
-    return Schedule(times, angles, duration=float(times[-1]), dt=dt, n=n)
+# direct spiral levels [rad]: 25 deg to either side in 5 deg steps, finer near midships
+# where the loop of a course-unstable ship lies (MSC/Circ.1053 app. 4 2.1.5)
+SPIRAL_LEVELS = tuple(np.deg2rad((25.0, 20.0, 15.0, 10.0, 5.0, 2.0, 1.0)).tolist())
+
+
+def spiral(hold=300.0, *, levels=SPIRAL_LEVELS, dt=0.1, n=None):
+    """Direct (Dieudonne) spiral (MSC/Circ.1053 app. 4 2.1; ITTC 7.5-04-02-01 2.2.4): the
+    rudder at each of `levels` [rad] (the positive ones; default 25, 20, 15, 10, 5, 2 and
+    1 deg) to starboard, then midships, the same to port and back up, each held `hold`
+    [s] (the steady yaw rate is read at the end of each). `jaxship simulate --manoeuvre
+    spiral` holds each level 30 L/U (`StandardTrial`)."""
+    side = np.asarray(levels, dtype=float)
+    side = np.sort(side[side > 0])[::-1]
+    down = np.concatenate([side, [0.0], -side[::-1]])
+    steps = np.concatenate([down, down[::-1][1:]])
+    edges = hold * np.arange(steps.size + 1)
+    times = np.repeat(edges, 2)[1:-1]
+    return Schedule(times, np.repeat(steps, 2), duration=float(edges[-1]), dt=dt, n=n)
 
 
 def pull_out(angle=np.deg2rad(20), turn_time=300.0, release_time=300.0, *, dt=0.1, n=None):
@@ -438,7 +448,7 @@ class ReverseSpiral(AbstractManoeuvre):
     $\\dot r = -a r + b\\delta$ its closed loop is $s^2 + (a + bK_d)s + bK_p$.
     `jaxship simulate` places those poles from the vessel's linearised yaw dynamics
     and sizes the rates from its steady turn at the direct spiral's largest rudder
-    angle (`jaxship.cli._trials.reverse_spiral`).
+    angle (`jaxship.StandardTrial`).
     """
 
     rates: ArrayLike  # r_ref levels [rad/s]

@@ -1,7 +1,8 @@
-"""`jaxship simulate --manoeuvre imo`: the IMO MSC.137(76) trials of a vessel (the 35 deg
-turn, the 10/10 and 20/20 zig-zags and, with a propeller, the full-astern stop), each
-criterion met or not with its margin, and the band of each index that the parameters'
-standard errors give (`simulate_batch` over parameter draws)."""
+"""The IMO check (`js.indices.check_imo`, what `jaxship simulate --manoeuvre imo` runs): the
+IMO MSC.137(76) trials of a vessel (the 35 deg turn, the 10/10 and 20/20 zig-zags and,
+with a propeller, the full-astern stop), each criterion met or not with its margin, and
+the band of each index that the parameters' standard errors give (`simulate_batch` over
+parameter draws)."""
 
 import dataclasses
 
@@ -10,38 +11,20 @@ import numpy as np
 
 import jaxship as js
 
-from .._models._vessel._base import surge_force
-from ._trials import (
-    TrialSpec,
-    initial_state,
-    run_spec,
-    spec_text,
-    trial_criteria,
-    trial_marks,
-)
+from ._trials import StandardTrial, _cut_at_stop, _size, initial_state, length_over_speed
 
 
 DRAWS = 64  # parameter draws of the band
 LEVEL = 0.9  # the band: the central 90 % of the draws' values
 SEED = 0
-SIMULATOR = js.Simulator(substeps=2)  # as `run_spec`'s
-
-
-def imo_specs(vessel) -> tuple[TrialSpec, ...]:
-    """The trials of MSC.137(76) 5.3 for `vessel`: the stop only where it has a
-    propeller model (astern thrust differs from ahead)."""
-    specs = [TrialSpec.parse(s) for s in ("turn:35", "zigzag:10/10", "zigzag:20/20")]
-    u, n = float(vessel.nominal_speed), float(vessel.nominal_n)
-    if n and float(surge_force(vessel, u, n) - surge_force(vessel, u, -n)) != 0.0:
-        specs.append(TrialSpec.parse("stop"))
-    return tuple(specs)
 
 
 @dataclasses.dataclass(frozen=True)
 class ImoCheck:
-    """The criteria rows (`CriterionRow`), the runs `{spec text: (manoeuvre, trajectory,
-    marks)}` and the band: `bands` `{criterion: (low, high)}`, `passed` `{criterion:
-    fraction of the draws that meet it}`, `draws` (how many, from what)."""
+    """The IMO check of `check_imo`: the criteria `rows` (`CriterionRow`: value, limit,
+    met), the `runs` `{trial as written: (manoeuvre, trajectory, marks)}` and the band:
+    `bands` `{criterion: (low, high)}`, `passed` `{criterion: fraction of the draws that
+    meet it}`, `draws` (how many, how many ran, from what). `str()` is `table()`."""
 
     rows: list
     runs: dict
@@ -67,6 +50,16 @@ class ImoCheck:
                          f"{row.unit} | {row.limit - row.value:+.2f} {row.unit} | {band} | "
                          f"{'yes' if row.passed else 'NO'} |")
         return "\n".join(lines) + "\n"
+
+    def __str__(self) -> str:
+        return self.table()
+
+    def to_markdown(self, title: str) -> str:
+        """The check as `criteria.md` holds it: a heading with `title`, the table, and
+        what the band was drawn from."""
+        return (f"# IMO MSC.137(76) criteria: {title}\n\n{self.table()}\nBand: the central "
+                f"{self.draws['level']:.0%} of {self.draws['used']} of {self.draws['draws']} "
+                f"parameter draws from {self.draws['from']}.\n")
 
 
 def parameter_draws(report, rng) -> tuple[tuple, np.ndarray, str]:
@@ -106,21 +99,33 @@ def _float(value) -> float:
         return np.inf
 
 
-def check_imo(vessel, *, report=None, speed=None, rpm=None) -> ImoCheck:
-    """Run the IMO trials of `vessel` (`imo_specs`), check the criteria, and with the
-    identify `report` propagate its standard errors to a band on each criterion."""
-    runs, rows = {}, []
-    for spec in imo_specs(vessel):
-        manoeuvre, traj = run_spec(vessel, spec, speed=speed, rpm=rpm)
+def check_imo(model, *, identification=None, speed=None, rpm=None) -> ImoCheck:
+    """Run the IMO MSC.137(76) 5.3 trials of the vessel `model` (`StandardTrial.imo`,
+    each sized by `StandardTrial.sized`) from the straight run at `speed` [m/s] and/or
+    `rpm` (nominal if neither), check each criterion (`js.indices.imo_criteria`: value,
+    limit, margin = limit - value, met), and with `identification` (an identification
+    result, anything with `to_dict()`, or the dict of its `result.json`) give each
+    criterion its band: the central 90 % of its values over 64 parameter draws from
+    the fit's covariance $D C D$ (std and correlation; seed 0), each draw run through
+    every trial at once (`js.simulate_batch`)."""
+    report = identification.to_dict() if callable(getattr(identification, "to_dict", None)) \
+        else identification
+    runs, batch, rows = {}, {}, []
+    x0 = initial_state(model, speed=speed, rpm=rpm)
+    tau = length_over_speed(model, x0)
+    for trial in StandardTrial.imo(model):
+        manoeuvre, traj = _size(trial, model, x0, tau, duration=None, dt=None)
+        traj = js.simulate(model, manoeuvre, x0, simulator=StandardTrial.simulator) \
+            if traj is None else _cut_at_stop(traj) if trial.kind == "stop" else traj
         if not bool(traj.success):
-            raise ValueError(f"the {spec.kind} trial failed (non-finite state).")
-        marks = trial_marks(spec, manoeuvre, traj)
-        runs[spec] = (manoeuvre, traj, marks)
-        rows += trial_criteria(spec, vessel, traj, marks)
+            raise ValueError(f"the {trial.kind} trial failed (non-finite state).")
+        marks = trial.marks(manoeuvre, traj)
+        runs[str(trial)], batch[trial] = (manoeuvre, traj, marks), manoeuvre
+        rows += trial.criteria(model, traj, marks)
     names, draws, how = parameter_draws(report, np.random.default_rng(SEED))
     bands, passed, used = {}, {}, 0
     if names:
-        values, used = _drawn_criteria(vessel, names, draws, runs, speed=speed, rpm=rpm)
+        values, used = _drawn_criteria(model, names, draws, batch, speed=speed, rpm=rpm)
         for criterion, (found, met) in values.items():
             if not found.size:
                 continue
@@ -129,12 +134,13 @@ def check_imo(vessel, *, report=None, speed=None, rpm=None) -> ImoCheck:
             passed[criterion] = float(np.mean(met))
     info = {"draws": DRAWS if names else 0, "used": used, "level": LEVEL, "from": how,
             "parameters": list(names), "seed": SEED}
-    return ImoCheck(rows, {spec_text(s): r for s, r in runs.items()}, bands, passed, info)
+    return ImoCheck(rows, runs, bands, passed, info)
 
 
-def _drawn_criteria(vessel, names, draws, runs, *, speed, rpm):
+def _drawn_criteria(vessel, names, draws, batch, *, speed, rpm):
     """`({criterion: (values, met or not)}, how many)` of the draws that ran every trial:
-    each trial of `runs` simulated at once for every parameter draw (`simulate_batch`)."""
+    each manoeuvre of `batch` `{trial: manoeuvre}` simulated at once for every parameter
+    draw (`simulate_batch`; a stop for its whole duration)."""
     vessels = [vessel.with_parameters(dict(zip(names, row))) for row in draws]
     nominal = initial_state(vessel, speed=speed, rpm=rpm)
     starts, ran = [], np.ones(len(vessels), bool)
@@ -144,14 +150,15 @@ def _drawn_criteria(vessel, names, draws, runs, *, speed, rpm):
         except ValueError:
             starts.append(nominal)
             ran[k] = False
-    x0, batch, found = js.stack(starts), js.stack(vessels), {}
-    for spec, (manoeuvre, _, _) in runs.items():
+    x0, stacked, found = js.stack(starts), js.stack(vessels), {}
+    for trial, manoeuvre in batch.items():
         trajs = jax.tree.map(np.asarray, js.simulate_batch(
-            batch, manoeuvre, x0, in_axes=(0, None, 0, None), simulator=SIMULATOR))
+            stacked, manoeuvre, x0, in_axes=(0, None, 0, None),
+            simulator=StandardTrial.simulator))
         for k, v in enumerate(vessels):
             traj = jax.tree.map(lambda a, k=k: a[k], trajs)
-            marks = trial_marks(spec, manoeuvre, traj) if traj.success else None
-            rows = trial_criteria(spec, v, traj, marks)
+            marks = trial.marks(manoeuvre, traj) if traj.success else None
+            rows = trial.criteria(v, traj, marks)
             ran[k] &= bool(rows)
             for row in rows:
                 found.setdefault(row.criterion, {})[k] = (row.value, row.passed)

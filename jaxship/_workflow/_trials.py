@@ -1,11 +1,13 @@
-"""Trial specifications such as `turn:35` or `zigzag:-10/10`, and running them.
+"""The standard trials of a vessel (`StandardTrial`): specs such as `turn:35` or
+`zigzag:-10/10`, sized for the vessel, and their indices.
 
 Specs are strings in degrees, as written on the command line (`jaxship simulate
 --manoeuvre`). Durations default to multiples of the vessel's time scale L/U so that the same
-spec suits a 4 m model and a 160 m ship.
+spec suits a 4 m model and a 160 m ship; this module is the one place of that rule.
 """
 
 import dataclasses
+from typing import ClassVar
 
 import jax
 import jax.numpy as jnp
@@ -13,7 +15,7 @@ import numpy as np
 
 import jaxship as js
 
-from .. import Simulator, simulate, straight_run, straight_state
+from .. import AbstractVessel, Simulator, simulate, straight_run, straight_state
 from .._models._vessel._base import surge_force
 
 
@@ -22,71 +24,74 @@ SPEC_HELP = (
     "reverse-spiral, pullout:ANGLE, stop, prbs:AMPLITUDE, 3211:AMPLITUDE, thesis, "
     "heading-steps:AMPLITUDE (angles in degrees)"
 )
+# how many values each kind takes (pullout, prbs and 3211 may take none: their defaults)
+VALUES = {"turn": 1, "zigzag": 2, "spiral": 0, "reverse-spiral": 0, "pullout": 1, "stop": 0,
+          "prbs": 1, "3211": 1, "thesis": 0, "heading-steps": 1}
 
 
 @dataclasses.dataclass(frozen=True)
-class TrialSpec:
-    """A parsed trial specification (angles in degrees as written)."""
+class StandardTrial:
+    """A standard trial as `jaxship simulate --manoeuvre` names it (`StandardTrial.parse(
+    "zigzag:20/20")`: `kind` and `values`, angles in degrees as written), sized for a
+    vessel by one rule (`sized`) and read by its indices (`indices`, `marks`, `criteria`).
+
+    The size: durations in multiples of the time scale $\\tau = L/U$ (a turn 60 $\\tau$,
+    extended until it has turned 540 deg (ITTC 7.5-04-02-01 2.2.1); a zig-zag 35
+    $\\tau$; a spiral's levels `js.spiral`'s, each held 30 $\\tau$; a pull-out 30
+    $\\tau$ turning, 30 $\\tau$ released; a stop 80 $\\tau$, ended when the ship lies
+    stopped (ITTC 2.2.7); a PRBS 100 $\\tau$ with a bit every 2 $\\tau$; a 3-2-1-1 in
+    units of $\\tau$, 30 $\\tau$ in all; heading steps every 10 $\\tau$ for 80 $\\tau$),
+    the sample interval about $\\tau/20$ (1, 2 or 5 times a power
+    of ten). `js.simulate(vessel, *trial.sized(vessel), simulator=trial.simulator)` is
+    the trajectory of `jaxship simulate`.
+    """
 
     kind: str
     values: tuple[float, ...] = ()
+    # the trials' numerics: at least two RK4 steps per sample
+    simulator: ClassVar[Simulator] = Simulator(substeps=2)
+    # the kinds a steering model runs (it has no track, speed or propeller)
+    steering_kinds: ClassVar[tuple[str, ...]] = ("zigzag", "prbs", "3211", "heading-steps",
+                                                  "thesis")
 
     @classmethod
-    def parse(cls, text: str) -> "TrialSpec":
+    def parse(cls, text: str) -> "StandardTrial":
+        """The trial of `text` (`turn:35`, `zigzag:-10/10`, `spiral`, ...). **Raises**
+        `ValueError` for an unknown kind or values it cannot take."""
         kind, _, rest = text.strip().lower().partition(":")
-        expected = {
-            "turn": 1,
-            "zigzag": 2,
-            "spiral": 0,
-            "reverse-spiral": 0,
-            "pullout": 1,
-            "stop": 0,
-            "prbs": 1,
-            "3211": 1,
-            "thesis": 0,
-            "heading-steps": 1,
-        }
-        if kind not in expected:
+        if kind not in VALUES:
             raise ValueError(f"Unknown manoeuvre {text!r}; use one of: {SPEC_HELP}.")
         try:
             values = tuple(float(v) for v in rest.split("/")) if rest else ()
         except ValueError:
             raise ValueError(f"Manoeuvre {text!r}: values must be numbers in degrees.") from None
-        if len(values) != expected[kind] and not (
-            kind in ("pullout", "prbs", "3211") and not values
-        ):
+        if len(values) != VALUES[kind] and not (kind in ("pullout", "prbs", "3211")
+                                                and not values):
             raise ValueError(
-                f"Manoeuvre {text!r} takes {expected[kind]} value(s); use one of: {SPEC_HELP}."
+                f"Manoeuvre {text!r} takes {VALUES[kind]} value(s); use one of: {SPEC_HELP}."
             )
         for value in values:
             if not np.isfinite(value):
                 raise ValueError(f"Manoeuvre {text!r}: values must be finite numbers in degrees, "
                                  f"got {value:g}.")
-        spec = cls(kind, values)
-        for angle in spec.rudder_angles:
-            if abs(angle) > 90:
-                raise ValueError(f"Manoeuvre {text!r}: the rudder angle {angle:g} deg is beyond "
-                                 "90 deg; give a rudder angle in degrees within the vessel's "
-                                 "limit (e.g. 35).")
-        if kind == "zigzag" and values[0] == 0:
-            raise ValueError(f"Manoeuvre {text!r}: the rudder angle must not be 0 (e.g. "
-                             "zigzag:20/20, or zigzag:-20/20 to port first).")
-        if kind == "zigzag" and not 0 < values[1] < 180:
-            raise ValueError(f"Manoeuvre {text!r}: the heading change must be positive and below "
-                             "180 deg (e.g. zigzag:20/20).")
-        if kind in ("pullout", "3211") and values and values[0] == 0:
-            raise ValueError(f"Manoeuvre {text!r}: the rudder angle must not be 0.")
-        if kind == "prbs" and values and values[0] <= 0:
-            raise ValueError(f"Manoeuvre {text!r}: the amplitude must be positive (the sequence "
-                             "takes both signs).")
-        if kind == "heading-steps" and not 0 < values[0] <= 180:
-            raise ValueError(f"Manoeuvre {text!r}: the heading amplitude must be positive and at "
-                             "most 180 deg (the steps take both signs).")
-        return spec
+        trial = cls(kind, values)
+        _check_values(trial, text)
+        return trial
+
+    @classmethod
+    def imo(cls, vessel) -> tuple["StandardTrial", ...]:
+        """The trials of IMO MSC.137(76) 5.3 for `vessel`: the 35 deg turn, the 10/10 and
+        20/20 zig-zags and the stop, the stop only where `vessel` has a propeller model
+        (astern thrust differs from ahead)."""
+        trials = [cls.parse(s) for s in ("turn:35", "zigzag:10/10", "zigzag:20/20")]
+        u, n = float(vessel.nominal_speed), float(vessel.nominal_n)
+        if n and float(surge_force(vessel, u, n) - surge_force(vessel, u, -n)) != 0.0:
+            trials.append(cls.parse("stop"))
+        return tuple(trials)
 
     @property
     def rudder_angles(self) -> tuple[float, ...]:
-        """The rudder angles [deg] the spec orders (its own or the defaults), for checks
+        """The rudder angles [deg] the trial orders (its own or the defaults), for checks
         against a vessel's rudder limit; heading values are not included."""
         if self.kind in ("turn", "zigzag"):
             return self.values[:1]
@@ -96,43 +101,184 @@ class TrialSpec:
             return self.values or (10.0,)
         return ()
 
+    def __str__(self) -> str:
+        """The trial as written: `turn:35`, `zigzag:10/10`, `spiral`."""
+        values = "/".join(f"{v:g}" for v in self.values)
+        return f"{self.kind}:{values}" if values else self.kind
 
-def build_manoeuvre(spec: TrialSpec, vessel, x0, *, duration=None, dt=None):
-    """The manoeuvre for `spec` on `vessel` starting from `x0`."""
-    speed = float(np.hypot(x0.u, x0.v)) or float(vessel.nominal_speed)
-    tau = float(vessel.length) / speed  # L/U [s]
+    def sized(self, model, *, speed=None, rpm=None, duration=None, dt=None,
+              time_scale=None) -> tuple:
+        """`(manoeuvre, x0)`: the trial sized for `model` (see the class) from the straight
+        run at `speed` [m/s] and/or `rpm` (the nominal one if neither); `duration` and
+        `dt` [s] replace the rule's (a turn is then not extended, a stop not ended).
+
+        A steering model has no length, speed or propeller: give `time_scale` [s] (L/U)
+        and `duration`; `x0` is then None (at rest) and only the kinds of
+        `steering_kinds` run."""
+        if isinstance(model, AbstractVessel):
+            x0 = initial_state(model, speed=speed, rpm=rpm)
+            tau = length_over_speed(model, x0)
+        elif self.kind not in self.steering_kinds or time_scale is None or duration is None:
+            raise ValueError(f"a {type(model).__name__} steering model has no track, speed or "
+                             f"propeller: give time_scale and duration, and one of "
+                             f"{', '.join(self.steering_kinds)} (not {self}).")
+        else:
+            x0 = None
+        tau = tau if time_scale is None else float(time_scale)
+        manoeuvre, traj = _size(self, model, x0, tau, duration=duration, dt=dt)
+        if self.kind == "stop" and traj is not None and bool(traj.success):
+            manoeuvre = _until_stopped(manoeuvre, traj)
+        return manoeuvre, x0
+
+    def indices(self, manoeuvre, traj) -> dict:
+        """The indices of this trial run as `(manoeuvre, traj)`, as a JSON-ready dict
+        (display units in the names): the largest yaw rate and the speed's range, then
+        the trial's own (`js.indices.turning_indices`, `zigzag_indices`, `spiral_curve`
+        with its loop, `reverse_spiral_curve`, `pull_out_indices`, `stopping_indices`)."""
+        base = {
+            "max_yaw_rate_deg_s": float(np.rad2deg(np.max(np.abs(traj.state.r)))),
+            "min_speed_m_s": float(np.min(traj.speed)),
+            "max_speed_m_s": float(np.max(traj.speed)),
+        }
+        if self.kind in ("spiral", "reverse-spiral"):
+            curve = self.curve(manoeuvre, traj)
+            ordered = ({} if self.kind == "spiral" else {"r_ordered_deg_s": np.rad2deg(
+                np.asarray(manoeuvre.rates, dtype=float)[: curve.r.size]).tolist()})
+            return base | curve.to_dict() | ordered | curve.loop.to_dict()
+        reading = {"turn": js.indices.turning_indices, "pullout": js.indices.pull_out_indices,
+                   "stop": js.indices.stopping_indices}.get(self.kind)
+        if self.kind == "turn" and self.values[0] == 0:
+            return base
+        if self.kind == "zigzag":
+            return base | js.indices.zigzag_indices(traj, manoeuvre.heading).to_dict()
+        return base | reading(traj).to_dict() if reading else base
+
+    def curve(self, manoeuvre, traj):
+        """The steady yaw rate against the rudder of a spiral (`js.indices.spiral_curve`)
+        or a reverse spiral (`js.indices.reverse_spiral_curve`)."""
+        if self.kind == "spiral":
+            hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
+            return js.indices.spiral_curve(traj, hold=hold)
+        return js.indices.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
+
+    def marks(self, manoeuvre, traj):
+        """The indices drawn on the trial's figure: turning, zig-zag or stopping; None for
+        the other trials, or where the run is too short for them."""
+        try:
+            if self.kind == "turn" and self.values[0] != 0:
+                return js.indices.turning_indices(traj)
+            if self.kind == "zigzag":
+                return js.indices.zigzag_indices(traj, manoeuvre.heading)
+            if self.kind == "stop":
+                return js.indices.stopping_indices(traj)
+        except ValueError:
+            return None
+        return None
+
+    def criteria(self, vessel, traj, marks) -> list:
+        """The IMO MSC.137(76) 5.3 criteria that this trial checks (a 35 deg turn, a 10/10
+        or 20/20 zig-zag, the stop) from its `marks`, as `CriterionRow`s
+        (`js.indices.imo_criteria` at the approach speed of `traj`); [] for the others."""
+        if marks is None:
+            return []
+        angle = abs(self.values[0]) if self.values else None
+        kwargs = {}
+        if self.kind == "turn" and angle == 35:
+            kwargs["turning35"] = marks
+        elif self.kind == "zigzag" and angle == self.values[1] == 10:
+            if len(marks.overshoots) < 2:
+                return []
+            kwargs["zigzag10"] = marks
+        elif self.kind == "zigzag" and angle == self.values[1] == 20:
+            kwargs["zigzag20"] = marks
+        elif self.kind == "stop":
+            kwargs["stopping"] = marks
+        if not kwargs:
+            return []
+        speed = float(np.hypot(traj.state.u[0], traj.state.v[0]))
+        return js.indices.imo_criteria(float(vessel.length), speed, **kwargs)
+
+
+def _check_values(trial, text):
+    """Refuse values a trial cannot take: a rudder beyond 90 deg, a zero rudder, a heading
+    change outside (0, 180) deg, a PRBS amplitude or heading steps not positive."""
+    kind, values = trial.kind, trial.values
+    for angle in trial.rudder_angles:
+        if abs(angle) > 90:
+            raise ValueError(f"Manoeuvre {text!r}: the rudder angle {angle:g} deg is beyond "
+                             "90 deg; give a rudder angle in degrees within the vessel's "
+                             "limit (e.g. 35).")
+    if kind == "zigzag" and values[0] == 0:
+        raise ValueError(f"Manoeuvre {text!r}: the rudder angle must not be 0 (e.g. "
+                         "zigzag:20/20, or zigzag:-20/20 to port first).")
+    if kind == "zigzag" and not 0 < values[1] < 180:
+        raise ValueError(f"Manoeuvre {text!r}: the heading change must be positive and below "
+                         "180 deg (e.g. zigzag:20/20).")
+    if kind in ("pullout", "3211") and values and values[0] == 0:
+        raise ValueError(f"Manoeuvre {text!r}: the rudder angle must not be 0.")
+    if kind == "prbs" and values and values[0] <= 0:
+        raise ValueError(f"Manoeuvre {text!r}: the amplitude must be positive (the sequence "
+                         "takes both signs).")
+    if kind == "heading-steps" and not 0 < values[0] <= 180:
+        raise ValueError(f"Manoeuvre {text!r}: the heading amplitude must be positive and at "
+                         "most 180 deg (the steps take both signs).")
+
+
+def _size(trial, model, x0, tau, *, duration, dt):
+    """`(manoeuvre, trajectory or None)`: the manoeuvre of `trial` on `model` from `x0`
+    with durations in multiples of `tau` [s]; a turn with no `duration` simulated and
+    doubled until it has turned 540 deg (ITTC 7.5-04-02-01 2.2.1; at most 1000 nominal
+    L/U), a stop with none simulated (`sized` ends it at the stop)."""
+    manoeuvre = build_manoeuvre(trial, model, x0, tau, duration=duration, dt=dt)
+    turn = trial.kind == "turn" and trial.values[0] != 0
+    if duration is not None or not (turn or trial.kind == "stop"):
+        return manoeuvre, None
+    traj = simulate(model, manoeuvre, x0, simulator=StandardTrial.simulator)
+    longest = 1000 * float(model.length) / float(model.nominal_speed)
+    while turn and abs(float(traj.state.psi[-1] - traj.state.psi[0])) < np.deg2rad(540):
+        if manoeuvre.duration > longest:
+            break
+        manoeuvre = js.Turn(manoeuvre.angle, duration=2 * float(manoeuvre.duration),
+                            dt=manoeuvre.dt)
+        traj = simulate(model, manoeuvre, x0, simulator=StandardTrial.simulator)
+    return manoeuvre, traj
+
+
+def build_manoeuvre(trial, vessel, x0, tau, *, duration=None, dt=None):
+    """The manoeuvre of `trial` on `vessel` from `x0`, its durations in multiples of the
+    time scale `tau` [s] (L/U) unless `duration` [s] is given."""
     dt = dt if dt is not None else _default_dt(tau)
     rad = np.deg2rad
-    v = spec.values
+    v = trial.values
     pick = lambda default: float(duration) if duration is not None else default
-    if spec.kind == "turn":
+    if trial.kind == "turn":
         return js.Turn(rad(v[0]), duration=pick(60 * tau), dt=dt)
-    if spec.kind == "zigzag":
+    if trial.kind == "zigzag":
         return js.ZigZag(rad(v[0]), rad(v[1]), duration=pick(35 * tau), dt=dt)
-    if spec.kind == "spiral":
-        return direct_spiral(_whole(30 * tau, dt), dt=dt)
-    if spec.kind == "reverse-spiral":
+    if trial.kind == "spiral":
+        return js.spiral(_whole(30 * tau, dt), dt=dt)
+    if trial.kind == "reverse-spiral":
         return reverse_spiral(vessel, x0, hold=_whole(30 * tau, dt), dt=dt)
-    if spec.kind == "pullout":
+    if trial.kind == "pullout":
         angle = rad(v[0]) if v else rad(20.0)
         return js.pull_out(
             angle, turn_time=30 * tau, release_time=pick(60 * tau) - 30 * tau, dt=dt
         )
-    if spec.kind == "stop":
+    if trial.kind == "stop":
         if abs(float(surge_force(vessel, x0.u, x0.n) - surge_force(vessel, x0.u, -x0.n))) < 1e-9:
             raise ValueError(
                 f"{type(vessel).__name__} has no propeller model: a stop cannot be simulated."
             )
         return js.Stop(-abs(float(x0.n)), duration=pick(80 * tau), dt=dt, until_stopped=True)
-    if spec.kind == "prbs":
+    if trial.kind == "prbs":
         amp = rad(v[0]) if v else rad(10.0)
         return js.prbs(amp, bit_time=2 * tau, duration=pick(100 * tau), dt=dt)
-    if spec.kind == "3211":
+    if trial.kind == "3211":
         amp = rad(v[0]) if v else rad(10.0)
         return js.multi_step_3211(amp, unit=tau, settle=pick(30 * tau) - 7 * tau, dt=dt)
-    if spec.kind == "thesis":
+    if trial.kind == "thesis":
         return js.thesis_manoeuvre(dt=dt)
-    if spec.kind == "heading-steps":
+    if trial.kind == "heading-steps":
         return js.heading_perturbations(
             rad(v[0]),
             period=20 * tau,
@@ -142,12 +288,9 @@ def build_manoeuvre(spec: TrialSpec, vessel, x0, *, duration=None, dt=None):
             duration=pick(80 * tau),
             dt=dt,
         )
-    raise AssertionError(spec.kind)
+    raise AssertionError(trial.kind)
 
 
-# direct spiral levels [deg]: 25 deg to either side in 5 deg steps, finer near midships
-# where the loop of a course-unstable ship lies (MSC/Circ.1053 app. 4 2.1.5)
-SPIRAL_LEVELS_DEG = (25.0, 20.0, 15.0, 10.0, 5.0, 2.0, 1.0, 0.0)
 # reverse spiral levels: fractions of the steady yaw rate at the direct spiral's largest
 # rudder angle, from starboard to port; the small ones fall inside the loop of an
 # unstable ship (the S-shaped part of Bech's delta(r) curve)
@@ -157,19 +300,6 @@ REVERSE_SPIRAL_FRACTIONS = (0.8, 0.55, 0.35, 0.2, 0.1, 0.03)
 def _whole(duration, dt):
     """`duration` [s] rounded to a whole number (at least one) of sample intervals `dt`."""
     return float(max(1, round(duration / dt)) * dt)
-
-
-def direct_spiral(hold, *, dt, levels_deg=SPIRAL_LEVELS_DEG, n=None):
-    """Direct (Dieudonne) spiral (MSC/Circ.1053 app. 4 2.1; ITTC 7.5-04-02-01 2.2.4):
-    the rudder at each of `levels_deg` to starboard, down through midships to the
-    same angles to port and back, each held `hold` [s]; returns a `Schedule`."""
-    side = np.asarray(levels_deg, dtype=float)
-    side = side[side > 0]
-    down = np.deg2rad(np.concatenate([side, [0.0], -side[::-1]]))
-    levels = np.concatenate([down, down[::-1][1:]])
-    edges = hold * np.arange(levels.size + 1)
-    times = np.repeat(edges, 2)[1:-1]
-    return js.Schedule(times, np.repeat(levels, 2), duration=float(edges[-1]), dt=dt, n=n)
 
 
 def linear_yaw(vessel, x0):
@@ -265,28 +395,10 @@ def initial_state(vessel, *, speed=None, rpm=None):
     return straight_run(vessel, speed=speed, n=n)
 
 
-def run_spec(vessel, spec, *, speed=None, rpm=None, duration=None, dt=None, substeps=2):
-    """Simulate the trial `spec` (a string or `TrialSpec`); returns `(manoeuvre, trajectory)`.
-
-    A turning circle is extended until it has turned at least 540 degrees (ITTC).
-    """
-    spec = TrialSpec.parse(spec) if isinstance(spec, str) else spec
-    x0 = initial_state(vessel, speed=speed, rpm=rpm)
-    manoeuvre = build_manoeuvre(spec, vessel, x0, duration=duration, dt=dt)
-    simulator = Simulator(substeps=substeps)  # `_imo.SIMULATOR` too
-    traj = simulate(vessel, manoeuvre, x0, simulator=simulator)
-    if spec.kind == "stop" and duration is None and bool(traj.success):
-        traj = _cut_at_stop(traj)
-    while spec.kind == "turn" and duration is None and spec.values[0] != 0:
-        if abs(float(traj.state.psi[-1] - traj.state.psi[0])) >= np.deg2rad(540):
-            break
-        if manoeuvre.duration > 1000 * float(vessel.length) / float(vessel.nominal_speed):
-            break
-        manoeuvre = js.Turn(
-            manoeuvre.angle, duration=2 * float(manoeuvre.duration), dt=manoeuvre.dt
-        )
-        traj = simulate(vessel, manoeuvre, x0, simulator=simulator)
-    return manoeuvre, traj
+def length_over_speed(vessel, x0) -> float:
+    """The time scale L/U [s] of `vessel` at the approach speed of `x0` (its nominal
+    speed where `x0` lies still)."""
+    return float(vessel.length) / (float(np.hypot(x0.u, x0.v)) or float(vessel.nominal_speed))
 
 
 def _cut_at_stop(traj):
@@ -305,92 +417,9 @@ def _cut_at_stop(traj):
                         traj)
 
 
-def trial_indices(spec, manoeuvre, traj) -> dict:
-    """The indices of the trial `spec` as a JSON-ready dict (display units in the names)."""
-    spec = TrialSpec.parse(spec) if isinstance(spec, str) else spec
-    base = {
-        "max_yaw_rate_deg_s": float(np.rad2deg(np.max(np.abs(traj.state.r)))),
-        "min_speed_m_s": float(np.min(traj.speed)),
-        "max_speed_m_s": float(np.max(traj.speed)),
-    }
-    if spec.kind == "turn" and spec.values[0] != 0:
-        return base | js.indices.turning_indices(traj).to_dict()
-    if spec.kind == "zigzag":
-        return base | js.indices.zigzag_indices(traj, manoeuvre.heading).to_dict()
-    if spec.kind == "spiral":
-        hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
-        curve = js.indices.spiral_curve(traj, hold=hold)
-        return base | curve.to_dict() | curve.loop.to_dict()
-    if spec.kind == "reverse-spiral":
-        curve = _reverse_curve(manoeuvre, traj)
-        ordered = np.asarray(manoeuvre.rates, dtype=float)[: curve.r.size]
-        return (base | curve.to_dict() | {"r_ordered_deg_s": np.rad2deg(ordered).tolist()}
-                | curve.loop.to_dict())
-    if spec.kind == "pullout":
-        return base | js.indices.pull_out_indices(traj).to_dict()
-    if spec.kind == "stop":
-        return base | js.indices.stopping_indices(traj).to_dict()
-    return base
-
-
-def _reverse_curve(manoeuvre, traj):
-    return js.indices.reverse_spiral_curve(traj, rates=manoeuvre.rates, hold=manoeuvre.hold)
-
-
-def spiral_curve(spec, manoeuvre, traj):
-    if spec.kind == "spiral":
-        hold = float(np.diff(np.unique(np.asarray(manoeuvre.times)))[0])
-        return js.indices.spiral_curve(traj, hold=hold)
-    return _reverse_curve(manoeuvre, traj)
-
-
-def trial_marks(spec, manoeuvre, traj):
-    """The indices drawn on the trial figure: turning, zig-zag or stopping."""
-    try:
-        if spec.kind == "turn" and spec.values[0] != 0:
-            return js.indices.turning_indices(traj)
-        if spec.kind == "zigzag":
-            return js.indices.zigzag_indices(traj, manoeuvre.heading)
-        if spec.kind == "stop":
-            return js.indices.stopping_indices(traj)
-    except ValueError:  # the run is too short for them: the figure goes without
-        return None
-    return None
-
-
-def trial_criteria(spec, vessel, traj, marks) -> list:
-    """The IMO MSC.137(76) 5.3 criteria that the trial `spec` checks (a 35 deg turn,
-    a 10/10 or 20/20 zig-zag, the stop), as `CriterionRow`s; [] for the others."""
-    spec = TrialSpec.parse(spec) if isinstance(spec, str) else spec
-    if marks is None:
-        return []
-    angle = abs(spec.values[0]) if spec.values else None
-    kwargs = {}
-    if spec.kind == "turn" and angle == 35:
-        kwargs["turning35"] = marks
-    elif spec.kind == "zigzag" and angle == spec.values[1] == 10:
-        if len(marks.overshoots) < 2:
-            return []
-        kwargs["zigzag10"] = marks
-    elif spec.kind == "zigzag" and angle == spec.values[1] == 20:
-        kwargs["zigzag20"] = marks
-    elif spec.kind == "stop":
-        kwargs["stopping"] = marks
-    if not kwargs:
-        return []
-    speed = float(np.hypot(traj.state.u[0], traj.state.v[0]))
-    return js.indices.imo_criteria(float(vessel.length), speed, **kwargs)
-
-
-@dataclasses.dataclass(frozen=True)
-class TimeScale:
-    """What `build_manoeuvre` reads of a vessel, for a steering model: L/U = `length`."""
-
-    length: float
-    nominal_speed: float
-
-
-def spec_text(spec) -> str:
-    """The spec as written: `turn:35`, `zigzag:10/10`, `spiral`."""
-    values = "/".join(f"{v:g}" for v in spec.values)
-    return f"{spec.kind}:{values}" if values else spec.kind
+def _until_stopped(stop, traj):
+    """The `Stop` manoeuvre `stop`, run as `traj`, shortened to end where `_cut_at_stop`
+    ends its run."""
+    cut = _cut_at_stop(traj)
+    return js.Stop(stop.astern_n, duration=float(cut.t[-1] - cut.t[0]), dt=stop.dt,
+                   execute=stop.execute, until_stopped=stop.until_stopped)

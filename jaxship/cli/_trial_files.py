@@ -1,5 +1,5 @@
 """`jaxship simulate`'s files: a trial run into `trial.csv`, `indices.json` and its
-figures (the trial itself is the library's, `jaxship._workflow._trials`)."""
+figures (the trial itself is the library's, `jaxship.StandardTrial`)."""
 
 import json
 import pathlib
@@ -7,18 +7,7 @@ import pathlib
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .. import Experiment, Simulator, simulate, straight_state, write_trial_csv
-from .._workflow._trials import (
-    TimeScale,
-    TrialSpec,
-    build_manoeuvre,
-    run_spec,
-    spec_text,
-    spiral_curve,
-    trial_criteria,
-    trial_indices,
-    trial_marks,
-)
+from .. import Experiment, StandardTrial, simulate, write_trial_csv
 from ..plotting import plot_imo_criteria, plot_spiral, plot_trajectory
 
 
@@ -29,8 +18,9 @@ def simulate_to_folder(
     with `spiral.png` (the r-delta curve) for a spiral and `imo_criteria.png` (and the
     rows under "imo_criteria" in `indices.json`) for a trial that an IMO criterion
     checks."""
-    spec = TrialSpec.parse(spec) if isinstance(spec, str) else spec
-    manoeuvre, traj = run_spec(vessel, spec, speed=speed, rpm=rpm, duration=duration, dt=dt)
+    spec = StandardTrial.parse(spec) if isinstance(spec, str) else spec
+    manoeuvre, x0 = spec.sized(vessel, speed=speed, rpm=rpm, duration=duration, dt=dt)
+    traj = simulate(vessel, manoeuvre, x0, simulator=spec.simulator)
     if not bool(traj.success):
         raise ValueError(
             f"the simulation of {spec!r} failed (non-finite state); try a smaller --dt."
@@ -44,20 +34,20 @@ def simulate_to_folder(
     write_trial_csv(out / "trial.csv", record)
     indices = {
         k: (None if isinstance(v, float) and not np.isfinite(v) else v)
-        for k, v in trial_indices(spec, manoeuvre, traj).items()
+        for k, v in spec.indices(manoeuvre, traj).items()
     }
-    marks = trial_marks(spec, manoeuvre, traj)
-    criteria = trial_criteria(spec, vessel, traj, marks)
+    marks = spec.marks(manoeuvre, traj)
+    criteria = spec.criteria(vessel, traj, marks)
     if criteria:
         indices["imo_criteria"] = [row.to_dict() for row in criteria]
     (out / "indices.json").write_text(json.dumps(indices, indent=2) + "\n")
-    name = title or spec_text(spec)
+    name = title or str(spec)
     fig = plot_trajectory(traj, length=float(vessel.length), title=name, labels=[name],
                           indices=marks)
     fig.savefig(out / "trial.png", dpi=110)
     plt.close(fig)
     if spec.kind in ("spiral", "reverse-spiral"):
-        curve = spiral_curve(spec, manoeuvre, traj)
+        curve = spec.curve(manoeuvre, traj)
         ordered = manoeuvre.rates if spec.kind == "reverse-spiral" else None
         fig = plot_spiral(curve, title=f"{name}: steady yaw rate against rudder angle",
                           ordered=ordered)
@@ -74,24 +64,21 @@ def simulate_steering_to_folder(model, spec, out, *, dt, duration, title="") -> 
     """Run `spec` on the steering `model` from rest (`jaxship.simulate`'s closed loop on
     its heading and yaw rate), its time scale `duration / 35` (a zig-zag's 35 L/U),
     and write `trial.csv` (t, delta, r, psi), `indices.json` and `trial.png` to `out`."""
-    tau = duration / 35
-    vessel = TimeScale(length=tau, nominal_speed=1.0)
-    manoeuvre = build_manoeuvre(spec, vessel, straight_state(0.0, 0.0), duration=duration,
-                                dt=dt)
-    traj = simulate(model, manoeuvre, simulator=Simulator(substeps=2))
+    manoeuvre, _ = spec.sized(model, duration=duration, dt=dt, time_scale=duration / 35)
+    traj = simulate(model, manoeuvre, simulator=spec.simulator)
     if not bool(traj.success):
-        raise ValueError(f"the simulation of {spec_text(spec)} failed (non-finite state); "
+        raise ValueError(f"the simulation of {spec} failed (non-finite state); "
                          "try a smaller --dt.")
     record = Experiment.from_trajectory(traj)
     record = Experiment(record.t, record.delta, name=record.name, r=record.r, psi=record.psi)
     write_trial_csv(pathlib.Path(out) / "trial.csv", record)
     indices = {k: (None if isinstance(v, float) and not np.isfinite(v) else v)
-               for k, v in trial_indices(spec, manoeuvre, traj).items()
+               for k, v in spec.indices(manoeuvre, traj).items()
                if k != "min_speed_m_s" and k != "max_speed_m_s"}
     (pathlib.Path(out) / "indices.json").write_text(json.dumps(indices, indent=2) + "\n")
-    name = title or spec_text(spec)
+    name = title or str(spec)
     fig = plot_trajectory(traj, title=name, labels=[name],
-                          indices=trial_marks(spec, manoeuvre, traj))
+                          indices=spec.marks(manoeuvre, traj))
     fig.savefig(pathlib.Path(out) / "trial.png", dpi=110)
     plt.close(fig)
     return indices

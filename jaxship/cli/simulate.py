@@ -8,10 +8,9 @@ import sys
 
 import matplotlib.pyplot as plt
 
-from .. import AbstractVessel, froude_scale
+from .. import AbstractVessel, StandardTrial, froude_scale
 from .._workflow._identify import unconverged_fit
-from .._workflow._imo import check_imo, imo_specs
-from .._workflow._trials import TrialSpec
+from ..indices import check_imo
 from ..plotting import plot_imo_criteria, plot_trajectory
 from ._common import check_operating_point, check_out, note, positive
 from ._files import staged_folder
@@ -61,7 +60,7 @@ def run_vessel(args, chosen) -> int:
                              f"{LENGTHS[0]:g} and {LENGTHS[1]:g} m ({args.vessel} is "
                              f"{float(vessel.length):.4g} m).")
         vessel = froude_scale(vessel, args.length / float(vessel.length))
-    spec = TrialSpec.parse("zigzag:20/20" if imo else args.manoeuvre)
+    spec = StandardTrial.parse("zigzag:20/20" if imo else args.manoeuvre)
     speed, rpm = positive("--speed", args.speed), positive("--rpm", args.rpm)
     if chosen.report is not None and speed is None and rpm is None and vessel.nominal_n:
         rpm = 60.0 * float(vessel.nominal_n)  # fitted: the speed its coefficients give
@@ -69,7 +68,8 @@ def run_vessel(args, chosen) -> int:
              "(the fitted coefficients set the speed); give --speed or --rpm to choose.")
     duration, dt = positive("--duration", args.duration), positive("--dt", args.dt)
     limit = math.degrees(float(vessel.rudder.max_angle))
-    for angle in [a for s in (imo_specs(vessel) if imo else [spec]) for a in s.rudder_angles]:
+    trials = StandardTrial.imo(vessel) if imo else [spec]
+    for angle in [a for trial in trials for a in trial.rudder_angles]:
         if abs(angle) > limit * (1 + 1e-12):
             raise ValueError(f"--manoeuvre {args.manoeuvre}: the rudder angle {angle:g} deg is "
                              f"beyond the rudder limit of {args.vessel} ({limit:g} deg); give "
@@ -107,20 +107,18 @@ def run_vessel(args, chosen) -> int:
 
 
 def run_imo(args, chosen, vessel, *, speed, rpm) -> int:
-    """`--manoeuvre imo`: the trials of `imo_specs`, the criteria with margins and bands;
+    """`--manoeuvre imo`: the trials of `StandardTrial.imo`, the criteria with margins and bands
+    (`jaxship.indices.check_imo`);
     writes `criteria.md`, `indices.json`, `imo_criteria.png` and one figure a trial."""
     if args.duration is not None or args.dt is not None:
         raise ValueError("--manoeuvre imo runs each trial for its own duration and sample "
                          "interval; leave out --duration and --dt.")
     figures = [f"{spec.kind}{''.join(f'{v:g}' for v in spec.values[:1])}.png"
-               for spec in imo_specs(vessel)]
+               for spec in StandardTrial.imo(vessel)]
     check_out(args.out, writes=("criteria.md", "indices.json", "imo_criteria.png", *figures))
-    check = check_imo(vessel, report=chosen.report, speed=speed, rpm=rpm)
+    check = check_imo(vessel, identification=chosen.report, speed=speed, rpm=rpm)
     with staged_folder(args.out) as stage:
-        (stage / "criteria.md").write_text(
-            f"# IMO MSC.137(76) criteria: {chosen.label}\n\n{check.table()}\nBand: the "
-            f"central {check.draws['level']:.0%} of {check.draws['used']} of "
-            f"{check.draws['draws']} parameter draws from {check.draws['from']}.\n")
+        (stage / "criteria.md").write_text(check.to_markdown(chosen.label))
         (stage / "indices.json").write_text(json.dumps(check.to_dict(), indent=2) + "\n")
         fig = plot_imo_criteria(check.rows, bands=check.bands,
                                 title=f"{chosen.label}: IMO MSC.137(76) criteria")
@@ -143,19 +141,17 @@ def run_imo(args, chosen, vessel, *, speed, rpm) -> int:
     return 0
 
 
-STEERING_KINDS = ("zigzag", "prbs", "3211", "heading-steps", "thesis")
-
-
 def run_steering(args, chosen) -> int:
     """A steering model of an identify result through a closed-loop trial: its heading
     and yaw rate (no track, no speed); `--dt` and `--duration` default to its first
     training record's."""
-    spec = TrialSpec.parse(args.manoeuvre) if args.manoeuvre.strip().lower() != "imo" \
+    spec = StandardTrial.parse(args.manoeuvre) if args.manoeuvre.strip().lower() != "imo" \
         else None
-    if spec is None or spec.kind not in STEERING_KINDS:
+    kinds = StandardTrial.steering_kinds
+    if spec is None or spec.kind not in kinds:
         raise ValueError(f"--vessel {args.vessel}: a {type(chosen.model).__name__} steering "
                          "model has no track, speed or propeller, so it has no "
-                         f"{args.manoeuvre} trial; give one of {', '.join(STEERING_KINDS)} "
+                         f"{args.manoeuvre} trial; give one of {', '.join(kinds)} "
                          "(the IMO check needs a vessel: identify a vessel preset).")
     for option in ("length", "speed", "rpm"):
         if getattr(args, option) is not None:

@@ -43,7 +43,6 @@ import numpy as np
 from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
 
 import jaxship as js
-from jaxship._workflow._trials import trial_indices
 
 from ...thesis import autopilot as chapter5, identification as thesis
 from ...thesis.discovery_case import hidden_effect_records
@@ -259,7 +258,7 @@ def _trials(vessel, families, out, progress):
     for family, spec, rpm, manoeuvre, traj in sorted(design.values(), key=lambda d: d[2]):
         name = _file_name(spec, rpm)
         js.write_trial_csv(out / "trials" / f"{name}.csv", traj)
-        indices[name] = _finite(trial_indices(spec, manoeuvre, traj))
+        indices[name] = _finite(js.StandardTrial.parse(spec).indices(manoeuvre, traj))
     return design, indices
 
 
