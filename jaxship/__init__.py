@@ -158,6 +158,16 @@ from . import (
 )
 
 
+# isort: split
+# the workflow's verbs, last: their modules use the names above (`import jaxship as js`)
+from . import identification as identification  # noqa: E402
+from ._workflow._identify import (  # noqa: E402
+    Identification as Identification,
+    identify as identify,
+    load_model as load_model,
+)
+
+
 # The public names, grouped by layer as in docs/architecture.md (`# -- layer`); a
 # `# page: section` line puts the names after it in that section of docs/api/<page>.md
 # (docs/api_pages.py generates the entries of the API pages from every `__all__`).
@@ -307,4 +317,9 @@ __all__ = [
     "DiscoveryOptions",
     "DiscoveryReport",
     "Verdict",
+    # analysis: Identification
+    "identify",
+    "Identification",
+    "load_model",
+    "identification",
 ]

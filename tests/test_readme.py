@@ -15,9 +15,9 @@ import pytest
 
 import jaxship.cli as cli
 from jaxship._models._vessel.catalogue import get_vessel
-from jaxship._workflow._identify import MODELS
 from jaxship._workflow._trials import TrialSpec
 from jaxship.cli import main
+from jaxship.identification import MODELS
 
 
 ROOT = pathlib.Path(__file__).parent.parent

@@ -17,7 +17,7 @@ import matplotlib
 
 from .. import FitError, __version__, enable_compilation_cache  # noqa: E402
 from .._workflow._compiler import SMALL_PROGRAMS, compile_for_small_programs  # noqa: E402, F401
-from .._workflow._identify.workflow import FitDivergedError  # noqa: E402
+from ..identification import FitDivergedError  # noqa: E402
 from . import autopilot, discover, identify, reproduce, simulate, vessels  # noqa: E402
 from ._common import one_line  # noqa: E402
 from ._files import discard_open_stages  # noqa: E402

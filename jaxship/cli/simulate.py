@@ -9,9 +9,9 @@ import sys
 import matplotlib.pyplot as plt
 
 from .. import AbstractVessel, froude_scale
-from .._workflow._identify import unconverged_fit
 from .._workflow._imo import check_imo, imo_specs
 from .._workflow._trials import TrialSpec
+from ..identification import unconverged_fit
 from ..plotting import plot_imo_criteria, plot_trajectory
 from ._common import check_operating_point, check_out, note, positive
 from ._files import staged_folder
