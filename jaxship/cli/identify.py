@@ -144,7 +144,9 @@ def run(args) -> int:
             paths = save_identification_figures(result, stage / "figures")
             written.append(f"figures/ ({len(paths)} figures)")
         (stage / "result.json").write_text(result.to_json() + "\n")
-        if isinstance(result.model, js.AbstractVessel):  # `--vessel out/vessel.toml` later
+        # `--vessel out/vessel.toml` later; a vessel file holds no effects (result.json does)
+        if isinstance(result.model, js.AbstractVessel) and not isinstance(
+                result.model, js.effects.AugmentedVessel):
             js.save_vessel(result.model, stage / "vessel.toml",
                            source=f"jaxship identify --model {result.model_name} "
                            f"({result.fit.code_name})")
