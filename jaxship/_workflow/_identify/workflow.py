@@ -71,7 +71,7 @@ def _parse_channels(channels, allowed) -> tuple[str, ...]:
 
 def identify(model, train, *, validate=None, horizon=..., free=None,
              sample_interval: float | None = None, velocities: str | None = None,
-             rudder: str = "delta", channels=None, initial: str = "auto",
+             rudder: str = "delta", channels=None, initial=None,
              max_steps: int = 256, progress: Callable[[Progress], None] | None = None,
              name: str | None = None, substeps: int = 1) -> Identification:
     """Estimate a steering model or a vessel from training records and validate it, as
@@ -107,11 +107,12 @@ def identify(model, train, *, validate=None, horizon=..., free=None,
     - `channels`: fitted outputs, a subset of the entry's `channels` (or a text such as
       `"psi,r"`); None: the entry's `default_channels` (`psi, r`; `psi, r, u, v` for
       vessels; `r` for armax).
-    - `initial`: start of each fitted window (`PredictionError.initial`): `"measured"`,
-      `"estimate"` (corrections of the measured r and psi estimated with the
-      parameters) or `"auto"` (default): `"estimate"` for output error where the entry
-      supports it, `"measured"` otherwise. Validation always starts from the measured
-      state.
+    - `initial`: start of each fitted window (`PredictionError.initial`):
+      `MeasuredStates()` (the measured r and psi), `EstimatedStarts()` (corrections of
+      them estimated with the parameters, which removes the bias a noisy start sample
+      gives output error) or None (default): `EstimatedStarts` for output error where the
+      entry supports it, `MeasuredStates` otherwise (the command's `--initial measured`,
+      `estimate`, `auto` are the same). Validation always starts from the measured state.
     - `max_steps`: optimiser step limit; `substeps`: RK4 steps per sample interval.
     - `progress`: a callable receiving `Progress` reports, or None (quiet).
     - `name`: the catalogue name a `model` object is fitted as (a preset's name for its
@@ -148,7 +149,7 @@ def identify(model, train, *, validate=None, horizon=..., free=None,
                    over_ground=over_ground(velocities))
     train = as_experiments(train, "training", **reading)
     validate = None if validate is None else as_experiments(validate, "validation", **reading)
-    options = _Options(settings.horizon, rudder, channels, initial, max_steps, substeps,
+    options = _Options(settings.horizon, rudder, channels, _initial(initial), max_steps, substeps,
                        settings.free, default_channels=channels is None)
     if settings.name == AUTO:  # each candidate fitted, one chosen (`selection`)
         result = _chosen((train, validate), options, progress)
@@ -209,6 +210,14 @@ def _chosen(records, options: _Options, progress) -> Identification:
             failed[name] = str(error)
     name, selection = choose(results, failed)
     return with_selection(results[name], selection)
+
+
+def _initial(initial) -> str:
+    """The name of `identify`'s `initial` (a strategy, None, or the command's text)."""
+    if initial is None:
+        return "auto"
+    names = {js.MeasuredStates: "measured", js.EstimatedStarts: "estimate"}
+    return names.get(type(initial), initial)
 
 
 class _Options(NamedTuple):
