@@ -16,8 +16,8 @@ import re
 
 API_MARKER = "<!-- API: the entries of __all__ -->"
 # the modules whose `__all__` are documented: the package and its namespaces
-MODULES = ("jaxship", "jaxship.effects", "jaxship.indices", "jaxship.plotting",
-           "jaxship.strategies", "jaxship.wind_loads")
+MODULES = ("jaxship", "jaxship.effects", "jaxship.identification", "jaxship.indices",
+           "jaxship.plotting", "jaxship.strategies", "jaxship.wind_loads")
 NAMESPACES = tuple(m.split(".")[1] for m in MODULES[1:])
 
 _SECTION = re.compile(r"^\s*#\s*([a-z_]+):\s*(.+?)\s*$")

@@ -159,8 +159,14 @@ from . import (
 
 
 # isort: split
-# the workflow's verbs, last: their modules `import jaxship as js` at module level
-from ._workflow._trials import StandardTrial as StandardTrial
+# the workflow's verbs, last: their modules use the names above (`import jaxship as js`)
+from . import identification as identification  # noqa: E402
+from ._workflow._identify import (  # noqa: E402
+    Identification as Identification,
+    identify as identify,
+    load_model as load_model,
+)
+from ._workflow._trials import StandardTrial as StandardTrial  # noqa: E402
 
 
 # The public names, grouped by layer as in docs/architecture.md (`# -- layer`); a
@@ -314,4 +320,9 @@ __all__ = [
     "DiscoveryOptions",
     "DiscoveryReport",
     "Verdict",
+    # analysis: Identification
+    "identify",
+    "Identification",
+    "load_model",
+    "identification",
 ]

@@ -20,10 +20,10 @@ LAYERS = {
     "simulate": ["_simulation"],
     "estimate": ["_estimate"],
     "analysis": ["_analysis"],
-    # the public namespaces (effects, indices, strategies, wind_loads) only re-export, as
-    # __init__ does
+    # the public namespaces (effects, identification, indices, strategies, wind_loads) only
+    # re-export, as __init__ does
     "application": ["_workflow", "thesis", "studies", "cli", "plotting", "__init__", "effects",
-                    "indices", "strategies", "wind_loads"],
+                    "identification", "indices", "strategies", "wind_loads"],
 }
 RANK = {name: i for i, names in enumerate(LAYERS.values()) for name in names}
 PUBLIC = set(ast.literal_eval(next(  # the names of `jaxship.__all__`, read without importing
@@ -458,6 +458,15 @@ def test_the_package_never_imports_the_benchmarks_nor_loads_its_studies_on_impor
     from jaxship.thesis import autopilot, discovery_case, identification  # noqa: F401
 
 
+def test_the_identification_is_a_library_verb():
+    """The identification the command runs is the library verb `jaxship.identify`, its
+    result `jaxship.Identification` (issue 68)."""
+    import jaxship as js
+
+    assert js.identify.__module__ == "jaxship._workflow._identify.workflow"
+    assert not hasattr(js, "IdentificationResult")
+
+
 def test_every_public_estimator_is_accepted_by_fit_and_predict():
     """One door per verb: each estimator of the public API fits through `jaxship.fit`,
     and `jaxship.predict` of its `FitResult` with that estimator gives back the
@@ -537,7 +546,7 @@ def test_a_replay_of_a_closed_loop_run_reproduces_it():
 
 # the public surface (issue 59): `jaxship.__all__`, the namespaces that re-export, and the
 # command line that goes through them
-NAMESPACES = ("effects", "indices", "plotting", "strategies", "wind_loads")
+NAMESPACES = ("effects", "identification", "indices", "plotting", "strategies", "wind_loads")
 MAX_PUBLIC_NAMES = 125  # issue 68: the workflow verbs
 
 
@@ -632,7 +641,7 @@ def test_the_public_surface_is_all_of_at_most_110_names_without_aliases():
                           cwd=ROOT, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == str(sorted(names))
-    for space in ("effects", "indices", "strategies", "wind_loads"):
+    for space in ("effects", "identification", "indices", "strategies", "wind_loads"):
         module = getattr(js, space)
         held = {n for n, v in vars(module).items() if not n.startswith("_")}
         assert held == set(module.__all__), held ^ set(module.__all__)
@@ -766,7 +775,8 @@ OVER_THE_LIMITS = {
     # the command's reference: 66 of its 102 lines are the docstring (every option and
     # the result's JSON); the body is 31 lines of named steps. Its 12 parameters are the
     # command's options, keywords of one call
-    "jaxship/cli/_identification/workflow.py:identify": "the docstring is the reference",
+    "jaxship/_workflow/_identify/workflow.py:identify": "the docstring is the reference; "
+    "keyword options of one call",
     # public calls whose options are keywords of one call, each with a default, as
     # diffrax.diffeqsolve takes its options (saveat, stepsize_controller, max_steps, ...):
     # grouping them would make each caller build an object to change one option

@@ -14,9 +14,9 @@ from helpers import per_sample
 import jaxship as js
 import jaxship.cli as cli
 from jaxship._foundation._params import parameter_fields, resolve_free
-from jaxship._workflow._identify.workflow import FitDivergedError
 from jaxship.cli import main
 from jaxship.cli._files import MANIFEST, staged_folder
+from jaxship.identification import FitDivergedError
 
 
 def test_vessels_lists_every_preset_with_source(capsys):

@@ -16,7 +16,7 @@ from jaxship import (
 )
 from jaxship._simulation._data import CHANNELS
 from jaxship._simulation._measured import read_esso_osaka, read_hsva_kvlcc2, read_marin_kvlcc2
-from jaxship._workflow._identify import read_experiments
+from jaxship.identification import read_experiments
 
 
 def synthetic_experiment(num=201, dt=0.1, t0=5.0):

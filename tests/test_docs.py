@@ -1,7 +1,7 @@
 """The documentation site (mkdocs.yml) documents the whole public API and nothing
 else. The API pages' entries are generated from the `__all__` lists (docs/api_pages.py:
 `# page: section` comments place the names), so every name of `jaxship.__all__` and of
-the namespaces' (`jaxship.effects`, `.indices`, `.plotting`, `.strategies`,
+the namespaces' (`jaxship.effects`, `.identification`, `.indices`, `.plotting`, `.strategies`,
 `.wind_loads`) has its `::: jaxship.NAME` entry on a page of the site's navigation, and
 every entry names an export; `mkdocs build --strict` (.ci/run) then checks that each
 renders. Reads the pages' text: mkdocs need not be installed."""

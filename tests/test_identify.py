@@ -15,23 +15,17 @@ from helpers import per_sample
 import jaxship as js
 from jaxship import (
     AuxInputs,
+    Identification,
     LinearSwayYaw,
     Nomoto1,
     Nomoto2,
     NonlinearNomoto,
     NorrbinCrossFlow,
+    Progress,
     RossAutopilot,
 )
-from jaxship._workflow._identify import (
-    MODELS,
-    IdentificationResult,
-    Progress,
-    identify,
-    linear_candidate,
-    model_from_report,
-    read_experiments,
-)
 from jaxship.cli import main
+from jaxship.identification import MODELS, linear_candidate, model_from_report, read_experiments
 
 
 FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
@@ -213,8 +207,8 @@ def test_every_registered_model_recovers_quietly(name, truth, capsys):
     train = record(truth, rudder_sequence(5, amplitudes=(5.0, 15.0, 30.0)), name="a")
     test = record(truth, rudder_sequence(6, amplitudes=(5.0, 15.0, 30.0)), name="b")
     events = []
-    res = identify(train, model=name, validate=[test], progress=events.append)
-    assert isinstance(res, IdentificationResult) and res.fit.success
+    res = js.identify(name, train, validate=[test], progress=events.append)
+    assert isinstance(res, Identification) and res.fit.success
     expected = {n: float(getattr(truth, n)) for n in res.fit.names}
     np.testing.assert_allclose(res.fit.values, list(expected.values()), rtol=1e-5)
     assert res.validation.metrics["psi"].fit_percent > 99.9
@@ -237,7 +231,7 @@ def test_norrbin_of_either_stability_recovers_a_course_unstable_truth():
     recovers the truth scaled by T_start / T_truth, n1 < 0 included."""
     truth = NonlinearNomoto(K=0.06, T=25.0, n3=300.0, n1=-1.0)
     train = record(truth, rudder_sequence(5, amplitudes=(5.0, 15.0, 30.0)), name="a")
-    res = identify(train, model="nomoto1-norrbin")
+    res = js.identify("nomoto1-norrbin", train)
     assert res.fit.success and res.fit.names == ("K", "n3", "n1")
     scale = float(res.model.T) / truth.T
     np.testing.assert_allclose(res.fit.values, [scale * truth.K, scale * truth.n3,
@@ -368,8 +362,8 @@ def ross_aux(t):
                      n=np.full(t.shape, 8.0))
 
 
-def quiet_identify(*args, **kwargs):
-    return identify(*args, **kwargs)
+def quiet_identify(train, *, model, **kwargs):
+    return js.identify(model, train, **kwargs)
 
 
 def test_ross_autopilot_recovers_from_trial_csvs(tmp_path):
@@ -545,13 +539,13 @@ def test_auto_chooses_the_nonlinear_model_only_where_the_steady_turn_is_nonlinea
     cubic = NonlinearNomoto(K=0.06, T=25.0, n3=300.0)
     train = record(cubic, steps, name="a", noise=0.05, seed=1)
     held_out = record(TRUTH, rudder_sequence(2), name="held-out", noise=0.05, seed=3)
-    chosen = identify(train, model="auto", validate=held_out)
+    chosen = js.identify("auto", train, validate=held_out)
     assert chosen.model_name == "nomoto1-norrbin" and isinstance(chosen.model, NonlinearNomoto)
     figures = chosen.selection["candidates"]
     assert chosen.selection["chosen"] == "nomoto1-norrbin"
     assert figures["nomoto1-norrbin"]["bic"] < figures["nomoto1"]["bic"]
     assert (figures["nomoto1"]["num_params"], figures["nomoto1-norrbin"]["num_params"]) == (2, 3)
-    assert identify(train, model="auto").selection == chosen.selection
+    assert js.identify("auto", train).selection == chosen.selection
     report = json.loads(chosen.to_json())
     assert report["selection"]["chosen"] == report["model"] == "nomoto1-norrbin"
     assert any(n.startswith("model chosen: nomoto1-norrbin") for n in report["notes"])
@@ -561,7 +555,7 @@ def test_auto_chooses_the_nonlinear_model_only_where_the_steady_turn_is_nonlinea
     # ... and places the PID's poles on the linear candidate, kept in the selection: the
     # same fit as `identify --model nomoto1`
     feedback = model_from_report(linear_candidate(report["selection"]))
-    alone = identify(train, model="nomoto1", validate=held_out).model
+    alone = js.identify("nomoto1", train, validate=held_out).model
     assert isinstance(feedback, Nomoto1)
     assert (float(feedback.K), float(feedback.T)) == pytest.approx(
         (float(alone.K), float(alone.T)), rel=1e-12)
@@ -569,13 +563,13 @@ def test_auto_chooses_the_nonlinear_model_only_where_the_steady_turn_is_nonlinea
         unusable = json.loads(json.dumps(report["selection"]))
         unusable["candidates"]["nomoto1"]["fit_code"] = code
         assert linear_candidate(unusable) is None
-    linear = identify(record(TRUTH, steps, name="b", noise=0.05, seed=1), model="auto")
+    linear = js.identify("auto", record(TRUTH, steps, name="b", noise=0.05, seed=1))
     assert linear.model_name == "nomoto1" and isinstance(linear.model, Nomoto1)
     figures = linear.selection["candidates"]
     assert figures["nomoto1"]["bic"] < figures["nomoto1-norrbin"]["bic"]
     assert linear_candidate(linear.selection) is None  # the poles on the chosen model
     with pytest.raises(ValueError, match="--free does not go with --model auto"):
-        identify(train, model="auto", free=("K",))
+        js.identify("auto", train, free=("K",))
 
 
 def test_cli_auto_writes_the_choice_and_refuses_a_vessel(files, tmp_path, capsys):

@@ -102,12 +102,11 @@ def test_identify_takes_the_hull_length_from_the_records():
     (`lpp`, set by the measured-data readers): on records of a 5 m hull it recovers
     the hull coefficients (the cross-flow ones depend on L) from the registry's start;
     records without one length keep the class's 3 m, and the note says which."""
-    from jaxship._workflow._identify import identify
     from jaxship._workflow._identify.starts import StartContext, start_low_speed
 
     truth = eqx.tree_at(lambda m: m.length, TRUTH, 5.0)
     records = [low_speed_record(s, truth, {"lpp": 5.0}) for s in range(3)]
-    result = identify(records, model="low-speed-sway-yaw", channels="r,v")
+    result = js.identify("low-speed-sway-yaw", records, channels="r,v")
     assert float(result.fit.model.length) == 5.0
     got = dict(zip(result.fit.names, np.asarray(result.fit.values)))
     np.testing.assert_allclose([got[k] for k in HULL], [ESSO[k] for k in HULL], rtol=1e-4)

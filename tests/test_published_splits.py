@@ -179,8 +179,10 @@ def test_identify_takes_the_presets_chosen_settings(tmp_path, monkeypatch, capsy
 
     seen = {}
 
-    def fake_identify(train, **kwargs):
-        seen.update(kwargs, train=train)
+    def fake_identify(model, train, **kwargs):  # the library's settings of the call
+        chosen = js.identification.fit_settings(
+            model, **{k: kwargs[k] for k in ("name", "horizon", "sample_interval", "free")})
+        seen.update(horizon=chosen.horizon, free=chosen.free, start=chosen.start, train=train)
         raise StopBeforeFit  # stop before any fit
 
     monkeypatch.setattr(command, "identify", fake_identify)

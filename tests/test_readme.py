@@ -16,8 +16,8 @@ import pytest
 import jaxship as js
 import jaxship.cli as cli
 from jaxship._models._vessel.catalogue import get_vessel
-from jaxship._workflow._identify import MODELS
 from jaxship.cli import main
+from jaxship.identification import MODELS
 
 
 ROOT = pathlib.Path(__file__).parent.parent

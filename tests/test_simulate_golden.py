@@ -14,7 +14,7 @@ import sys
 import pytest
 
 import jaxship as js
-from jaxship._workflow._compiler import compiles_for_cpu
+from jaxship._foundation._compiler import compiles_for_cpu
 
 
 sys.path.insert(0, str(pathlib.Path(__file__).parent / "golden"))

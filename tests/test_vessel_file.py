@@ -13,8 +13,8 @@ import pytest
 import jaxship as js
 from jaxship._foundation._validate import _to_plain
 from jaxship._models._vessel.file import vessel_text, vessel_to_dict
-from jaxship._workflow._identify import model_from_report, read_result
 from jaxship.cli import main
+from jaxship.identification import model_from_report, read_result
 
 
 @pytest.mark.parametrize("name", list(js.VESSELS))

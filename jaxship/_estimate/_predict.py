@@ -20,7 +20,9 @@ def predict(model, dataset, *, estimator: AbstractEstimator = PredictionError()
     """Predict the measured outputs of `dataset` with `model` (a steering model, a
     vessel, or a `FitResult`, whose model is used) as `estimator` does, and validate
     them (see `Prediction`). An `Innovations` estimator without given noise variances
-    takes those a `FitResult` estimated.
+    takes those a `FitResult` estimated. A `FitResult`'s d estimated parameters (its
+    `names`) are counted in FPE, AIC and BIC (FPE = V (1 + d/N) / (1 - d/N), thesis
+    eq. 3.21; a model alone counts none).
 
     Raises `ValueError` for bad data as `fit` does, and for an estimator that cannot
     predict without what it lacks (the noise variances of `Innovations`).
@@ -29,8 +31,11 @@ def predict(model, dataset, *, estimator: AbstractEstimator = PredictionError()
         raise ValueError(f"`estimator` must be a jaxship estimator (PredictionError, "
                          f"Innovations, ARMAX, DiscreteResponse), got "
                          f"{type(estimator).__name__}.")
-    if isinstance(model, FitResult):
-        if isinstance(estimator, Innovations) and model.noise is not None:
-            estimator = dataclasses.replace(estimator, noise=estimator.noise.given(model.noise))
-        model = model.model
-    return estimator.predict(model, dataset)
+    if not isinstance(model, FitResult):
+        return estimator.predict(model, dataset)
+    if isinstance(estimator, Innovations) and model.noise is not None:
+        estimator = dataclasses.replace(estimator, noise=estimator.noise.given(model.noise))
+    prediction = estimator.predict(model.model, dataset)
+    d = len(model.names)
+    return dataclasses.replace(prediction, metrics={
+        c: m.counting(d) for c, m in prediction.metrics.items()})

@@ -213,6 +213,12 @@ class ValidationReport:
         """The residuals pass the 99 % whiteness test."""
         return self.autocorrelation.passed
 
+    def counting(self, num_params: int) -> "ValidationReport":
+        """This report with `num_params` d estimated parameters: FPE, AIC and BIC
+        charged for them (the formulas above), the other figures unchanged."""
+        return dataclasses.replace(self, num_params=int(num_params),
+                                   **_criteria(self.loss, int(num_params), self.num_samples))
+
     def to_dict(self) -> dict:
         return {f.name: _to_plain(getattr(self, f.name)) for f in dataclasses.fields(self)}
 
@@ -236,6 +242,16 @@ def final_prediction_error(loss: float, num_params: int, num_samples: int) -> fl
     """Akaike's FPE $V_N(1 + d/N)/(1 - d/N)$ (thesis eq. 3.21); inf for $d \\ge N$."""
     ratio = num_params / num_samples
     return math.inf if ratio >= 1 else float(loss * (1 + ratio) / (1 - ratio))
+
+
+def _criteria(loss: float, d: int, num: int) -> dict:
+    """`fpe`, `aic`, `bic` of a loss on `num` samples with `d` estimated parameters (see
+    `ValidationReport`)."""
+    log_loss = math.log(loss) if loss > 0 else -math.inf
+    const = num * (math.log(2 * math.pi) + 1)
+    return {"fpe": final_prediction_error(loss, d, num),
+            "aic": num * log_loss + 2 * d + const,
+            "bic": num * log_loss + d * math.log(num) + const}
 
 
 def validate(y, yhat, mask=None, *, num_params: int = 0, u=None, max_lag: int = 25,
@@ -269,8 +285,6 @@ def validate(y, yhat, mask=None, *, num_params: int = 0, u=None, max_lag: int = 
     mean = float(np.sum(e) / num)
     # (a prediction that blew up but stayed finite squares to inf: no OverflowError)
     std = float(np.sqrt(max(loss - np.square(mean), 0.0)))
-    log_loss = math.log(loss) if loss > 0 else -math.inf
-    const = num * (math.log(2 * math.pi) + 1)
     per_experiment = np.array([
         fit_percent(y[i], yhat[i], mask[i]) if mask[i].sum() >= 2 else np.nan
         for i in range(y.shape[0])
@@ -284,9 +298,7 @@ def validate(y, yhat, mask=None, *, num_params: int = 0, u=None, max_lag: int = 
         rms=math.sqrt(loss),
         mean=mean,
         std=std,
-        fpe=final_prediction_error(loss, d, num),
-        aic=num * log_loss + 2 * d + const,
-        bic=num * log_loss + d * math.log(num) + const,
+        **_criteria(loss, d, num),
         fit_percent=fit_percent(y, yhat, mask),
         fit_per_experiment=per_experiment,
         autocorrelation=residual_autocorrelation(e, mask, max_lag=max_lag),

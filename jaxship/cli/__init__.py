@@ -21,7 +21,7 @@ from .. import (  # noqa: E402
     compile_for_small_programs,
     enable_compilation_cache,
 )
-from .._workflow._identify.workflow import FitDivergedError  # noqa: E402
+from ..identification import FitDivergedError  # noqa: E402
 from . import autopilot, discover, identify, reproduce, simulate, vessels  # noqa: E402
 from ._common import one_line  # noqa: E402
 from ._files import discard_open_stages  # noqa: E402

@@ -10,15 +10,20 @@ import numpy as np
 
 import jaxship as js
 
-from .._workflow._identify.data import check_froude, preset_length, read_experiments
-from .._workflow._identify.registry import model_key, start_entry
-from .._workflow._identify.workflow import identify, logs_wind
+from .. import identify
+from ..identification import (
+    check_froude,
+    fit_settings,
+    logs_wind,
+    preset_length,
+    read_experiments,
+)
 from ._common import check_writes
 from ._files import staged_folder
 
 
-def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
-                  options=None, reading=None, progress=None, start=None):
+def run_discovery(train_paths, holdout_paths, *, model, out: pathlib.Path,
+                  options=None, reading=None, progress=None, name=None):
     """Read the records (`reading`: `read_experiments`' keywords `sample_interval` [s] to
     resample to, `over_ground` for the trial CSVs' u, v, and `note`, default a stage
     report, which hears what was done to the records: files skipped, resampling; the
@@ -26,14 +31,14 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
     start values), run discovery with `options` (a `jaxship.DiscoveryOptions`, default
     its defaults) and write `out/discovery.json`, `out/report.md` and `out/figures/`.
     Returns the `DiscoveryReport`. `progress` takes the stage reports
-    (`jaxship.Progress`). `start`: a model to start from (`--vessel`), fitted as `model`
-    (`start_entry`)."""
+    (`jaxship.Progress`). `model`, `name`: as `jaxship.identify` takes them (a catalogue
+    name, or a model to start from, `--vessel`, fitted as the catalogue's `name`)."""
     say = (lambda message: None) if progress is None else (
         lambda message: progress(js.Progress("discover", message)))
     options = js.DiscoveryOptions() if options is None else options
     reading = dict(reading or {})
     reading["note"] = reading.get("note") or say
-    name = start_entry(model, start)[0] if start is not None else model_key(model)
+    settings = fit_settings(model, name=name)  # an unknown model fails here
     if options.max_effects < 1:
         raise ValueError(f"--max-effects must be at least 1, got {options.max_effects}.")
     if not 0 < options.alpha < 1:
@@ -44,12 +49,14 @@ def run_discovery(train_paths, holdout_paths, *, model: str, out: pathlib.Path,
                                **reading) if holdout_paths else None
     check_writes(pathlib.Path(out), tuple(f"figures/{_figure_name(i)}"
                                           for i in range(len(holdout or train))))
+    name = settings.name or "vessel"  # a vessel of one's own
+    start = settings.start
     length = float(start.length) if isinstance(start, js.AbstractVessel) else \
         preset_length(name)
     if holdout and length is not None:  # identify checks the training records
         check_froude(holdout, length, "held-out", name)
     say(f"start values: identify {name} on {len(train)} training records")
-    start = identify(train, model=name, start=start).fit.model
+    start = identify(model, train, name=name if settings.name else None).model
     report = js.discover(start, train, holdout, options=options, progress=progress)
     with staged_folder(pathlib.Path(out)) as stage:  # all or nothing
         figures = save_discovery_figures(report, train, holdout, stage / "figures")

@@ -1,12 +1,12 @@
 """What `--vessel` names in every command: a preset, a vessel file (TOML) or the
-`result.json` of `jaxship identify` (its fitted vessel or steering model, rebuilt by
-`read_result`)."""
+`result.json` of `jaxship identify` (its fitted vessel or steering model): the model of
+`jaxship.load_model`, with a label and the report."""
 
 import dataclasses
 import pathlib
 
-from .. import VESSELS, AbstractVessel, get_vessel, load_vessel
-from .._workflow._identify import read_result
+from .. import VESSELS, AbstractVessel, load_model
+from ..identification import read_report
 
 
 VESSEL_HELP = ("a preset (see `jaxship vessels`), a vessel file (TOML; `jaxship vessels "
@@ -38,14 +38,15 @@ def read_vessel_option(text: str, *, vessel_only: bool = False,
     (one line) for a name that is none of the three forms or a file that is bad."""
     key = _preset(text)
     if key is not None:
-        return ChosenModel(get_vessel(key), key, key)
+        return ChosenModel(load_model(key), key, key)
     path = pathlib.Path(text)
     if path.suffix.lower() == ".toml":
         if not path.is_file():
             raise ValueError(f"{option} {text}: no such vessel file.")
-        return ChosenModel(load_vessel(path), None, path.stem)
+        return ChosenModel(load_model(path), None, path.stem)
     if path.suffix.lower() == ".json" or path.is_dir():
-        model, report = read_result(path)
+        model = load_model(path)
+        report = read_report(path)
         label = f"{report['model']} fitted ({path})"
         chosen = ChosenModel(model, str(report["model"]), label, report)
         if vessel_only and not isinstance(model, AbstractVessel):

@@ -10,7 +10,7 @@ from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without i
 
 from .._workflow import _autopilot as autopilot_study
 from .._workflow._autopilot import cell
-from .._workflow._identify import (
+from ..identification import (
     linear_candidate,
     model_from_report,
     read_result,

@@ -43,10 +43,10 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    name, start = start_model(args.model, args.vessel)
+    model, name = start_model(args)
     check_out(args.out, writes=("discovery.json", "report.md", "figures/"),
               inputs=[*args.train, *(args.holdout or [])])
-    report = run_discovery(args.train, args.holdout, model=name, start=start, out=args.out,
+    report = run_discovery(args.train, args.holdout, model=model, name=name, out=args.out,
                            options=DiscoveryOptions(max_effects=args.max_effects,
                                                     alpha=args.alpha),
                            reading=dict(sample_interval=args.sample_interval,

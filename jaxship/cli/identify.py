@@ -6,13 +6,10 @@ import math
 import pathlib
 import sys
 
-import equinox as eqx
-
 import jaxship as js
 
-from .. import VESSELS
-from .._workflow._identify import MODELS, get_model_entry, identify, read_experiments
-from .._workflow._identify.selection import AUTO, CANDIDATES, is_auto
+from .. import VESSELS, identify
+from ..identification import AUTO, CANDIDATES, MODELS, fit_settings, read_experiments
 from ..plotting import identification_figure_names, save_identification_figures
 from ._common import (
     VELOCITIES,
@@ -95,101 +92,64 @@ def _horizon(text):
     return value
 
 
-def _free(text, default):
-    """`--free`: None (the model's default), or the names given (after a `+`: added to
-    `default`, the preset's set or None for the model's own)."""
-    if text is None:
-        return default
-    add = text.strip().startswith("+")
-    names = tuple(n.strip() for n in text.strip().lstrip("+").split(",") if n.strip())
-    if not names:
-        raise ValueError(f"--free {text!r}: give coefficient names, comma separated.")
-    if not add:
-        return names
-    return None if default is None else tuple(dict.fromkeys(default + names))
-
-
-def _preset_fit_settings(name, args):
-    """The `fit_settings` of the preset `name` when the fit starts from the preset itself
-    (`--model NAME` or `--vessel NAME`, not a file or an earlier result), else None."""
-    given = args.model if args.vessel is None else args.vessel.strip().lower().replace("-", "_")
-    return VESSELS[name].fit_settings if name in VESSELS and given == name else None
-
-
-def preset_settings(name, args):
-    """`(horizon, sample_interval, free, note)`: the options given, else the preset's
-    `fit_settings` (a protocol's choice) where `name` is a preset that has them."""
-    settings = _preset_fit_settings(name, args)
-    horizon = _horizon(args.horizon) if args.horizon is not None or settings is None \
-        else settings.horizon
-    sample_interval = args.sample_interval if args.sample_interval is not None \
-        or settings is None else settings.sample_interval
-    base_free = None if settings is None else settings.free
-    if args.free is not None and args.free.strip().startswith("+") and base_free is None:
-        base_free = js.default_free(js.get_vessel(name)) if name in VESSELS else None
-    free = _free(args.free, base_free)
-    used = [] if settings is None else [
-        text for given, text in (
-            (args.horizon, f"--horizon {settings.horizon:g}"),
-            (args.sample_interval, f"--sample-interval {settings.sample_interval:g}"),
-            (args.free, "--free " + ",".join(settings.free))) if given is None]
-    if settings is not None and settings.wind_model is not None:
-        used.append(f"wind loads {type(settings.wind_model).__name__}")
-    note = None if not used else (f"the {name} preset's settings: {'; '.join(used)} "
-                                  f"({settings.source}).")
-    return horizon, sample_interval, free, note
-
-
-def start_model(model, vessel):
-    """`(name, start model or None)` of `--model` or `--vessel` (one of them)."""
-    if (model is None) == (vessel is None):
+def start_model(args):
+    """`(model, name)` of `--model` or `--vessel` (one of them), as `identify` takes them:
+    a catalogue name (or auto) and None, or the model `--vessel` names and the catalogue
+    name it is fitted as (a preset's, an earlier result's; None for a vessel file)."""
+    if (args.model is None) == (args.vessel is None):
         raise ValueError("give --model (a registered model) or --vessel (a preset, a vessel "
                          "file or a result.json to start from), one of them.")
-    if vessel is None:
-        if not is_auto(model):
-            get_model_entry(model)
-        return model, None
-    chosen = read_vessel_option(vessel)
-    return chosen.name, chosen.model
+    if args.vessel is None:
+        return args.model, None
+    chosen = read_vessel_option(args.vessel)
+    return chosen.model, chosen.name
+
+
+def settings(args):
+    """The `jaxship.identification.fit_settings` of the command's options (unknown models
+    fail here, before any file): `(model, name, settings)`."""
+    model, name = start_model(args)
+    horizon = ... if args.horizon is None else _horizon(args.horizon)
+    return model, name, fit_settings(model, name=name, horizon=horizon,
+                                     sample_interval=args.sample_interval, free=args.free)
 
 
 def run(args) -> int:
     # every check before the fit; the files appear in --out only when all are written
-    name, start = start_model(args.model, args.vessel)  # unknown ones fail before any file
-    horizon, sample_interval, free, settings_note = preset_settings(name, args)
-    settings = _preset_fit_settings(name, args)
-    if settings is not None and settings.wind_model is not None:  # the chosen wind loads
-        start = eqx.tree_at(lambda v: v.wind_model, js.get_vessel(name), settings.wind_model)
+    model, name, chosen = settings(args)  # unknown ones fail before any file
     if args.max_steps < 1:
         raise ValueError(f"--max-steps {args.max_steps}: give a positive number of optimiser "
                          "steps (default 256).")
-    vessel = isinstance(start, js.AbstractVessel) or name in VESSELS  # writes vessel.toml
+    vessel = isinstance(chosen.start, js.AbstractVessel) or chosen.name in VESSELS
     check_out(args.out, writes=("result.json",) + (("vessel.toml",) if vessel else ())
               + (() if args.no_figures else ("figures/",)),
               inputs=[*args.train, *(args.validate or [])])
-    over_ground = VELOCITIES.get(args.velocities)
-    train = read_experiments(args.train, role="training", note=note,
-                             sample_interval=sample_interval, over_ground=over_ground)
+    reading = dict(note=note, sample_interval=chosen.sample_interval,
+                   over_ground=VELOCITIES.get(args.velocities))
+    train = read_experiments(args.train, role="training", **reading)
     held_out = None if args.validate is None else read_experiments(
-        args.validate, role="validation", note=note, sample_interval=sample_interval,
-        over_ground=over_ground)
+        args.validate, role="validation", **reading)
     if not args.no_figures:  # their names follow the records'
         names = identification_figure_names(
             [e.name for e in train], None if held_out is None else [e.name for e in held_out])
         check_writes(args.out, tuple(f"figures/{name}" for name in names))
-    bar = ProgressBar(not args.quiet)
-    result = identify(train, model=name, start=start, horizon=horizon, validate=held_out,
+    result = identify(model, train, validate=held_out, name=name,
+                      horizon=... if args.horizon is None else chosen.horizon,
+                      sample_interval=args.sample_interval, free=args.free,
                       rudder=args.rudder, channels=args.channels, initial=args.initial,
-                      max_steps=args.max_steps, progress=bar, free=free)
+                      max_steps=args.max_steps, progress=ProgressBar(not args.quiet))
     written = ["result.json"]
     with staged_folder(args.out) as stage:
         if not args.no_figures:
             paths = save_identification_figures(result, stage / "figures")
             written.append(f"figures/ ({len(paths)} figures)")
         (stage / "result.json").write_text(result.to_json() + "\n")
-        if isinstance(result.model, js.AbstractVessel):  # `--vessel out/vessel.toml` later
+        # `--vessel out/vessel.toml` later; a vessel file holds no effects (result.json does)
+        if isinstance(result.model, js.AbstractVessel) and not isinstance(
+                result.model, js.effects.AugmentedVessel):
             js.save_vessel(result.model, stage / "vessel.toml",
-                           source=f"jaxship identify --model {name} ({result.fit.code_name})")
+                           source=f"jaxship identify --model {result.model_name} "
+                           f"({result.fit.code_name})")
             written.append("vessel.toml")
     head, *lines = result.summary().splitlines()
     undetermined = result.fit.code == js.RESULTS.undetermined
@@ -200,7 +160,7 @@ def run(args) -> int:
         head = (f"{result.model_name}: {type(result.model).__name__}, NOT converged "
                 f"({result.fit.code_name}, after {result.fit.num_steps} steps)")
     print("\n".join([head, *lines]))
-    for text in ((settings_note,) if settings_note else ()) + result.notes:
+    for text in result.notes:
         print(f"note: {text}")
     for message in dict.fromkeys(result.warnings):
         print(f"jaxship: warning: {one_line(message)}", file=sys.stderr)

@@ -9,7 +9,7 @@ import sys
 import matplotlib.pyplot as plt
 
 from .. import AbstractVessel, StandardTrial, froude_scale
-from .._workflow._identify import unconverged_fit
+from ..identification import unconverged_fit
 from ..indices import check_imo
 from ..plotting import plot_imo_criteria, plot_trajectory
 from ._common import check_operating_point, check_out, note, positive

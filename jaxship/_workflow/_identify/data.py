@@ -143,22 +143,38 @@ def same_records(train, held_out) -> list[str]:
             and all(np.array_equal(getattr(e, k), getattr(f, k)) for k in ("t", *e.channels))]
 
 
-def as_experiments(data, role: str) -> list[js.Experiment]:
+VELOCITIES = {"through-water": False, "over-ground": True}  # `velocities`: over_ground
+
+
+def over_ground(velocities: str | None) -> bool | None:
+    """`read_experiments`' `over_ground` of `velocities` (`VELOCITIES`; None: as read)."""
+    if velocities is None:
+        return None
+    if velocities not in VELOCITIES:
+        raise ValueError(f"unknown velocities {velocities!r}; choose "
+                         f"{' or '.join(VELOCITIES)} (or None: as the records state).")
+    return VELOCITIES[velocities]
+
+
+def as_experiments(data, role: str, *, note=None, sample_interval: float | None = None,
+                   over_ground: bool | None = None) -> list[js.Experiment]:
     """`data` (an `Experiment`, a list of them, a `Dataset` or file paths) as a list
-    of experiments."""
-    if isinstance(data, js.Dataset):
-        return [data.experiment(i) for i in range(data.num_experiments)]
-    if isinstance(data, js.Experiment):
-        return [data]
+    of experiments, read (files) and resampled as `read_experiments` reads files."""
+    reading = dict(note=note, sample_interval=sample_interval, over_ground=over_ground)
     if isinstance(data, (str, Path)):
-        return read_experiments([data], role=role)
-    if isinstance(data, Sequence) and data:
-        if all(isinstance(e, js.Experiment) for e in data):
-            return list(data)
-        if all(isinstance(e, (str, Path)) for e in data):
-            return read_experiments(data, role=role)
-    raise ValueError(f"the {role} data must be an Experiment, a list of Experiments, a "
-                     f"Dataset or file paths, got {type(data).__name__}.")
+        return read_experiments([data], role=role, **reading)
+    if isinstance(data, Sequence) and data and all(isinstance(e, (str, Path)) for e in data):
+        return read_experiments(data, role=role, **reading)
+    if isinstance(data, js.Dataset):
+        data = [data.experiment(i) for i in range(data.num_experiments)]
+    elif isinstance(data, js.Experiment):
+        data = [data]
+    if not (isinstance(data, Sequence) and data
+            and all(isinstance(e, js.Experiment) for e in data)):
+        raise ValueError(f"the {role} data must be an Experiment, a list of Experiments, a "
+                         f"Dataset or file paths, got {type(data).__name__}.")
+    data = [_with_velocities(e, over_ground) for e in data]
+    return data if sample_interval is None else _resampled(data, sample_interval, role, note)
 
 
 # No displacement ship runs beyond a length Froude number U / sqrt(g L) of 1: merchant

@@ -166,3 +166,25 @@ def start_entry(name: str | None, start) -> tuple[str, ModelEntry]:
 def get_model_entry(name: str) -> ModelEntry:
     """The registry entry of `name`; `ValueError` listing the known names otherwise."""
     return MODELS[model_key(name)]
+
+
+# the catalogue name a steering model of each class is fitted as (`start_name`)
+_CLASS_NAMES = {js.Nomoto1: "nomoto1", js.Nomoto2: "nomoto2",
+                js.NonlinearNomoto: "nomoto1-nonlinear", js.RossAutopilot: "ross-autopilot",
+                js.LinearSwayYaw: "linear-sway-yaw", js.NorrbinCrossFlow: "norrbin-crossflow",
+                js.LowSpeedSwayYaw: "low-speed-sway-yaw", js.ARMAXModel: "armax"}
+
+
+def start_name(start, name: str | None) -> str | None:
+    """The catalogue name the model `start` is fitted as: `name` if given (a preset's
+    for a vessel, e.g. `nomoto1-norrbin` for a `NonlinearNomoto`); else None for a vessel
+    (a vessel of one's own) and the entry of its class for a steering model."""
+    if name is not None:
+        return name if isinstance(start, js.AbstractVessel) else model_key(name)
+    if isinstance(start, js.AbstractVessel):
+        return None
+    base = start.base if isinstance(start, js.effects.AugmentedSteering) else start
+    if type(base) not in _CLASS_NAMES:
+        raise ValueError(f"no catalogue model fits a {type(base).__name__}; give a vessel, "
+                         "a steering model of the catalogue or a catalogue name.")
+    return _CLASS_NAMES[type(base)]

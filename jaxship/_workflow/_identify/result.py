@@ -1,4 +1,4 @@
-"""`IdentificationResult`: the report of `identify` (fitted model, start, assessments on
+"""`Identification`: the report of `identify` (fitted model, start, assessments on
 the training and held-out records, notes), as text (`summary`) and JSON (`to_json`);
 `model_from_report` and `read_result` rebuild the fitted model from that JSON."""
 
@@ -21,8 +21,10 @@ from .registry import model_key
 
 
 @dataclasses.dataclass(frozen=True)
-class IdentificationResult:
-    """Result of `identify`.
+class Identification:
+    """Result of `identify`: the fitted model and how it was found and assessed. It prints
+    as text (`summary`), converts to the JSON of `jaxship identify`'s `result.json`
+    (`to_dict`, `to_json`) and saves to it (`save`), which `load_model` reads back.
 
     - `model_name`: the registry name; `description`: its line;
     - `fit`: the `FitResult` (fitted `model`, `parameters` report with standard
@@ -134,6 +136,13 @@ class IdentificationResult:
         """`to_dict` as JSON text (non-finite numbers as "inf"/"-inf"/null)."""
         return json.dumps(self.to_dict(), indent=indent)
 
+    def save(self, path) -> pathlib.Path:
+        """Write `to_json()` to the file `path` (the `result.json` that `jaxship identify`
+        writes; `load_model(path)` gives the fitted model back). Returns the path."""
+        path = pathlib.Path(path)
+        path.write_text(self.to_json() + "\n", encoding="utf-8")
+        return path
+
 
 def _constants(model) -> dict:
     """The scalar fields of a steering model that are not parameters (reference scales
@@ -197,7 +206,7 @@ def _number(name, value) -> float:
 
 
 def model_from_report(report: dict):
-    """The fitted model of an `identify` report (`IdentificationResult.to_dict()`, i.e.
+    """The fitted model of an `identify` report (`Identification.to_dict()`, i.e.
     the parsed `result.json` of `jaxship identify`): a steering model rebuilt from its
     class name, `parameters` (values), `frozen` and `constants`, or a vessel from its
     `vessel` (the vessel file's form; older reports: the preset `model`) with its
@@ -302,10 +311,10 @@ def unconverged_fit(report: dict, source) -> str:
         "identify the model again on records that excite it (e.g. a zig-zag).")
 
 
-def read_result(path) -> tuple[object, dict]:
-    """`(model, report)` from the `result.json` of `jaxship identify` at `path`
-    (see `model_from_report`). **Raises** `ValueError` (one line) when the file is
-    missing or unreadable, not JSON, or not an identify result."""
+def read_report(path) -> dict:
+    """The parsed `result.json` of `jaxship identify` (or `Identification.save`) at `path`
+    (a file, or a folder holding `result.json`). **Raises** `ValueError` (one line) when
+    the file is missing or unreadable, or not JSON."""
     path = pathlib.Path(path)
     if path.is_dir():
         path = path / "result.json"
@@ -320,13 +329,22 @@ def read_result(path) -> tuple[object, dict]:
         raise ValueError(f"{path} is not a text file (byte {error.start} is not UTF-8); "
                          "give the result.json that `jaxship identify` wrote.") from None
     try:
-        report = json.loads(text)
+        return json.loads(text)
     except json.JSONDecodeError as error:
         raise ValueError(f"{path} is not valid JSON ({error.msg}, line {error.lineno}).") \
             from None
     except RecursionError:
         raise ValueError(f"{path} is nested too deeply to be an identify result.") from None
+
+
+def read_result(path) -> tuple[object, dict]:
+    """`(model, report)` from the `result.json` of `jaxship identify` at `path`
+    (`read_report`, `model_from_report`). **Raises** `ValueError` (one line) when the file
+    is missing or unreadable, not JSON, or not an identify result."""
+    report = read_report(path)
     try:
         return model_from_report(report), report
     except ValueError as error:
-        raise ValueError(f"{path}: {error}") from None
+        path = pathlib.Path(path)
+        raise ValueError(f"{path / 'result.json' if path.is_dir() else path}: {error}") \
+            from None

@@ -49,7 +49,7 @@ def is_auto(model) -> bool:
 
 
 def criterion(result) -> dict:
-    """The choice's figures of one candidate's `IdentificationResult`, from its
+    """The choice's figures of one candidate's `Identification`, from its
     `train` assessment only (the fit criterion on the training records): `bic` and `fpe`
     (module text; inf for a fit that did not converge, or non-positive or non-finite
     losses), `losses` per channel, `num_params` d, `num_samples` N, `fit_code`."""
@@ -69,7 +69,7 @@ def criterion(result) -> dict:
 
 
 def choose(results: dict, failed: dict) -> tuple[str, dict]:
-    """`(name, selection)`: the candidate of `results` {name: IdentificationResult} with the
+    """`(name, selection)`: the candidate of `results` {name: Identification} with the
     least BIC (`criterion`; the first listed on a tie: the simpler); `failed` {name: why} are
     the candidates whose fit diverged. `selection` (JSON-ready): `criterion` (in words),
     `chosen`, `candidates` {name: `criterion`, or {"failed": why}}."""
@@ -83,7 +83,7 @@ def choose(results: dict, failed: dict) -> tuple[str, dict]:
 
 
 def fitted(result) -> dict:
-    """The fitted model of a candidate's `IdentificationResult` in the report's own form
+    """The fitted model of a candidate's `Identification` in the report's own form
     (`model`, `model_class`, `parameters`, `frozen`, `constants`: what `model_from_report`
     rebuilds), so that `autopilot` can design its feedback on the linear candidate."""
     report = result.to_dict()

@@ -6,7 +6,7 @@ linear least squares (`initial_estimate`), fit by prediction error (`fit`), simu
 the fitted model on the training and on held-out records (output error, starting
 from the measured state), and collect loss, FPE, AIC/BIC, fit %, residual tests,
 standard errors, the correlation matrix and plain-language identifiability flags
-in an `IdentificationResult`.
+in an `Identification`.
 
 The library stays quiet: progress goes to the `progress` callable (see `Progress`),
 which the `jaxship identify` command turns into a tqdm bar; the fit's result code says
@@ -30,13 +30,15 @@ from .data import (
     as_experiments,
     check_experiments,
     check_froude,
+    over_ground,
     preset_length,
     same_records,
     valid_samples,
 )
 from .registry import MODELS, model_key, start_entry
-from .result import IdentificationResult
-from .selection import CANDIDATES, choose, is_auto, with_selection
+from .result import Identification
+from .selection import AUTO, CANDIDATES, choose, with_selection
+from .settings import fit_settings
 from .simulation import simulate_records
 from .starts import StartContext
 
@@ -67,89 +69,105 @@ def _parse_channels(channels, allowed) -> tuple[str, ...]:
     return channels
 
 
-def identify(train, *, model: str, horizon: float | None = None, validate=None,
-             rudder: str = "delta", channels=None, initial: str = "auto",
-             max_steps: int = 256, substeps: int = 1,
-             progress: Callable[[Progress], None] | None = None,
-             start=None, free=None) -> IdentificationResult:
-    """Estimate a registered steering model from training records and validate it.
+def identify(model, train, *, validate=None, horizon=..., free=None,
+             sample_interval: float | None = None, velocities: str | None = None,
+             rudder: str = "delta", channels=None, initial=None,
+             max_steps: int = 256, progress: Callable[[Progress], None] | None = None,
+             name: str | None = None, substeps: int = 1) -> Identification:
+    """Estimate a steering model or a vessel from training records and validate it, as
+    `jaxship identify` does (the command calls this).
 
     **Arguments:**
 
-    - `train`: the training records: an `Experiment`, a list of them, a `Dataset`,
-      or file/folder paths (see `read_experiments`).
-    - `model`: `"auto"` (each steering model of `selection.CANDIDATES` fitted, the one
-      with the least BIC on the training records returned, with its `selection`) or a
-      name in `MODELS`: `nomoto1`, `nomoto2`, `nomoto1-nonlinear`,
-      `ross-autopilot`, `linear-sway-yaw`, `norrbin-crossflow`, `low-speed-sway-yaw`,
-      `armax` or a vessel preset of `jaxship.VESSELS` (its `default_free`
-      coefficients are estimated from the preset's values; records need u and v).
-      Models that feel the wind (vessels, `low-speed-sway-yaw`) get the logged wind
-      replayed when every training record logs it (each validation set likewise).
-    - `horizon`: prediction horizon of the fit [s] (`PredictionError.horizon`):
-      None (default) output error, 0 equation error, else windows of `horizon`
-      seconds from the measured state.
-    - `validate`: held-out records (same forms as `train`) or None. The fitted
-      model is simulated on them from each record's measured first state (output
-      error) and assessed with the same figures.
+    - `model`: the start: a catalogue name of `jaxship.identification.MODELS`
+      (`nomoto1`, `nomoto2`, `nomoto1-nonlinear`, `nomoto1-norrbin`, `ross-autopilot`,
+      `linear-sway-yaw`, `norrbin-crossflow`, `low-speed-sway-yaw`, `armax` or a vessel
+      preset of `jaxship.VESSELS`: its `default_free` coefficients are estimated from the
+      preset's values; records need u and v), `"auto"` (each model of
+      `jaxship.identification.CANDIDATES` fitted, the one with the least BIC of its fit
+      criterion on the training records returned, with its `selection`), a model (a
+      vessel or a steering model, e.g. from `load_model`: fitted from its own values) or
+      an earlier `Identification` (its fitted model, fitted as it was).
+    - `train`, `validate`: records: file or folder paths, an `Experiment`, a list of
+      them or a `Dataset` (`jaxship.identification.read_experiments`); `validate` None:
+      no held-out records. Models that feel the wind (vessels, `low-speed-sway-yaw`)
+      get the logged wind replayed when every training record logs it.
+    - `horizon`: prediction horizon of the fit [s] (`PredictionError.horizon`): None
+      output error, 0 equation error, else windows of `horizon` seconds from the
+      measured state; `...` (default): the preset's own where the fit starts from a
+      preset that has `fit_settings`, else None.
+    - `free`: the estimated parameters (names, or a comma-separated text; a leading `+`
+      adds them to the default set); None: the preset's own set where it has one, else
+      the model's `default_free`.
+    - `sample_interval`: each record keeps every k-th sample, k the integer nearest to
+      `sample_interval / dt` [s]; None: the preset's own where it has one, else as
+      recorded. `velocities`: the trial CSVs' u, v, `"through-water"` or `"over-ground"`
+      (None: as the records state).
     - `rudder`: the replayed rudder channel, `"delta"` or `"delta_c"`.
-    - `channels`: fitted outputs, a subset of the entry's `channels` (or a text
-      such as `"psi,r"`); None: the entry's `default_channels` (`psi, r`; `psi, r,
-      u, v` for vessel presets; `r` for armax).
+    - `channels`: fitted outputs, a subset of the entry's `channels` (or a text such as
+      `"psi,r"`); None: the entry's `default_channels` (`psi, r`; `psi, r, u, v` for
+      vessels; `r` for armax).
     - `initial`: start of each fitted window (`PredictionError.initial`):
-      `"measured"` (the measured r and psi), `"estimate"` (corrections of them are
-      estimated with the parameters, which removes the bias a noisy start sample
-      gives output error) or `"auto"` (default): `"estimate"` for output error
-      (`horizon=None`) where the entry supports it, `"measured"` otherwise. Validation
-      simulations always start from the measured state.
+      `MeasuredStates()` (the measured r and psi), `EstimatedStarts()` (corrections of
+      them estimated with the parameters, which removes the bias a noisy start sample
+      gives output error) or None (default): `EstimatedStarts` for output error where the
+      entry supports it, `MeasuredStates` otherwise (the command's `--initial measured`,
+      `estimate`, `auto` are the same). Validation always starts from the measured state.
     - `max_steps`: optimiser step limit; `substeps`: RK4 steps per sample interval.
     - `progress`: a callable receiving `Progress` reports, or None (quiet).
-    - `start`: a model to start from (`--vessel`: a vessel of a preset or a vessel
-      file, the model of an earlier result), fitted as `model` is (`start_entry`); a
-      vessel's `model` is its preset name, or None for a vessel of one's own.
-    - `free`: the names of the estimated parameters; None: the model's `default_free`.
+    - `name`: the catalogue name a `model` object is fitted as (a preset's name for its
+      vessel, `nomoto1-norrbin` for a `NonlinearNomoto`); None: a vessel of one's own,
+      a steering model's class's entry.
 
-    Start values: the entry's `start` (linear least squares by `initial_estimate`,
-    or a nested fit); if it fails (e.g. no excitation) the entry's neutral
-    `fallback`, with a note. Then `fit` with `PredictionError(horizon, channels,
-    rudder)`.
+    The preset's `fit_settings` (horizon, sample interval, free set, wind loads) apply
+    where the fit starts from the preset itself (its name, or its unchanged instance with
+    `name`) and the option is not given; a note says which were used. Start values: the
+    entry's `start` (linear least squares by `initial_estimate`, or a nested fit); if it
+    fails (e.g. no excitation) the entry's neutral `fallback`, with a note; a fit that
+    diverges from a regression start is restarted once from the fallback. Then `fit` with
+    `PredictionError(horizon, channels, rudder)` and Levenberg-Marquardt (rtol = atol =
+    1e-9); the assessment counts the d estimated parameters in FPE and AIC/BIC
+    (FPE = V (1 + d/N) / (1 - d/N), thesis eq. 3.21).
 
-    **Returns:** an `IdentificationResult`; `to_json()` gives `model`,
-    `parameters` (`{name: {value, std, unit, relative_std, start}}`, SI), `frozen`,
-    `constants` (fixed non-parameter fields: `model_from_report` rebuilds the model),
-    `fit` (optimiser result), `train` (the fit criterion), `train_simulation` and
-    `validation` (output error; None without held-out data), each with
-    `channels: {psi|r|u|v: {loss, fpe, aic, bic, fit_percent,
-    fit_percent_per_experiment, whiteness, input_independence, ...}}`,
-    `correlation` (`names`, `matrix`), `identifiability` (`identifiable`,
-    `condition_number`, plain-language `flags`), `data`, `start`, `options`,
-    `notes`, `warnings`.
+    **Returns:** an `Identification` (`summary()`, `to_dict()`, `save(path)`).
 
-    **Raises:** `ValueError` naming the file/record and column for unknown models
-    or channels, missing files, a missing rudder column, a missing u or v the model
-    needs (`ross-autopilot`, vessel presets; u for the sway-yaw models), non-finite
-    values or non-uniform sampling; for `armax`, more than one training record.
-    `FitDivergedError` (a `ValueError`) when the fit diverged from every start tried.
+    **Raises:** `ValueError` (one line) naming the file/record and column for unknown
+    models or channels, missing files, a missing rudder column, a missing u or v the
+    model needs, non-finite values or non-uniform sampling; for `armax`, more than one
+    training record. `FitDivergedError` (a `ValueError`) when the fit diverged from every
+    start tried.
 
     Nothing is warned or printed: the fit's result code (`result.fit.code`) says whether
     it converged, and the result's `warnings` hold a plain sentence for a fit that did not
-    (the step limit, divergence, a blow-up) and every flag of the estimates (an estimate
-    on a bound, no excitation: the fit still returns, with infinite standard errors).
-
-    Records without a measured psi (or r) are filled by `Experiment` (psi integrated
-    from r, r differenced from psi); a note says so, and with the default `channels`
-    such a channel is not fitted when every training record lacks it.
+    and every flag of the estimates; `notes` say what was done to the records and the
+    options.
     """
-    if start is None and is_auto(model):  # each candidate fitted, one chosen (`selection`)
-        return _chosen(train, horizon=horizon, validate=validate, rudder=rudder,
-                       channels=channels, initial=initial, max_steps=max_steps,
-                       substeps=substeps, progress=progress, free=free)
+    settings = fit_settings(model, name=name, horizon=horizon,
+                            sample_interval=sample_interval, free=free)
+    notes = [] if settings.note is None else [settings.note]
+    reading = dict(note=notes.append, sample_interval=settings.sample_interval,
+                   over_ground=over_ground(velocities))
+    train = as_experiments(train, "training", **reading)
+    validate = None if validate is None else as_experiments(validate, "validation", **reading)
+    options = _Options(settings.horizon, rudder, channels, _initial(initial), max_steps, substeps,
+                       settings.free, default_channels=channels is None)
+    if settings.name == AUTO:  # each candidate fitted, one chosen (`selection`)
+        result = _chosen((train, validate), options, progress)
+    else:
+        result = _identify((train, validate), settings.name, settings.start, options,
+                           progress)
+    return dataclasses.replace(result, notes=tuple(notes) + result.notes)
+
+
+def _identify(records, model: str | None, start, asked: _Options,
+              progress: Callable[[Progress], None] | None) -> Identification:
+    """`identify` of the catalogue model `model` (None: a vessel of one's own, `start`)
+    from `start` (None: the entry's start values) on the read `records = (train,
+    validate)`, with the options `asked`."""
     name, entry = start_entry(model, start) if start is not None else \
         (model_key(model), MODELS[model_key(model)])
-    options = _checked_options(name, entry, _Options(
-        horizon, rudder, channels, initial, max_steps, substeps, free,
-        default_channels=channels is None))
-    records = _read_records(train, validate, options.rudder, name, entry, start)
+    options = _checked_options(name, entry, asked)
+    records = _read_records(*records, options.rudder, name, entry, start)
     notes, caught = same_records(records.train, records.held_out or []), []
     options = options._replace(channels=_fitted_channels(records, options, notes))
     report = progress if progress is not None else (lambda event: None)
@@ -169,7 +187,7 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     caught.extend(result.flags)
     blocks = _assessments(result, entry, records, options, fitting, wind, notes)
     _frozen_notes(result, notes)
-    return IdentificationResult(
+    return Identification(
         model_name=name, description=entry.description, fit=result, start=start,
         start_method=method, train=blocks[0], train_simulation=blocks[1],
         validation=blocks[2], options=options.to_json(), notes=tuple(notes),
@@ -177,21 +195,29 @@ def identify(train, *, model: str, horizon: float | None = None, validate=None,
     )
 
 
-def _chosen(train, *, free=None, **options) -> IdentificationResult:
-    """`identify` of each model of `CANDIDATES` on `train` with the same `options`, the one
-    chosen by `selection.choose` (the training records' fit criterion only) returned with
-    its `selection`."""
-    if free is not None:
+def _chosen(records, options: _Options, progress) -> Identification:
+    """`_identify` of each model of `CANDIDATES` on `records = (train, validate)` with the
+    same `options`, the one chosen by `selection.choose` (the training records' fit
+    criterion only) returned with its `selection`."""
+    if options.free is not None:
         raise ValueError("--free does not go with --model auto: the candidates estimate "
                          "different parameters; choose a model to set them.")
     results, failed = {}, {}
     for name in CANDIDATES:
         try:
-            results[name] = identify(train, model=name, **options)
+            results[name] = _identify(records, name, None, options, progress)
         except FitDivergedError as error:
             failed[name] = str(error)
     name, selection = choose(results, failed)
     return with_selection(results[name], selection)
+
+
+def _initial(initial) -> str:
+    """The name of `identify`'s `initial` (a strategy, None, or the command's text)."""
+    if initial is None:
+        return "auto"
+    names = {js.MeasuredStates: "measured", js.EstimatedStarts: "estimate"}
+    return names.get(type(initial), initial)
 
 
 class _Options(NamedTuple):

@@ -1,0 +1,108 @@
+"""The settings of a fit: a preset's own (`VESSELS[name].fit_settings`: the horizon, the
+records' sample interval, the free coefficients and the wind loads a protocol chose on
+training runs only) where the fit starts from the preset itself and the option is not
+given; the leading `+` of `free`, which adds names to the default set."""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import equinox as eqx
+
+import jaxship as js
+
+from .registry import model_key, start_name
+from .result import Identification
+from .selection import AUTO, is_auto
+
+
+class Settings(NamedTuple):
+    """The settings `identify` fits with: `name`, the catalogue name (`"auto"`: the
+    choice; None: a vessel of one's own), `horizon` [s] (None: output error),
+    `sample_interval` [s] (None: as recorded), `free` (None: the model's default set),
+    `start` (the model to start from; None: the catalogue's start values) and `note`
+    (the preset's settings used, in one sentence; None when none was)."""
+
+    name: str | None
+    horizon: float | None
+    sample_interval: float | None
+    free: tuple[str, ...] | None
+    start: object
+    note: str | None
+
+
+def _is_preset(name, start) -> bool:
+    """Whether the fit starts from the preset `name` itself: named (`start` None) or its
+    unchanged instance (`--vessel NAME`), not a vessel file or an earlier result."""
+    if name not in js.VESSELS:
+        return False
+    if start is None:
+        return True
+    preset = js.get_vessel(name)
+    same = eqx.tree_equal(start, preset)
+    return type(start) is type(preset) and bool(same)
+
+
+def free_names(free, default) -> tuple[str, ...] | None:
+    """`free`: None (`default`), names (a sequence, or a text of comma-separated names),
+    or a text starting with `+`: its names added to `default` (None for a model that has
+    no set of its own: the model's `default_free`, unchanged)."""
+    if free is None:
+        return default
+    text = free if isinstance(free, str) else ",".join(free)
+    add = text.strip().startswith("+")
+    names = tuple(n.strip() for n in text.strip().lstrip("+").split(",") if n.strip())
+    if not names:
+        raise ValueError(f"--free {free!r}: give coefficient names, comma separated.")
+    if not add:
+        return names
+    return None if default is None else tuple(dict.fromkeys(default + names))
+
+
+def fit_settings(model, *, name: str | None = None, horizon=..., sample_interval=None,
+                 free=None) -> Settings:
+    """The `Settings` `identify(model, ..., name=name, horizon=horizon, ...)` fits with:
+    the options given, else the preset's `fit_settings` where the fit starts from a
+    preset that has them, the preset itself (its name, or its unchanged instance with its
+    `name`); then the preset starts with the settings' wind loads. `horizon=...`: not
+    given (None is output error). A `free` text starting with `+` adds to the preset's
+    set (its `default_free` where it has no settings). **Raises** `ValueError` for an
+    unknown model name."""
+    name, start = _start(model, name)
+    if name == AUTO:
+        return Settings(AUTO, None if horizon is ... else horizon, sample_interval, free,
+                        None, None)
+    settings = js.VESSELS[name].fit_settings if _is_preset(name, start) else None
+    given_horizon = horizon is not ...
+    if settings is None:
+        base_free = None
+        if isinstance(free, str) and free.strip().startswith("+") and name in js.VESSELS:
+            base_free = js.default_free(js.get_vessel(name))
+        return Settings(name, horizon if given_horizon else None, sample_interval,
+                        free_names(free, base_free), start, None)
+    used = [text for given, text in (
+        (given_horizon, f"--horizon {settings.horizon:g}"),
+        (sample_interval is not None, f"--sample-interval {settings.sample_interval:g}"),
+        (free is not None, "--free " + ",".join(settings.free))) if not given]
+    if settings.wind_model is not None:  # the chosen wind loads
+        start = eqx.tree_at(lambda v: v.wind_model, js.get_vessel(name), settings.wind_model)
+        used.append(f"wind loads {type(settings.wind_model).__name__}")
+    note = None if not used else (f"the {name} preset's settings: {'; '.join(used)} "
+                                  f"({settings.source}).")
+    return Settings(name, horizon if given_horizon else settings.horizon,
+                    settings.sample_interval if sample_interval is None else sample_interval,
+                    free_names(free, settings.free), start, note)
+
+
+def _start(model, name) -> tuple[str | None, object]:
+    """`(name, start)` of `identify`'s `model`: a catalogue name (`AUTO` for the choice)
+    and no start, or the catalogue name a model object is fitted as (`start_name`) and
+    the model."""
+    if isinstance(model, Identification):
+        return start_name(model.model, name or model.model_name), model.model
+    if isinstance(model, str):
+        return (AUTO if is_auto(model) else model_key(model)), None
+    if not isinstance(model, (js.AbstractModel, js.ARMAXModel)):
+        raise ValueError(f"`model` must be a catalogue name, 'auto', a model or an "
+                         f"Identification, got {type(model).__name__}.")
+    return start_name(model, name), model
