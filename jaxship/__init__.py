@@ -11,11 +11,7 @@ __version__ = "0.1.0"  # the one place of the version (pyproject.toml reads it)
 # foundation: parameters, state, progress, the compilation cache
 # analysis: manoeuvre indices, autopilot design and closed loops, experiment design,
 # discovery
-from ._analysis._autopilot import (
-    design_autopilot as design_autopilot,
-    tune_autopilot as tune_autopilot,
-    yaw_inertia as yaw_inertia,
-)
+from ._analysis._autopilot import yaw_inertia as yaw_inertia
 from ._analysis._closed_loop import (
     ClosedLoop as ClosedLoop,
     YawDisturbance as YawDisturbance,
@@ -158,6 +154,17 @@ from . import (
 )
 
 
+# isort: split
+# the workflow's verbs, last: its modules `import jaxship as js` at module level
+from ._workflow._autopilot import AutopilotDesign as AutopilotDesign
+from ._workflow._autopilot_evaluation import (
+    AutopilotEvaluation as AutopilotEvaluation,
+    design_autopilot as design_autopilot,
+    evaluate_autopilot as evaluate_autopilot,
+)
+from ._workflow._autopilot_reference import tune_autopilot as tune_autopilot
+
+
 # The public names, grouped by layer as in docs/architecture.md (`# -- layer`); a
 # `# page: section` line puts the names after it in that section of docs/api/<page>.md
 # (docs/api_pages.py generates the entries of the API pages from every `__all__`).
@@ -294,6 +301,9 @@ __all__ = [
     # analysis: Autopilot
     "design_autopilot",
     "tune_autopilot",
+    "evaluate_autopilot",
+    "AutopilotDesign",
+    "AutopilotEvaluation",
     "yaw_inertia",
     "closed_loop",
     "ClosedLoop",
