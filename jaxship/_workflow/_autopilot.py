@@ -427,13 +427,13 @@ def operating_points(plant, *, rpm=None, speeds=None) -> tuple:
     return key, values, points, (u0, n0)
 
 
-def design_on_vessel(models: DesignModels, plant, design: AutopilotDesign, *, key: str,
-                     mean: float, u0: float, n0: float, steady_turn: str = "model",
-                     say=None) -> tuple:
+def design_on_vessel(models: DesignModels, plant, design: AutopilotDesign, *, at: dict,
+                     u0: float, n0: float, steady_turn: str = "model", say=None) -> tuple:
     """`(controllers, model, at_step)`: `design_controllers` of `models` about the straight
     run `u0`, `n0`; with `steady_turn="trial"` the feed-forward inverts the model nearer the
     vessel's steady turn at the step's peak rate, its steady-turn part scaled to it
-    (`nearest_steady_turn` at the operating point `key` = `mean`); `model`: the one the
+    (`nearest_steady_turn` at the operating point `at`, {"rpm" or "speed": the mean});
+    `model`: the one the
     feed-forward inverts; `at_step`: the trial (None for "model")."""
     model, feedback = models
     controllers = design_controllers(model, plant, design, speed=u0, n=n0, feedback=feedback)
@@ -441,7 +441,7 @@ def design_on_vessel(models: DesignModels, plant, design: AutopilotDesign, *, ke
     if steady_turn == "trial":
         (say or (lambda message: None))("the vessel's steady turn at the step's peak rate")
         model, at_step = nearest_steady_turn((model, feedback), plant, design,
-                                             controllers["pid"], **{key: mean})
+                                             controllers["pid"], **at)
         controllers = design_controllers(model, plant, design, speed=u0, n=n0,
                                          steady_gain=at_step["steady_gain"], feedback=feedback)
     elif steady_turn != "model":
@@ -469,7 +469,7 @@ def evaluate(model, plant, *, rpm=None, speeds=None,
     key, values, points, (u0, n0) = operating_points(plant, rpm=rpm, speeds=speeds)
     say = progress or (lambda message: None)
     controllers, model, at_step = design_on_vessel(
-        models, plant, design, key=key, mean=float(np.mean(values)), u0=u0, n0=n0,
+        models, plant, design, at={key: float(np.mean(values))}, u0=u0, n0=n0,
         steady_turn=steady_turn, say=say)
     run_kw = {"rpm": values} if key == "rpm" else {"speeds": values}
     tuning = None

@@ -13,7 +13,7 @@ from ._autopilot import (
     design_on_vessel,
     evaluate,
     operating_points,
-    steady_turn_trial,
+    steady_turn_trial as measure_steady_turn,
 )
 from ._autopilot_source import chosen_text, resolve
 from ._autopilot_steady_turn import feedforward_gain_text
@@ -27,7 +27,7 @@ from ._autopilot_text import (
 
 
 def design_autopilot(model, *, plant=None, rpm=None, speeds=None,
-                     design: AutopilotDesign | None = None, steady_turn: str = "trial",
+                     design: AutopilotDesign | None = None, steady_turn_trial: bool = True,
                      feedforward=True, **options):
     """A `HeadingAutopilot` by pole placement (thesis eq. 5.3-5.5; Fossen 2011, sec.
     12.2): $K_p = m\\omega_n^2$, $K_d = 2\\zeta\\omega_n m - d$, $K_i = \\omega_n K_p/10$
@@ -63,9 +63,9 @@ def design_autopilot(model, *, plant=None, rpm=None, speeds=None,
         design = AutopilotDesign.auto(source.models, plant, rpm=rpm, speeds=speeds)
     design.check()
     key, values, _, (u0, n0) = operating_points(plant, rpm=rpm, speeds=speeds)
-    controllers, _, _ = design_on_vessel(source.models, plant, design, key=key,
-                                         mean=float(np.mean(values)), u0=u0, n0=n0,
-                                         steady_turn=steady_turn)
+    controllers, _, _ = design_on_vessel(source.models, plant, design,
+                                         at={key: float(np.mean(values))}, u0=u0, n0=n0,
+                                         steady_turn="trial" if steady_turn_trial else "model")
     return controllers["pid+ff" if feedforward else "pid"]
 
 
@@ -75,14 +75,14 @@ class AutopilotEvaluation(Evaluation):
     "pid+ff", "pid" and with tuning "tuned", their closed-loop runs and the rows of their
     metrics) with `source`, the model it was designed from (autopilot.json's "model": name,
     class, the fit's code, the selection, the model of the poles, the parameters), and
-    `chosen`, how `identify --model auto` chose it in words ("" otherwise).
+    `chosen`, how `identify --model auto` chose it in words (None otherwise).
     `feedforward_at_step` is always measured (with the model's own steady turn too).
     `to_dict()` is autopilot.json without the command's own entries (the model file, the
     vessel's name, the figures); `summary()` the text the command prints, `report()` the
     page it writes."""
 
     source: dict | None = None
-    chosen: str = ""
+    chosen: str | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready: "model" (`source`), "feedforward_at_step", "design", "gains",
@@ -93,7 +93,7 @@ class AutopilotEvaluation(Evaluation):
     def inverse_text(self) -> str:
         """The model the feed-forward inverts and its steady turn where the step steers,
         then how the model was chosen, in words."""
-        return feedforward_gain_text(self.feedforward_at_step) + self.chosen
+        return feedforward_gain_text(self.feedforward_at_step) + (self.chosen or "")
 
     def problems(self) -> tuple[str, str]:
         """`(failure, saturation)`: the sentences on runs that blew up and on runs whose
@@ -106,8 +106,8 @@ class AutopilotEvaluation(Evaluation):
                  tuning_text(self.tuning))
         return "\n".join(text for text in texts if text)
 
-    def report(self, *, vessel: str = "", file: str = "", figures=(),
-               unconverged: str = "") -> str:
+    def report(self, *, vessel: str | None = None, file: str | None = None, figures=(),
+               unconverged: str | None = None) -> str:
         """The markdown page (report.md): its title names the model and the `vessel`, the
         model's line its `file`; the sentences on saturated or blown-up runs and
         `unconverged` (a fit that did not converge) first, in bold; `figures` (paths
@@ -129,7 +129,7 @@ class AutopilotEvaluation(Evaluation):
 
 def evaluate_autopilot(source, plant, *, rpm=None, speeds=None,
                        design: AutopilotDesign | None = None, tune: bool = False,
-                       steady_turn: str = "trial", progress=None) -> AutopilotEvaluation:
+                       steady_turn_trial: bool = True, progress=None) -> AutopilotEvaluation:
     """`jaxship autopilot` as a verb: design the autopilots of `source` (a model, an
     identification or a parsed result.json; `design_autopilot`'s rules, `design` default
     `AutopilotDesign.auto`) and run each on the vessel `plant` from straight runs at each
@@ -137,21 +137,22 @@ def evaluate_autopilot(source, plant, *, rpm=None, speeds=None,
     (feedback only) and with `tune` "tuned" (its gains, then its reference bandwidth,
     tuned on `plant`: `tune_autopilot(..., reference_bandwidth=True)`). The metrics of
     each run: thesis eq. 3.19 sampled over the design's window, RMS error, overshoot,
-    settling time, rudder use (`closed_loop_metrics`). `steady_turn`: "trial" (the
-    feed-forward's steady-turn part scaled to the vessel's at the step's peak yaw rate)
-    or "model" (the model's own, thesis eq. 5.2/5.6). `progress`: a callable taking a
-    message (each stage), or None."""
+    settling time, rudder use (`closed_loop_metrics`). `steady_turn_trial`: True (the
+    feed-forward's steady-turn part scaled to the vessel's at the step's peak yaw rate;
+    `--steady-turn trial`) or False (the model's own, thesis eq. 5.2/5.6). `progress`: a
+    callable taking a message (each stage), or None."""
     resolved = resolve(source)
     if design is None:
         design = AutopilotDesign.auto(resolved.models, plant, rpm=rpm, speeds=speeds)
     evaluation = evaluate(resolved.models, plant, rpm=rpm, speeds=speeds, design=design,
-                          tune=tune, progress=progress, steady_turn=steady_turn)
+                          tune=tune, progress=progress,
+                          steady_turn="trial" if steady_turn_trial else "model")
     at_step = evaluation.feedforward_at_step
     if at_step is None:  # the model's own steady turn: the trial's numbers for the report
         (progress or (lambda message: None))("the vessel's steady turn at the step's peak rate")
         key, values = ("rpm", rpm) if rpm is not None else ("speed", speeds)
         values = [float(x) for x in values]
-        at_step = steady_turn_trial(evaluation.model, plant, design,
+        at_step = measure_steady_turn(evaluation.model, plant, design,
                                     evaluation.controllers["pid"],
                                     **{key: sum(values) / len(values)})
         del at_step["steady_gain"]

@@ -172,14 +172,14 @@ def tune_reference(plant, autopilot, demand: RudderDemand, *, duration: float, d
 RUDDER_SHARE = 0.5
 
 
-def tune_autopilot(plant, autopilot, *, speeds=None, rpm=None, duration: float = 300.0,
-                   dt: float = 1.0, rudder_weight: float = 0.1,
+def tune_autopilot(plant, autopilot, *, speeds=None, rpm=None,
                    reference_bandwidth: bool = False, progress=None, **options):
     """Tune `autopilot` on `plant` at `speeds` [m/s] or `rpm`: its gains (`kp`, `ki`,
     `kd` and the feed-forward's `gain`, `steady_gain`) by Levenberg-Marquardt on the
     objective $\\overline{\\mathrm{ssa}(\\psi_d - \\psi)^2} + w\\,\\overline{\\delta_c^2}$
-    (`tracking_objective`, $w$ = `rudder_weight`; the other `options`: `disturbance`,
-    `max_steps`, `rtol`, `atol`, `simulator`, `throw`); then, with
+    (`tracking_objective`; the `options` of the gains' tuning: `duration` [s] (300),
+    `dt` [s] (1), `rudder_weight` $w$ (0.1), `disturbance`, `max_steps`, `rtol`, `atol`,
+    `simulator`, `throw`); then, with
     `reference_bandwidth=True` (`jaxship autopilot --tune`), the reference model's
     bandwidth $\\omega$ (eq. 5.7) against the ordered heading (`tune_reference`): a log
     grid up to what keeps the feed-forward of the autopilot's one heading step within half
@@ -190,8 +190,10 @@ def tune_autopilot(plant, autopilot, *, speeds=None, rpm=None, duration: float =
     bandwidth's summary in `reference`)."""
     say = progress or (lambda message: None)
     say("tuning the gains on the vessel")
-    tuned = tune_gains(plant, autopilot, speeds=speeds, rpm=rpm, duration=duration, dt=dt,
-                       rudder_weight=rudder_weight, **options)
+    # the defaults of the gains' tuning (`jaxship._analysis`' `tune_autopilot`), which the
+    # bandwidth's runs share
+    options = {"duration": 300.0, "dt": 1.0, "rudder_weight": 0.1} | options
+    tuned = tune_gains(plant, autopilot, speeds=speeds, rpm=rpm, **options)
     if not reference_bandwidth:
         return tuned
     headings = np.atleast_1d(np.asarray(autopilot.steps.headings, dtype=float))
@@ -203,8 +205,9 @@ def tune_autopilot(plant, autopilot, *, speeds=None, rpm=None, duration: float =
     demand = RudderDemand(_straight_run(plant, speeds, rpm), float(headings[0]),
                           float(autopilot.max_angle), float(autopilot.max_rate),
                           damping=float(autopilot.reference.damping), share=RUDDER_SHARE)
-    better, summary = tune_reference(plant, tuned.autopilot, demand, duration=duration, dt=dt,
-                                     rudder_weight=rudder_weight, run_kw=run_kw)
+    better, summary = tune_reference(plant, tuned.autopilot, demand,
+                                     duration=options["duration"], dt=options["dt"],
+                                     rudder_weight=options["rudder_weight"], run_kw=run_kw)
     return dataclasses.replace(tuned, autopilot=better, reference=summary)
 
 

@@ -8,6 +8,8 @@ two (`nearest_steady_turn`)."""
 
 from typing import NamedTuple
 
+import jaxship as js
+
 from ._identify.result import model_from_report
 from ._identify.selection import linear_candidate
 
@@ -62,11 +64,11 @@ def resolve(source) -> Source:
     if isinstance(source, dict):
         model, report = model_from_report(source), source
         selection = report.get("selection")
-    elif hasattr(source, "model") and hasattr(source, "selection"):
-        model, selection = source.model, source.selection
-        report = source.to_dict() if callable(getattr(source, "to_dict", None)) else None
-    else:
+    elif isinstance(source, js.AbstractModel):
         return Source(DesignModels(source, source), None, None)
+    else:  # an identification
+        model, selection = source.model, getattr(source, "selection", None)
+        report = source.to_dict() if callable(getattr(source, "to_dict", None)) else None
     linear = linear_candidate(selection)
     if linear is None:
         return Source(DesignModels(model, model), report, selection)

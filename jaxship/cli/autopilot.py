@@ -119,7 +119,8 @@ def run(args) -> int:
 
     bar, progress = _stage_bar(args)
     evaluation = js.evaluate_autopilot(report, vessel, design=design, tune=args.tune,
-                                       progress=progress, steady_turn=args.steady_turn, **kw)
+                                       progress=progress,
+                                       steady_turn_trial=args.steady_turn == "trial", **kw)
     bar.update(bar.total - bar.n)
     bar.close()
 
