@@ -11,11 +11,7 @@ __version__ = "0.1.0"  # the one place of the version (pyproject.toml reads it)
 # foundation: parameters, state, progress, the compilation cache
 # analysis: manoeuvre indices, autopilot design and closed loops, experiment design,
 # discovery
-from ._analysis._autopilot import (
-    design_autopilot as design_autopilot,
-    tune_autopilot as tune_autopilot,
-    yaw_inertia as yaw_inertia,
-)
+from ._analysis._autopilot import yaw_inertia as yaw_inertia
 from ._analysis._closed_loop import (
     ClosedLoop as ClosedLoop,
     YawDisturbance as YawDisturbance,
@@ -161,6 +157,13 @@ from . import (
 # isort: split
 # the workflow's verbs, last: their modules use the names above (`import jaxship as js`)
 from . import identification as identification  # noqa: E402
+from ._workflow._autopilot import AutopilotDesign as AutopilotDesign  # noqa: E402
+from ._workflow._autopilot_evaluation import (  # noqa: E402
+    AutopilotEvaluation as AutopilotEvaluation,
+    design_autopilot as design_autopilot,
+    evaluate_autopilot as evaluate_autopilot,
+)
+from ._workflow._autopilot_reference import tune_autopilot as tune_autopilot  # noqa: E402
 from ._workflow._identify import (  # noqa: E402
     Identification as Identification,
     identify as identify,
@@ -307,6 +310,9 @@ __all__ = [
     # analysis: Autopilot
     "design_autopilot",
     "tune_autopilot",
+    "evaluate_autopilot",
+    "AutopilotDesign",
+    "AutopilotEvaluation",
     "yaw_inertia",
     "closed_loop",
     "ClosedLoop",

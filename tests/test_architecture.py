@@ -696,6 +696,7 @@ NOT_STRATEGIES = {
     "source",  # a vessel file's citation
     "separate",  # a catalogue entry's sentence on telling it apart
     "criterion",  # FitResult: the label of what was minimised (a report, not an input)
+    "basis",  # AutopilotDesign: the sentence on how its numbers were chosen
 }
 
 

@@ -272,14 +272,14 @@ def test_a_closed_loop_that_blew_up_exits_3_and_says_so(identified, tmp_path, ca
     """A run whose simulation did not stay finite (`success` false: the trust audit's
     --speed 1e6, now refused before any work) is not a success: exit 3, and the report
     says so first, under its title."""
-    evaluate = study.evaluate
+    evaluate = js.evaluate_autopilot
 
     def blown(*args, **kwargs):
         evaluation = evaluate(*args, **kwargs)
         evaluation.rows[0]["success"] = False
         return evaluation
 
-    monkeypatch.setattr("jaxship.cli.autopilot.autopilot_study.evaluate", blown)
+    monkeypatch.setattr(js, "evaluate_autopilot", blown)
     out = tmp_path / "run"
     assert main(["autopilot", "--model", str(identified), "--vessel", "thesis", "--rpm", "300",
                  "--out", str(out), "--quiet"]) == 3
@@ -423,14 +423,14 @@ def test_the_default_design_follows_the_models_time_constant():
     omega, basis = study.natural_frequency_for(js.Nomoto1(K=0.033, T=21.0), mariner,
                                                speed=7.7, n=0.0)
     assert omega == pytest.approx(1.25 / 21.0) and "T = 21 s" in basis
-    design = study.Design.scaled(omega, basis=basis)
+    design = js.AutopilotDesign.scaled(omega, basis=basis)
     assert design.reference_frequency == pytest.approx(0.4 * omega)
     assert (design.step_time, design.duration) == (840.0, 1680.0)
     omega, basis = study.natural_frequency_for(js.Nomoto1(K=0.2, T=2.0), thesis,
                                                speed=1.5, n=6.0)
     assert omega == 0.5 and "half the servo bandwidth" in basis
-    default = study.Design()
-    scaled = study.Design.scaled(0.5)
+    default = js.AutopilotDesign()
+    scaled = js.AutopilotDesign.scaled(0.5)
     assert (scaled.reference_frequency, scaled.step_time, scaled.duration) == (
         default.reference_frequency, default.step_time, default.duration)
 
@@ -573,7 +573,7 @@ def test_the_mariner_at_the_defaults(tmp_path):
     mariner = js.get_vessel("mariner")
     u0, n0 = study.operating_point(mariner, speed=7.7)
     omega, basis = study.natural_frequency_for(mariner, mariner, speed=u0, n=n0)
-    own = study.evaluate(mariner, mariner, speeds=[7.7], design=study.Design.scaled(omega))
+    own = study.evaluate(mariner, mariner, speeds=[7.7], design=js.AutopilotDesign.scaled(omega))
     by = {r["controller"]: r for r in own.rows}
     assert by["pid+ff"]["code"] == "successful"
     assert by["pid+ff"]["sum_abs_error_deg"] < 0.2 * by["pid"]["sum_abs_error_deg"]
@@ -611,7 +611,7 @@ def test_the_steady_turn_trial_measures_the_vessels_steady_turn():
     """`vessel_steady_rudder` (issue 61) against the open loop: the thesis vessel (course-
     stable) held at the measured rudder, +- it, turns steadily at the step's peak desired
     yaw rate within 2 %; a trial too short to settle is refused with a sentence."""
-    thesis, design = js.get_vessel("thesis"), study.Design()
+    thesis, design = js.get_vessel("thesis"), js.AutopilotDesign()
     u0, n0 = study.operating_point(thesis, rpm=400.0)
     pid = study.design_controllers(js.Nomoto1(K=0.2, T=2.5), thesis, design, speed=u0,
                                    n=n0)["pid"]
@@ -621,7 +621,7 @@ def test_the_steady_turn_trial_measures_the_vessels_steady_turn():
                                x0).state.r[-1]) for s in (1, -1)]
     assert (rates[0] - rates[1]) / 2 == pytest.approx(study.peak_reference_rate(design),
                                                       rel=0.02)
-    short = study.Design(step_time=1.0, duration=4.0)
+    short = js.AutopilotDesign(step_time=1.0, duration=4.0)
     with pytest.raises(ValueError, match="did not settle on the reverse-spiral trial"):
         study.vessel_steady_rudder(thesis, pid, short, rpm=400.0)
 

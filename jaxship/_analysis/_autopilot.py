@@ -117,13 +117,17 @@ class TunedAutopilot(eqx.Module):
     """Result of `tune_autopilot`: the tuned `autopilot`, the objective
     (`tracking_objective`) of the start and of the result [rad^2] on the tuning runs,
     the optimiser's step count, its `RESULTS` code `result` (optimistix's, passed through)
-    and `success`, `result == successful`."""
+    and `success`, `result == successful`; `reference`: with the reference bandwidth tuned
+    after the gains (`jaxship.tune_autopilot(..., reference_bandwidth=True)`) its summary
+    (the bandwidth before and after, its bounds, the objectives against the ordered
+    heading), else None."""
 
     autopilot: HeadingAutopilot
     objective_before: Array
     objective_after: Array
     num_steps: Array
     result: RESULTS
+    reference: dict | None = None
 
     @property
     def success(self) -> Array:

@@ -1,6 +1,8 @@
 """Closed-loop runs of heading autopilots on a plant (a truth vessel or a steering
 model), batched over autopilots x speeds, and their metrics (Odegard 2009, sec. 5.4)."""
 
+import dataclasses
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -82,11 +84,27 @@ class ClosedLoop(eqx.Module):
 def _autopilot_batch(autopilots) -> HeadingAutopilot:
     """One autopilot, a list of them, or a `stack` of them, as a stack."""
     if isinstance(autopilots, (list, tuple)):
-        return stack(list(autopilots))
+        return stack(_one_structure(list(autopilots)))
     if not isinstance(autopilots, HeadingAutopilot):
         raise ValueError(f"`autopilots` must be HeadingAutopilot(s), got "
                          f"{type(autopilots).__name__}.")
     return autopilots if np.ndim(autopilots.kp) == 1 else stack([autopilots])
+
+
+def _one_structure(autopilots: list) -> list:
+    """`autopilots` of one tree structure for `stack`: where some have a feed-forward and
+    others none (issue 68: "pid+ff" beside "pid"), those without take the first one's
+    `Feedforward` with both gains zero, $\\delta_{ff} = 0\\cdot(\\ldots) + 0\\cdot
+    \\delta_s = 0$ (its Newton steps clip the model's rudder to the rudder's limit, so the
+    product is an exact zero and the command that of no feed-forward)."""
+    present = [a.feedforward for a in autopilots if a.feedforward is not None]
+    if not present or len(present) == len(autopilots):
+        return autopilots
+    zero = lambda x: jnp.zeros_like(jnp.asarray(x, dtype=float))
+    off = eqx.tree_at(lambda f: (f.gain, f.steady_gain), present[0],
+                      (zero(present[0].gain), zero(present[0].steady_gain)))
+    return [a if a.feedforward is not None else dataclasses.replace(a, feedforward=off)
+            for a in autopilots]
 
 
 def initial_states(plant, speeds=None, rpm=None) -> ShipState:
@@ -120,7 +138,8 @@ def closed_loop(plant, autopilots, *, speeds=None, rpm=None, duration: float = 3
     - `plant`: a vessel (the autopilot's command goes through its rudder servo) or a
       steering model (ideal rudder: the command is the angle; constant auxiliary
       inputs u = speed, v = 0, n = rpm/60).
-    - `autopilots`: a `HeadingAutopilot`, a list of them or a `jaxship.stack` of them.
+    - `autopilots`: a `HeadingAutopilot`, a list of them (with and without feed-forward
+      alike) or a `jaxship.stack` of them.
     - `disturbance`: an optional `YawDisturbance` (vessels only), one realisation
       shared by all runs.
 

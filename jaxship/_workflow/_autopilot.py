@@ -16,7 +16,7 @@ $\\sum_k|\\psi_d(t_k) - \\psi(t_k)|$ in degrees, **sampled every 1 s over 100-20
 ordering and ratios, not by absolute size).
 
 **The controller's own natural frequency and damping** are not in the thesis (only
-the reference model's, Table 5.1). `Design` uses $\\omega_n$ = 0.5 rad/s, 2.5 times
+the reference model's, Table 5.1). `AutopilotDesign` uses $\\omega_n$ = 0.5 rad/s, 2.5 times
 the reference's 0.2 rad/s (the error stays small while $\\psi_d$ moves) and half the
 bandwidth of the rudder servo it does not model (1 s), and $\\zeta$ = 1 as the
 reference (no overshoot). $K_d$ is Fossen's $2\\zeta\\omega_n m - d$ (exact pole
@@ -28,13 +28,18 @@ runs, and kept for every run; the feed-forward uses the simulated vessel's $u$, 
 
 import dataclasses
 import math
-from typing import NamedTuple
 
 import numpy as np
 
 import jaxship as js
 
-from ._autopilot_reference import RudderDemand, ordered_error_deg, tune_reference
+from .._analysis._autopilot import design_autopilot as design_pid
+from ._autopilot_reference import (
+    RUDDER_SHARE as RUDDER_SHARE,
+    ordered_error_deg,
+    tune_autopilot,
+)
+from ._autopilot_source import DesignModels as DesignModels, resolve
 from ._autopilot_steady_turn import (
     feedforward_at_step as feedforward_at_step,
     feedforward_gain_text as feedforward_gain_text,
@@ -53,9 +58,6 @@ DEG = math.pi / 180.0
 REFERENCE_RATIO = 0.4
 STEP_TIME_RATIO = 50.0
 BANDWIDTH_TIMES_T = 1.25
-# the share of the rudder's angle and rate limits the reference step's feed-forward may
-# use (the rest is the feedback's)
-RUDDER_SHARE = 0.5
 CONTROLLERS = ("pid+ff", "pid")  # with and without the reference feed-forward
 # the columns of a run (`Evaluation.rows`, `autopilot.json` "runs")
 RUN_KEYS = ("controller", "rpm", "speed", "sum_abs_error_deg", "rms_error_deg",
@@ -63,14 +65,14 @@ RUN_KEYS = ("controller", "rpm", "speed", "sum_abs_error_deg", "rms_error_deg",
             "rudder_travel_deg", "time_rate_limited_s")
 
 
-# the most output samples of one closed-loop run (`Design.check`): 10^6 at 0.1 s is 28 h;
+# the most output samples of one closed-loop run (`AutopilotDesign.check`): 10^6 at 0.1 s is 28 h;
 # a model with a yaw time constant of years (a fit the data did not determine) would
 # otherwise ask for petabytes
 MAX_SAMPLES = 1e6
 
 
 @dataclasses.dataclass(frozen=True)
-class Design:
+class AutopilotDesign:
     """Numbers of the autopilot design and of the closed-loop runs.
 
     - `natural_frequency` $\\omega_n$ [rad/s], `damping` $\\zeta$ [-]: the PID's pole
@@ -86,7 +88,7 @@ class Design:
       interval, step limit and rudder weight (`--tune`);
     - `basis`: how the numbers were chosen, in one sentence (`scaled`).
 
-    `Design.scaled(omega_n)` keeps the thesis' proportions for any ship: the reference at
+    `AutopilotDesign.scaled(omega_n)` keeps the thesis' proportions for any ship: the reference at
     0.4 omega_n, the step at 50 / omega_n (two digits) and the run twice as long (Table 5.1's 0.2
     rad/s, 100 s and 200 s for 0.5 rad/s); `natural_frequency_for` derives omega_n from
     the model's own yaw time constant.
@@ -109,7 +111,7 @@ class Design:
     basis: str = "the thesis' numbers (Table 5.1) and omega_n = 0.5 rad/s"
 
     @classmethod
-    def scaled(cls, natural_frequency: float, *, basis: str = "", **kwargs) -> "Design":
+    def scaled(cls, natural_frequency: float, *, basis: str = "", **kwargs) -> "AutopilotDesign":
         """The thesis' proportions about `natural_frequency` [rad/s] (class text)."""
         w = float(natural_frequency)
         step_time = float(f"{STEP_TIME_RATIO / w:.2g}")  # two digits: 100 s, 840 s
@@ -117,6 +119,24 @@ class Design:
                    step_time=step_time, duration=2 * step_time,
                    basis=basis or f"omega_n = {w:.4g} rad/s as given, the reference and "
                    "timing in the thesis' proportions", **kwargs)
+
+    @classmethod
+    def auto(cls, source, plant, *, rpm=None, speeds=None, step: float = 45.0,
+             damping: float = 1.0, **kwargs) -> "AutopilotDesign":
+        """The design `jaxship autopilot` takes by default: `scaled` about omega_n of
+        `natural_frequency_for` (1.25 / T, at most half the servo bandwidth and what keeps
+        the feed-forward of the `step` [deg] within half the rudder's limits) from the
+        model the poles are placed on (`source`: a model, an identification or a parsed
+        result.json; from `--model auto` its linear candidate), about the straight run of
+        the vessel `plant` at the mean of `rpm` or `speeds` [m/s]."""
+        if (rpm is None) == (speeds is None):
+            raise ValueError("give exactly one of rpm and speeds.")
+        key, values = ("rpm", rpm) if rpm is not None else ("speed", speeds)
+        values = [float(x) for x in values]
+        u0, n0 = operating_point(plant, **{key: sum(values) / len(values)})
+        omega, basis = natural_frequency_for(resolve(source).models.feedback, plant,
+                                             speed=u0, n=n0, step=step)
+        return cls.scaled(omega, step=step, damping=damping, basis=basis, **kwargs)
 
     @property
     def window(self) -> tuple[float, float]:
@@ -164,7 +184,7 @@ class Evaluation:
 
     model: object
     plant: object
-    design: Design
+    design: AutopilotDesign
     design_speed: float
     design_rpm: float
     controllers: dict
@@ -285,18 +305,7 @@ def natural_frequency_for(model, plant, *, speed: float, n: float,
                "the thesis' proportions")
 
 
-class DesignModels(NamedTuple):
-    """`evaluate`'s two models where they differ (a chosen Norrbin model and the linear
-    candidate of `identify --model auto`, `selection.linear_candidate`): the one the
-    feed-forward inverts and the one the PID's poles are placed on. With the steady-turn
-    trial the feed-forward inverts whichever turns steadily nearer the vessel at the
-    step's peak rate (`nearest_steady_turn`)."""
-
-    feedforward: object
-    feedback: object
-
-
-def design_controllers(model, plant, design: Design = Design(), *, speed: float,
+def design_controllers(model, plant, design: AutopilotDesign = AutopilotDesign(), *, speed: float,
                        n: float, steady_gain: float = 1.0, feedback=None) -> dict:
     """{"pid+ff": ..., "pid": ...}: `HeadingAutopilot`s for `model` (a steering model
     or vessel) by pole placement about the straight run at `speed` [m/s] and `n`
@@ -320,8 +329,8 @@ def design_controllers(model, plant, design: Design = Design(), *, speed: float,
                              f"rudder at {speed:.3g} m/s (yaw inertia m = {m:.3g}): no "
                              "autopilot design.")
     inverse = js.Feedforward(model, steady_gain=steady_gain)
-    return {"pid+ff": js.design_autopilot(feedback, feedforward=inverse, **kw),
-            "pid": js.design_autopilot(feedback, feedforward=False, **kw)}
+    return {"pid+ff": design_pid(feedback, feedforward=inverse, **kw),
+            "pid": design_pid(feedback, feedforward=False, **kw)}
 
 
 def cell(x, digits=2) -> str:  # a table cell: "-" for None
@@ -338,7 +347,7 @@ def _finite(x):
 SATURATED_SHARE = 0.5
 
 
-def run_rows(name: str, run, design: Design, rpm, speed, max_angle: float) -> list[dict]:
+def run_rows(name: str, run, design: AutopilotDesign, rpm, speed, max_angle: float) -> list[dict]:
     """The rows (`RUN_KEYS`, `success`, `time_saturated_s` and the run's `code`:
     "successful", "blew_up" or "rudder_saturated", the rudder command within 1 % of its
     limit `max_angle` [rad] for more than half the window) of the closed-loop `run` of
@@ -371,59 +380,40 @@ def run_rows(name: str, run, design: Design, rpm, speed, max_angle: float) -> li
     return rows
 
 
-def tune_on_vessel(model, plant, design: Design, controllers: dict, *, speed: float,
+def tune_on_vessel(model, plant, design: AutopilotDesign, controllers: dict, *, speed: float,
                    n: float, run_kw: dict, say) -> tuple:
-    """`(tuned autopilot, summary)`: `tune_autopilot` on `plant` at the operating points
-    `run_kw` from the "pid+ff" gains of `controllers` (if its $K_d \\le 0$, from the
-    thesis' $K_d = 2\\zeta\\omega_n m$, designed about `speed`, `n`), then the reference
-    model's bandwidth with those PID gains (`tune_reference`), against the ordered heading,
-    the tuned feed-forward of the step within `RUDDER_SHARE` of the rudder's limits at the
-    straight run at `speed` (`RudderDemand`). `say`: the
-    progress callable. `model`: the one the poles are placed on (`design_controllers`'
-    `feedback`); the feed-forward keeps its own."""
+    """`(tuned autopilot, summary)`: `tune_autopilot` with its reference bandwidth
+    (`reference_bandwidth=True`) on `plant` at the operating points `run_kw` from the
+    "pid+ff" gains of `controllers` (if its $K_d \\le 0$, from the thesis' $K_d =
+    2\\zeta\\omega_n m$, designed about `speed`, `n`), with the design's run length,
+    output interval, rudder weight and step limit. `say`: the progress callable.
+    `model`: the one the poles are placed on (`design_controllers`' `feedback`); the
+    feed-forward keeps its own."""
     start = controllers["pid+ff"]
     if not float(start.kd) > 0:
         start = design_controllers(start.feedforward.model, plant, dataclasses.replace(
             design, subtract_damping=False), speed=speed, n=n,
             steady_gain=start.feedforward.steady_gain, feedback=model)["pid+ff"]
-    say("tuning the gains on the vessel")
-    tuned = js.tune_autopilot(plant, start, duration=design.duration, dt=design.tune_dt,
-                              rudder_weight=design.rudder_weight,
-                              max_steps=design.tune_steps, **run_kw)
-    say("tuning the reference model's bandwidth on the vessel")
-    demand = RudderDemand(js.straight_run(plant, speed=speed), design.step * DEG,
-                          float(plant.rudder.max_angle), float(plant.rudder.max_rate),
-                          damping=design.reference_damping, share=RUDDER_SHARE)
-    autopilot, reference = tune_reference(plant, tuned.autopilot, demand,
-                                          duration=design.duration, dt=design.tune_dt,
-                                          rudder_weight=design.rudder_weight, run_kw=run_kw)
-    return autopilot, {"objective_before": float(tuned.objective_before),
-                       "objective_after": float(tuned.objective_after),
-                       "steps": int(tuned.num_steps), "converged": bool(tuned.success),
-                       **reference}
+    tuned = tune_autopilot(plant, start, duration=design.duration, dt=design.tune_dt,
+                           rudder_weight=design.rudder_weight, max_steps=design.tune_steps,
+                           reference_bandwidth=True, progress=say, **run_kw)
+    return tuned.autopilot, {"objective_before": float(tuned.objective_before),
+                             "objective_after": float(tuned.objective_after),
+                             "steps": int(tuned.num_steps), "converged": bool(tuned.success),
+                             **tuned.reference}
 
 
-def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
-             tune: bool = False, progress=None, steady_turn: str = "model") -> Evaluation:
-    """Design the autopilots of `model` (`design_controllers`, about the mean operating
-    point of the runs) and run each on the vessel `plant` from straight runs at each
-    of `rpm` or `speeds` [m/s] (exactly one of them, a sequence). `tune`: also a
-    `"tuned"` controller, its gains and reference bandwidth tuned on `plant` at the same
-    operating points (`tune_on_vessel`). `progress`: a callable taking a message, or None.
-    `steady_turn`: "model" (the feed-forward inverts the model as it is; the thesis'
-    eq. 5.2/5.6) or "trial" (its steady-turn part scaled to the vessel's own rudder at
-    the step's peak rate, `steady_turn_trial`). `model` may be a `DesignModels` pair: the
-    PID's poles are placed on its `feedback`, the feed-forward inverts its `feedforward`
-    (with the trial: the nearer of the two, `nearest_steady_turn`)."""
-    model, feedback = model if isinstance(model, DesignModels) else (model, model)
+def operating_points(plant, *, rpm=None, speeds=None) -> tuple:
+    """`(key, values, points, (u0, n0))` of the runs at `rpm` or `speeds` [m/s] (exactly
+    one of them, positive): "rpm" or "speed", the values, each one's straight run `(u, n)`
+    and the design's, at their mean. **Raises** `ValueError` (one line) where the vessel
+    has no straight run there, or no propeller model for `rpm`."""
     if (rpm is None) == (speeds is None):
         raise ValueError("give exactly one of rpm and speeds.")
-    design.check()
     values = [float(x) for x in (rpm if rpm is not None else speeds)]
     if not values or not all(math.isfinite(x) and x > 0 for x in values):
         raise ValueError(f"{'rpm' if rpm is not None else 'speeds'} must be positive numbers, "
                          f"got {values}.")
-    say = progress or (lambda message: None)
     key = "rpm" if rpm is not None else "speed"
     points = [operating_point(plant, **{key: x}) for x in values]
     mean = float(np.mean(values))
@@ -434,21 +424,59 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
     if key == "rpm" and operating_point(plant, rpm=1.25 * mean)[0] == u0:
         raise ValueError(f"the {type(plant).__name__} has no propeller model (its speed does "
                          "not depend on the rpm): give speeds (--speed) instead.")
+    return key, values, points, (u0, n0)
+
+
+def design_on_vessel(models: DesignModels, plant, design: AutopilotDesign, *, at: dict,
+                     u0: float, n0: float, steady_turn: str = "model", say=None) -> tuple:
+    """`(controllers, model, at_step)`: `design_controllers` of `models` about the straight
+    run `u0`, `n0`; with `steady_turn="trial"` the feed-forward inverts the model nearer the
+    vessel's steady turn at the step's peak rate, its steady-turn part scaled to it
+    (`nearest_steady_turn` at the operating point `at`, {"rpm" or "speed": the mean});
+    `model`: the one the
+    feed-forward inverts; `at_step`: the trial (None for "model")."""
+    model, feedback = models
     controllers = design_controllers(model, plant, design, speed=u0, n=n0, feedback=feedback)
     at_step = None
     if steady_turn == "trial":
-        say("the vessel's steady turn at the step's peak rate")
+        (say or (lambda message: None))("the vessel's steady turn at the step's peak rate")
         model, at_step = nearest_steady_turn((model, feedback), plant, design,
-                                             controllers["pid"], **{key: mean})
+                                             controllers["pid"], **at)
         controllers = design_controllers(model, plant, design, speed=u0, n=n0,
                                          steady_gain=at_step["steady_gain"], feedback=feedback)
     elif steady_turn != "model":
         raise ValueError(f"steady_turn is 'trial' or 'model', got {steady_turn!r}.")
+    return controllers, model, at_step
+
+
+def evaluate(model, plant, *, rpm=None, speeds=None,
+             design: AutopilotDesign = AutopilotDesign(), tune: bool = False, progress=None,
+             steady_turn: str = "model") -> Evaluation:
+    """Design the autopilots of `model` (`design_controllers`, about the mean operating
+    point of the runs) and run each on the vessel `plant` from straight runs at each
+    of `rpm` or `speeds` [m/s] (exactly one of them, a sequence). `tune`: also a
+    `"tuned"` controller, its gains and reference bandwidth tuned on `plant` at the same
+    operating points (`tune_on_vessel`). `progress`: a callable taking a message, or None.
+    `steady_turn`: "model" (the feed-forward inverts the model as it is; the thesis'
+    eq. 5.2/5.6) or "trial" (its steady-turn part scaled to the vessel's own rudder at
+    the step's peak rate, `steady_turn_trial`). `model` may be a `DesignModels` pair: the
+    PID's poles are placed on its `feedback`, the feed-forward inverts its `feedforward`
+    (with the trial: the nearer of the two, `nearest_steady_turn`)."""
+    models = model if isinstance(model, DesignModels) else DesignModels(model, model)
+    if (rpm is None) == (speeds is None):
+        raise ValueError("give exactly one of rpm and speeds.")
+    design.check()
+    key, values, points, (u0, n0) = operating_points(plant, rpm=rpm, speeds=speeds)
+    say = progress or (lambda message: None)
+    controllers, model, at_step = design_on_vessel(
+        models, plant, design, at={key: float(np.mean(values))}, u0=u0, n0=n0,
+        steady_turn=steady_turn, say=say)
     run_kw = {"rpm": values} if key == "rpm" else {"speeds": values}
     tuning = None
     if tune:
-        controllers["tuned"], tuning = tune_on_vessel(feedback, plant, design, controllers,
-                                                      speed=u0, n=n0, run_kw=run_kw, say=say)
+        controllers["tuned"], tuning = tune_on_vessel(models.feedback, plant, design,
+                                                      controllers, speed=u0, n=n0,
+                                                      run_kw=run_kw, say=say)
     runs, rows = {}, []
     rpms = values if key == "rpm" else [60.0 * n for _, n in points]
     speeds_ = values if key == "speed" else [u for u, _ in points]
@@ -461,4 +489,4 @@ def evaluate(model, plant, *, rpm=None, speeds=None, design: Design = Design(),
     return Evaluation(model=model, plant=plant, design=design, design_speed=u0,
                       design_rpm=60.0 * n0, controllers=controllers, runs=runs, rpm=rpms,
                       speed=speeds_, rows=rows, tuning=tuning, feedforward_at_step=at_step,
-                      feedback=feedback)
+                      feedback=models.feedback)

@@ -16,6 +16,7 @@ rudder rate. The bandwidth $\\omega$ is therefore chosen
   ordered course.
 """
 
+import dataclasses
 import math
 
 import equinox as eqx
@@ -24,6 +25,9 @@ import jax.numpy as jnp
 import numpy as np
 
 import jaxship as js
+
+from .._analysis._autopilot import tune_autopilot as tune_gains
+from ._autopilot_steady_turn import operating_point
 
 
 # the grid of the bandwidth search: log-spaced from the lower end to the rudder's bound
@@ -161,3 +165,60 @@ def tune_reference(plant, autopilot, demand: RudderDemand, *, duration: float, d
         "ordered_objective_before": float(objective[at_own]) if ok[at_own] else None,
         "ordered_objective_after": float(objective[best]) if ok[best] else None,
         "reference_candidates": len(grid)}
+
+
+# the share of the rudder's angle and rate limits the reference step's feed-forward may
+# use (the rest is the feedback's)
+RUDDER_SHARE = 0.5
+
+
+def tune_autopilot(plant, autopilot, *, speeds=None, rpm=None,
+                   reference_bandwidth: bool = False, progress=None, **options):
+    """Tune `autopilot` on `plant` at `speeds` [m/s] or `rpm`: its gains (`kp`, `ki`,
+    `kd` and the feed-forward's `gain`, `steady_gain`) by Levenberg-Marquardt on the
+    objective $\\overline{\\mathrm{ssa}(\\psi_d - \\psi)^2} + w\\,\\overline{\\delta_c^2}$
+    (`tracking_objective`; the `options` of the gains' tuning: `duration` [s] (300),
+    `dt` [s] (1), `rudder_weight` $w$ (0.1), `disturbance`, `max_steps`, `rtol`, `atol`,
+    `simulator`, `throw`); then, with
+    `reference_bandwidth=True` (`jaxship autopilot --tune`), the reference model's
+    bandwidth $\\omega$ (eq. 5.7) against the ordered heading (`tune_reference`): a log
+    grid up to what keeps the feed-forward of the autopilot's one heading step within half
+    (`RUDDER_SHARE`) of its rudder's angle and rate limits at the straight run of the mean
+    operating point (`RudderDemand`), each bandwidth with the largest acceleration gain
+    within them. `progress`: a callable taking a message, or None. **Returns** a
+    `TunedAutopilot` (with `reference_bandwidth`: the autopilot of both steps and the
+    bandwidth's summary in `reference`)."""
+    say = progress or (lambda message: None)
+    say("tuning the gains on the vessel")
+    # the defaults of the gains' tuning (`jaxship._analysis`' `tune_autopilot`), which the
+    # bandwidth's runs share
+    options = {"duration": 300.0, "dt": 1.0, "rudder_weight": 0.1} | options
+    tuned = tune_gains(plant, autopilot, speeds=speeds, rpm=rpm, **options)
+    if not reference_bandwidth:
+        return tuned
+    headings = np.atleast_1d(np.asarray(autopilot.steps.headings, dtype=float))
+    if headings.size != 1:
+        raise ValueError("the reference bandwidth is tuned for one heading step; the "
+                         f"autopilot orders {headings.size}.")
+    say("tuning the reference model's bandwidth on the vessel")
+    run_kw = {"rpm": rpm} if rpm is not None else {"speeds": speeds}
+    demand = RudderDemand(_straight_run(plant, speeds, rpm), float(headings[0]),
+                          float(autopilot.max_angle), float(autopilot.max_rate),
+                          damping=float(autopilot.reference.damping), share=RUDDER_SHARE)
+    better, summary = tune_reference(plant, tuned.autopilot, demand,
+                                     duration=options["duration"], dt=options["dt"],
+                                     rudder_weight=options["rudder_weight"], run_kw=run_kw)
+    return dataclasses.replace(tuned, autopilot=better, reference=summary)
+
+
+def _straight_run(plant, speeds, rpm):
+    """The straight run at the mean of `speeds` or `rpm` (a vessel's, at the speed of its
+    run at the mean rpm as `evaluate`'s design point; a steering model: u = the mean speed,
+    n = the mean rpm / 60)."""
+    if not isinstance(plant, js.AbstractVessel):
+        mean = lambda x: 0.0 if x is None else float(np.mean(x))
+        return js.ShipState(u=mean(speeds), v=0.0, r=0.0, x=0.0, y=0.0, psi=0.0, delta=0.0,
+                            n=mean(rpm) / 60.0)
+    key, values = ("rpm", rpm) if rpm is not None else ("speed", speeds)
+    u0, _ = operating_point(plant, **{key: float(np.mean(values))})
+    return js.straight_run(plant, speed=u0)

@@ -4,7 +4,7 @@ yaw rate, the rudder the vessel itself needs there (two points of Bech's reverse
 flown in closed loop, `vessel_steady_rudder`), the model's own rudder there
 (`feedforward_at_step`), the steady-turn gain between them (`steady_turn_trial`) and the
 choice between two models by it (`nearest_steady_turn`). `design` is the autopilot
-study's `Design` (its step, reference frequency, run length and output interval)."""
+study's `AutopilotDesign` (its step, reference frequency, run length and output interval)."""
 
 import math
 

@@ -1,6 +1,6 @@
 """The heading-autopilot study of the thesis (Odegard 2009, seed 000, chapter 5) on the
 built-in thesis vessel: the chapter-4 models identified from the merged experiments of
-each family, their autopilots (`autopilot.Design`, `autopilot.evaluate`) on the true
+each family, their autopilots (`jaxship.AutopilotDesign`, `autopilot.evaluate`) on the true
 thesis vessel at 300 and 400 rpm, and their comparison with the thesis' Tables 5.2-5.7
 (the goals, the ordering by Spearman rank correlation, the best run)."""
 
@@ -12,7 +12,7 @@ import scipy  # scipy.stats loads on first use (an import-time saving)
 
 import jaxship as js
 
-from .._workflow._autopilot import CONTROLLERS, Design, _finite, cell, evaluate
+from .._workflow._autopilot import CONTROLLERS, _finite, cell, evaluate
 from . import identification as thesis
 
 
@@ -65,14 +65,15 @@ def merged_models(vessel=None, *, quick: bool = False,
 
 
 def autopilot_study(vessel=None, *, identification=None, quick: bool = False,
-                    settings: thesis.Settings = thesis.Settings(), design: Design = Design(),
+                    settings: thesis.Settings = thesis.Settings(),
+                    design: js.AutopilotDesign = js.AutopilotDesign(),
                     rpms=RPMS, models=MODELS, progress=None) -> dict:
     """Thesis chapter 5 on `vessel` (default `jaxship.get_vessel("thesis")`).
 
     - `identification`: the chapter-4 study (`thesis.identification_study`, e.g. from
       `jaxship reproduce`) whose merged models are reused; None: `merged_models`
       (`quick`: its reduced design, two trials per family).
-    - `design`: `Design`; `rpms`: the closed-loop propeller rates; `models`: which
+    - `design`: `jaxship.AutopilotDesign`; `rpms`: the closed-loop propeller rates; `models`: which
       identified models (`"nomoto"`, `"ross"`, `"ross_speed_rudder"`).
 
     Returns a dict: `table` (one row per model, family, controller and rpm: the run
