@@ -13,7 +13,6 @@ from jaxship.plotting import (
     plot_trial_vs_thesis,
 )
 
-from ..._workflow import _autopilot as autopilot
 from ...thesis import autopilot as chapter5, identification as thesis
 
 
@@ -401,7 +400,7 @@ def autopilot_section(study, identification, out, quick):
     vessel_pid = [r["sum_abs_error_deg"] for r in study["reference"] if r["controller"] == "pid"]
     for (model, family), table in chapter5.THESIS_TABLES.items():
         rows = {c: [r for r in study["table"] if r["model"] == model and r["family"] == family
-                    and r["controller"] == c] for c in autopilot.CONTROLLERS}
+                    and r["controller"] == c] for c in chapter5.CONTROLLERS}
         if rows["pid+ff"]:
             lines.append(f"- **Table {table}** ({chapter5.MODEL_NAMES[model]} from the merged "
                          f"{FAMILY_NAMES[family]}): "
