@@ -1,13 +1,14 @@
 """Does the autopilot's reference feed-forward help on vessels jaxship did not fit? (issue 61)
 
-Run as a new user would, through the command line: each vessel's steering model from
-`jaxship identify` on that vessel's zig-zags, then `jaxship autopilot` with its defaults
-(45 deg step) on a vessel preset, PID with feed-forward (pid+ff) against the same PID
-without it (pid). Printed per run: the summed heading error (thesis eq. 3.19, deg at 1 s
-over the window after the step), the overshoot [deg], and the ratio pid+ff / pid; and
+Run as a notebook user would, through the library verbs the command calls: each vessel's
+steering model from `jaxship.identify` on that vessel's zig-zags, then
+`jaxship.evaluate_autopilot` with its defaults (45 deg step) on a vessel preset, PID with
+feed-forward (pid+ff) against the same PID without it (pid). Printed per run: the summed
+heading error (thesis eq. 3.19, deg at 1 s over the window after the step), the overshoot
+[deg], and the ratio pid+ff / pid; and
 the diagnosis of issue 61: at the step's peak desired yaw rate, the steady-turn rudder the
 model's feed-forward orders against the one the vessel itself needs there (a reverse-spiral
-point flown in closed loop by `autopilot`, "feedforward_at_step" in autopilot.json).
+point flown in closed loop, "feedforward_at_step" of the evaluation, as in autopilot.json).
 
 - Mariner at 7.7 m/s: zig-zags 10/10 and 20/20 of jaxship's `mariner` preset, which
   is also the plant;
@@ -19,10 +20,11 @@ point flown in closed loop by `autopilot`, "feedforward_at_step" in autopilot.js
 
 With `--tune` (issue 61 point 2) a second table follows: per run the summed
 error against the ordered heading (the step) of pid+ff (untuned) and of the tuned
-design (gains, then the reference model's bandwidth, `autopilot --tune`), the error of
+design (gains, then the reference model's bandwidth: `evaluate_autopilot(..., tune=True)`,
+as `autopilot --tune`), the error of
 each against its own reference, and the bandwidth before and after with its bound.
 
-`--models auto` fits with `identify --model auto` (issue 61 point 1: the model chosen by
+`--models auto` fits with `identify("auto", ...)` (issue 61 point 1: the model chosen by
 its BIC on the training records); the fit column says which.
 
 `--vessels` chooses the cases: by default the issue's three vessels above; `more` are
@@ -37,11 +39,11 @@ plant the preset itself).
 """
 
 import argparse
-import json
 import pathlib
-import subprocess
 import sys
 import tempfile
+
+import jax
 
 import jaxship as js
 
@@ -53,26 +55,20 @@ ESSO = ("zigzag_31-Jul-2020_13_29_19", "zigzag_31-Jul-2020_13_50_28",
 PRESETS = ("sea_stratus_nonlinear", "compass_island_nonlinear", "sea_swift", "sea_scout")
 
 
-def jaxship(*args) -> subprocess.CompletedProcess:
-    """One `jaxship` command; exit code 3 (a fit not converged) is reported, not fatal."""
-    quiet = ["--quiet"] if args[0] != "simulate" else []
-    done = subprocess.run([sys.executable, "-m", "jaxship.cli", *map(str, args), *quiet],
-                          capture_output=True, text=True)
-    if done.returncode not in (0, 3):
-        raise RuntimeError(f"jaxship {' '.join(map(str, args))} failed:\n{done.stderr}")
-    return done
-
-
 def zigzags(vessel: str, folder: pathlib.Path, **point) -> list:
-    """10/10 and 20/20 zig-zags of a preset at each given --speed or --rpm."""
+    """10/10 and 20/20 zig-zags of a preset at each given `speed` or `rpm`, sized and
+    simulated as `jaxship simulate` does (`StandardTrial`), written as trial CSV files."""
     (key, values), = point.items()
+    model = js.get_vessel(vessel)
     paths = []
     for value in values:
         for angle in (10, 20):
-            out = folder / f"{vessel}_{angle}_{value:g}"
-            jaxship("simulate", "--vessel", vessel, "--manoeuvre", f"zigzag:{angle}/{angle}",
-                    f"--{key}", value, "--out", out)
-            paths.append(out / "trial.csv")
+            trial = js.StandardTrial.parse(f"zigzag:{angle}/{angle}")
+            manoeuvre, x0 = trial.sized(model, **{key: value})
+            traj = js.simulate(model, manoeuvre, x0, simulator=trial.simulator)
+            path = folder / f"{vessel}_{angle}_{value:g}.csv"
+            js.write_trial_csv(path, js.Experiment.from_trajectory(traj))
+            paths.append(path)
     return paths
 
 
@@ -91,31 +87,31 @@ def cases(folder: pathlib.Path, which=("issue",)) -> list:
     and (`more`) the checks on other vessels (module text)."""
     out = []
     if "issue" in which:
-        out.append(("Mariner", zigzags("mariner", folder, speed=[7.7]), "mariner", "--speed",
+        out.append(("Mariner", zigzags("mariner", folder, speed=[7.7]), "mariner", "speeds",
                     [7.7]))
         if hsva := measured("kvlcc2_simman2008_hsva", HSVA, ".dat"):
-            out.append(("KVLCC2 (HSVA)", hsva, "kvlcc2", "--rpm", [600, 711]))
-        out.append(("thesis", zigzags("thesis", folder, rpm=[300, 400]), "thesis", "--rpm",
+            out.append(("KVLCC2 (HSVA)", hsva, "kvlcc2", "rpm", [600, 711]))
+        out.append(("thesis", zigzags("thesis", folder, rpm=[300, 400]), "thesis", "rpm",
                     [300, 400]))
     if "more" in which:
         if esso := measured("esso_osaka_frt/zigzag", ESSO, ".csv"):
-            out.append(("Esso Osaka (12 rps)", esso, "esso_osaka", "--rpm", [600, 720]))
+            out.append(("Esso Osaka (12 rps)", esso, "esso_osaka", "rpm", [600, 720]))
         for name in PRESETS:
             speed = float(js.get_vessel(name).nominal_speed)
-            out.append((name, zigzags(name, folder, speed=[speed]), name, "--speed", [speed]))
+            out.append((name, zigzags(name, folder, speed=[speed]), name, "speeds", [speed]))
     return out
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--models", nargs="+", default=["nomoto1", "nomoto1-norrbin"])
-    parser.add_argument("--autopilot", nargs="*", default=[],
-                        help="extra options passed to `jaxship autopilot`")
     parser.add_argument("--tune", action="store_true",
-                        help="run `jaxship autopilot --tune` (the second table)")
+                        help="tune as `jaxship autopilot --tune` does (the second table)")
     parser.add_argument("--vessels", nargs="+", choices=("issue", "more"), default=["issue"],
                         help="the issue's vessels, and/or more (module text)")
     args = parser.parse_args(argv)
+    jax.config.update("jax_enable_x64", True)  # as the command
+    js.enable_compilation_cache()
     print("| vessel | model | run | pid+ff sum [deg] | pid sum [deg] | ratio | "
           "pid+ff overshoot [deg] | pid overshoot [deg] | peak r_d [deg/s] | "
           "model's steady rudder there [deg] | vessel's [deg] | fit |")
@@ -125,23 +121,19 @@ def main(argv=None) -> int:
         folder = pathlib.Path(tmp)
         for name, train, plant, option, values in cases(folder, args.vessels):
             for model in args.models:
-                fit = folder / f"{plant}_{model}"
-                done = jaxship("identify", *train, "--model", model, "--out", fit,
-                               "--no-figures")
-                fitted = "converged" if done.returncode == 0 else "NOT converged"
-                if model == "auto":  # identify --model auto: the model it chose
-                    chosen = json.loads((fit / "result.json").read_text())["model"]
-                    fitted += f"; auto chose {chosen}"
-                ap = folder / f"{plant}_{model}_ap"
+                result = js.identify(model, train)
+                determined = result.fit.success and result.fit.code != js.RESULTS.undetermined
+                fitted = "converged" if determined else "NOT converged"
+                if model == "auto":  # identify("auto", ...): the model it chose
+                    fitted += f"; auto chose {result.model_name}"
                 try:
-                    jaxship("autopilot", "--model", fit / "result.json", "--vessel", plant,
-                            option, *values, "--out", ap, *args.autopilot,
-                            *(["--tune"] if args.tune else []))
-                except RuntimeError as error:
-                    print(f"| {name} | {model} | autopilot failed: "
+                    evaluation = js.evaluate_autopilot(result, js.get_vessel(plant),
+                                                       **{option: values}, tune=args.tune)
+                except ValueError as error:  # a design the command refuses (exit 2)
+                    print(f"| {name} | {model} | autopilot refused: "
                           f"{str(error).splitlines()[-1][:80]} | | | | | | | | | {fitted} |")
                     continue
-                written = json.loads((ap / "autopilot.json").read_text())
+                written = evaluation.to_dict()
                 rows, at = written["runs"], written["feedforward_at_step"]
                 if "candidates" in at:  # from auto: the two designed on, say which does what
                     fitted += (f"; poles on {written['gains']['pid']['feedback']}, "
@@ -151,7 +143,7 @@ def main(argv=None) -> int:
                     if controller != "pid+ff":
                         continue
                     fb = by[("pid", rpm, speed)]
-                    run = f"{speed:.3g} m/s" if option == "--speed" else f"{rpm:.0f} rpm"
+                    run = f"{speed:.3g} m/s" if option == "speeds" else f"{rpm:.0f} rpm"
                     a, b = ff["sum_abs_error_deg"], fb["sum_abs_error_deg"]
                     ratio = "-" if None in (a, b) else f"{a / b:.2f}"
                     print(f"| {name} | {model} | {run} | {_cell(a, '.1f')} | {_cell(b, '.1f')} | "

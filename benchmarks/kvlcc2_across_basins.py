@@ -24,19 +24,18 @@ HSVA-identified hull improves every MARIN index over the preset (the issue's goa
 """
 
 import math
-import pathlib
 import sys
 import time
 
-import numpy as np
+import jax
 
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))  # benchmarks.*
+jax.config.update("jax_enable_x64", True)
 
-from jaxship.cli._identification import identify  # noqa: E402
+import numpy as np  # noqa: E402
 
 import jaxship as js  # noqa: E402
-from benchmarks.kvlcc2_simman import (  # noqa: E402 (enables float64)
+from jaxship.studies.kvlcc2_simman import (  # noqa: E402
     DT,
     LENGTH,
     execute_index,
@@ -94,7 +93,7 @@ def main():
     js.enable_compilation_cache()
     began = time.perf_counter()
     train, holdout = kvlcc2_discovery_split(marin=False)
-    start = identify(train, model="kvlcc2").fit.model
+    start = js.identify("kvlcc2", train).model
     report = js.discover(start, train, holdout)
     named = [e.id for e in report.effects]
     print(f"discover on HSVA ({time.perf_counter() - began:.0f} s): named {named or 'nothing'}",

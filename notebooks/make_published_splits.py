@@ -49,8 +49,6 @@ The lists live in one place, `jaxship/studies/published_splits.py` (`SPLITS`).
     new_code_cell("""import json
 import os
 import pathlib
-import sys
-import tempfile
 import time
 
 import jax
@@ -63,9 +61,8 @@ import jaxship as js
 
 jax.config.update("jax_enable_x64", True)
 plt.rcParams["figure.dpi"] = 80  # eight wide figures: the notebook stays under 1 MB
-sys.path.insert(0, str(pathlib.Path.cwd().parent))  # the project root: benchmarks
-from benchmarks import published_splits as protocol  # noqa: E402
-from jaxship.studies.published_splits import SPLITS, free_run, run_score  # noqa: E402
+from jaxship.studies import published_splits as protocol
+from jaxship.studies.published_splits import SPLITS, free_run, run_score
 
 
 data = js.shared_data_dir()
@@ -73,7 +70,10 @@ HAVE = data is not None and (data / "esso_osaka_frt").is_dir()
 print("Esso Osaka data:", "found" if HAVE else "absent: the cells below do nothing")
 if os.environ.get("CI") and not HAVE:
     raise FileNotFoundError("CI: ../shared/data must be beside the checkout")
-recorded = json.loads(protocol.RESULTS.read_text())"""),
+# what benchmarks/published_splits.py recorded (in a checkout of the repository)
+RECORDED = pathlib.Path.cwd().parent / "benchmarks" / "results" / "published_splits.json"
+recorded = json.loads(RECORDED.read_text()) if RECORDED.is_file() else None
+print("recorded results:", RECORDED if recorded else "absent (not a checkout)")"""),
     new_markdown_cell("## The splits"),
     new_code_cell("""rows = ["| paper | set | runs |", "|---|---|---|"]
 for paper, split in SPLITS.items():
@@ -87,16 +87,15 @@ Each candidate was fitted on three of Train-R's runs and scored on the fourth, f
 over; the score is the held-out r RMSE as a share of the lab's coefficients' on that run.
 The search starts from the command's settings and tries each factor in turn. (Recorded by
 `benchmarks/published_splits.py`: about half an hour, so not rerun here.)"""),
-    new_code_cell("""display(Markdown(protocol.tables({"selection": recorded["selection"]})))
-print("chosen:", protocol.key(recorded["selection"]["chosen"]))
+    new_code_cell("""if recorded:
+    display(Markdown(protocol.tables({"selection": recorded["selection"]})))
+    print("chosen:", protocol.key(recorded["selection"]["chosen"]))
 print("jaxship identify's defaults for esso_osaka:", js.VESSELS["esso_osaka"].fit_settings)"""),
-    new_markdown_cell("## `jaxship identify --model esso_osaka` on Train-R, no option"),
+    new_markdown_cell("## `js.identify(\"esso_osaka\", ...)` on Train-R, no option"),
     new_code_cell("""if HAVE:
     t0 = time.perf_counter()
     reader = protocol.Reader()
-    with tempfile.TemporaryDirectory() as workdir:
-        fitted, code = protocol.identify(reader, SPLITS["Miyauchi 2022"]["Train-R"], None,
-                                         workdir=workdir)
+    fitted, code = protocol.identify(reader, SPLITS["Miyauchi 2022"]["Train-R"], None)
     print(f"exit {code}, {time.perf_counter() - t0:.0f} s")
     assert code == 0"""),
     new_markdown_cell("""## Every test run of both papers, free simulation
@@ -126,7 +125,7 @@ position errors no worse than the lab's."""),
     new_markdown_cell("""The slow test tier runs this notebook. It checks that the user's command gives the
 numbers the results file (and so the documentation) carries, run for run, and states the
 goal with the measured figures."""),
-    new_code_cell("""if HAVE:
+    new_code_cell("""if HAVE and recorded:
     block = recorded["headline"]["Miyauchi 2022"]
     mine = {s.run: s for s in scores["jaxship, Train-R"]}
     for row in block["columns"]["Train-R"]:

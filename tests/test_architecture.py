@@ -135,17 +135,6 @@ COMMAND_TIMERS = {
     "benchmarks/discovery.py",  # `jaxship discover` end to end beside `js.discover`
     "benchmarks/gpu.py",  # the README's `discover` command on a GPU
 }
-# TEMPORARY (issue 68): users of the command as a library that the integrator converts to
-# the new verbs (`js.identify`, the autopilot's), then this list goes
-PENDING_CONVERSION = {
-    "benchmarks/published_splits.py",  # calls jaxship.cli.main(argv): js.identify
-    "benchmarks/kvlcc2_across_basins.py",  # imports jaxship.cli._identification
-    "benchmarks/autopilot_feedforward.py",  # runs `python -m jaxship.cli` and parses its JSON
-    # import benchmarks/published_splits.py (its `identify` runs the command): its protocol
-    # moves to jaxship.studies.published_splits once it calls js.identify
-    "notebooks/published_splits.ipynb",
-    "notebooks/make_published_splits.py",
-}
 COMMAND_NAMES = {"vessels", "simulate", "reproduce", "identify", "autopilot", "discover"}
 
 
@@ -189,12 +178,10 @@ def outside_offences(root: pathlib.Path = ROOT) -> list[str]:
     imported `main`), and, except in `COMMAND_TIMERS`, a run of the command (`-m
     jaxship.cli`, an argv `["jaxship", "identify", ...]`); in the notebooks also an import
     of `benchmarks` or a change to `sys.path` (a notebook runs wherever jaxship is
-    installed). `PENDING_CONVERSION` files are skipped."""
+    installed)."""
     found = []
     for where, source in code_outside(root):
         file = where.split(":")[0]
-        if file in PENDING_CONVERSION:
-            continue
         try:
             tree = ast.parse(source)
         except SyntaxError:
@@ -246,7 +233,7 @@ def test_nothing_outside_the_package_goes_round_the_front_door():
     found = outside_offences()
     assert not found, f"{len(found)} ways round:\n" + "\n".join(found)
     files = {w.split(":")[0] for w, _ in code_outside(ROOT)}
-    assert COMMAND_TIMERS | PENDING_CONVERSION <= files, (COMMAND_TIMERS | PENDING_CONVERSION)
+    assert COMMAND_TIMERS <= files, COMMAND_TIMERS
     assert any(f.endswith(".ipynb") for f in files) and "README.md" in files
 
 
@@ -283,7 +270,6 @@ def test_the_checker_outside_the_package_catches_each_spelling(tmp_path, monkeyp
     (tmp_path / "notebooks" / "n.ipynb").write_text(json.dumps(notebook))
     (tmp_path / "README.md").write_text("```python\nfrom jaxship._x import y\n```\n")
     (tmp_path / "docs" / "d.md").write_text("```python\nimport jaxship as js\n```\n")
-    monkeypatch.setattr(sys.modules[__name__], "PENDING_CONVERSION", set())
     found = outside_offences(tmp_path)
     in_b = [f for f in found if f.startswith("benchmarks/b.py")]
     assert [int(f.split(":")[1].split()[0]) for f in in_b] == list(

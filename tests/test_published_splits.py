@@ -2,13 +2,14 @@
 (issue 32; the data are needed only for the split check)."""
 
 import json
+import pathlib
 
 import jax
 import numpy as np
 import pytest
 
 import jaxship as js
-from benchmarks import published_splits as protocol
+from jaxship.studies import published_splits as protocol
 from jaxship.studies.published_splits import (
     MIYAUCHI_2022,
     WAKITA_2022,
@@ -19,6 +20,8 @@ from jaxship.studies.published_splits import (
 from jaxship.studies.real_data import ESSO_TEST
 
 
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "benchmarks" / "results" / "published_splits.json"  # the protocol's record
 DATA = js.shared_data_dir()
 UPSTREAM = None if DATA is None else DATA / "esso_osaka_frt" / "UPSTREAM_README.md"
 needs_esso = pytest.mark.skipif(UPSTREAM is None or not UPSTREAM.is_file(),
@@ -88,7 +91,7 @@ def test_the_free_run_score_is_the_hand_computed_one():
 
 
 @needs_esso
-def test_the_selection_never_opens_a_test_run(tmp_path):
+def test_the_selection_never_opens_a_test_run():
     """Issue 58, point 1: while the selection runs, the reader refuses every test run of
     both papers (a real read of a test run raises), the candidates are scored only on the
     training runs of the set being fitted, and every factor's values are tried."""
@@ -105,8 +108,7 @@ def test_the_selection_never_opens_a_test_run(tmp_path):
         return {"folds": [], "score": 1.0 / setting["horizon"]
                 + (0.0 if setting["free"] == "default" else -0.001)}
 
-    chosen = protocol.select(reader, train, workdir=tmp_path, say=lambda text: None,
-                             evaluate=evaluate)
+    chosen = protocol.select(reader, train, say=lambda text: None, evaluate=evaluate)
     assert set(seen) <= set(train) and not set(seen) & protocol.test_names()
     for factor, values in protocol.FACTORS.items():
         assert set(values) <= {t[factor] for t in tried}, factor
@@ -118,7 +120,7 @@ def test_the_selection_never_opens_a_test_run(tmp_path):
 def test_the_presets_defaults_are_the_recorded_selection():
     """Issue 58, point 2: what `jaxship identify --model esso_osaka` does by default is
     what the protocol chose (benchmarks/results/published_splits.json)."""
-    results = json.loads(protocol.RESULTS.read_text())
+    results = json.loads(RESULTS.read_text())
     chosen = results["selection"]["chosen"]
     settings = js.VESSELS["esso_osaka"].fit_settings
     assert settings.horizon == chosen["horizon"]
@@ -134,8 +136,8 @@ def test_the_presets_defaults_are_the_recorded_selection():
 def test_the_documents_carry_the_results_files_tables():
     """Issue 58, point 6: the tables in docs/results.md and benchmarks/README.md are the
     ones the results file gives, character for character."""
-    text = protocol.tables(json.loads(protocol.RESULTS.read_text()))
-    root = protocol.ROOT
+    text = protocol.tables(json.loads(RESULTS.read_text()))
+    root = ROOT
     for doc in ("docs/results.md", "benchmarks/README.md"):
         body = (root / doc).read_text(encoding="utf-8")
         start = body.index("<!-- published_splits.json: begin -->")

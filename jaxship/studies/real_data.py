@@ -154,7 +154,7 @@ def _nomoto_models(train, test, estimator, horizons):
     fit1 = js.fit(js.Nomoto1(K=0.1, T=10.0), train,
                   estimator=dataclasses.replace(est, start=js.LinearStart()))
     K, T = float(fit1.model.K), float(fit1.model.T)
-    start2 = js.Nomoto2(K=K, T1=T, T2=0.1 * T, T3=0.05 * T)
+    start2 = js.Nomoto2.from_first_order(K, T)  # the start `jaxship.identify` uses
     fit2 = js.fit(start2, train, estimator=est)
     return (Identified("Nomoto1", fit1, _validate(fit1.model, test, est, horizons)),
             Identified("Nomoto2", fit2, _validate(fit2.model, test, est, horizons)))

@@ -82,6 +82,14 @@ class Nomoto2(AbstractSteeringModel):
     state_names = ("r", "r_aux")
     yaw_term_unit = "rad/s"  # T r' + r = K delta + f
 
+    @classmethod
+    def from_first_order(cls, K, T) -> "Nomoto2":
+        """The start of a fit from a first-order model's $K$, $T$: the same effective
+        $T = T_1 + T_2 - T_3$ (Nomoto's first-order approximation) spread as
+        $T_1 = 1.1\\,T$, $T_2 = 0.2\\,T$, $T_3 = 0.3\\,T$ (a small lead-lag pair; $T_2
+        \\ne T_3$ so that neither cancels), the rule of `jaxship.identify`'s start."""
+        return cls(K=K, T1=1.1 * T, T2=0.2 * T, T3=0.3 * T)
+
     def rhs(self, state: Array, delta: ArrayLike, aux: AuxInputs) -> Array:
         del aux
         r, r_aux = state[0], state[1]

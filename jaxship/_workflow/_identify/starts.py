@@ -57,9 +57,8 @@ def fallback_nomoto1(train: js.Dataset, context: StartContext) -> js.Nomoto1:
 
 
 def start_nomoto2(train: js.Dataset, context: StartContext) -> js.Nomoto2:
-    """A fitted `Nomoto1` (K, T) spread over the three time constants with the
-    same effective $T = T_1 + T_2 - T_3$: $T_2 = 0.2\\,T$, $T_3 = 0.3\\,T$, $T_1 =
-    1.1\\,T$ (a small lead-lag pair; $T_2 \\ne T_3$ so that neither cancels)."""
+    """A fitted `Nomoto1` (K, T) spread over the three time constants
+    (`Nomoto2.from_first_order`)."""
     try:
         first = start_nomoto1(train, context)
     except ValueError as error:
@@ -68,12 +67,12 @@ def start_nomoto2(train: js.Dataset, context: StartContext) -> js.Nomoto2:
     first = context.fit(first, stage="fitting Nomoto1 for the Nomoto2 start").model
     k, t = float(first.K), float(first.T)
     context.note(f"Nomoto2 start from the fitted Nomoto1: K = {k:.6g} 1/s, T = {t:.6g} s.")
-    return js.Nomoto2(K=k, T1=1.1 * t, T2=0.2 * t, T3=0.3 * t)
+    return js.Nomoto2.from_first_order(k, t)
 
 
 def fallback_nomoto2(train: js.Dataset, context: StartContext) -> js.Nomoto2:
     first = neutral_nomoto1(train, context.rudder)
-    return js.Nomoto2(K=first.K, T1=1.1 * first.T, T2=0.2 * first.T, T3=0.3 * first.T)
+    return js.Nomoto2.from_first_order(first.K, first.T)
 
 
 def _linear_nonlinear(train: js.Dataset, context: StartContext, why: str) -> js.NonlinearNomoto:
