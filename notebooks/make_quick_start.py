@@ -1,5 +1,8 @@
 """Write notebooks/quick_start.ipynb: a turning circle and a zig-zag of the Mariner with
-their indices, figures and the IMO MSC.137(76) check, through the public API.
+their indices, figures and the IMO MSC.137(76) check, then a steering model identified from
+the zig-zags, validated, saved, loaded and steered by an autopilot designed from it, through
+the public API (`IDENTIFY`: the workflow of `jaxship identify` and `jaxship autopilot` in
+at most 25 lines, tests/test_notebooks.py).
 
 Run: python notebooks/make_quick_start.py (then execute the notebook).
 """
@@ -9,6 +12,25 @@ import pathlib
 import nbformat
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
 
+
+IDENTIFY = """import pathlib
+import tempfile
+
+records = [js.Experiment.from_trajectory(zigzag)]  # the 20/20 zig-zag above
+held_out = [js.Experiment.from_trajectory(zigzag10)]  # the 10/10 one, held out
+fit = js.identify("nomoto1", records, validate=held_out)
+print(fit.summary())  # K and T with standard errors, fit % and FPE per channel
+
+path = pathlib.Path(tempfile.mkdtemp()) / "result.json"
+fit.save(path)  # the file `jaxship identify` writes
+model = js.load_model(path)  # the fitted Nomoto1 again
+print(model)
+
+autopilot = js.design_autopilot(fit, plant=ship, speeds=[U])  # the command's rules
+print(f"K_p = {float(autopilot.kp):.3g}, K_i = {float(autopilot.ki):.3g} 1/s, "
+      f"K_d = {float(autopilot.kd):.3g} s")
+evaluation = js.evaluate_autopilot(fit, ship, speeds=[U])  # PID +- feed-forward, closed loop
+print(evaluation.summary())"""
 
 CELLS = [
     new_markdown_cell("""# Quick start: a turning circle and a zig-zag
@@ -70,10 +92,23 @@ rows = js.indices.imo_criteria(L, U, turning35=turning, zigzag10=zz10, zigzag20=
 display(Markdown(js.indices.format_table(rows)))
 fig = plot_imo_criteria(rows)"""),
     new_markdown_cell("""The same from a shell: `jaxship simulate --vessel mariner --manoeuvre turn:35 --out
-out/turn35` writes the trial's CSV, its indices as JSON and these figures. Next:
-`identification` of a steering model from such records (`thesis_identification.ipynb`,
-`esso_osaka_identification.ipynb`), the heading autopilot (`autopilot.ipynb`) and what a
-model is missing (`discovery.ipynb`)."""),
+out/turn35` writes the trial's CSV, its indices as JSON and these figures.
+
+## Identify, validate, save, load, steer
+
+What `jaxship identify` and `jaxship autopilot` do, as library verbs: `js.identify` fits
+Nomoto's first-order model to the 20/20 zig-zag (start values, the fit, the assessment with
+fit %, FPE and residual tests on the training and the held-out records), `save` writes the
+`result.json` the command writes and `js.load_model` reads it back; `js.design_autopilot`
+applies the command's design rules (omega_n = 1.25 / T, the reference at 0.4 omega_n, the
+rudder's share) and `js.evaluate_autopilot` runs the PID with and without the reference
+feed-forward on the Mariner itself. The Mariner turns nonlinearly, so a linear model
+simulated over a whole zig-zag drifts in heading (the psi fit of the simulation): the
+autopilot's feedback corrects what the model misses."""),
+    new_code_cell(IDENTIFY),
+    new_markdown_cell("""Next: identification from measured records (`esso_osaka_identification.ipynb`),
+the thesis' study (`thesis_identification.ipynb`), the heading autopilot in depth
+(`autopilot.ipynb`) and what a model is missing (`discovery.ipynb`)."""),
 ]
 
 
