@@ -268,7 +268,7 @@ def _no_work(monkeypatch):
 
     for name in ("simulate.simulate_to_folder", "identify.identify",
                  "identify.read_experiments", "discover.run_discovery",
-                 "reproduce.reproduce", "autopilot.autopilot_study.evaluate"):
+                 "reproduce.reproduce", "autopilot.js.evaluate_autopilot"):
         monkeypatch.setattr(f"jaxship.cli.{name}", no_work)
 
 

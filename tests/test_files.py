@@ -220,7 +220,7 @@ def test_a_file_of_the_users_among_the_figures_is_refused_before_the_work(tmp_pa
 
     monkeypatch.setattr("jaxship.cli.identify.identify", never)
     monkeypatch.setattr("jaxship.cli._discovery.identify", never)
-    monkeypatch.setattr("jaxship.cli.autopilot.autopilot_study.evaluate", never)
+    monkeypatch.setattr("jaxship.cli.autopilot.js.evaluate_autopilot", never)
     record = tmp_path / "zz.csv"
     t = np.arange(200) * 0.5
     js.write_trial_csv(record, js.Experiment(t, np.full_like(t, 0.1), name="zz",
