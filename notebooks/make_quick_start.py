@@ -16,6 +16,7 @@ from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
 IDENTIFY = """import pathlib
 import tempfile
 
+
 records = [js.Experiment.from_trajectory(zigzag)]  # the 20/20 zig-zag above
 held_out = [js.Experiment.from_trajectory(zigzag10)]  # the 10/10 one, held out
 fit = js.identify("nomoto1", records, validate=held_out)
