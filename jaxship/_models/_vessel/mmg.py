@@ -146,6 +146,19 @@ class MMGVessel(AbstractVessel):
     rho: float = param(1025.0, free=False, unit="kg/m^3")  # water density
     wind_model: AbstractWindLoads = FossenWindLoads()  # wind loads on A_F, A_L
 
+    @classmethod
+    def from_particulars(cls, particulars) -> "MMGVessel":
+        """The MMG vessel of a ship's main particulars (`jaxship.MainParticulars`) by
+        published empirical formulas: the hull derivatives of Yoshimura & Masumoto (2012),
+        Zhou et al.'s (1983) added masses, Kijima et al.'s (1990) and Yoshimura &
+        Masumoto's interaction factors, Fujii's f_alpha, an ITTC 1957 resistance, and the
+        self-propulsion rate at the particulars' speed (each formula and its source in
+        `jaxship/_models/_vessel/particulars.py`). A first estimate where there are no
+        captive tests: on the KVLCC2 see `benchmarks/results/particulars.md`."""
+        from .particulars import mmg_from_particulars
+
+        return mmg_from_particulars(particulars)
+
     def mass(self) -> Array:
         """Displacement mass $m = \\rho\\nabla$ [kg]."""
         return self.rho * self.volume
