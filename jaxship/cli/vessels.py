@@ -2,7 +2,10 @@
 `--show NAME`, a preset as a vessel file (TOML) to start one's own ship from; with
 `--from-particulars FILE`, the MMG vessel computed from a ship's main particulars."""
 
-from .. import VESSELS, MainParticulars, MMGVessel, get_vessel, save_vessel
+import pathlib
+import tomllib
+
+from .. import VESSELS, get_vessel, load_vessel, save_vessel
 
 
 def register(sub) -> None:
@@ -23,9 +26,13 @@ def run(args) -> int:
     if args.show is not None and args.from_particulars is not None:
         raise ValueError("give --show NAME or --from-particulars FILE, not both.")
     if args.from_particulars is not None:
-        vessel = MMGVessel.from_particulars(MainParticulars.load(args.from_particulars))
-        print(save_vessel(vessel, source=f"computed from the main particulars in "
-                          f"{args.from_particulars} (MMGVessel.from_particulars)"), end="")
+        path = pathlib.Path(args.from_particulars)
+        vessel = load_vessel(path)  # a bad file: one line naming it and the field
+        if "particulars" not in tomllib.loads(path.read_text(encoding="utf-8")):
+            raise ValueError(f"{path}: no table [particulars]: give the main particulars "
+                             f"(the fields of jaxship.MainParticulars) under [particulars].")
+        print(save_vessel(vessel, source=f"computed from the main particulars in {path} "
+                          f"(MMGVessel.from_particulars)"), end="")
         return 0
     if args.show is not None:
         vessel = get_vessel(args.show)

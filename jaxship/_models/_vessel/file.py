@@ -362,9 +362,3 @@ def load_vessel(source) -> AbstractVessel:
     missing field, a wrong unit, a value out of its physical range."""
     return _read(source, vessel_from_dict)
 
-
-def load_particulars(source) -> MainParticulars:
-    """The `MainParticulars` of a vessel file with the table [particulars] (a path or
-    the parsed dict). **Raises** `ValueError` as `load_vessel`, and for a file without
-    that table."""
-    return _read(source, particulars_from_dict)

@@ -24,10 +24,7 @@ about 0.5-0.8, L/B about 4-7.5); beyond them the formulas extrapolate.
 import dataclasses
 import math
 
-import numpy as np
-
 from ..._foundation._params import param
-from .._actuators import RudderServo, Shaft
 
 
 @dataclasses.dataclass(frozen=True)
@@ -35,6 +32,8 @@ class MainParticulars:
     """A single-screw, single-rudder ship's main particulars (SI units, radians):
     what `MMGVessel.from_particulars` builds an MMG vessel from.
 
+    `MMGVessel.from_particulars(particulars)` is the vessel; `save_vessel` writes the
+    particulars as a vessel file's table [particulars], which `load_vessel` reads.
     `k_t` are the propeller's open-water coefficients, K_T = k_0 + k_1 J + k_2 J^2 (from
     the propeller's open-water test or a series chart); `speed` the approach speed U_0
     (the self-propulsion rate is solved for it, and it sets the Reynolds number of the
@@ -61,15 +60,6 @@ class MainParticulars:
     def volume(self) -> float:
         """Displacement volume nabla = C_b L B d [m^3]."""
         return self.block_coefficient * self.length * self.breadth * self.draft
-
-    @classmethod
-    def load(cls, source) -> "MainParticulars":
-        """The main particulars of a vessel file's table [particulars] (a path, or the
-        file's content as `tomllib` reads it; `jaxship.save_vessel(particulars, path)`
-        writes one). **Raises** `ValueError`, one line naming the file and the field."""
-        from .file import load_particulars
-
-        return load_particulars(source)
 
     def coefficients(self) -> dict:
         """Every `MMGVessel` coefficient that the formulas give, non-dimensional, by field
@@ -165,25 +155,3 @@ def particulars_coefficients(p: MainParticulars) -> dict:
     added = added_masses(p)
     return {**added, "r_0": resistance(p), **hull_derivatives(p, added["m_x"], added["m_y"]),
             **propeller_rudder(p)}
-
-
-def mmg_from_particulars(p: MainParticulars):
-    """The `MMGVessel` of `p`: `particulars_coefficients`, the particulars themselves,
-    and the self-propulsion rate at `p.speed` (`straight_run`, X = 0)."""
-    from ._base import straight_run
-    from .mmg import MMGVessel
-
-    coefficients = particulars_coefficients(p)
-    # start of the self-propulsion Newton iteration: J_P = 0.5
-    n_start = p.speed * (1.0 - coefficients["w_p0"]) / (0.5 * p.propeller_diameter)
-    vessel = MMGVessel(
-        length=p.length,
-        rudder=RudderServo(max_angle=p.rudder_max_angle, max_rate=p.rudder_rate,
-                           time_constant=0.1),  # T_delta: practically a pure rate limit
-        shaft=Shaft(max_rate=float("inf"), time_constant=1.0),  # as the kvlcc2 preset
-        nominal_speed=p.speed, nominal_n=n_start, frontal_wind_area=0.0,
-        lateral_wind_area=0.0, draft=p.draft, volume=p.volume(), x_g=p.x_g,
-        radius_of_gyration=p.gyration_ratio * p.length, propeller_diameter=p.propeller_diameter,
-        rudder_area=p.rudder_area, rudder_span=p.rudder_span, rho=p.rho, **coefficients)
-    n = float(np.asarray(straight_run(vessel, speed=p.speed).n))
-    return dataclasses.replace(vessel, nominal_n=n)
