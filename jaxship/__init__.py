@@ -122,6 +122,7 @@ from ._models._vessel._base import (
 from ._models._vessel.catalogue import VESSELS as VESSELS, get_vessel as get_vessel
 from ._models._vessel.file import load_vessel as load_vessel, save_vessel as save_vessel
 from ._models._vessel.mmg import MMGVessel as MMGVessel
+from ._models._vessel.particulars import MainParticulars as MainParticulars
 from ._models._vessel.ross import RossVessel as RossVessel
 
 # simulate: the one time loop, batches, records and readers
@@ -207,6 +208,7 @@ __all__ = [
     # vessels: Vessels
     "AbstractVessel",
     "MMGVessel",
+    "MainParticulars",
     "RossVessel",
     "straight_run",
     "state_derivative",

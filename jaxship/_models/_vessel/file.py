@@ -5,10 +5,12 @@ and a bare number where it is not (units as in the class's `param` fields: SI, r
 rev/s; degrees, deg/s and rpm are read too); the rudder servo and the shaft are the
 tables `[rudder]` and `[shaft]`, and a wind-load model other than the default
 (`FossenWindLoads`) the table `[wind_model]` (`model = "FujiwaraWindLoads"` and its
-geometry). Floats are written with `repr`, so that a vessel
-reads back bit for bit. `vessel_to_dict` / `vessel_from_dict` are the same content as
-a dict; `save_vessel(vessel)` (no path) gives the text, `load_vessel(dict)` reads the
-dict (what `jaxship identify` stores in its result).
+geometry). An MMG vessel may instead be given by its main particulars: `model =
+"MMGVessel"` and the table `[particulars]` alone (the fields of `MainParticulars`), from
+which `MMGVessel.from_particulars` computes the coefficients. Floats are written with
+`repr`, so that a vessel reads back bit for bit. `vessel_to_dict` / `vessel_from_dict`
+are the same content as a dict; `save_vessel(vessel)` (no path) gives the text,
+`load_vessel(dict)` reads the dict (what `jaxship identify` stores in its result).
 """
 
 import dataclasses
@@ -27,6 +29,7 @@ from .esso_osaka import LowSpeedMMGVessel
 from .mariner import Mariner
 from .mmg import MMGVessel
 from .nomoto import NomotoVessel
+from .particulars import MainParticulars
 from .ross import RossVessel
 from .sway_yaw import SwayYawVessel
 
@@ -52,6 +55,12 @@ WIND = "wind_model"
 POSITIVE |= {f"{WIND}.{k}" for k in ("length_overall", "breadth", "superstructure_area",
                                      "area_centre_height", "bridge_height")}
 UNBOUNDED_OK = {"shaft.max_rate"}  # no limit on the shaft's rate
+# the table [particulars] (MainParticulars) of an MMG vessel given by its main particulars
+PARTICULARS = "particulars"
+POSITIVE |= {f"{PARTICULARS}.{k}" for k in (
+    "length", "breadth", "draft", "speed", "propeller_diameter", "rudder_area", "rudder_span",
+    "rudder_rate", "gyration_ratio", "rho", "viscosity")}
+ANGLE_LIMITS = {"rudder.max_angle", f"{PARTICULARS}.rudder_max_angle"}  # within (0, 90] deg
 
 
 def _unit(info) -> str:
@@ -138,9 +147,9 @@ def _value(name, entry, unit, bounds=(-math.inf, math.inf)) -> float:
     if not (math.isfinite(value) or name in UNBOUNDED_OK and value == math.inf):
         raise ValueError(f"field '{name}' is {value!r}: give a finite number.")
     if (name in POSITIVE and not value > 0) or (name in NON_NEGATIVE and value < 0) \
-            or not lower <= value <= upper or name == "rudder.max_angle" and \
+            or not lower <= value <= upper or name in ANGLE_LIMITS and \
             not 0 < value <= math.pi / 2:
-        what = ("between 0 and 90 deg" if name == "rudder.max_angle" else "positive"
+        what = ("between 0 and 90 deg" if name in ANGLE_LIMITS else "positive"
                 if name in POSITIVE else "not negative" if name in NON_NEGATIVE
                 else f"between {lower:g} and {upper:g}")
         shown = f"{value!r} {unit}".strip()
@@ -161,8 +170,58 @@ def _fields(cls, data: dict, expected: dict, where: str = "") -> dict:
     return data
 
 
+def particulars_to_dict(particulars: MainParticulars) -> dict:
+    """`{"model": "MMGVessel", "particulars": {field: value or {"value", "unit"}}}`."""
+    params = parameter_fields(particulars)
+    table = {}
+    for field in dataclasses.fields(particulars):
+        value = getattr(particulars, field.name)
+        if field.name in params:
+            unit = _unit(params[field.name])
+            table[field.name] = {"value": float(value), "unit": unit} if unit else float(value)
+        else:  # k_t
+            table[field.name] = [float(v) for v in value]
+    return {"model": MMGVessel.__name__, PARTICULARS: table}
+
+
+def particulars_from_dict(data: dict) -> MainParticulars:
+    """The `MainParticulars` of a vessel file's content with the table [particulars]
+    (`particulars_to_dict`'s form; the fields with defaults may be left out).
+    **Raises** `ValueError`, one line naming the field."""
+    if not isinstance(data, dict) or PARTICULARS not in data:
+        raise ValueError(f"no table [{PARTICULARS}]: give the main particulars (the fields "
+                         f"of MainParticulars) under [{PARTICULARS}].")
+    if data.get("model") != MMGVessel.__name__ or set(data) != {"model", PARTICULARS}:
+        raise ValueError(f"a vessel file with [{PARTICULARS}] has model = \"MMGVessel\" and "
+                         f"no other field (got {', '.join(sorted(set(data) - {PARTICULARS}))}).")
+    table = data[PARTICULARS]
+    if not isinstance(table, dict):
+        raise ValueError(f"field '{PARTICULARS}' must be a table [{PARTICULARS}].")
+    fields = {f.name: f for f in dataclasses.fields(MainParticulars)}
+    for key in table:
+        if key not in fields:
+            raise ValueError(f"unknown field '{PARTICULARS}.{key}'; the main particulars are "
+                             f"{', '.join(fields)}.")
+    for key, field in fields.items():
+        if key not in table and field.default is dataclasses.MISSING:
+            raise ValueError(f"missing field '{PARTICULARS}.{key}' of MainParticulars.")
+    params = parameter_fields(MainParticulars)
+    kwargs = {}
+    for name, entry in table.items():
+        where = f"{PARTICULARS}.{name}"
+        if name not in params:  # k_t
+            if not isinstance(entry, list) or len(entry) != 3:
+                raise ValueError(f"field '{where}' must be a list of 3 numbers, [k_0, k_1, k_2].")
+            kwargs[name] = tuple(_number(f"field '{where}'", v) for v in entry)
+        else:
+            info = params[name]
+            kwargs[name] = _value(where, entry, _unit(info), (info.lower, info.upper))
+    return MainParticulars(**kwargs)
+
+
 def vessel_from_dict(data: dict) -> AbstractVessel:
-    """The vessel of `vessel_to_dict`'s form. **Raises** `ValueError` (one line naming
+    """The vessel of `vessel_to_dict`'s form, or of `particulars_to_dict`'s (an MMG
+    vessel by `MMGVessel.from_particulars`). **Raises** `ValueError` (one line naming
     the field) for an unknown model class, an unknown or missing field, a wrong unit or
     a value outside its physical range."""
     if not isinstance(data, dict) or "model" not in data:
@@ -171,6 +230,8 @@ def vessel_from_dict(data: dict) -> AbstractVessel:
     if cls is None:
         raise ValueError(f"field 'model': unknown vessel class {data['model']!r}; choose "
                          f"one of {', '.join(CLASSES)}.")
+    if PARTICULARS in data:
+        return MMGVessel.from_particulars(particulars_from_dict(data))
     params = {f.name: f.metadata.get("jaxship_parameter") for f in dataclasses.fields(cls)
               if f.name != WIND}
     kwargs = {} if WIND not in data else {WIND: _wind_from_dict(data[WIND])}
@@ -216,9 +277,12 @@ def _float(value: float) -> str:
     return repr(float(value))  # exact; TOML spells inf, -inf and nan as Python does
 
 
-def vessel_text(vessel: AbstractVessel, *, source: str = "") -> str:
-    """The vessel file's text (TOML) of `vessel`, with `source` (a line: where its
-    coefficients come from) in the header."""
+def vessel_text(vessel: AbstractVessel | MainParticulars, *, source: str = "") -> str:
+    """The vessel file's text (TOML) of `vessel` (or of a ship's `MainParticulars`: the
+    table [particulars]), with `source` (a line: where its coefficients come from) in
+    the header."""
+    if isinstance(vessel, MainParticulars):
+        return _particulars_text(vessel, source)
     data = vessel_to_dict(vessel)
     comments = _comments(type(vessel))
     lines = ["# jaxship vessel file: `--vessel FILE` on the command line, "
@@ -239,10 +303,29 @@ def vessel_text(vessel: AbstractVessel, *, source: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
-def save_vessel(vessel: AbstractVessel, path=None, *, source: str = ""):
+def _particulars_text(particulars: MainParticulars, source: str) -> str:
+    """The vessel file of an MMG vessel given by its main particulars."""
+    table = particulars_to_dict(particulars)[PARTICULARS]
+    comments = _comments(MainParticulars)
+    lines = ["# jaxship vessel file: an MMG vessel by its main particulars; "
+             "`jaxship vessels --from-particulars FILE`",
+             "# prints its coefficients (MMGVessel.from_particulars). Dimensional values "
+             "{ value = ..., unit = \"...\" } in SI",
+             "# units (deg, deg/s read too); x_g, gyration_ratio, rudder_max_angle, rho and "
+             "viscosity may be left out (defaults).",
+             *([f"# {source}"] if source else []),
+             f"model = \"{MMGVessel.__name__}\"", "", f"[{PARTICULARS}]"]
+    for name, entry in table.items():
+        note = comments.get(name, "")
+        lines.append(f"{name} = {_toml_value(entry)}" + (f"  # {note}" if note else ""))
+    return "\n".join(lines) + "\n"
+
+
+def save_vessel(vessel: AbstractVessel | MainParticulars, path=None, *, source: str = ""):
     """Write `vessel` as a vessel file (TOML, `vessel_text`) at `path` and return the
     path; with `path=None`, return the file's text instead (`tomllib.loads` of it is the
-    dict `load_vessel` also reads)."""
+    dict `load_vessel` also reads). A ship's `MainParticulars` are written as the table
+    [particulars], which `load_vessel` turns into `MMGVessel.from_particulars`."""
     text = vessel_text(vessel, source=source)
     if path is None:
         return text
@@ -251,13 +334,11 @@ def save_vessel(vessel: AbstractVessel, path=None, *, source: str = ""):
     return path
 
 
-def load_vessel(source) -> AbstractVessel:
-    """The vessel of the vessel file at `source` (a path; see `save_vessel`), or of a
-    vessel file's content already parsed (a dict, as `tomllib` reads it). **Raises**
-    `ValueError`, one line naming the file and the field: not TOML, an unknown or
-    missing field, a wrong unit, a value out of its physical range."""
+def _read(source, parse):
+    """`parse` of the vessel file at `source` (a path) or of its parsed content (a dict);
+    errors name the file."""
     if isinstance(source, dict):
-        return vessel_from_dict(source)
+        return parse(source)
     path = pathlib.Path(source)
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
@@ -268,6 +349,16 @@ def load_vessel(source) -> AbstractVessel:
     except tomllib.TOMLDecodeError as error:
         raise ValueError(f"{path} is not a vessel file (TOML): {error}.") from None
     try:
-        return vessel_from_dict(data)
+        return parse(data)
     except ValueError as error:
         raise ValueError(f"{path}: {error}") from None
+
+
+def load_vessel(source) -> AbstractVessel:
+    """The vessel of the vessel file at `source` (a path; see `save_vessel`), or of a
+    vessel file's content already parsed (a dict, as `tomllib` reads it); a file with
+    the table [particulars] gives `MMGVessel.from_particulars` of them. **Raises**
+    `ValueError`, one line naming the file and the field: not TOML, an unknown or
+    missing field, a wrong unit, a value out of its physical range."""
+    return _read(source, vessel_from_dict)
+

@@ -8,6 +8,8 @@ project notes `reference/vessel-models.md` sec. 2.2 (cross-checked there against
 """
 
 
+import dataclasses
+
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
@@ -15,7 +17,8 @@ from jaxtyping import Array
 from ..._foundation._params import param
 from .._actuators import RudderServo, Shaft
 from .._environment import AbstractWindLoads, FossenWindLoads
-from ._base import AbstractVessel
+from ._base import AbstractVessel, straight_run
+from .particulars import MainParticulars, particulars_coefficients
 
 
 GRAVITY = 9.80665  # g [m/s^2]
@@ -145,6 +148,33 @@ class MMGVessel(AbstractVessel):
     gamma_r_minus: float = param(free=False, unit="-")  # gamma_R for beta_R < 0
     rho: float = param(1025.0, free=False, unit="kg/m^3")  # water density
     wind_model: AbstractWindLoads = FossenWindLoads()  # wind loads on A_F, A_L
+
+    @classmethod
+    def from_particulars(cls, particulars: MainParticulars) -> "MMGVessel":
+        """The MMG vessel of a ship's main particulars (`jaxship.MainParticulars`) by
+        published empirical formulas (`particulars_coefficients`): the hull derivatives of
+        Yoshimura & Masumoto (2012), Zhou et al.'s (1983) added masses, Kijima et al.'s
+        (1990) and Yoshimura & Masumoto's interaction factors, Fujii's f_alpha, an ITTC
+        1957 resistance; `nominal_n` is the self-propulsion rate at the particulars'
+        speed (`straight_run`, X = 0). Each formula and its source are in
+        `jaxship/_models/_vessel/particulars.py`. A first estimate where there are no
+        captive tests: on the KVLCC2 see `benchmarks/results/particulars.md`."""
+        p = particulars
+        coefficients = particulars_coefficients(p)
+        # start of the self-propulsion Newton iteration: J_P = 0.5
+        n_start = p.speed * (1.0 - coefficients["w_p0"]) / (0.5 * p.propeller_diameter)
+        vessel = cls(
+            length=p.length,
+            rudder=RudderServo(max_angle=p.rudder_max_angle, max_rate=p.rudder_rate,
+                               time_constant=0.1),  # T_delta: practically a pure rate limit
+            shaft=Shaft(max_rate=float("inf"), time_constant=1.0),  # as the kvlcc2 preset
+            nominal_speed=p.speed, nominal_n=n_start, frontal_wind_area=0.0,
+            lateral_wind_area=0.0, draft=p.draft, volume=p.volume(), x_g=p.x_g,
+            radius_of_gyration=p.gyration_ratio * p.length,
+            propeller_diameter=p.propeller_diameter, rudder_area=p.rudder_area,
+            rudder_span=p.rudder_span, rho=p.rho, **coefficients)
+        n = float(np.asarray(straight_run(vessel, speed=p.speed).n))
+        return dataclasses.replace(vessel, nominal_n=n)
 
     def mass(self) -> Array:
         """Displacement mass $m = \\rho\\nabla$ [kg]."""
