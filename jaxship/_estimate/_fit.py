@@ -632,7 +632,10 @@ def _report(problem: _Problem, optimum: _Optimum) -> FitResult:
     mask = layout["mask"]
     weights = layout["weights"]
     resid = weights[:, None, None, None] * (targets - pred)
-    result = _verdict(as_code(result), specs, p, rows, jrows[:, :d], pred, targets, mask)
+    code = as_code(result)
+    result = _verdict(code, specs, p, rows, jrows[:, :d], pred, targets, mask)
+    if prior is not None and result == RESULTS.did_not_move:
+        result = code  # a narrow prior centred on the start holds the estimate there
     blown = result == RESULTS.simulation_blew_up  # nothing below means anything: NaN
     with np.errstate(all="ignore") if blown else contextlib.nullcontext():
         cost = 0.5 * float(np.sum(rows**2))
