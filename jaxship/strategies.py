@@ -13,7 +13,8 @@ signature asks for one:
   `HeldNoise`;
 - how Lu & Zhao's discrete models map to continuous ones (`DiscreteResponse`):
   `ExactDiscretisation`, `EulerDiscretisation`;
-- the units of a written trial file (`write_trial_csv`): `DisplayUnits`, `SIUnits`.
+- the units of a written trial file (`write_trial_csv`): `DisplayUnits`, `SIUnits`;
+- what is known of the coefficients before the data (`PredictionError.prior`): `Prior`.
 
     import jaxship as js
     js.Replay(delta, dt=0.5, delta_hold=js.strategies.FirstOrderHold())
@@ -35,6 +36,7 @@ from ._estimate._likelihood import (
     HeldNoise as HeldNoise,
     ProcessNoise as ProcessNoise,
 )
+from ._estimate._prior import Prior as Prior
 from ._models._holds import FirstOrderHold as FirstOrderHold, ZeroOrderHold as ZeroOrderHold
 from ._models._manoeuvres import (
     SwitchAtCrossing as SwitchAtCrossing,
@@ -66,4 +68,6 @@ __all__ = [
     # strategies: The units of a written trial file
     "DisplayUnits",
     "SIUnits",
+    # strategies: What is known of the coefficients before the data
+    "Prior",
 ]

@@ -27,7 +27,9 @@ from .._foundation._contract import AbstractModel, rebuild
 from .._foundation._covariance import (
     RobustErrors,
     cluster_from_windows,
+    effective_parameters,
     hac_from_windows,
+    information_share,
     least_squares_covariance,
     parameter_report,
 )
@@ -50,6 +52,7 @@ from ._lm import (
     solve_least_squares,
     value_and_jacfwd,
 )
+from ._prior import PRIOR_PASSES, PRIOR_RTOL, Prior, prior_report
 from ._result import FitError, FitResult, Prediction, Validation, assemble_result
 from ._step import MAX_SUBSTEPS, stable_substeps
 from ._verdict import final_verdict
@@ -136,6 +139,11 @@ class PredictionError(AbstractEstimator):
       held for commands (`delta_c`) and the wind direction (zero-order hold);
       `ZeroOrderHold()` or `FirstOrderHold()` for all; or a dict by channel name
       overriding some.
+    - `prior`: a Gaussian prior on the free coefficients (`jaxship.strategies.Prior`):
+      the fit returns the maximum a posteriori estimate with its posterior covariance,
+      charges FPE, AIC and BIC for the effective number of parameters and reports each
+      coefficient's prior and the data's share of its information (`FitResult.prior`).
+      None (default): no prior, least squares.
     """
 
     horizon: float | None = None
@@ -150,6 +158,7 @@ class PredictionError(AbstractEstimator):
     initial: MeasuredStates | EstimatedStarts | list = MeasuredStates()
     wind: bool = False
     hold: ZeroOrderHold | FirstOrderHold | dict | None = None
+    prior: Prior | None = None
 
     def fit(self, model, dataset, free=None, progress=None) -> "FitResult":
         return _fit_prediction_error(self, model, dataset, free, progress)
@@ -221,15 +230,23 @@ def _split(q, transform, w, offset_scale):
 
 
 def _residual_fn(z, args):
-    model, transform, w, offset_scale = args
+    model, transform, w, offset_scale, prior = args
     p, offsets = _split(z, transform, w, offset_scale)
-    return _residuals(rebuild(model, transform.names, transform.to_physical(p)), w, offsets)
+    physical = transform.to_physical(p)
+    out = _residuals(rebuild(model, transform.names, physical), w, offsets)
+    if prior is None:
+        return out
+    mean, weight = prior  # the prior's rows sigma (p - mu) / s (`_prior.py`), laid in one
+    rows = weight * (physical - mean)  # more channel of zeros: the windows' layout stays
+    slab = jnp.zeros(math.prod(out.shape[1:]), out.dtype).at[: rows.shape[0]].set(rows)
+    return jnp.concatenate([out, slab.reshape((1,) + out.shape[1:])])
 
 
 @eqx.filter_jit
-def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
+def _solve(z0, model, transform, windows, offset_scale, solver, max_steps, prior=None):
     """LM from z0; the estimate z, result, steps, the physical parameters and start
-    offsets q, the predictions (C, E, W, L) and the Jacobian with respect to q."""
+    offsets q, the predictions (C, E, W, L) and the Jacobian with respect to q. `prior`:
+    None, or the arrays `(mean, sigma / sd)` of a Gaussian prior's residual rows."""
 
     def physical(z):
         p, offsets = _split(z, transform, windows, offset_scale)
@@ -244,8 +261,10 @@ def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
             solver = eqx.tree_at(lambda s: s.descent, solver,
                                  BlockDampedNewtonDescent(*shared_and_blocks))
     z, result, steps, q, residual, jac = solve_least_squares(
-        _residual_fn, solver, z0, (model, transform, windows, offset_scale), max_steps,
+        _residual_fn, solver, z0, (model, transform, windows, offset_scale, prior), max_steps,
         physical, jacobian)
+    if prior is not None:  # the windows' channels, without the prior's
+        residual, jac = residual[:-1], jac[:-1]
     pred = windows.targets - residual / windows.weights[:, None, None, None]
     return z, result, steps, q[: len(transform.names)], pred, jac
 
@@ -326,24 +345,119 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
     solver = estimator.solver
     if progress is not None and isinstance(solver, LevenbergMarquardt):
         solver = eqx.tree_at(lambda s: s.verbose, solver, step_hook)
+    prior = _GaussianPrior.build(estimator.prior, specs, model, windows)
     with reporting_steps(progress, f"fitting {type(model).__name__}",
                          int(estimator.max_steps)) as finish:
-        for _ in range(3):  # and the estimate's: refitted with the steps it needs
-            z, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows,
-                                                        offset_scale, solver,
-                                                        int(estimator.max_steps))
-            fitted = rebuild(base, transform.names, p)
-            needed = stable_substeps(fitted, windows, refuse=False)
-            if needed <= windows.substeps or needed > MAX_SUBSTEPS:
-                break
-            windows, z0 = dataclasses.replace(windows, substeps=needed), z
+        z, windows, optimum, prior = _optimise(
+            z0, _Problem(base, ds, estimator, specs, transform, windows, layout, starts,
+                         prior), offset_scale, solver)
         out = _report(_Problem(model, ds, estimator, specs, transform, windows, layout,
-                               starts), _Optimum(p, pred, jac, result, num_steps))
+                               starts, prior), optimum)
         finish(out.num_steps, out.cost)
     if offset_scale is not None:
         offsets = _split(z, transform, windows, offset_scale)[1]
         out = dataclasses.replace(out, start_offsets=np.asarray(offsets, dtype=np.float64))
     return out
+
+
+def _optimise(z0, problem, offset_scale, solver):
+    """Levenberg-Marquardt from z0 on `problem` (its model the start as arrays), refitted
+    from the estimate with the integration steps its fastest mode needs and, with a prior,
+    until the noise variance that weighs the prior settles (`_prior.py`). Returns `(z,
+    windows, _Optimum, prior)`, the prior with the variance of the last solve."""
+    base, transform, windows, prior = (problem.model, problem.transform, problem.windows,
+                                       problem.prior)
+    max_steps, total = int(problem.estimator.max_steps), 0
+    for _ in range(1 if prior is None else PRIOR_PASSES):
+        for _ in range(3):  # and the estimate's: refitted with the steps it needs
+            z, result, num_steps, p, pred, jac = _solve(
+                z0, base, transform, windows, offset_scale, solver, max_steps,
+                None if prior is None else prior.arrays())
+            total += int(num_steps)
+            needed = stable_substeps(rebuild(base, transform.names, p), windows, refuse=False)
+            if needed <= windows.substeps or needed > MAX_SUBSTEPS:
+                break
+            windows, z0 = dataclasses.replace(windows, substeps=needed), z
+        if prior is None:
+            break
+        rows, jrows, _, _ = _rows(problem._replace(windows=windows), pred, jac)
+        variance = prior.noise_variance(rows, jrows)
+        if not abs(variance - prior.variance) > PRIOR_RTOL * prior.variance:
+            break  # settled (or not finite: the report says the simulation blew up)
+        prior, z0 = dataclasses.replace(prior, variance=variance), z
+    return z, windows, _Optimum(p, pred, jac, result, total), prior
+
+
+@dataclasses.dataclass(frozen=True)
+class _GaussianPrior:
+    """A `Prior` resolved for a fit: the means and standard deviations (d,) of the free
+    parameters (sd inf: none), the number of columns of the Jacobian (with estimated
+    window starts, which have no prior) and the noise variance of the weighted residuals
+    that weighs it (`_prior.py`)."""
+
+    prior: Prior
+    names: tuple[str, ...]
+    mean: np.ndarray
+    sd: np.ndarray
+    columns: int
+    variance: float
+
+    @classmethod
+    def build(cls, prior, specs, model, windows) -> "_GaussianPrior | None":
+        """None without a prior (or with no finite scale), else the start's: the variance
+        of the start's weighted residuals (1, the measured spread, where not finite)."""
+        if prior is None:
+            return None
+        if not isinstance(prior, Prior):
+            raise ValueError(f"`prior` must be a jaxship.strategies.Prior, got "
+                             f"{type(prior).__name__}.")
+        names = tuple(s.name for s in specs)
+        mean, sd = prior.resolve(names, [s.start for s in specs], model)
+        if not np.isfinite(sd).any():
+            return None
+        if math.prod(windows.targets.shape[1:]) < len(specs):
+            raise ValueError(f"a prior on {len(specs)} coefficients needs at least as many "
+                             "predicted samples.")
+        pred = np.asarray(_predict_jit(as_arrays(model), windows), dtype=np.float64)
+        resid = np.asarray(windows.weights)[:, None, None, None] * (windows.targets - pred)
+        mask = np.broadcast_to(np.asarray(windows.mask), resid.shape)
+        variance = float(np.mean(resid[mask] ** 2))
+        return cls(prior, names, mean, sd, len(specs),
+                   variance if np.isfinite(variance) else 1.0)
+
+    def precision(self, columns: int) -> np.ndarray:
+        """The prior's precision in the residuals' scale, sigma^2 / sd^2, for `columns`
+        columns (0 for those beyond the free parameters)."""
+        out = np.zeros(columns)
+        out[: self.columns] = self.variance / self.sd**2
+        return out
+
+    def arrays(self):
+        return (jnp.asarray(self.mean, dtype=float),
+                jnp.asarray(np.sqrt(self.precision(self.columns)), dtype=float))
+
+    def noise_variance(self, rows, jrows) -> float:
+        """$\\hat\\sigma^2 = \\sum\\varepsilon^2 / (N - d_\\text{eff})$ at this MAP."""
+        d_eff = effective_parameters(jrows, self.precision(jrows.shape[1]))
+        return float(np.sum(rows**2)) / max(rows.size - d_eff, 1.0)
+
+
+def _rows(problem, pred, jac):
+    """`(rows, jrows, groups, columns)`: the weighted residuals (N,) of the windows'
+    samples, channel by channel, their Jacobian (N, d + estimated window starts), the
+    channel of each row and the Jacobian's columns used (the free parameters, then the
+    start offsets of windows that exist, where they are estimated)."""
+    channels, mask = problem.windows.channels, problem.layout["mask"]
+    pred = np.asarray(pred, dtype=np.float64)
+    jac = np.asarray(jac, dtype=np.float64)
+    targets = np.asarray(problem.windows.targets, dtype=np.float64)
+    d = len(problem.specs)
+    columns = np.concatenate([np.arange(d), d + problem.starts.start_columns(mask)])
+    resid = problem.layout["weights"][:, None, None, None] * (targets - pred)
+    rows = np.concatenate([resid[c][mask] for c in range(len(channels))])
+    jrows = np.concatenate([jac[c][mask][:, columns] for c in range(len(channels))])
+    groups = np.concatenate([np.full(int(mask.sum()), c) for c in range(len(channels))])
+    return rows, jrows, groups, columns
 
 
 def _starts(initial) -> MeasuredStates | EstimatedStarts:
@@ -486,6 +600,7 @@ class _Problem(NamedTuple):
     windows: object
     layout: dict
     starts: object
+    prior: _GaussianPrior | None = None
 
 
 class _Optimum(NamedTuple):
@@ -502,7 +617,7 @@ class _Optimum(NamedTuple):
 def _report(problem: _Problem, optimum: _Optimum) -> FitResult:
     """The `FitResult` from the optimum: residuals, covariance, identifiability and
     validation metrics on the host (shared by steering-model and vessel fits)."""
-    model, ds, estimator, specs, transform, windows, layout, starts = problem
+    model, ds, estimator, specs, transform, windows, layout, starts, prior = problem
     p, pred, jac, result, num_steps = optimum
     channels = windows.channels
     d = len(specs)
@@ -510,24 +625,26 @@ def _report(problem: _Problem, optimum: _Optimum) -> FitResult:
     fitted = rebuild(model, transform.names, [float(v) for v in values])
 
     # residuals, Jacobian and covariance on the host
+    rows, jrows, groups, columns = _rows(problem, pred, jac)
     pred = np.asarray(pred, dtype=np.float64)
     jac = np.asarray(jac, dtype=np.float64)
     targets = np.asarray(windows.targets, dtype=np.float64)
     mask = layout["mask"]
     weights = layout["weights"]
-    # and the start offsets of windows that exist, where they are estimated
-    columns = np.concatenate([np.arange(d), d + starts.start_columns(mask)])
     resid = weights[:, None, None, None] * (targets - pred)
-    rows = np.concatenate([resid[c][mask] for c in range(len(channels))])
-    jrows = np.concatenate([jac[c][mask][:, columns] for c in range(len(channels))])
-    groups = np.concatenate([np.full(int(mask.sum()), c) for c in range(len(channels))])
-    result = _verdict(as_code(result), specs, p, rows, jrows[:, :d], pred, targets, mask)
+    code = as_code(result)
+    result = _verdict(code, specs, p, rows, jrows[:, :d], pred, targets, mask)
+    if prior is not None and result == RESULTS.did_not_move:
+        result = code  # a narrow prior centred on the start holds the estimate there
     blown = result == RESULTS.simulation_blew_up  # nothing below means anything: NaN
     with np.errstate(all="ignore") if blown else contextlib.nullcontext():
         cost = 0.5 * float(np.sum(rows**2))
     nan = np.full((columns.shape[0],) * 2, np.nan)
-    full, null = (nan, []) if blown else least_squares_covariance(jrows, rows, groups)
+    precision = None if prior is None else prior.precision(columns.shape[0])
+    full, null = (nan, []) if blown else least_squares_covariance(
+        jrows, rows, groups, prior_precision=precision)
     covariance = full[:d, :d]
+    posterior = _posterior(prior, precision, jrows, values, blown)
     null = [v[:d] / np.linalg.norm(v[:d]) for v in null if np.linalg.norm(v[:d]) > 1e-3]
     flags, no_excitation = excitation_flags(ds, estimator.rudder, rows.size, columns.shape[0])
 
@@ -545,11 +662,13 @@ def _report(problem: _Problem, optimum: _Optimum) -> FitResult:
         if blown:
             robust, lags, method = nan, None, "none (the simulation blew up)"
         elif windows_used >= MIN_CLUSTERS:
-            robust, _ = cluster_from_windows(jac[..., columns], resid, mask)
+            robust, _ = cluster_from_windows(jac[..., columns], resid, mask,
+                                             prior=posterior.get("robust"))
             lags, method = None, f"clustered by prediction window, {windows_used} windows"
         else:
             robust, lags = hac_from_windows(jac[..., columns], resid, layout,
-                                            num_samples=shape[1], focus=np.arange(d))
+                                            num_samples=shape[1], focus=np.arange(d),
+                                            prior=posterior.get("robust"))
             method = f"Newey-West HAC, {lags} lags"
         return parameter_report(transform.names, values, covariance,
                                 units=tuple(s.unit for s in specs), null_directions=null,
@@ -559,9 +678,27 @@ def _report(problem: _Problem, optimum: _Optimum) -> FitResult:
 
     return assemble_result(
         fitted, report, ds, predictions, hit, validation=Validation(
-            estimator.rudder, columns.shape[0], estimator.max_lag, quiet=blown,
+            estimator.rudder, posterior.get("effective_params", columns.shape[0]),
+            estimator.max_lag, quiet=blown,
             # blown up: the finite samples only
             valid={c: hit & np.isfinite(line) for c, line in predictions.items()}),
         result=result, num_steps=num_steps, cost=cost,
         weights={c: float(w) for c, w in zip(channels, weights)},
-        window_samples=layout["lengths"], horizon=estimator.horizon)
+        window_samples=layout["lengths"], horizon=estimator.horizon,
+        **{k: v for k, v in posterior.items() if k != "robust"})
+
+
+def _posterior(prior, precision, jrows, values, blown) -> dict:
+    """With a prior: the `FitResult` fields `effective_params` (the trace of the hat
+    matrix, window starts counted in full), `prior` (per coefficient its prior, estimate
+    and the data's share of its information) and `prior_settings`, and `robust`, the
+    prior's `(precision, variance)` for the robust covariances. Without one: {}."""
+    if prior is None:
+        return {}
+    d = prior.columns
+    nan = np.full(d, np.nan)
+    share = nan if blown else information_share(jrows, precision)[:d]
+    d_eff = math.nan if blown else effective_parameters(jrows, precision)
+    return {"effective_params": d_eff, "robust": (precision, prior.variance),
+            "prior": prior_report(prior.names, prior.mean, prior.sd, values, share),
+            "prior_settings": prior.prior.to_dict() | {"noise_variance": prior.variance}}

@@ -47,6 +47,14 @@ class FitResult(SolverOutcome):
       innovations); `noise`, `noise_std`: the noise variances an `Innovations`
       estimator estimates with the model (None otherwise);
     - `names`, `values`, `std`, `covariance`, `correlation`: shortcuts.
+
+    With a prior (`PredictionError(prior=...)`): the estimates are the maximum a
+    posteriori ones and the covariance the posterior one; `effective_params` is the
+    effective number of estimated values (the trace of the hat matrix) that FPE, AIC and BIC
+    charge; `prior` `{name: {"prior_mean", "prior_std", "value", "data_share"}}`, the data's
+    share of each coefficient's information (1 - posterior / prior variance); and
+    `prior_settings` the prior as set, with the noise variance that weighed it. All None
+    without a prior.
     """
 
     model: eqx.Module  # an AbstractSteeringModel or an AbstractVessel
@@ -67,6 +75,9 @@ class FitResult(SolverOutcome):
     # `initial=EstimatedStarts()`: the estimated corrections of the window starts' (r, psi),
     # shape (E, W, 2) as the windows of the fit
     start_offsets: np.ndarray | None = None
+    effective_params: float | None = None
+    prior: dict | None = None
+    prior_settings: dict | None = None
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -111,6 +122,8 @@ class FitResult(SolverOutcome):
                  f"experiment(s), {how}: {self.message}, "
                  f"{self.num_steps} steps, cost {self.cost:.6g}",
                  self.parameters.table()]
+        if self.prior is not None:
+            lines.append(self.prior_table())
         if self.noise is not None:
             lines.append("noise variances: " + ", ".join(
                 f"{k} {v:.4g} +- {self.noise_std[k]:.2g}" for k, v in self.noise.items()))
@@ -119,9 +132,23 @@ class FitResult(SolverOutcome):
                          f"residuals {'white' if m.white else 'not white'}")
         return "\n".join(lines)
 
+    def prior_table(self) -> str:
+        """Per coefficient its prior (mean, standard deviation), its estimate and the data's
+        share of its information, and the effective number of parameters ("" without a
+        prior)."""
+        if self.prior is None:
+            return ""
+        lines = [f"{'prior':>12} {'mean':>14} {'std':>12} {'estimate':>14} {'data share':>10}"]
+        for n, row in self.prior.items():
+            lines.append(f"{n:>12} {row['prior_mean']:14.6g} {row['prior_std']:12.4g} "
+                         f"{row['value']:14.6g} {100 * row['data_share']:9.1f}%")
+        lines.append(f"effective number of parameters: {self.effective_params:.4g}")
+        return "\n".join(lines)
+
     def to_dict(self) -> dict:
-        """JSON-ready summary: model name, parameters (value, std, unit), frozen
-        values, metrics per channel, correlation, condition number, flags, result."""
+        """JSON-ready summary: model name, parameters (value, std, unit; with a prior its
+        mean and std and the data's share), frozen values, metrics per channel,
+        correlation, condition number, flags, result."""
         fields = {n: get_path(self.model, n) for n in _field_names(self.model)}
         report = self.parameters
         params = {
@@ -130,7 +157,14 @@ class FitResult(SolverOutcome):
             for n, v, s, u, rel in zip(self.names, self.values, self.std, report.units,
                                        report.relative_std)
         }
-        return {
+        prior = {}
+        if self.prior is not None:
+            for n, row in self.prior.items():
+                params[n] |= {k: _to_plain(row[k]) for k in ("prior_mean", "prior_std",
+                                                              "data_share")}
+            prior = {"prior": _to_plain(self.prior_settings),
+                     "effective_params": _to_plain(self.effective_params)}
+        return prior | {
             "model": type(self.model).__name__,
             "parameters": params,
             "frozen": {n: _to_plain(float(v)) for n, v in fields.items() if n not in params},
@@ -166,7 +200,7 @@ class Validation:
     floating-point warnings silenced (nothing of a blown-up fit means anything)."""
 
     rudder: str
-    num_params: int
+    num_params: int | float  # float: the effective number of a fit with a prior
     max_lag: int
     valid: dict | None = None
     quiet: bool = False
@@ -200,7 +234,7 @@ def assemble_result(model, parameters, ds, predictions: dict, predicted, *,
 
 
 def _validate_channels(ds, predictions: dict, predicted, valid=None, *, rudder: str,
-                       num_params: int = 0, max_lag: int) -> dict[str, ValidationReport]:
+                       num_params: int | float = 0, max_lag: int) -> dict[str, ValidationReport]:
     """`{channel: ValidationReport}` of `predictions` against the measurements in `ds`,
     each on its `valid` mask (default `predicted`)."""
     u = np.asarray(getattr(ds, rudder), dtype=np.float64)

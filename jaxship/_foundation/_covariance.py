@@ -42,7 +42,7 @@ def _normalised_inverse(jac, rcond):
 
 
 def least_squares_covariance(jacobian, residuals, groups=None, *, num_params=None,
-                             rcond: float = 1e-10):
+                             rcond: float = 1e-10, prior_precision=None):
     """Covariance of a least-squares estimate from the Jacobian at the optimum.
 
     With one group (all residuals equally weighted) this is
@@ -62,6 +62,13 @@ def least_squares_covariance(jacobian, residuals, groups=None, *, num_params=Non
     **Arguments:** `jacobian` (N, d) of the (weighted) residuals with respect to
     the physical parameters; `residuals` (N,); `groups` (N,) integer labels or None.
 
+    **Prior.** `prior_precision` (d,): the diagonal of a Gaussian prior's precision $P$ in
+    the residuals' scale (0 where a parameter has none; see `jaxship/_estimate/_prior.py`):
+    the posterior covariance $A^{-1}(\\sum_g\\hat\\sigma_g^2 J_g^TJ_g + \\hat\\sigma^2 P)
+    A^{-1}$, $A = J^TJ + P$ (the prior's rows a group of the pooled variance
+    $\\hat\\sigma^2$; with one group $\\hat\\sigma^2 A^{-1}$), and the degrees of freedom
+    $N - d_\\text{eff}$ (`effective_parameters`).
+
     **Returns:** `(covariance (d, d), null_directions)`, the second a list of unit
     vectors (d,) spanning the undetermined directions (empty if none).
     """
@@ -71,6 +78,8 @@ def least_squares_covariance(jacobian, residuals, groups=None, *, num_params=Non
     if res.shape[0] != num:
         raise ValueError(f"`residuals` has {res.shape[0]} entries, `jacobian` {num} rows.")
     groups = np.zeros(num, dtype=int) if groups is None else np.asarray(groups).reshape(-1)
+    if prior_precision is not None:
+        return _posterior_covariance(jac, res, groups, prior_precision, rcond)
     pinv_a, safe, undetermined, null = _normalised_inverse(jac, rcond)
     jn = jac / safe
     dof = max(num - d, 1)
@@ -82,6 +91,58 @@ def least_squares_covariance(jacobian, residuals, groups=None, *, num_params=Non
         middle += sigma2 * jn[sel].T @ jn[sel]
     cov_n = pinv_a @ middle @ pinv_a
     cov = cov_n / safe[:, None] / safe[None, :]
+    cov[undetermined, :] = np.inf
+    cov[:, undetermined] = np.inf
+    return cov, null
+
+
+def _with_prior(rows, prior, rcond):
+    """`_normalised_inverse` of `rows` (N, d) with the rows $\\sqrt{P}$ of a prior below
+    and the prior's term $\\hat\\sigma^2 P$ of the sandwich's middle (normalised), for
+    `prior = (precision (d,), variance)`; without a prior (None) the rows' own and 0."""
+    if prior is None:
+        return _normalised_inverse(rows, rcond), 0.0
+    precision, variance = np.asarray(prior[0], dtype=np.float64), float(prior[1])
+    out = _normalised_inverse(np.vstack([rows, np.diag(np.sqrt(precision))]), rcond)
+    return out, variance * np.diag(precision / out[1] ** 2)
+
+
+def effective_parameters(jacobian, prior_precision) -> float:
+    """The effective number of parameters of a regularised least-squares fit, the trace
+    of its hat matrix $d_\\text{eff} = \\mathrm{tr}\\,J(J^TJ + P)^{-1}J^T$ (Hastie,
+    Tibshirani & Friedman 2009, eq. 3.50), for `jacobian` (N, d) and the diagonal
+    `prior_precision` (d,) in the residuals' scale: d without a prior (P = 0, J of full
+    rank), 0 for an infinitely strong one."""
+    jac = np.asarray(jacobian, dtype=np.float64)
+    (pinv_a, safe, _, _), _ = _with_prior(jac, (prior_precision, 0.0), 1e-10)
+    jn = jac / safe
+    return float(np.trace(pinv_a @ (jn.T @ jn)))
+
+
+def information_share(jacobian, prior_precision) -> np.ndarray:
+    """The data's share of each parameter's information in a fit with a Gaussian prior of
+    diagonal precision `prior_precision` (d,), one minus the posterior over the prior
+    variance, $1 - [(J^TJ + P)^{-1}]_{ii}P_{ii}$: in [0, 1] since $(J^TJ + P)^{-1} \\preceq
+    P^{-1}$; 1 where a parameter has no prior."""
+    jac = np.asarray(jacobian, dtype=np.float64)
+    precision = np.asarray(prior_precision, dtype=np.float64)
+    (pinv_a, safe, _, _), _ = _with_prior(jac, (precision, 0.0), 1e-10)
+    return 1.0 - np.diag(pinv_a) * precision / safe**2
+
+
+def _posterior_covariance(jac, res, groups, precision, rcond):
+    """`least_squares_covariance` with a prior (its docstring)."""
+    num, d = jac.shape
+    d_eff = effective_parameters(jac, precision)
+    dof = max(num - d_eff, 1.0)
+    pooled = float(np.sum(res**2)) / dof
+    (pinv_a, safe, undetermined, null), middle = _with_prior(jac, (precision, pooled), rcond)
+    jn = jac / safe
+    for g in np.unique(groups):
+        sel = groups == g
+        sigma2 = float(np.sum(res[sel] ** 2)) * num / (int(sel.sum()) * dof)
+        middle = middle + sigma2 * jn[sel].T @ jn[sel]
+    cov = pinv_a @ middle @ pinv_a / safe[:, None] / safe[None, :]
     cov[undetermined, :] = np.inf
     cov[:, undetermined] = np.inf
     return cov, null
@@ -145,11 +206,11 @@ def bartlett_long_run(scores, lags: int) -> np.ndarray:
     return np.einsum("etp,etq->pq", blocks, blocks) / (lags + 1)
 
 
-def _hac(rows, scores, valid, lags, focus, rcond):
+def _hac(rows, scores, valid, lags, focus, rcond, prior=None):
     num, d = rows.shape
     if num == 0:
         raise ValueError("no valid residuals.")
-    pinv_a, safe, undetermined, _ = _normalised_inverse(rows, rcond)
+    (pinv_a, safe, undetermined, _), prior_middle = _with_prior(rows, prior, rcond)
     g = scores / safe
     if lags is None:
         sel = g if focus is None else g[..., np.asarray(focus)]
@@ -158,6 +219,10 @@ def _hac(rows, scores, valid, lags, focus, rcond):
         raise ValueError(f"`lags` must be None or a non-negative integer, got {lags!r}.")
     lags = int(lags)
     middle = bartlett_long_run(g, lags)
+    if prior is not None:  # the long-run variance of the data, the prior's beside it
+        d_eff = float(np.trace(pinv_a @ ((rows / safe).T @ (rows / safe))))
+        return _finish(pinv_a @ (middle * (num / max(num - d_eff, 1.0)) + prior_middle)
+                       @ pinv_a, safe, undetermined), lags
     cov = pinv_a @ middle @ pinv_a * (num / max(num - d, 1))
     cov = cov / safe[:, None] / safe[None, :]
     cov[undetermined, :] = np.inf
@@ -235,14 +300,25 @@ def hac_covariance(jacobian, residuals, mask=None, *, lags=None, focus=None,
     return _hac(jac[valid], scores, valid.any(axis=0), lags, focus, rcond)
 
 
+def _finish(cov_n, safe, undetermined):
+    """A normalised covariance back in the parameters' units, undetermined ones inf."""
+    cov = cov_n / safe[:, None] / safe[None, :]
+    cov[undetermined, :] = np.inf
+    cov[:, undetermined] = np.inf
+    return cov
+
+
 def hac_from_windows(jacobian, residuals, layout, *, num_samples=None, lags=None,
-                     focus=None, rcond: float = 1e-10):
+                     focus=None, rcond: float = 1e-10, prior=None):
     """`hac_covariance` of a windowed prediction-error fit: the Jacobian
     `(C, E, W, L, d)` and residuals `(C, E, W, L)` at the window samples are put in
     time order with `layout["target"]` (E, W, L) sample indices and `layout["mask"]`
     (as `jaxship._estimate._windows.to_timeline` does); scores of window samples that
     land on the same sample are added. `num_samples`: length of the timeline
-    (default the largest target index + 1). Returns `(covariance (d, d), lags)`."""
+    (default the largest target index + 1). `prior = (precision (d,), variance)`: a
+    Gaussian prior's (see `least_squares_covariance`), whose information is added to
+    $J^TJ$ and, times the variance, to the long-run variance. Returns `(covariance (d, d),
+    lags)`."""
     jac = np.asarray(jacobian, dtype=np.float64)
     res = np.asarray(residuals, dtype=np.float64)
     mask = np.asarray(layout["mask"], dtype=bool)
@@ -264,10 +340,10 @@ def hac_from_windows(jacobian, residuals, layout, *, num_samples=None, lags=None
     np.add.at(scores, (e_idx[mask], target[mask]), per_window[mask])
     valid = np.zeros((mask.shape[0], num), dtype=bool)
     valid[e_idx[mask], target[mask]] = True
-    return _hac(rows, scores, valid, lags, focus, rcond)
+    return _hac(rows, scores, valid, lags, focus, rcond, prior)
 
 
-def cluster_from_windows(jacobian, residuals, mask, *, rcond: float = 1e-10):
+def cluster_from_windows(jacobian, residuals, mask, *, rcond: float = 1e-10, prior=None):
     """Cluster-robust covariance of a windowed prediction-error fit, each prediction
     window a cluster (Liang & Zeger 1986; Cameron & Miller 2015, *J. Human Resources*
     50, eq. 11):
@@ -279,12 +355,13 @@ def cluster_from_windows(jacobian, residuals, mask, *, rcond: float = 1e-10):
     residuals are strongly correlated; windows restart from measurements, so
     different windows are nearly independent: the sandwich allows any correlation
     inside a cluster. Needs many windows (G of 20 or more). `jacobian` (C, E, W, L, d),
-    `residuals` (C, E, W, L), `mask` (E, W, L). Returns `(covariance, G)`."""
+    `residuals` (C, E, W, L), `mask` (E, W, L); `prior` as in `hac_from_windows`. Returns
+    `(covariance, G)`."""
     jac = np.asarray(jacobian, dtype=np.float64)
     res = np.asarray(residuals, dtype=np.float64)
     mask = np.asarray(mask, dtype=bool)
     rows = np.concatenate([jac[c][mask] for c in range(res.shape[0])])
-    pinv_a, safe, undetermined, _ = _normalised_inverse(rows, rcond)
+    (pinv_a, safe, undetermined, _), prior_middle = _with_prior(rows, prior, rcond)
     jac0 = np.where(mask[None, ..., None], jac, 0.0)
     scores = np.einsum("cewlp,cewl->ewp", jac0, np.where(mask[None], res, 0.0))
     used = mask.any(axis=-1)
@@ -292,6 +369,9 @@ def cluster_from_windows(jacobian, residuals, mask, *, rcond: float = 1e-10):
     count = int(used.sum())
     if count < 2:
         raise ValueError("a cluster-robust covariance needs at least two windows.")
+    if prior is not None:
+        return _finish(pinv_a @ ((g.T @ g) * (count / (count - 1)) + prior_middle) @ pinv_a,
+                       safe, undetermined), count
     cov = pinv_a @ (g.T @ g) @ pinv_a * (count / (count - 1))
     cov = cov / safe[:, None] / safe[None, :]
     cov[undetermined, :] = np.inf

@@ -194,7 +194,7 @@ class ValidationReport:
 
     channel: str
     num_samples: int
-    num_params: int
+    num_params: int | float
     loss: float
     abs_sum: float
     rms: float
@@ -244,7 +244,7 @@ def final_prediction_error(loss: float, num_params: int, num_samples: int) -> fl
     return math.inf if ratio >= 1 else float(loss * (1 + ratio) / (1 - ratio))
 
 
-def _criteria(loss: float, d: int, num: int) -> dict:
+def _criteria(loss: float, d: float, num: int) -> dict:
     """`fpe`, `aic`, `bic` of a loss on `num` samples with `d` estimated parameters (see
     `ValidationReport`)."""
     log_loss = math.log(loss) if loss > 0 else -math.inf
@@ -263,7 +263,8 @@ def validate(y, yhat, mask=None, *, num_params: int = 0, u=None, max_lag: int = 
 
     - `y`, `yhat`: arrays `(N,)` or `(E, N)`.
     - `mask`: valid samples (default all).
-    - `num_params`: the number d of estimated parameters.
+    - `num_params`: the number d of estimated parameters (a float: an effective
+      number, e.g. of a fit with a prior).
     - `u`: the input (e.g. rudder angle) at the same samples, or None.
     - `max_lag`: largest lag M of the correlation tests [samples].
     - `channel`: a name for the report.
@@ -281,7 +282,8 @@ def validate(y, yhat, mask=None, *, num_params: int = 0, u=None, max_lag: int = 
                              "valid samples.")
     e = np.where(mask, y - yhat, 0.0)
     loss = float(np.sum(e**2) / num)
-    d = int(num_params)
+    # the effective number of parameters of a fit with a prior is not a whole number
+    d = num_params if isinstance(num_params, float) else int(num_params)
     mean = float(np.sum(e) / num)
     # (a prediction that blew up but stayed finite squares to inf: no OverflowError)
     std = float(np.sqrt(max(loss - np.square(mean), 0.0)))

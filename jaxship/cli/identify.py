@@ -51,6 +51,12 @@ def register(sub) -> None:
                        help="the estimated coefficients, comma separated; a leading + adds "
                        "them to the default set (default: the model's default free set; a "
                        "preset's own where it has one)")
+    ident.add_argument("--prior", default=None, metavar="SCALE",
+                       help="a Gaussian prior on the estimated coefficients centred on the "
+                       "start (--model's preset, --vessel's file or result.json), with a "
+                       "standard deviation of SCALE times each start value (e.g. 0.3): the "
+                       "fit is the maximum a posteriori estimate; inf or none: no prior "
+                       "(default)")
     ident.add_argument("--validate", nargs="+", type=pathlib.Path, default=None,
                        metavar="TEST", help="held-out records to validate on")
     ident.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
@@ -137,7 +143,8 @@ def run(args) -> int:
                       horizon=... if args.horizon is None else chosen.horizon,
                       sample_interval=args.sample_interval, free=args.free,
                       rudder=args.rudder, channels=args.channels, initial=args.initial,
-                      max_steps=args.max_steps, progress=ProgressBar(not args.quiet))
+                      max_steps=args.max_steps, progress=ProgressBar(not args.quiet),
+                      prior=args.prior)
     written = ["result.json"]
     with staged_folder(args.out) as stage:
         if not args.no_figures:

@@ -79,6 +79,8 @@ class Identification:
             parts = [f"{c} fit {m.fit_percent:.2f} %, FPE {m.fpe:.4g}"
                      for c, m in block.metrics.items()]
             lines.append(f"{label}: " + "; ".join(parts))
+        if self.fit.prior is not None:
+            lines.insert(2, self.fit.prior_table())
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
@@ -116,7 +118,8 @@ class Identification:
             "constants": _constants(self.model),
             **_structure(self.model),
             "fit": {k: fitted[k] for k in ("success", "code", "result", "num_steps", "cost",
-                                          "window_samples", "weights")},
+                                          "window_samples", "weights", "prior",
+                                          "effective_params") if k in fitted},
             "train": self.train.to_dict(),
             "train_simulation": self.train_simulation.to_dict(),
             "validation": None if self.validation is None else self.validation.to_dict(),

@@ -55,7 +55,8 @@ def criterion(result) -> dict:
     losses), `losses` per channel, `num_params` d, `num_samples` N, `fit_code`."""
     metrics = result.train.metrics
     losses = {c: float(m.loss) for c, m in metrics.items()}
-    d = len(result.fit.names)
+    d = len(result.fit.names) if result.fit.effective_params is None else \
+        result.fit.effective_params  # with a prior: the effective number
     n = min(int(m.num_samples) for m in metrics.values())
     usable = (bool(result.fit.success) and d < n
               and all(math.isfinite(v) and v > 0 for v in losses.values()))

@@ -73,7 +73,8 @@ def identify(model, train, *, validate=None, horizon=..., free=None,
              sample_interval: float | None = None, velocities: str | None = None,
              rudder: str = "delta", channels=None, initial=None,
              max_steps: int = 256, progress: Callable[[Progress], None] | None = None,
-             name: str | None = None, substeps: int = 1) -> Identification:
+             name: str | None = None, substeps: int = 1,
+             prior: float | None = None) -> Identification:
     """Estimate a steering model or a vessel from training records and validate it, as
     `jaxship identify` does (the command calls this).
 
@@ -114,6 +115,12 @@ def identify(model, train, *, validate=None, horizon=..., free=None,
       entry supports it, `MeasuredStates` otherwise (the command's `--initial measured`,
       `estimate`, `auto` are the same). Validation always starts from the measured state.
     - `max_steps`: optimiser step limit; `substeps`: RK4 steps per sample interval.
+    - `prior`: a Gaussian prior on the estimated coefficients centred on the start (the
+      preset's, the vessel file's, the earlier result's values; a steering model's start
+      values), with a standard deviation of `prior` times each start value's magnitude
+      (`jaxship.strategies.Prior(scale=prior)`): the fit returns the maximum a posteriori
+      estimate, charged for its effective number of parameters; result.json records the
+      prior and per coefficient its data share. None or `math.inf` (default): no prior.
     - `progress`: a callable receiving `Progress` reports, or None (quiet).
     - `name`: the catalogue name a `model` object is fitted as (a preset's name for its
       vessel, `nomoto1-norrbin` for a `NonlinearNomoto`); None: a vessel of one's own,
@@ -150,7 +157,8 @@ def identify(model, train, *, validate=None, horizon=..., free=None,
     train = as_experiments(train, "training", **reading)
     validate = None if validate is None else as_experiments(validate, "validation", **reading)
     options = _Options(settings.horizon, rudder, channels, _initial(initial), max_steps, substeps,
-                       settings.free, default_channels=channels is None)
+                       settings.free, default_channels=channels is None,
+                       prior=prior_scale(prior))
     if settings.name == AUTO:  # each candidate fitted, one chosen (`selection`)
         result = _chosen((train, validate), options, progress)
     else:
@@ -212,6 +220,22 @@ def _chosen(records, options: _Options, progress) -> Identification:
     return with_selection(results[name], selection)
 
 
+def prior_scale(scale) -> float | None:
+    """`identify`'s relative prior scale checked: a positive number, None for no prior (also
+    for infinity, or the texts "inf" and "none")."""
+    if scale is None or (isinstance(scale, str) and scale.strip().lower() in ("none", "inf")):
+        return None
+    try:
+        value = float(scale)
+    except (TypeError, ValueError):
+        value = math.nan
+    if not value > 0:
+        raise ValueError(f"the prior's scale (--prior) {scale!r} must be a positive number "
+                         "(a standard deviation relative to each start value, e.g. 0.3) or "
+                         "inf/none (no prior).")
+    return None if math.isinf(value) else value
+
+
 def _initial(initial) -> str:
     """The name of `identify`'s `initial` (a strategy, None, or the command's text)."""
     if initial is None:
@@ -231,12 +255,14 @@ class _Options(NamedTuple):
     substeps: int
     free: tuple[str, ...] | None
     default_channels: bool  # no channels given: the entry's defaults, which data may thin
+    prior: float | None = None  # the prior's scale relative to the start values
 
     def to_json(self) -> dict:
         return {"horizon_s": self.horizon, "rudder": self.rudder,
                 "channels": list(self.channels), "initial": self.initial,
                 "max_steps": self.max_steps, "substeps": self.substeps,
-                "free": None if self.free is None else list(self.free)}
+                "free": None if self.free is None else list(self.free)} | (
+                    {} if self.prior is None else {"prior_scale": self.prior})
 
 
 def _checked_options(name, entry, asked: _Options) -> _Options:
@@ -322,7 +348,8 @@ def _estimator(options: _Options) -> js.PredictionError:
         simulator=js.Simulator(max_step=math.inf, substeps=options.substeps),
         solver=js.LevenbergMarquardt(rtol=1e-9, atol=1e-9), max_steps=options.max_steps,
         initial={"estimate": js.EstimatedStarts(),
-                 "measured": js.MeasuredStates()}[options.initial])
+                 "measured": js.MeasuredStates()}[options.initial],
+        prior=None if options.prior is None else js.strategies.Prior(scale=options.prior))
 
 
 @dataclasses.dataclass
@@ -405,7 +432,8 @@ def _fit_or_restart(fitting, entry, options, context, begun, notes):
 def _assessments(result, entry, records, options, fitting, wind, notes):
     """The fit criterion on the training records, and the output-error simulations of the
     fitted model on the training and held-out records (None without held-out records)."""
-    d = len(result.names)
+    # the estimated parameters, or with a prior their effective number
+    d = len(result.names) if result.effective_params is None else result.effective_params
     simulate = entry.simulate or simulate_records
     max_lag = int(fitting.estimator.max_lag)
     report, rudder, channels = fitting.report, options.rudder, options.channels
@@ -413,7 +441,7 @@ def _assessments(result, entry, records, options, fitting, wind, notes):
     criterion = result.horizon
     train_block = assess("prediction" if criterion is not None else "simulation", criterion,
                           records.train_ds, rudder, (result.predictions, result.predicted),
-                          (int(result.metrics[channels[0]].num_params), max_lag),
+                          (result.metrics[channels[0]].num_params, max_lag),
                           start="estimated" if options.initial == "estimate" else "measured")
     report(Progress("validate", "simulating the training records"))
 
