@@ -64,7 +64,7 @@ from jaxship.thesis import autopilot as ap
 
 jax.config.update("jax_enable_x64", True)
 vessel = js.get_vessel("thesis")
-design = ap.Design()
+design = js.AutopilotDesign()
 print(f"controller: omega_n = {design.natural_frequency} rad/s, zeta = {design.damping}; "
       f"reference: omega = {design.reference_frequency} rad/s, zeta = "
       f"{design.reference_damping}; step {design.step} deg at {design.step_time} s")
