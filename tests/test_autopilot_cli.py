@@ -460,8 +460,9 @@ def test_a_rudder_on_its_limits_is_a_code_and_a_sentence(identified, tmp_path, c
     that fast and the rudder sits at its limit for most of the window; the report says
     so first and stderr warns. The ship is still 140 deg off the ordered heading at the
     end of the 10 s window: since issue 72 such a run is not_settled, not only
-    rudder_saturated, and the command exits 3 (it exited 0). The model file gives its parameters as bare numbers, which the
-    loader accepts (the trust audit: the command then ended in a TypeError traceback)."""
+    rudder_saturated, and the command exits 3 (it exited 0). The model file gives its
+    parameters as bare numbers, which the loader accepts (the trust audit: the command
+    then ended in a TypeError traceback)."""
     report = json.loads(identified.read_text())
     report["parameters"] = {k: e["value"] for k, e in report["parameters"].items()}
     bare = tmp_path / "bare.json"
