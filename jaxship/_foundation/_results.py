@@ -23,8 +23,9 @@ class RESULTS(dfx.RESULTS):
     poorly_determined = ("the data do not determine a combination of the parameters (a "
                          "singular information matrix, no excitation, or a record too "
                          "short) or, by the robust standard errors of residuals that are "
-                         "not white, a parameter (its 95 % interval includes zero): only "
-                         "the others are identified (see the parameter flags)")
+                         "not white, a parameter (relative standard error above 50 %: its "
+                         "95 % interval about reaches zero): only the others are identified "
+                         "(see the parameter flags)")
     not_settled = ("the closed loop did not settle: at the end of the run the heading is "
                    "outside the band about the ordered heading (or the ship circles), so "
                    "its metrics say nothing about the autopilot")

@@ -71,11 +71,10 @@ def read_experiments(paths, *, role: str = "training", note=None, taken=(),
         paths = [paths]
     experiments = []
 
-    def read(item):  # with the reader's notes (a heading unwrapped, columns unchecked) said
+    def read(item):  # with the reader's note (a heading unwrapped) said
         e = _with_velocities(js.read_measured(item), over_ground)
-        for key in ("note", "unchecked"):
-            if note is not None and key in e.meta:
-                note(f"{item}: {e.meta[key]}")
+        if note is not None and "note" in e.meta:
+            note(f"{item}: {e.meta['note']}")
         return e
 
     for path in paths:
