@@ -1,7 +1,10 @@
 """The `jaxship` command's entry point, outside the package so that it runs before the
 package's imports (seconds: jax's among them): Ctrl-C or SIGTERM in that time ends the
 command with its line and status (130, 143), as `jaxship.cli.run` does later, not with
-a traceback. Nothing is written before those imports end."""
+a traceback. Nothing is written before those imports end. `python -m jaxship.cli` goes
+through the same door: the package installs these handlers first when Python imports
+it to run that module (`jaxship/__init__.py`), and `jaxship/cli/__main__.py` calls
+`run`."""
 
 import os
 import signal
@@ -14,9 +17,14 @@ def _end(signum, frame):
     os._exit(128 + signum)
 
 
-def run() -> None:
+def install() -> None:
+    """The handlers of the imports' time: the line and status of the signal."""
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, _end)
+
+
+def run() -> None:
+    install()
     from jaxship.cli import run as command  # `command` installs its own handlers
 
     command()

@@ -8,6 +8,26 @@ strategy objects a third, `jaxship.strategies`.
 
 __version__ = "0.1.0"  # the one place of the version (pyproject.toml reads it)
 
+import sys as _sys
+
+
+# `python -m jaxship.cli` imports this package (seconds: jax's imports) before the
+# command's module runs: there, and only there (`sys.argv[0]` is "-m" while Python
+# locates the module to run), the command's entry installs its signal handlers first,
+# as the console script does, so that Ctrl-C or SIGTERM during the imports ends with the
+# command's line and status (issue 72). Any other import sets nothing global.
+def _run_as_the_command() -> bool:
+    argv = list(getattr(_sys, "orig_argv", ()))
+    named = [argv[i + 1] for i, a in enumerate(argv[:-1]) if a == "-m"]
+    named += [a[2:] for a in argv if a.startswith("-m") and len(a) > 2]
+    return _sys.argv[:1] == ["-m"] and named[:1] == ["jaxship.cli"]
+
+
+if _run_as_the_command():
+    import _jaxship_cli
+
+    _jaxship_cli.install()
+
 # foundation: parameters, state, progress, the compilation cache
 # analysis: manoeuvre indices, autopilot design and closed loops, experiment design,
 # discovery

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship._workflow import _autopilot as study
+from jaxship._workflow import _autopilot as study, _autopilot_text as study_text
 from jaxship._workflow._autopilot_reference import (
     RudderDemand,
     ordered_error_deg,
@@ -457,10 +457,12 @@ def test_the_default_design_keeps_the_feedforward_within_the_rudders_limits():
 
 def test_a_rudder_on_its_limits_is_a_code_and_a_sentence(identified, tmp_path, capsys):
     """omega_n = 5 rad/s and a 180 deg step on the thesis vessel: the ship cannot turn
-    that fast and the rudder sits at its limit for most of the window; each such run
-    has the code rudder_saturated, the report says so first and stderr warns (exit 0:
-    the runs are finite). The model file gives its parameters as bare numbers, which the
-    loader accepts (the trust audit: the command then ended in a TypeError traceback)."""
+    that fast and the rudder sits at its limit for most of the window; the report says
+    so first and stderr warns. The ship is still 140 deg off the ordered heading at the
+    end of the 10 s window: since issue 72 such a run is not_settled, not only
+    rudder_saturated, and the command exits 3 (it exited 0). The model file gives its
+    parameters as bare numbers, which the loader accepts (the trust audit: the command
+    then ended in a TypeError traceback)."""
     report = json.loads(identified.read_text())
     report["parameters"] = {k: e["value"] for k, e in report["parameters"].items()}
     bare = tmp_path / "bare.json"
@@ -468,13 +470,15 @@ def test_a_rudder_on_its_limits_is_a_code_and_a_sentence(identified, tmp_path, c
     out = tmp_path / "fast"
     assert main(["autopilot", "--model", str(bare), "--vessel", "thesis", "--rpm",
                  "400", "--natural-frequency", "5", "--step", "180", "--out", str(out),
-                 "--quiet"]) == 0
+                 "--quiet"]) == 3
     written = json.loads((out / "autopilot.json").read_text())
     assert written["model"]["parameters"] == report["parameters"]
     runs = written["runs"]
-    assert {r["code"] for r in runs} == {"rudder_saturated"}
+    assert {r["code"] for r in runs} == {"not_settled"}
+    assert all(r["end_error_deg"] > 0.05 * 180.0 for r in runs)
     assert all(r["time_saturated_s"] > 0.5 * 10.0 for r in runs)  # window 10-20 s
-    assert "rudder_saturated" in (out / "report.md").read_text().split("##")[0]
+    head = (out / "report.md").read_text().split("##")[0]
+    assert "The rudder sat at its limit" in head and "code not_settled" in head
     # issue 61: no steady turn at the 180 deg step's peak rate; the model's own, said so
     at_step = written["feedforward_at_step"]
     assert at_step["vessel_rudder_deg"] is None and at_step["steady_gain"] == 1.0
@@ -658,3 +662,50 @@ def test_the_tuned_reference_bandwidth_stays_within_the_rudder_and_tracks_the_st
     runs = js.closed_loop(plant, [start, tuned], speeds=[5.0], duration=400.0, dt=0.1)
     before, after = ordered_error_deg(runs, 1.0, (50.0, 400.0))[:, 0]
     assert after < before, summary
+
+
+def test_a_loop_that_never_settles_is_not_settled_and_exits_3(tmp_path, capsys):
+    """Issue 72, "Broken 5": from a model with K = 1e-9 1/s and --natural-frequency 0.3
+    the gains are K_p = 1.6e8 and the heading never settles (it was exit 0, code
+    successful, nothing on stderr): every run's code is not_settled, the heading error
+    over the window's last tenth beyond 5 % of the 45 deg step, and the command exits 3
+    with one line on stderr."""
+    model = tmp_path / "tiny_k.json"
+    model.write_text(json.dumps({"model": "nomoto1", "model_class": "Nomoto1", "frozen": {},
+                                 "parameters": {"K": {"value": 1e-9}, "T": {"value": 1.8}}}))
+    out = tmp_path / "run"
+    assert main(["autopilot", "--model", str(model), "--vessel", "thesis", "--rpm", "350",
+                 "--natural-frequency", "0.3", "--out", str(out), "--quiet"]) == 3
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "did not settle (code not_settled)" in err, err
+    runs = json.loads((out / "autopilot.json").read_text())["runs"]
+    assert {r["code"] for r in runs} == {"not_settled"}
+    assert all(r["end_error_deg"] > 0.05 * 45.0 for r in runs)
+
+
+def test_a_ship_that_turns_away_is_not_settled():
+    """A closed loop whose ship turns away from the ordered heading (issue 72: a ship that
+    circled passed it by 4e8 deg with a saturation warning only): the thesis vessel
+    steered by the PID of its Nomoto model with the sign of every gain reversed turns
+    away with its rudder hard over and ends near the opposite heading (its wrapped error
+    is then stable), 190 deg off in the unwrapped heading the band is judged on: its run
+    is not_settled and the failure sentence says so."""
+    vessel = js.get_vessel("thesis")
+    design = js.AutopilotDesign.scaled(0.5)
+    pid = js.design_autopilot(js.Nomoto1(K=0.3, T=2.6), plant=vessel, rpm=[350.0],
+                              design=design, feedforward=False)
+    reversed_pid = eqx_negate(pid)
+    run = js.closed_loop(vessel, reversed_pid, duration=design.duration, dt=design.dt,
+                         rpm=[350.0])
+    rows = study.run_rows("pid", run, design, [350.0], [1.0], float(vessel.rudder.max_angle))
+    assert rows[0]["success"] and rows[0]["code"] == "not_settled", rows[0]
+    assert rows[0]["end_error_deg"] > 90.0  # turned away, not swinging about the order
+    failure, _ = study_text.problems(rows)
+    assert "did not settle (code not_settled) for pid at 350 rpm" in failure
+
+
+def eqx_negate(pid):
+    """`pid` with its gains K_p, K_i, K_d of the other sign."""
+    import equinox as eqx
+
+    return eqx.tree_at(lambda a: (a.kp, a.ki, a.kd), pid, (-pid.kp, -pid.ki, -pid.kd))

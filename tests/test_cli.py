@@ -889,19 +889,23 @@ def test_ctrl_c_while_a_worker_starts_leaves_no_worker_and_no_traceback(tmp_path
     assert not stat.exists() or stat.read_text().rsplit(")", 1)[1].split()[0] == "Z", child
 
 
+@pytest.mark.parametrize("entry", ["_jaxship_cli", "jaxship.cli"])
 @pytest.mark.parametrize("signum, status, line", [(2, 130, "jaxship: interrupted."),
                                                   (15, 143, "jaxship: terminated.")])
-def test_a_signal_during_the_imports_ends_with_its_line_and_status(signum, status, line):
+def test_a_signal_during_the_imports_ends_with_its_line_and_status(signum, status, line,
+                                                                   entry):
     """Issue 57, case 8: Ctrl-C in the first second, while Python imports the package
     (jax's import takes seconds), printed a KeyboardInterrupt traceback, and SIGTERM had
     no handler at all (exit 143, no line). The console entry (`_jaxship_cli`, outside the
-    package) handles both before those imports."""
+    package) handles both before those imports; so does `python -m jaxship.cli` (issue
+    72: its handlers came after the imports, and Ctrl-C was swallowed inside JAX's
+    import or ended in a traceback), which installs the same entry's handlers first."""
     import subprocess
     import sys
     import time
 
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    process = subprocess.Popen([sys.executable, "-m", "_jaxship_cli", "vessels"],
+    process = subprocess.Popen([sys.executable, "-m", entry, "vessels"],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                env=env, cwd=pathlib.Path(cli.__file__).parents[2])
     time.sleep(0.3)  # the interpreter up, the package's imports under way

@@ -589,3 +589,29 @@ def test_cli_auto_writes_the_choice_and_refuses_a_vessel(files, tmp_path, capsys
     code, _, err = run([files["train"], "--model", "auto", "--vessel", "thesis", "--out",
                         str(tmp_path / "no")], capsys)
     assert code == 2 and "give --model" in err and not (tmp_path / "no").exists()
+
+
+def test_free_plus_adds_to_a_steering_models_default_set(files, tmp_path, capsys):
+    """`--free +delta0` on a model that is no preset (issue 72, "Broken 3") frees delta0
+    beside the default K, T and the result's `options.free` records the set; an unknown
+    name is refused in one line naming the model's parameters (exit 2)."""
+    out = tmp_path / "plus"
+    code, _, err = run([files["train"], "--model", "nomoto1", "--free", "+delta0",
+                        "--out", str(out), "--no-figures", "--quiet"], capsys)
+    assert code == 0, err
+    result = json.loads((out / "result.json").read_text())
+    assert result["options"]["free"] == ["K", "T", "delta0"]
+    assert set(result["parameters"]) == {"K", "T", "delta0"} and "delta0" not in result["frozen"]
+    code, _, err = run([files["train"], "--model", "nomoto1", "--free", "+bogus",
+                        "--out", str(tmp_path / "bogus"), "--no-figures", "--quiet"], capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert "'bogus'" in err and "K, T, delta0" in err, err
+
+
+@pytest.mark.parametrize("name", ["nomoto1", "nomoto2", "nomoto1-nonlinear", "nomoto1-norrbin"])
+def test_free_plus_an_unknown_name_is_refused_for_every_model(name, files):
+    """`free="+bogus"` is refused for every catalogue model, naming its parameters, as
+    a list of names is (issue 72)."""
+    with pytest.raises(ValueError, match=r"'bogus', which is not a parameter of \w+; its "
+                                         r"parameters are K, T"):
+        js.identify(name, files["train"], free="+bogus")

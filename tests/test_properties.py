@@ -9,15 +9,18 @@ import re
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings, strategies as st
+from hypothesis import HealthCheck, assume, example, given, settings, strategies as st
 
 import jaxship as js
 from jaxship._foundation._kinematics import ssa
+from jaxship._simulation._consistency import HEADING_SPAN
 from jaxship._simulation._data import _cumulative_trapezoid
 from jaxship._simulation._readers import _PLAUSIBLE, _UNITS, _from_si, _to_si
 
 
-SETTINGS = settings(max_examples=60, deadline=None, database=None,
+# derandomize: every run draws the same examples (issue 72: the README's test command
+# gives every user the same answer); a failure found once becomes an `@example`
+SETTINGS = settings(max_examples=60, deadline=None, database=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow])
 OPTIONAL = ("psi", "r", "u", "v", "x", "y", "n", "delta_c", "wind_speed", "wind_dir")
 ANGLES = {"delta", "delta_c", "psi", "r", "wind_dir"}  # written in degrees in display units
@@ -134,7 +137,7 @@ def test_values_beyond_any_ship_are_refused_naming_the_column(tmp_path_factory, 
 
 
 @given(st.floats(allow_nan=False, allow_infinity=False, min_value=-1e300, max_value=1e300))
-@settings(max_examples=300, deadline=None, database=None)
+@settings(max_examples=300, deadline=None, database=None, derandomize=True)
 def test_unit_conversions_invert_each_other(value):
     x = np.array([value])
     for unit in ("deg", "deg/s", "rpm"):
@@ -151,7 +154,7 @@ def test_unit_conversions_invert_each_other(value):
 
 
 @given(st.floats(-1e6, 1e6, allow_nan=False))
-@settings(max_examples=300, deadline=None, database=None)
+@settings(max_examples=300, deadline=None, database=None, derandomize=True)
 def test_ssa_wraps_to_the_equivalent_angle_in_minus_pi_pi(angle):
     wrapped = float(ssa(angle))
     # [-pi, pi): an angle a rounding step below -pi can come out as +pi (the same angle)
@@ -253,7 +256,7 @@ def test_the_fuzz_seeds_are_valid_files(tmp_path, suffix, data):
     assert js.read_measured(path).num_samples >= 1
 
 
-@settings(max_examples=400, deadline=None, database=None,
+@settings(max_examples=400, deadline=None, database=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow])
 @given(st.one_of(st.tuples(st.sampled_from([".csv", ".dat", ".txt"]), st.binary(max_size=300)),
                  mutated()))
@@ -330,30 +333,60 @@ CORRUPTIONS = {
 }
 
 
-# without r: a heading in rad labelled deg barely turns, which the track cannot tell from
-# a ship that held its course
-NEED_R = ("r in rad/s labelled deg/s", "psi in rad labelled deg")
+def short_turn():
+    """The record hypothesis found on a fresh machine (issue 72): 1.45 s, 30 samples at
+    20 Hz, a 10 deg rudder step, the heading turning by 2 deg with r logged: too little
+    for the heading and the integrated yaw rate to tell a unit error."""
+    t = 0.05 * np.arange(30)
+    r = np.deg2rad(2.0) / t[-1] * np.minimum(1.0, t / 0.3) * 1.12
+    delta = np.where(t >= 0.25, np.deg2rad(10.0), 0.0)
+    return js.Experiment(t, delta, name="ship", psi=_cumulative_trapezoid(r, t), r=r,
+                         u=np.full(30, 5.0), v=np.zeros(30))
+
+
+def heading_turn(path) -> float:
+    """The largest turn [rad] of the heading in the trial CSV at `path`, as its labels
+    say it is: of the psi column and of the integral of the r column."""
+    headers = path.read_text().splitlines()[0].split(",")
+    data = dict(zip(headers, np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2).T))
+    si = {h.split(" [")[0]: _to_si(v, h.split(" [")[1].rstrip("]")) for h, v in data.items()}
+    turns = [np.ptp(si["psi"])] if "psi" in si else []
+    turns += [np.ptp(_cumulative_trapezoid(si["r"], si["t"]))] if "r" in si else []
+    return max(turns)
 
 
 @SETTINGS
 @given(ship_records(), st.sampled_from(sorted(CORRUPTIONS)))
+@example(short_turn(), "psi in rad labelled deg")
 def test_columns_that_disagree_by_a_unit_are_refused_naming_the_column(tmp_path_factory,
                                                                        experiment, case):
     """Cross-channel inconsistencies (issue 57): a record that agrees with itself reads;
     a heading, yaw rate or time column scaled by a unit error (57.3 or 1000) is refused,
-    naming the column and the unit it likely holds."""
+    naming the column and the unit it likely holds. The limit of the check (issue 72):
+    heading against yaw rate has power only where the heading, as the file labels it,
+    turns by `HEADING_SPAN` (5 deg): there a psi or r unit error is refused; below it,
+    and for a heading with no r (the track cannot tell a ship that barely turns from one
+    that holds its course), the record is refused or reads with a note that says which
+    columns cannot be checked."""
     units, change, header, likely = CORRUPTIONS[case]
     path = tmp_path_factory.mktemp("units") / "trial.csv"
     js.write_trial_csv(path, experiment, units=units)
     js.read_trial_csv(path)  # the record as logged agrees with itself
-    if case in NEED_R and not experiment.has("r"):
-        return
+    if case.startswith("r ") and not experiment.has("r"):
+        return  # no r column to corrupt
     rewritten(path, change)
-    with pytest.raises(ValueError) as error:
-        js.read_trial_csv(path)
-    message = str(error.value)
-    assert "\n" not in message and f"'{header}'" in message, message
-    assert f"in {likely} rather than" in message or "is beyond" in message, message
+    powered = case.startswith("t ") or (experiment.has("r")
+                                        and heading_turn(path) >= HEADING_SPAN)
+    try:
+        back = js.read_trial_csv(path)
+    except ValueError as error:
+        message = str(error)
+        assert "\n" not in message and f"'{header}'" in message, message
+        assert f"in {likely} rather than" in message or "is beyond" in message, message
+    else:
+        assert not powered, f"{case} read where the check has power"
+        note = back.meta.get("unchecked", "")
+        assert f"'{header}'" in note and "cannot be checked" in note, note
 
 
 @SETTINGS

@@ -3,6 +3,8 @@ optimistix's, each of which a fit once reported as converged, and no warning or 
 from the library on the way."""
 
 
+import json
+
 import jax
 import numpy as np
 import pytest
@@ -141,3 +143,50 @@ def test_a_fit_of_white_noise_is_undetermined():
         js.fit(js.Nomoto1(K=0.1, T=0.31), noise, throw=True)
     good = js.fit(js.Nomoto1(K=0.05, T=20.0), zigzag_record(1.0, noise=0.5 * DEG))
     assert good.success and good.code == js.RESULTS.successful, good.message
+
+
+def test_a_parameter_the_robust_errors_leave_undetermined_is_poorly_determined():
+    """Issue 72, point 3: a fit whose robust (HAC) standard errors leave a parameter
+    undetermined went through as successful (sea_swift's Norrbin fit: 211 % on K). A
+    Nomoto 1 zig-zag with AR(1) heading noise drawn by numpy (coefficient 0.98: the
+    residuals are far from white, so the robust errors are the ones to quote): K and T
+    alone are determined (successful); with the rudder offset, which is zero in the
+    truth, delta0's robust standard error is above 50 % of its value (its 95 % interval
+    about reaches zero), and the fit is poorly_determined, naming delta0."""
+    data = zigzag_record(0.5)
+    rng = np.random.default_rng(3)
+    noise = np.zeros(data.t.size)
+    for k in range(1, noise.size):
+        noise[k] = 0.98 * noise[k - 1] + rng.normal(0.0, 0.2 * DEG)
+    noisy = js.Experiment(data.t, data.delta, psi=data.psi + noise,
+                          r=data.r + np.gradient(noise, data.t))
+    two = js.fit(js.Nomoto1(K=0.05, T=20.0), noisy, free=("K", "T"))
+    assert two.parameters.residuals_white is False
+    assert two.code == js.RESULTS.successful, two.message
+    three = js.fit(js.Nomoto1(K=0.05, T=20.0), noisy, free=("K", "T", "delta0"))
+    assert three.code == js.RESULTS.poorly_determined and not three.success, three.message
+    (flag,) = three.parameters.undetermined
+    assert flag.startswith("delta0 = ") and "robust (HAC) standard error" in flag, flag
+    robust = dict(zip(three.names, three.parameters.std_robust))["delta0"]
+    assert robust > 0.5 * abs(dict(zip(three.names, three.values))["delta0"])
+
+
+@pytest.mark.slow  # about 50 s: the README's Esso Osaka 3-DOF identification
+def test_the_readmes_esso_osaka_fit_is_poorly_determined(tmp_path, capsys):
+    """Issue 72, point 7: `identify --model esso_osaka` on the README's measured
+    zig-zags exited 0, "successful", with five coefficients poorly determined by their
+    robust errors (x_0f, n_r, c_d, c_ry, c_rn on 2026-12 data): now poorly_determined,
+    exit 3, the results written."""
+    from jaxship.cli import main
+
+    root = js.shared_data_dir()
+    if root is None:
+        pytest.skip("measured data (../shared/data) not available")
+    files = sorted(str(p) for p in (root / "esso_osaka_frt" / "zigzag").glob("*.csv"))
+    out = tmp_path / "esso"
+    assert main(["identify", *files[:3], "--model", "esso_osaka", "--horizon", "10",
+                 "--validate", *files[3:5], "--out", str(out), "--no-figures",
+                 "--quiet"]) == 3
+    result = json.loads((out / "result.json").read_text())
+    assert result["fit"]["code"] == "poorly_determined"
+    assert any("robust (HAC) standard error" in f for f in result["identifiability"]["flags"])

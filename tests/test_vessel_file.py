@@ -273,3 +273,61 @@ def test_parameters_by_name_on_every_model():
     vessel = js.get_vessel("mariner")
     assert "length" in vessel.parameter_names()
     assert float(vessel.with_parameters({"length": 200.0}).get_parameter("length")) == 200.0
+
+
+def _damaged_results():
+    """A result.json of the KVLCC2 preset with two estimated coefficients, their
+    standard errors and correlation, and the damages a hand edit makes (issue 72): each
+    with the field the refusal names."""
+    vessel = js.get_vessel("kvlcc2")
+    good = {"model": "kvlcc2", "data": {"train": [{"dt_s": 0.5, "duration_s": 100.0}]},
+            "parameters": {"n_r": {"value": float(vessel.n_r), "std": 1e-4},
+                           "n_v": {"value": float(vessel.n_v), "std": 1e-4}},
+            "correlation": {"names": ["n_r", "n_v"], "matrix": [[1.0, 0.3], [0.3, 1.0]]}}
+    damages = {
+        "data as a list": (("data",), [], "field 'data' is a list, not an object"),
+        "correlation as a list": (("correlation",), [[1.0, 0.3], [0.3, 1.0]],
+                                  "field 'correlation' is a list, not an object"),
+        "a 1 x 1 matrix for 2 names": (("correlation", "matrix"), [[1.0]],
+                                       "field 'correlation.matrix' is 1 x 1, not 2 x 2"),
+        "a matrix of strings": (("correlation", "matrix"), [["a", "b"], ["c", "d"]],
+                                "field 'correlation.matrix' row 1, column 1 is \"a\""),
+        "a boolean value": (("parameters", "n_r", "value"), True,
+                            "parameter n_r is true, a boolean, not a number"),
+        "a boolean std": (("parameters", "n_r", "std"), True,
+                          "field 'parameters.n_r.std' is true, not a number"),
+    }
+    return good, damages
+
+
+@pytest.mark.parametrize("case", list(_damaged_results()[1]))
+def test_a_damaged_result_is_refused_naming_the_file_and_field_before_any_work(
+        case, tmp_path, capsys):
+    """A hand-edited result.json (issue 72, "Broken 2"): `load_model` and
+    `read_result` refuse it in one line naming the file and the field, and
+    `simulate --manoeuvre imo` exits 2 with that line before any trial (no output
+    folder); the undamaged file reads."""
+    good, damages = _damaged_results()
+    keys, value, message = damages[case]
+    result = tmp_path / "result.json"
+    result.write_text(json.dumps(good))
+    assert isinstance(js.load_model(result), js.MMGVessel)
+    report = json.loads(json.dumps(good))
+    place = report
+    for key in keys[:-1]:
+        place = place[key]
+    place[keys[-1]] = value
+    result.write_text(json.dumps(report))
+    for read in (js.load_model, read_result):
+        with pytest.raises(ValueError) as error:
+            read(result)
+        assert "\n" not in str(error.value) and str(error.value).startswith(f"{result}: ")
+        assert message in str(error.value), str(error.value)
+    out = tmp_path / "imo"
+    assert main(["simulate", "--vessel", str(result), "--manoeuvre", "imo", "--out",
+                 str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and str(result) in err and "\n" not in err, err
+    assert not out.exists()
+    with pytest.raises(ValueError, match=re.escape(message.split(" is ")[0])):
+        js.indices.check_imo(js.get_vessel("kvlcc2"), identification=report)

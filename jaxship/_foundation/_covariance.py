@@ -400,9 +400,10 @@ class ParameterReport:
     - `uncertainty_flags`: the flags (also in `flags`) about the standard errors
       rather than about identifiability; `identifiable` ignores them.
     - `undetermined`: the flags (also in `flags`) of what the data do not determine at
-      all (a singular information matrix, no excitation): a fit with any is
-      `RESULTS.poorly_determined`; `bound_flags`: those of estimates that ended on a
-      bound (`RESULTS.at_bound`).
+      all (a singular information matrix, no excitation) or, by the robust standard
+      error of residuals that are not white, a relative standard error above
+      `RELATIVE_STD_FLAG`: a fit with any is `RESULTS.poorly_determined`;
+      `bound_flags`: those of estimates that ended on a bound (`RESULTS.at_bound`).
 
     `std`, `covariance` and `correlation` are the usual white-noise ones; when
     `residuals_white` is False they understate the uncertainty and `std_robust` is
@@ -468,7 +469,12 @@ def _combination(names, vector):
     return " ".join(terms).lstrip("+")
 
 
-# identifiability flags: a correlation above this, a relative standard error above this
+# identifiability flags: a correlation above this, a relative standard error above this.
+# 50 % puts zero at two standard errors, about the edge of the 95 % interval (value +-
+# 1.96 std includes zero from 51 %). Judged on the robust (HAC or cluster) standard error
+# where the residuals are not white, the flag leaves the parameter undetermined: the fit
+# is `RESULTS.poorly_determined` (issue 72: sea_swift's Norrbin fit, 211 % on K; the
+# README's Esso Osaka 3-DOF fit, five coefficients, went through as successful)
 CORRELATION_FLAG = 0.95
 RELATIVE_STD_FLAG = 0.5
 
@@ -531,6 +537,7 @@ def parameter_report(names, values, covariance, *, units=(), null_directions=(),
     use_robust = (white is False) & ~np.isnan(std_robust) & ~(std_robust <= std)
     judged = np.where(use_robust, std_robust, std)
     rel = np.abs(judged) / np.where(values != 0, np.abs(values), np.nan)
+    robust_poor = []  # by the robust errors: undetermined (`RELATIVE_STD_FLAG`)
     for i in range(d):
         if np.isfinite(judged[i]) and not (rel[i] <= rel_std_threshold):
             percent = f"{100 * rel[i]:.0f} %" if np.isfinite(rel[i]) else "inf %"
@@ -538,7 +545,9 @@ def parameter_report(names, values, covariance, *, units=(), null_directions=(),
             flags.append(f"{names[i]} = {values[i]:.4g} is poorly determined: {kind} "
                          f"{judged[i]:.3g} is {percent} of the value (threshold "
                          f"{100 * rel_std_threshold:.0f} %).")
-    undetermined = null_flags + tuple(f for f in extra_flags if f in undetermined_flags)
+            robust_poor += flags[-1:] if use_robust[i] else []
+    undetermined = (null_flags + tuple(f for f in extra_flags if f in undetermined_flags)
+                    + tuple(robust_poor))
     flags.extend(extra_flags)
     uncertainty = ()
     if white is False:

@@ -22,8 +22,13 @@ class RESULTS(dfx.RESULTS):
                 "so the fit is not a proper optimum (see the parameter flags)")
     poorly_determined = ("the data do not determine a combination of the parameters (a "
                          "singular information matrix, no excitation, or a record too "
-                         "short): only other combinations are identified (see the "
-                         "parameter flags)")
+                         "short) or, by the robust standard errors of residuals that are "
+                         "not white, a parameter (relative standard error above 50 %: its "
+                         "95 % interval about reaches zero): only the others are identified "
+                         "(see the parameter flags)")
+    not_settled = ("the closed loop did not settle: at the end of the run the heading is "
+                   "outside the band about the ordered heading (or the ship circles), so "
+                   "its metrics say nothing about the autopilot")
     undetermined = ("the fit explains almost nothing (no fitted channel's fit reaches 5 %) "
                     "and a parameter's 95 % interval includes zero: the data, noise to this "
                     "model, do not determine it (see the parameter flags)")

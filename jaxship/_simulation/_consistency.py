@@ -69,10 +69,12 @@ def _likely(scale, keys, headers, units, tolerance) -> str:
     return f"is {' or '.join(guesses)}?" if guesses else "check the units of these columns."
 
 
-def check_consistency(where: str, t, si: dict, headers: dict, units: dict) -> None:
+def check_consistency(where: str, t, si: dict, headers: dict, units: dict) -> list[str]:
     """A one-line `ValueError` where the measured channels `si` (SI, at the times `t`)
     disagree by a unit error, naming the columns (`headers`, with their `units`) and
-    the likely unit:
+    the likely unit; else the sentences saying which logged pairs cannot be checked
+    (`_unchecked`: a record too short, or a heading that turns too little, to tell a unit
+    error from agreement), empty where every pair was judged:
 
     - heading against yaw rate: $\\psi - \\bar\\psi \\approx s\\,(R - \\bar R)$,
       $R(t) = \\int_{t_0}^t r\\,dt$, $s$ by least squares, must give $s \\approx 1$
@@ -87,13 +89,21 @@ def check_consistency(where: str, t, si: dict, headers: dict, units: dict) -> No
     """
     t = np.asarray(t, dtype=np.float64)
     if t.shape[0] < 3:
-        return
+        return _unchecked(headers, [k for k in ("psi", "r", "x", "y", "u") if k in si],
+                          f"the record has {t.shape[0]} sample(s), fewer than 3")
+    unchecked = []
     if "psi" in si and "r" in si and _resolved(si["psi"], math.pi):
         r_int = _cumulative_trapezoid(si["r"], t)
         a, b = r_int - r_int.mean(), si["psi"] - si["psi"].mean()
         spans = max(np.ptp(a), np.ptp(b)) >= HEADING_SPAN
         scale = float(a @ b / (a @ a)) if a @ a > 0 else math.nan
         residual = np.linalg.norm(b - scale * a) / max(np.linalg.norm(b), 1e-300)
+        if not spans:
+            unchecked += _unchecked(headers, ("psi", "r"), _too_little(a, b))
+        elif residual >= 0.5:
+            unchecked += _unchecked(headers, ("psi", "r"), (
+                f"the heading follows the integrated yaw rate only to a residual of "
+                f"{residual:.2f} of its spread (below 0.5 to judge a scale)"))
         if spans and residual < 0.5 and not 0.5 <= scale <= 2.0:
             cols = {k: headers[k] for k in ("psi", "r", "t")}
             if scale < 0:
@@ -107,27 +117,67 @@ def check_consistency(where: str, t, si: dict, headers: dict, units: dict) -> No
                 f"integral of column '{cols['r']}' over column '{cols['t']}' (1 when they "
                 f"agree): {_likely(scale, ('psi', 'r', 't'), headers, units, 1.3)}")
     if {"x", "y", "u"} <= si.keys():
-        speed = np.hypot(si["u"], si.get("v", 0.0))
-        run = float(np.sum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t)))
-        path = float(np.sum(np.hypot(np.diff(si["x"]), np.diff(si["y"]))))
-        judged = run >= MIN_SPEED * (t[-1] - t[0]) and _resolved(np.hypot(si["x"], si["y"]),
-                                                                  run)
-        ratio = path / run if judged else 1.0
-        if judged and "psi" in si and _resolved(si["psi"], math.pi):  # against the track
-            agree = {k: _along_track(t, si, k) for k in (1.0, _DEG, 1 / _DEG)}
-            best = max(agree, key=agree.get)
-            if agree[1.0] < 0.5:
-                hint = (_likely(1 / best, ("psi",), headers, units, 1.3) if agree[best] >= 0.8
-                        else "check the units of these columns.")
-                raise ValueError(
-                    f"{where}: column '{headers['psi']}' heads the velocities of columns "
-                    f"'{headers['u']}', '{headers.get('v', 'v')}' along the track of columns "
-                    f"'{headers['x']}', '{headers['y']}' only to a mean cosine of "
-                    f"{agree[1.0]:.2f} (near 1 when they agree): {hint}")
-        if not 0.1 <= ratio <= 10.0:
-            hint = _likely(ratio, ("t", "x", "y", "u", "v"), headers, units, 3.0)
-            moved = ", ".join(f"'{headers[k]}'" for k in ("u", "v") if k in headers)
+        unchecked += _check_track(where, t, si, headers, units)
+    return unchecked
+
+
+def _check_track(where, t, si, headers, units) -> list[str]:
+    """`check_consistency`'s checks of the positions x, y against the velocities u, v
+    and the heading psi; the pairs that cannot be checked."""
+    speed = np.hypot(si["u"], si.get("v", 0.0))
+    run = float(np.sum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t)))
+    path = float(np.sum(np.hypot(np.diff(si["x"]), np.diff(si["y"]))))
+    slow = run < MIN_SPEED * (t[-1] - t[0])
+    judged = not slow and _resolved(np.hypot(si["x"], si["y"]), run)
+    ratio = path / run if judged else 1.0
+    unchecked = []
+    if slow:
+        unchecked += _unchecked(headers, ("x", "y", "u"), (
+            f"the ship runs at {run / (t[-1] - t[0]):.3g} m/s on average, below the "
+            f"{MIN_SPEED} m/s where GNSS noise swamps the speed from the positions"))
+    elif not judged:
+        unchecked += _unchecked(headers, ("x", "y", "u"), (
+            "floats as large as the positions do not resolve the distance run"))
+    if judged and "psi" in si and _resolved(si["psi"], math.pi):  # against the track
+        agree = {k: _along_track(t, si, k) for k in (1.0, _DEG, 1 / _DEG)}
+        best = max(agree, key=agree.get)
+        wrong = max(agree[_DEG], agree[1 / _DEG])  # the heading off by a unit
+        if "r" not in si and agree[1.0] >= 0.5 <= wrong:  # would pass as well
+            unchecked += _unchecked(headers, ("psi", "x", "y"), (
+                "the heading scaled by a unit error (57.3) heads the velocities along the "
+                "track as well (a mean cosine of "
+                f"{wrong:.2f}, at least 0.5): it turns too little"))
+        if agree[1.0] < 0.5:
+            hint = (_likely(1 / best, ("psi",), headers, units, 1.3) if agree[best] >= 0.8
+                    else "check the units of these columns.")
             raise ValueError(
-                f"{where}: the track of columns '{headers['x']}', '{headers['y']}' is "
-                f"{ratio:.4g} times as long as the distance run at the speed of columns "
-                f"{moved} over column '{headers['t']}' (1 when they agree): {hint}")
+                f"{where}: column '{headers['psi']}' heads the velocities of columns "
+                f"'{headers['u']}', '{headers.get('v', 'v')}' along the track of columns "
+                f"'{headers['x']}', '{headers['y']}' only to a mean cosine of "
+                f"{agree[1.0]:.2f} (near 1 when they agree): {hint}")
+    if not 0.1 <= ratio <= 10.0:
+        hint = _likely(ratio, ("t", "x", "y", "u", "v"), headers, units, 3.0)
+        moved = ", ".join(f"'{headers[k]}'" for k in ("u", "v") if k in headers)
+        raise ValueError(
+            f"{where}: the track of columns '{headers['x']}', '{headers['y']}' is "
+            f"{ratio:.4g} times as long as the distance run at the speed of columns "
+            f"{moved} over column '{headers['t']}' (1 when they agree): {hint}")
+    return unchecked
+
+
+def _too_little(*headings) -> str:
+    """Why a heading that turns too little cannot be checked for a unit error."""
+    turn = math.degrees(max(float(np.ptp(h)) for h in headings))
+    return (f"the heading turns by {turn:.3g} deg, less than the "
+            f"{math.degrees(HEADING_SPAN):.3g} deg needed to tell a unit error (a factor of "
+            "57.3) from a ship that holds its course")
+
+
+def _unchecked(headers, keys, why) -> list[str]:
+    """The sentence saying that the columns `keys` cannot be checked against each other
+    for a unit error, and `why`; none where fewer than two of them are logged."""
+    logged = [f"'{headers[k]}'" for k in keys if k in headers]
+    if len(logged) < 2:
+        return []
+    return [f"columns {', '.join(logged)} cannot be checked against each other for a unit "
+            f"error: {why}."]

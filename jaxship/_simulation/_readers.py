@@ -21,7 +21,9 @@ header `name [unit]`:
 `t`, `delta` and one of `psi`, `r` are required, the rest optional; column order is
 free. A wrapped heading (jumps of about 360 deg, at +-180 or in 0-360) is unwrapped, with
 a note in the metadata (`"note"`); columns that disagree by a unit (psi against the
-integrated r, the positions against u, v: `_consistency.check_consistency`) are refused.
+integrated r, the positions against u, v: `_consistency.check_consistency`) are refused;
+where a pair of columns cannot be checked so (a heading that turns less than 5 deg, fewer
+than 3 samples), the metadata's `"unchecked"` says which and why.
 Rows are numbered from 1 after the header ("row 3" is the third data row) and
 every error message names the file, the column, the row and its line. Blank lines and
 trailing rows whose cells are all empty (spreadsheet exports) are skipped; an empty or
@@ -364,9 +366,11 @@ def read_trial_csv(path, *, require_uniform: bool = False, allow_unknown: bool =
         if wraps:
             notes["note"] = (f"column '{headers[columns['psi'][0]]}' wraps around "
                              f"{wraps} time(s) (jumps of about 360 deg): unwrapped.")
-    check_consistency(str(path), values["t"], values,
-                      {k: headers[j] for k, (j, _) in columns.items()},
-                      {k: unit for k, (_, unit) in columns.items()})
+    unchecked = check_consistency(str(path), values["t"], values,
+                                  {k: headers[j] for k, (j, _) in columns.items()},
+                                  {k: unit for k, (_, unit) in columns.items()})
+    if unchecked:
+        notes["unchecked"] = " ".join(unchecked)
     return Experiment(
         name=path.stem if name is None else name,
         metadata={"file": str(path), "format": "trial csv", **notes,

@@ -345,25 +345,40 @@ def _finite(x):
 # a run whose rudder sits at its limit for more than this share of the window says
 # little about the controller (its code is "rudder_saturated")
 SATURATED_SHARE = 0.5
+# a run settled when its heading error |psi_ref - psi| (unwrapped: a ship that circles
+# is as far off as it turned) stays within SETTLED_BAND of the step over the last
+# SETTLED_TAIL of the window; else its code is "not_settled" (`RESULTS.not_settled`).
+# 5 % is the wider of the two customary settling bands (2 % and 5 % of the final value:
+# Ogata, Modern Control Engineering, 5th ed., sec. 5-3); the 2 % band times the
+# settling (`settling_time_s`), which a loop may reach late in the window, while a loop
+# outside 5 % at its end has not settled at all (issue 72: 18 deg off a 45 deg step)
+SETTLED_BAND = 0.05
+SETTLED_TAIL = 0.1
 
 
 def run_rows(name: str, run, design: AutopilotDesign, rpm, speed, max_angle: float) -> list[dict]:
-    """The rows (`RUN_KEYS`, `success`, `time_saturated_s` and the run's `code`:
-    "successful", "blew_up" or "rudder_saturated", the rudder command within 1 % of its
-    limit `max_angle` [rad] for more than half the window) of the closed-loop `run` of
-    controller `name` at the operating points `rpm`, `speed`."""
+    """The rows (`RUN_KEYS`, `success`, `time_saturated_s`, `end_error_deg` (the largest
+    heading error over the window's last tenth) and the run's `code`: "successful",
+    "blew_up", "not_settled" (`SETTLED_BAND`) or "rudder_saturated", the rudder command
+    within 1 % of its limit `max_angle` [rad] for more than half the window) of the
+    closed-loop `run` of controller `name` at the operating points `rpm`, `speed`."""
     metrics = js.closed_loop_metrics(run, design.sample_interval, window=design.window)
     m = metrics.to_dict_deg()
     ordered = ordered_error_deg(run, design.sample_interval, design.window)
     t = np.asarray(run.t)
     inside = (t >= design.window[0]) & (t <= design.window[1])
     at_limit = np.abs(np.asarray(run.delta_c)[0]) >= 0.99 * max_angle  # the command
+    start, end = design.window
+    tail = inside & (t >= end - SETTLED_TAIL * (end - start))
+    end_error = np.degrees(np.max(np.abs(np.asarray(run.psi_ref)[0][:, tail]
+                                         - np.asarray(run.psi)[0][:, tail]), axis=-1))
     rows = []
     for j in range(len(rpm)):
         ok = bool(np.asarray(run.success)[0, j])
         saturated = float(np.mean(at_limit[j][inside])) if ok else math.nan
-        code = ("blew_up" if not ok else "rudder_saturated" if saturated > SATURATED_SHARE
-                else "successful")
+        code = ("blew_up" if not ok else
+                "not_settled" if not end_error[j] <= SETTLED_BAND * abs(design.step) else
+                "rudder_saturated" if saturated > SATURATED_SHARE else "successful")
         rows.append({
             "controller": name, "rpm": float(rpm[j]), "speed": float(speed[j]),
             "sum_abs_error_deg": _finite(m["residual_sum_deg"][0][j]),
@@ -375,6 +390,7 @@ def run_rows(name: str, run, design: AutopilotDesign, rpm, speed, max_angle: flo
             "rudder_travel_deg": _finite(m["rudder_travel_deg"][0][j]),
             "time_rate_limited_s": _finite(m["time_at_rate_limit_s"][0][j]),
             "time_saturated_s": _finite(saturated * (design.window[1] - design.window[0])),
+            "end_error_deg": _finite(end_error[j]),
             "success": ok, "code": code,
         })
     return rows

@@ -96,9 +96,11 @@ class AutopilotEvaluation(Evaluation):
         return feedforward_gain_text(self.feedforward_at_step) + (self.chosen or "")
 
     def problems(self) -> tuple[str, str]:
-        """`(failure, saturation)`: the sentences on runs that blew up and on runs whose
-        rudder sat on its limit (code rudder_saturated); "" where none."""
-        return problems(self.rows)
+        """`(failure, saturation)`: the sentences on runs that blew up or did not settle
+        (code not_settled) and on runs whose rudder sat on its limit for more than half
+        the window; "" where none."""
+        start, end = self.design.window
+        return problems(self.rows, end - start)
 
     def summary(self) -> str:
         """The gains and runs as tables, the inverse's sentence and the tuning."""

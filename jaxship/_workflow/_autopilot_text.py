@@ -2,19 +2,31 @@
 gains and runs as markdown tables, the tuning, whether the feed-forward helped, the runs
 that blew up or saturated, and the page `jaxship autopilot` writes to report.md."""
 
-from ._autopilot import METRICS_TEXT, cell
+from ._autopilot import METRICS_TEXT, SATURATED_SHARE, cell
 
 
-def problems(rows) -> tuple[str, str]:
-    """`(failure, saturation)`: the sentences on runs that blew up and on runs whose
-    rudder sat on its limit (code rudder_saturated) among `rows`; "" where none."""
+def problems(rows, window_s: float | None = None) -> tuple[str, str]:
+    """`(failure, saturation)`: the sentences on runs that blew up or did not settle
+    (code not_settled: `RESULTS.not_settled`) and on runs whose rudder sat on its limit
+    (code rudder_saturated, or more than half the window `window_s` [s] for a run that
+    did not settle either) among `rows`; "" where none."""
     where = lambda row: f"{row['controller']} at {row['rpm']:.4g} rpm, {row['speed']:.3g} m/s"
     failed = [where(row) for row in rows if not row["success"]]
     failure = (f"The closed loop blew up (not finite) for {'; '.join(failed)}: those runs "
                "have no metrics and say nothing about the autopilot." if failed else "")
-    pinned = [where(row) for row in rows if row["code"] == "rudder_saturated"]
+    loose = [f"{where(row)} ({row['end_error_deg']:.3g} deg off)" for row in rows
+             if row["code"] == "not_settled"]
+    if loose:  # `SETTLED_BAND`: 5 % of the step
+        failure = " ".join(text for text in (failure, (
+            f"The closed loop did not settle (code not_settled) for {'; '.join(loose)}: the "
+            "heading error over the window's last tenth exceeds 5 % of the step (a ship "
+            "that circles, or a loop that still swings); the design's natural frequency "
+            "does not suit this model (check its K and T).")) if text)
+    pinned = [where(row) for row in rows if row["code"] == "rudder_saturated" or (
+        window_s and (row.get("time_saturated_s") or 0.0) > SATURATED_SHARE * window_s)]
     saturation = (f"The rudder sat at its limit for more than half the window in "
-                  f"{'; '.join(pinned)} (code rudder_saturated): the comparison there says "
+                  f"{'; '.join(pinned)} (code rudder_saturated where the loop settled): "
+                  "the comparison there says "
                   "little about the controllers; try a lower --natural-frequency."
                   if pinned else "")
     return failure, saturation

@@ -11,6 +11,7 @@ import numpy as np
 
 import jaxship as js
 
+from ._identify.result import check_fields
 from ._trials import StandardTrial, _cut_at_stop, _size, initial_state, length_over_speed
 
 
@@ -69,6 +70,7 @@ def parameter_draws(report, rng) -> tuple[tuple, np.ndarray, str]:
     standard error are held at their estimates (`how` says which)."""
     if not report or not isinstance(report.get("parameters"), dict):
         return (), np.zeros((DRAWS, 0)), "none: no standard errors (a preset or a vessel file)"
+    check_fields(report)  # a damaged std or correlation: one line, before any trial
     entries = {k: e for k, e in report["parameters"].items() if isinstance(e, dict)}
     std = {k: _float(e.get("std")) for k, e in entries.items()}
     names = tuple(k for k, s in std.items() if np.isfinite(s) and s >= 0)
@@ -110,6 +112,7 @@ def check_imo(model, *, identification=None, speed=None, rpm=None) -> ImoCheck:
     every trial at once (`js.simulate_batch`)."""
     report = identification.to_dict() if callable(getattr(identification, "to_dict", None)) \
         else identification
+    names, draws, how = parameter_draws(report, np.random.default_rng(SEED))  # read first
     runs, batch, rows = {}, {}, []
     x0 = initial_state(model, speed=speed, rpm=rpm)
     tau = length_over_speed(model, x0)
@@ -122,7 +125,6 @@ def check_imo(model, *, identification=None, speed=None, rpm=None) -> ImoCheck:
         marks = trial.marks(manoeuvre, traj)
         runs[str(trial)], batch[trial] = (manoeuvre, traj, marks), manoeuvre
         rows += trial.criteria(model, traj, marks)
-    names, draws, how = parameter_draws(report, np.random.default_rng(SEED))
     bands, passed, used = {}, {}, 0
     if names:
         values, used = _drawn_criteria(model, names, draws, batch, speed=speed, rpm=rpm)

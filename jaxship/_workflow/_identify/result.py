@@ -199,6 +199,8 @@ _ROSS_SCALES = re.compile(r"L = (\S+) m, U0 = (\S+) m/s, n0 = (\S+) rev/s")
 
 
 def _number(name, value) -> float:
+    if isinstance(value, bool):  # JSON's true is no number (as the vessel file reads it)
+        raise ValueError(f"parameter {name} is {json.dumps(value)}, a boolean, not a number.")
     try:
         number = float(value)
     except (TypeError, ValueError):
@@ -206,6 +208,64 @@ def _number(name, value) -> float:
     if not math.isfinite(number):
         raise ValueError(f"parameter {name} is {value!r}, not a finite number.")
     return number
+
+
+def _json_number(value) -> bool:
+    """Whether `value` is a number as `to_json` writes one: an int or float (no
+    boolean), or a non-finite one as `_json_floats` writes it (null, "inf", "-inf")."""
+    return value is None or value in ("inf", "-inf") or (
+        isinstance(value, (int, float)) and not isinstance(value, bool))
+
+
+def _kind(value) -> str:
+    return {dict: "an object", list: "a list", str: "a string", bool: "a boolean",
+            type(None): "null"}.get(type(value), "a number")
+
+
+def check_fields(report: dict) -> None:
+    """A one-line `ValueError` naming the field where an identify report (the parsed
+    `result.json`) has a field of the wrong type or shape, before any work: `data` an
+    object of lists of records, each parameter's `std` a number, `correlation` an object
+    of `names` (parameter names) and a square `matrix` of numbers, one row per name;
+    each parameter's value a finite number (no boolean)."""
+    data = report.get("data")
+    if data is not None and not isinstance(data, dict):
+        raise ValueError(f"field 'data' is {_kind(data)}, not an object "
+                         "({\"train\": [records], \"validation\": [records]}).")
+    for key, records in (data or {}).items():
+        if records is not None and not (isinstance(records, list)
+                                        and all(isinstance(r, dict) for r in records)):
+            raise ValueError(f"field 'data.{key}' is not a list of records (objects).")
+    for name, entry in report["parameters"].items():
+        _number(name, entry.get("value") if isinstance(entry, dict) else entry)
+        std = entry.get("std") if isinstance(entry, dict) else None
+        if not _json_number(std):
+            raise ValueError(f"field 'parameters.{name}.std' is {json.dumps(std)}, not a "
+                             "number.")
+    correlation = report.get("correlation")
+    if correlation is None:
+        return
+    if not isinstance(correlation, dict):
+        raise ValueError(f"field 'correlation' is {_kind(correlation)}, not an object "
+                         "({\"names\": [...], \"matrix\": [[...]]}).")
+    names, matrix = correlation.get("names"), correlation.get("matrix")
+    if not isinstance(names, list) or not all(n in report["parameters"] for n in names):
+        raise ValueError("field 'correlation.names' is not a list of the parameters' names.")
+    size = len(names)
+    if matrix is None:
+        return
+    if not (isinstance(matrix, list) and len(matrix) == size
+            and all(isinstance(row, list) and len(row) == size for row in matrix)):
+        first = matrix[0] if isinstance(matrix, list) and matrix else None
+        shape = (f"{len(matrix)} x {len(first) if isinstance(first, list) else 0}"
+                 if isinstance(matrix, list) else _kind(matrix))
+        raise ValueError(f"field 'correlation.matrix' is {shape}, not {size} x {size} for its "
+                         f"{size} names.")
+    for i, row in enumerate(matrix):
+        for j, value in enumerate(row):
+            if not _json_number(value):
+                raise ValueError(f"field 'correlation.matrix' row {i + 1}, column {j + 1} is "
+                                 f"{json.dumps(value)}, not a number.")
 
 
 def model_from_report(report: dict):
@@ -218,12 +278,14 @@ def model_from_report(report: dict):
     rebuild `RossAutopilot` from the reference-scale note of its start.
 
     **Raises** `ValueError` (one line) for a report without `model` and `parameters`,
-    non-numeric values, an ARMAX model (discrete, no yaw equation to design on) or an
+    a field of the wrong type or shape (`check_fields`), non-numeric or boolean values,
+    an ARMAX model (discrete, no yaw equation to design on) or an
     effect that needs more than its parameters (a recorded disturbance)."""
     if not isinstance(report, dict) or not isinstance(report.get("parameters"), dict) or \
             "model" not in report:
         raise ValueError("not an identify result: no 'model' and 'parameters' (write one "
                          "with `jaxship identify`).")
+    check_fields(report)
     own_vessel = isinstance(report.get("vessel"), dict)
     try:
         name = model_key(report["model"])

@@ -19,7 +19,8 @@ from .selection import AUTO, is_auto
 class Settings(NamedTuple):
     """The settings `identify` fits with: `name`, the catalogue name (`"auto"`: the
     choice; None: a vessel of one's own), `horizon` [s] (None: output error),
-    `sample_interval` [s] (None: as recorded), `free` (None: the model's default set),
+    `sample_interval` [s] (None: as recorded), `free` (None: the model's default set;
+    a text `"+NAME,..."`: names added to it, `added_free`),
     `start` (the model to start from; None: the catalogue's start values) and `note`
     (the preset's settings used, in one sentence; None when none was)."""
 
@@ -43,10 +44,11 @@ def _is_preset(name, start) -> bool:
     return type(start) is type(preset) and bool(same)
 
 
-def free_names(free, default) -> tuple[str, ...] | None:
+def free_names(free, default) -> tuple[str, ...] | str | None:
     """`free`: None (`default`), names (a sequence, or a text of comma-separated names),
-    or a text starting with `+`: its names added to `default` (None for a model that has
-    no set of its own: the model's `default_free`, unchanged)."""
+    or a text starting with `+`: its names added to `default`; where `default` is None
+    (a model whose set is known once its start is: its `default_free`), the text
+    `"+NAME,..."`, which `added_free` resolves then."""
     if free is None:
         return default
     text = free if isinstance(free, str) else ",".join(free)
@@ -56,7 +58,18 @@ def free_names(free, default) -> tuple[str, ...] | None:
         raise ValueError(f"--free {free!r}: give coefficient names, comma separated.")
     if not add:
         return names
-    return None if default is None else tuple(dict.fromkeys(default + names))
+    return "+" + ",".join(names) if default is None else tuple(dict.fromkeys(default + names))
+
+
+def added_free(free, default, start) -> tuple[str, ...] | None:
+    """The free set of a fit from the model `start`: `free` itself, or for a text
+    `"+NAME,..."` (`free_names`) its names added to `default` (None: `start`'s
+    `default_free`). An unknown name is left to `jaxship.fit`, which refuses it naming
+    the model's parameters."""
+    if not isinstance(free, str):
+        return free
+    base = js.default_free(start) if default is None else tuple(default)
+    return tuple(dict.fromkeys(base + free_names(free, ())))
 
 
 def fit_settings(model, *, name: str | None = None, horizon=..., sample_interval=None,
@@ -74,12 +87,9 @@ def fit_settings(model, *, name: str | None = None, horizon=..., sample_interval
                         None, None)
     settings = js.VESSELS[name].fit_settings if _is_preset(name, start) else None
     given_horizon = horizon is not ...
-    if settings is None:
-        base_free = None
-        if isinstance(free, str) and free.strip().startswith("+") and name in js.VESSELS:
-            base_free = js.default_free(js.get_vessel(name))
+    if settings is None:  # a "+" set is resolved once the start is known (`added_free`)
         return Settings(name, horizon if given_horizon else None, sample_interval,
-                        free_names(free, base_free), start, None)
+                        free_names(free, None), start, None)
     used = [text for given, text in (
         (given_horizon, f"--horizon {settings.horizon:g}"),
         (sample_interval is not None, f"--sample-interval {settings.sample_interval:g}"),

@@ -38,7 +38,7 @@ from .data import (
 from .registry import MODELS, model_key, start_entry
 from .result import Identification
 from .selection import AUTO, CANDIDATES, choose, with_selection
-from .settings import fit_settings
+from .settings import added_free, fit_settings
 from .simulation import simulate_records
 from .starts import StartContext
 
@@ -184,6 +184,8 @@ def _identify(records, model: str | None, start, asked: _Options,
                            estimator=fitting.estimator, fit=fitting.run, note=notes.append)
     fitting.context = context
     start, method, neutral = _start_values(entry, records.train_ds, context, report, notes)
+    if entry.fit is None:  # `--free +NAME`: added to the start's default set
+        options = options._replace(free=added_free(options.free, entry.free, start))
     wind = getattr(start, "wind_loads", False) and logs_wind(records.train_ds)
     if wind:  # replayed where the model feels it, as `jaxship.discover` does
         fitting.estimator = dataclasses.replace(fitting.estimator, wind=True)
