@@ -3,9 +3,14 @@ package's imports (seconds: jax's among them): Ctrl-C or SIGTERM in that time en
 command with its line and status (130, 143), as `jaxship.cli.run` does later, not with
 a traceback. Nothing is written before those imports end."""
 
-import os
-import signal
-import sys
+import time
+
+
+STARTED = time.perf_counter()  # the command's first line: its imports are timed from here
+
+import os  # noqa: E402
+import signal  # noqa: E402
+import sys  # noqa: E402
 
 
 def _end(signum, frame):
@@ -19,7 +24,7 @@ def run() -> None:
         signal.signal(signum, _end)
     from jaxship.cli import run as command  # `command` installs its own handlers
 
-    command()
+    command(started=STARTED)
 
 
 if __name__ == "__main__":
