@@ -13,7 +13,6 @@ import time
 import warnings
 
 import jax
-import matplotlib
 
 from .. import (  # noqa: E402
     FitError,
@@ -131,7 +130,7 @@ def run(started: float | None = None) -> None:
     committed whole or not at all (`staged_folder`), so ending there loses nothing."""
     # the command writes files and never opens a window; set here, not on import, so a
     # notebook that calls `main` keeps its own backend (its inline figures)
-    matplotlib.use("Agg")
+    os.environ["MPLBACKEND"] = "Agg"  # read when matplotlib is imported (figures only)
     if started is not None:
         CLOCK.last = started
     CLOCK.mark("imports")
