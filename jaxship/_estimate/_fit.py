@@ -15,6 +15,7 @@ import abc
 import contextlib
 import dataclasses
 import math
+from functools import partial
 from typing import NamedTuple
 
 import equinox as eqx
@@ -32,7 +33,7 @@ from .._foundation._covariance import (
     parameter_report,
 )
 from .._foundation._params import Transform, as_arrays, resolve_free
-from .._foundation._progress import ProgressCallback, reporting_steps, step_hook
+from .._foundation._progress import ProgressCallback, reporting_steps
 from .._foundation._sharding import sharded_vmap
 from .._models._holds import FirstOrderHold, ZeroOrderHold
 from .._simulation._data import Dataset
@@ -44,6 +45,7 @@ from ._linear import LinearStart
 from ._lm import (
     RESULTS,
     BlockDampedNewtonDescent,
+    Chunk,
     LevenbergMarquardt,
     as_code,
     blockwise_jacfwd,
@@ -59,6 +61,9 @@ from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_d
 # windows needed for window-clustered standard errors (Cameron & Miller 2015 advise
 # against few clusters); with fewer, the Newey-West HAC covariance is used
 MIN_CLUSTERS = 20
+# optimiser steps between two progress reports of a fit (`_solve_reporting`): the README's
+# identify example converges in 5, the 20-coefficient vessel fit of benchmarks/fit.py in 34
+PROGRESS_STEPS = 8
 
 
 class AbstractEstimator(eqx.Module):
@@ -227,9 +232,10 @@ def _residual_fn(z, args):
 
 
 @eqx.filter_jit
-def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
+def _solve(z0, model, transform, windows, offset_scale, solver, max_steps, chunk=None):
     """LM from z0; the estimate z, result, steps, the physical parameters and start
-    offsets q, the predictions (C, E, W, L) and the Jacobian with respect to q."""
+    offsets q, the predictions (C, E, W, L) and the Jacobian with respect to q (and
+    with a `Chunk`, `resume` and `stopped`: `solve_least_squares`)."""
 
     def physical(z):
         p, offsets = _split(z, transform, windows, offset_scale)
@@ -243,11 +249,35 @@ def _solve(z0, model, transform, windows, offset_scale, solver, max_steps):
         if isinstance(solver, LevenbergMarquardt) and solver.blockwise:  # block by block
             solver = eqx.tree_at(lambda s: s.descent, solver,
                                  BlockDampedNewtonDescent(*shared_and_blocks))
-    z, result, steps, q, residual, jac = solve_least_squares(
+    z, result, steps, q, residual, jac, *part = solve_least_squares(
         _residual_fn, solver, z0, (model, transform, windows, offset_scale), max_steps,
-        physical, jacobian)
+        physical, jacobian, chunk)
     pred = windows.targets - residual / windows.weights[:, None, None, None]
-    return z, result, steps, q[: len(transform.names)], pred, jac
+    return (z, result, steps, q[: len(transform.names)], pred, jac, *part)
+
+
+def _solve_reporting(z0, model, transform, windows, offset_scale, solver, max_steps,
+                     report):
+    """`_solve` in parts of at most `PROGRESS_STEPS` steps (`Chunk`), `report(steps,
+    cost)` after each: the same steps, iterates and outcome, and no host callback in
+    the compiled programs (one for the first part, one for the others)."""
+    if max_steps == 0 or not isinstance(solver, LevenbergMarquardt):
+        return _solve(z0, model, transform, windows, offset_scale, solver, max_steps)
+    z, resume, total = z0, None, 0
+    while True:
+        chunk = Chunk(resume, jnp.asarray(min(PROGRESS_STEPS, max_steps - total)))
+        z, result, steps, q, pred, jac, resume, stopped = _solve(
+            z, model, transform, windows, offset_scale, solver, max_steps, chunk)
+        total += int(steps)
+        residual = np.asarray(windows.weights)[:, None, None, None] * (
+            np.asarray(windows.targets) - np.asarray(pred))  # NumPy: no XLA program
+        report(total, 0.5 * float(np.sum(np.where(np.asarray(windows.mask)[None], residual,
+                                                  0.0) ** 2)))
+        if bool(stopped) or total >= max_steps:
+            break
+    if not bool(stopped):  # as optimistix says when its loop ends on `max_steps`
+        result = optx.RESULTS.nonlinear_max_steps_reached
+    return z, result, jnp.asarray(total), q, pred, jac
 
 
 def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), free=None,
@@ -324,14 +354,13 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
         offset_scale = jnp.asarray(offset_scale, dtype=float)
     z0 = jnp.asarray(np.concatenate([z0, offsets0]), dtype=float)
     solver = estimator.solver
-    if progress is not None and isinstance(solver, LevenbergMarquardt):
-        solver = eqx.tree_at(lambda s: s.verbose, solver, step_hook)
     with reporting_steps(progress, f"fitting {type(model).__name__}",
-                         int(estimator.max_steps)) as finish:
+                         int(estimator.max_steps)) as (step, finish):
         for _ in range(3):  # and the estimate's: refitted with the steps it needs
-            z, result, num_steps, p, pred, jac = _solve(z0, base, transform, windows,
-                                                        offset_scale, solver,
-                                                        int(estimator.max_steps))
+            solve = _solve if progress is None else partial(_solve_reporting, report=step)
+            z, result, num_steps, p, pred, jac = solve(z0, base, transform, windows,
+                                                       offset_scale, solver,
+                                                       int(estimator.max_steps))
             fitted = rebuild(base, transform.names, p)
             needed = stable_substeps(fitted, windows, refuse=False)
             if needed <= windows.substeps or needed > MAX_SUBSTEPS:
