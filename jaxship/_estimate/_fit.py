@@ -300,8 +300,9 @@ def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), fre
     - `free`: which parameters to estimate: `None` (the model's defaults: its `param`
       fields declared free), a sequence of field
       names, or `{name: Free(value, lower=, upper=, scale=) or None}`.
-    - `progress`: a callable receiving a `Progress` report per optimiser step (the
-      library never prints).
+    - `progress`: a callable receiving `Progress` reports of the optimiser's steps, at
+      most `PROGRESS_STEPS` (8) steps apart (the library never prints). The fit is the
+      same with or without one, bit for bit.
     - `throw`: raise `FitError` (the code's sentence) unless the fit converged. Default
       False: the outcome is `FitResult.result`, for batches of fits.
 
