@@ -60,15 +60,20 @@ def test_identify_imports_matplotlib_only_to_draw_figures(tmp_path, figures):
     assert done.stdout.split()[-2:] == ["0", str(figures)], done.stdout
 
 
-@pytest.mark.parametrize("max_steps", [256, 3])
-def test_progress_reports_parts_of_the_same_run(monkeypatch, max_steps):
+@pytest.mark.parametrize("max_steps, options", [
+    (256, {}), (3, {}),
+    # the start of every window estimated (block-wise steps), with geodesic acceleration
+    (256, dict(initial=js.EstimatedStarts(), solver=js.LevenbergMarquardt(
+        rtol=1e-9, atol=1e-9, ftol=1e-10, geodesic=True))),
+], ids=["converged", "max_steps", "estimated-starts-geodesic"])
+def test_progress_reports_parts_of_the_same_run(monkeypatch, max_steps, options):
     """A fit with a progress callable runs its optimiser in parts (here of 2 steps) and
     reports between them: the same steps, estimates, cost, covariance and outcome, bit
     for bit, as the fit without one (run in one compiled loop); a fit stopped by
     `max_steps` says so in both."""
     monkeypatch.setattr(_fit, "PROGRESS_STEPS", 2)
     data = _record(pathlib.Path("noisy"), noise=0.01)
-    estimator = js.PredictionError(horizon=20.0, max_steps=max_steps)
+    estimator = js.PredictionError(horizon=20.0, max_steps=max_steps, **options)
     start = js.Nomoto1(K=0.02, T=60.0)
     plain = js.fit(start, data, estimator=estimator)
     events = []
@@ -78,6 +83,8 @@ def test_progress_reports_parts_of_the_same_run(monkeypatch, max_steps):
     assert (plain.code == js.RESULTS.successful) == (max_steps == 256), plain.message
     np.testing.assert_array_equal(shown.values, plain.values)
     np.testing.assert_array_equal(shown.covariance, plain.covariance)
+    if plain.start_offsets is not None:
+        np.testing.assert_array_equal(shown.start_offsets, plain.start_offsets)
     assert shown.cost == plain.cost
     steps = [e.step for e in events if not e.done]
     assert steps == [0] + sorted(set(range(2, plain.num_steps, 2)) | {plain.num_steps})
