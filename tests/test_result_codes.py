@@ -11,6 +11,7 @@ import pytest
 from helpers import per_sample
 
 import jaxship as js
+from jaxship._estimate._fit import PROGRESS_STEPS
 
 
 FOH = js.strategies.FirstOrderHold()  # the replayed rudder linear between samples
@@ -115,8 +116,10 @@ def test_progress_reaches_the_callable_and_nothing_is_printed(capfd):
     assert events[0] == js.Progress("fit", "fitting Nomoto1", step=0, total=256)
     assert events[-1].done and events[-1].step == res.num_steps
     assert events[-1].cost == pytest.approx(res.cost)
+    # between parts of at most PROGRESS_STEPS steps (issue 70: no host callback)
     steps = [e.step for e in events[1:-1]]
-    assert steps == sorted(steps) and len(steps) >= res.num_steps
+    assert steps == sorted(steps) and steps[-1] == res.num_steps
+    assert len(steps) == -(-res.num_steps // PROGRESS_STEPS)
     out, err = capfd.readouterr()
     assert out == "" and err == ""
 

@@ -34,7 +34,7 @@ from .._foundation._covariance import (
     parameter_report,
 )
 from .._foundation._params import Transform, as_arrays, resolve_free
-from .._foundation._progress import ProgressCallback, reporting_steps, step_hook
+from .._foundation._progress import ProgressCallback, reporting_steps
 from .._foundation._sharding import sharded_vmap
 from .._models._holds import FirstOrderHold, ZeroOrderHold
 from .._simulation._data import Dataset
@@ -46,6 +46,7 @@ from ._linear import LinearStart
 from ._lm import (
     RESULTS,
     BlockDampedNewtonDescent,
+    Chunk,
     LevenbergMarquardt,
     as_code,
     blockwise_jacfwd,
@@ -62,6 +63,9 @@ from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_d
 # windows needed for window-clustered standard errors (Cameron & Miller 2015 advise
 # against few clusters); with fewer, the Newey-West HAC covariance is used
 MIN_CLUSTERS = 20
+# optimiser steps between two progress reports of a fit (`_solve_reporting`): the README's
+# identify example converges in 5, the 20-coefficient vessel fit of benchmarks/fit.py in 34
+PROGRESS_STEPS = 8
 
 
 class AbstractEstimator(eqx.Module):
@@ -243,10 +247,12 @@ def _residual_fn(z, args):
 
 
 @eqx.filter_jit
-def _solve(z0, model, transform, windows, offset_scale, solver, max_steps, prior=None):
+def _solve(z0, model, transform, windows, offset_scale, solver, max_steps, prior=None,
+           chunk=None):
     """LM from z0; the estimate z, result, steps, the physical parameters and start
-    offsets q, the predictions (C, E, W, L) and the Jacobian with respect to q. `prior`:
-    None, or the arrays `(mean, sigma / sd)` of a Gaussian prior's residual rows."""
+    offsets q, the predictions (C, E, W, L) and the Jacobian with respect to q (and
+    with a `Chunk`, `resume` and `stopped`: `solve_least_squares`). `prior`: None, or
+    the arrays `(mean, sigma / sd)` of a Gaussian prior's residual rows."""
 
     def physical(z):
         p, offsets = _split(z, transform, windows, offset_scale)
@@ -260,13 +266,37 @@ def _solve(z0, model, transform, windows, offset_scale, solver, max_steps, prior
         if isinstance(solver, LevenbergMarquardt) and solver.blockwise:  # block by block
             solver = eqx.tree_at(lambda s: s.descent, solver,
                                  BlockDampedNewtonDescent(*shared_and_blocks))
-    z, result, steps, q, residual, jac = solve_least_squares(
+    z, result, steps, q, residual, jac, *part = solve_least_squares(
         _residual_fn, solver, z0, (model, transform, windows, offset_scale, prior), max_steps,
-        physical, jacobian)
+        physical, jacobian, chunk)
     if prior is not None:  # the windows' channels, without the prior's
         residual, jac = residual[:-1], jac[:-1]
     pred = windows.targets - residual / windows.weights[:, None, None, None]
-    return z, result, steps, q[: len(transform.names)], pred, jac
+    return (z, result, steps, q[: len(transform.names)], pred, jac, *part)
+
+
+def _solve_reporting(z0, model, transform, windows, offset_scale, solver, max_steps,
+                     prior, report):
+    """`_solve` in parts of at most `PROGRESS_STEPS` steps (`Chunk`), `report(steps,
+    cost)` after each: the same steps, iterates and outcome, and no host callback in
+    the compiled programs (one for the first part, one for the others)."""
+    if max_steps == 0 or not isinstance(solver, LevenbergMarquardt):
+        return _solve(z0, model, transform, windows, offset_scale, solver, max_steps, prior)
+    z, resume, total = z0, None, 0
+    while True:
+        chunk = Chunk(resume, jnp.asarray(min(PROGRESS_STEPS, max_steps - total)))
+        z, result, steps, q, pred, jac, resume, stopped = _solve(
+            z, model, transform, windows, offset_scale, solver, max_steps, prior, chunk)
+        total += int(steps)
+        residual = np.asarray(windows.weights)[:, None, None, None] * (
+            np.asarray(windows.targets) - np.asarray(pred))  # NumPy: no XLA program
+        report(total, 0.5 * float(np.sum(np.where(np.asarray(windows.mask)[None], residual,
+                                                  0.0) ** 2)))
+        if bool(stopped) or total >= max_steps:
+            break
+    if not bool(stopped):  # as optimistix says when its loop ends on `max_steps`
+        result = optx.RESULTS.nonlinear_max_steps_reached
+    return z, result, jnp.asarray(total), q, pred, jac
 
 
 def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), free=None,
@@ -289,8 +319,9 @@ def fit(model, dataset, *, estimator: AbstractEstimator = PredictionError(), fre
     - `free`: which parameters to estimate: `None` (the model's defaults: its `param`
       fields declared free), a sequence of field
       names, or `{name: Free(value, lower=, upper=, scale=) or None}`.
-    - `progress`: a callable receiving a `Progress` report per optimiser step (the
-      library never prints).
+    - `progress`: a callable receiving `Progress` reports of the optimiser's steps, at
+      most `PROGRESS_STEPS` (8) steps apart (the library never prints). The fit is the
+      same with or without one, bit for bit.
     - `throw`: raise `FitError` (the code's sentence) unless the fit converged. Default
       False: the outcome is `FitResult.result`, for batches of fits.
 
@@ -343,14 +374,12 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
         offset_scale = jnp.asarray(offset_scale, dtype=float)
     z0 = jnp.asarray(np.concatenate([z0, offsets0]), dtype=float)
     solver = estimator.solver
-    if progress is not None and isinstance(solver, LevenbergMarquardt):
-        solver = eqx.tree_at(lambda s: s.verbose, solver, step_hook)
     prior = _GaussianPrior.build(estimator.prior, specs, model, windows)
     with reporting_steps(progress, f"fitting {type(model).__name__}",
-                         int(estimator.max_steps)) as finish:
+                         int(estimator.max_steps)) as (step, finish):
         z, windows, optimum, prior = _optimise(
             z0, _Problem(base, ds, estimator, specs, transform, windows, layout, starts,
-                         prior), offset_scale, solver)
+                         prior), offset_scale, solver, None if progress is None else step)
         out = _report(_Problem(model, ds, estimator, specs, transform, windows, layout,
                                starts, prior), optimum)
         finish(out.num_steps, out.cost)
@@ -360,19 +389,26 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
     return out
 
 
-def _optimise(z0, problem, offset_scale, solver):
+def _optimise(z0, problem, offset_scale, solver, report=None):
     """Levenberg-Marquardt from z0 on `problem` (its model the start as arrays), refitted
     from the estimate with the integration steps its fastest mode needs and, with a prior,
-    until the noise variance that weighs the prior settles (`_prior.py`). Returns `(z,
+    until the noise variance that weighs the prior settles (`_prior.py`); `report(steps,
+    cost)` between parts of each run (`_solve_reporting`) where given. Returns `(z,
     windows, _Optimum, prior)`, the prior with the variance of the last solve."""
     base, transform, windows, prior = (problem.model, problem.transform, problem.windows,
                                        problem.prior)
     max_steps, total = int(problem.estimator.max_steps), 0
     for _ in range(1 if prior is None else PRIOR_PASSES):
         for _ in range(3):  # and the estimate's: refitted with the steps it needs
-            z, result, num_steps, p, pred, jac = _solve(
-                z0, base, transform, windows, offset_scale, solver, max_steps,
-                None if prior is None else prior.arrays())
+            arrays = None if prior is None else prior.arrays()
+            if report is None:
+                solved = _solve(z0, base, transform, windows, offset_scale, solver,
+                                max_steps, arrays)
+            else:  # steps counted on from the runs before
+                solved = _solve_reporting(z0, base, transform, windows, offset_scale, solver,
+                                          max_steps, arrays,
+                                          lambda k, cost, t=total: report(t + k, cost))
+            z, result, num_steps, p, pred, jac = solved
             total += int(num_steps)
             needed = stable_substeps(rebuild(base, transform.names, p), windows, refuse=False)
             if needed <= windows.substeps or needed > MAX_SUBSTEPS:

@@ -358,14 +358,65 @@ def stored_jacobian(fn, jacobian=value_and_jacfwd):
     return lambda z, args: _value_and_jacobian(z, fn, args, jacobian)
 
 
+class Chunk(eqx.Module):
+    """A part of a Levenberg-Marquardt run (`solve_least_squares(..., chunk=)`): at most
+    `budget` steps (an array: every budget runs the same compiled program), from the
+    start (`resume` None) or from where the last part stopped (`resume`: the arrays of
+    its state, `Budgeted`'s `resume` output). The parts of a run take the steps of one
+    run in one go (the state carries everything the next step reads), so the caller can
+    report progress between them without a host callback in the compiled program
+    (JAX's persistent cache refuses programs holding one: issue 70)."""
+
+    resume: object
+    budget: jax.Array
+
+
+class Budgeted(optx.AbstractLeastSquaresSolver):
+    """`solver`, a `LevenbergMarquardt`, stopped after `options["budget"]` steps and
+    started from `options["resume"]`, the arrays of an earlier state (the rest of the
+    state, functions and static values, is this trace's own, from `init`): its state
+    is `(solver's state, steps taken in this part)`."""
+
+    solver: LevenbergMarquardt
+    rtol: float
+    atol: float
+    norm: object
+
+    def __init__(self, solver):
+        self.solver, self.rtol, self.atol, self.norm = (solver, solver.rtol, solver.atol,
+                                                        solver.norm)
+
+    def init(self, fn, y, args, options, f_struct, aux_struct, tags):
+        state = self.solver.init(fn, y, args, options, f_struct, aux_struct, tags)
+        if options["resume"] is not None:
+            state = eqx.combine(options["resume"], eqx.filter(state, eqx.is_array,
+                                                              inverse=True))
+        return state, jnp.array(0)
+
+    def step(self, fn, y, args, options, state, tags):
+        y, inner, aux = self.solver.step(fn, y, args, options, state[0], tags)
+        return y, (inner, state[1] + 1), aux
+
+    def terminate(self, fn, y, args, options, state, tags):
+        done, result = self.solver.terminate(fn, y, args, options, state[0], tags)
+        return done | (state[1] >= options["budget"]), result
+
+    def postprocess(self, fn, y, aux, args, options, state, tags, result):
+        return self.solver.postprocess(fn, y, aux, args, options, state[0], tags, result)
+
+
 def solve_least_squares(fn, solver, z0, args, max_steps, to_physical,
-                        jacobian=value_and_jacfwd):
+                        jacobian=value_and_jacfwd, chunk: Chunk | None = None):
     """Minimise $\\frac12\\|f(z)\\|^2$, `f = fn(z, args)`; return `(z, result, num_steps,
     q, residuals, J_q)` at the solution, with $q$ = `to_physical(z)` (an elementwise
     map) and $J_q = \\partial f / \\partial q$ (..., d). With a Gauss-Newton solver the
     residuals and Jacobian are those of its last accepted step (no second compilation
-    of the forward pass); other solvers evaluate them once more. `jacobian(f, z)`
-    computes `(f, J)` (default `value_and_jacfwd`; `blockwise_jacfwd`). Call under jit."""
+    of the forward pass); other solvers evaluate them once more.
+    `jacobian(f, z)` computes `(f, J)` (default `value_and_jacfwd`; `blockwise_jacfwd`).
+    `chunk`: one part of the run (`Chunk`; a `LevenbergMarquardt` only; `max_steps`
+    stays the whole run's), whose outcome has two more entries: `resume` (the state's
+    arrays for the next part) and `stopped` (the solver stopped: converged or failed).
+    Call under jit."""
     if isinstance(solver, LevenbergMarquardt) and solver.geodesic and solver.residuals is None:
         # geodesic acceleration evaluates the plain residuals, not the stored Jacobian
         solver = eqx.tree_at(lambda s: s.residuals, solver, fn, is_leaf=lambda x: x is None)
@@ -373,13 +424,23 @@ def solve_least_squares(fn, solver, z0, args, max_steps, to_physical,
     if max_steps == 0:  # the start is the estimate: no optimiser state to read
         residual, jac = fn(z0, args)
         q, dq_dz = jax.jvp(to_physical, (z0,), (jnp.ones_like(z0),))
-        return z0, RESULTS.nonlinear_max_steps_reached, jnp.array(0), q, residual, jac / dq_dz
-    sol = optx.least_squares(fn, solver, z0, args=args, options=dict(jac="fwd"),
+        out = (z0, RESULTS.nonlinear_max_steps_reached, jnp.array(0), q, residual, jac / dq_dz)
+        return out if chunk is None else out + (None, jnp.array(True))
+    options = dict(jac="fwd")
+    if chunk is not None:
+        solver, options = Budgeted(solver), dict(options, resume=chunk.resume,
+                                                 budget=chunk.budget)
+    sol = optx.least_squares(fn, solver, z0, args=args, options=options,
                              has_aux=True, max_steps=max_steps, throw=False)
-    info = getattr(sol.state, "f_info", None)
+    state = sol.state if chunk is None else sol.state[0]
+    info = getattr(state, "f_info", None)
     if isinstance(info, optx.FunctionInfo.ResidualJac):
-        residual, jac = info.residual, sol.state.aux
+        residual, jac = info.residual, state.aux
     else:
         residual, jac = fn(sol.value, args)
     q, dq_dz = jax.jvp(to_physical, (sol.value,), (jnp.ones_like(sol.value),))
-    return sol.value, sol.result, sol.stats["num_steps"], q, residual, jac / dq_dz
+    out = (sol.value, sol.result, sol.stats["num_steps"], q, residual, jac / dq_dz)
+    if chunk is None:
+        return out
+    return out + (eqx.filter(state, eqx.is_array),
+                  state.terminate | (sol.result != optx.RESULTS.successful))

@@ -1,19 +1,15 @@
 """Progress of long work: one report type, `Progress`, passed to a callable the caller
 gives (`fit(..., progress=)`, `identify(..., progress=)`); the library itself never prints.
 
-An optimiser's steps reach the callable from inside compiled code through one
-module-level hook (`step_hook`, the solver's `verbose`), so that a new callable never
-recompiles a fit: `reporting_steps` routes the hook to the callable of the fit that
-is running. (The route is a module-level stack, not a context variable: XLA runs host
-callbacks on its own threads. Fits reporting progress from several threads at once
-would mix their reports.)
+A fit reports its optimiser steps between parts of its run, from Python
+(`reporting_steps`; `_estimate/_fit.py`'s `_solve_reporting`): no host callback inside
+the compiled program, which JAX's persistent compilation cache would refuse to store
+(issue 70), so a callable never recompiles a fit.
 """
 
 import contextlib
 import dataclasses
 from collections.abc import Callable
-
-import jax
 
 
 @dataclasses.dataclass(frozen=True)
@@ -39,34 +35,18 @@ class Progress:
 
 ProgressCallback = Callable[[Progress], None]
 
-_RECEIVERS: list = []  # the running fits' step receivers, innermost last
-
-
-def _receive(step, cost):
-    if _RECEIVERS:
-        receiver = _RECEIVERS[-1]
-        step = int(step)  # before the first step the accepted cost is not yet known
-        receiver(step, float(cost) if step > 0 else None)
-
-
-def step_hook(**kwargs):
-    """An optimistix `verbose` hook sending each step to the running fit's callable."""
-    jax.debug.callback(_receive, kwargs["num_steps"][1], kwargs["loss_last_accepted_step"][1])
-
-
 @contextlib.contextmanager
 def reporting_steps(progress: ProgressCallback | None, message: str, total: int):
-    """Report the optimiser steps taken inside the block to `progress` as
-    `Progress("fit", message, step, total, cost)`, then one `done=True` report from
-    `finish(steps, cost)` (the yielded function)."""
+    """Report a fit's optimiser steps to `progress`: `Progress("fit", message, step=0,
+    total)` on entry, then yield `(step, finish)`: `step(steps, cost)` reports the steps
+    taken so far, `finish(steps, cost)` the last report (`done=True`)."""
     if progress is None:
-        yield lambda steps, cost: None
+        yield (lambda steps, cost: None), (lambda steps, cost: None)
         return
     progress(Progress("fit", message, step=0, total=total))
-    _RECEIVERS.append(lambda step, cost: progress(Progress("fit", message, step=step,
-                                                          total=total, cost=cost)))
-    try:
-        yield lambda steps, cost: progress(Progress("fit", message, step=int(steps),
-                                                    total=total, cost=float(cost), done=True))
-    finally:
-        _RECEIVERS.pop()
+
+    def report(steps, cost, done=False):
+        progress(Progress("fit", message, step=int(steps), total=total, cost=float(cost),
+                          done=done))
+
+    yield report, lambda steps, cost: report(steps, cost, done=True)

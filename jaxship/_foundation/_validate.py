@@ -13,10 +13,20 @@ each experiment (lagged pairs never straddle two experiments or a masked sample)
 pooled.
 """
 
+import collections
+import contextlib
 import dataclasses
+import functools
+import hashlib
 import math
 
 import numpy as np
+
+
+try:  # optional (scikit-learn's dependency): NumPy's BLAS on one thread, see `_one_thread`
+    from threadpoolctl import ThreadpoolController
+except ImportError:  # pragma: no cover - without it the BLAS keeps its threads
+    ThreadpoolController = None
 
 
 Z99 = 2.5758293035489004  # two-sided 99 % quantile of the standard normal (MATLAB `resid`)
@@ -161,13 +171,30 @@ def residual_input_correlation(e, u, mask=None, *, max_lag: int = 25) -> Correla
     values = np.array([_lagged_sum(e, u, mask, k) for k in lags]) / math.sqrt(ee * uu)
     ru = {k: _lagged_sum(u, u, mask, k) / uu for k in range(0, 2 * max_lag + 1)}
     matrix = np.array([[ru[abs(int(i - j))] for j in lags] for i in lags])
-    w, v = np.linalg.eigh(matrix)
+    with _one_thread():
+        w, v = np.linalg.eigh(matrix)
     keep = w > 1e-10 * max(w.max(), 1e-300)
     proj = v[:, keep].T @ values
     statistic = float(num * np.sum(proj**2 / w[keep]))
     threshold = chi2_quantile_99(int(keep.sum()))
     return Correlation(lags, values, band, statistic, threshold, bool(statistic <= threshold),
                        int(np.sum(np.abs(values) > band)))
+
+
+@functools.cache
+def _blas_pools():
+    """threadpoolctl's controller of the loaded thread pools (made once, on first use:
+    it scans the loaded libraries), or None without threadpoolctl."""
+    return None if ThreadpoolController is None else ThreadpoolController()
+
+
+def _one_thread():
+    """NumPy's BLAS held to one thread: a 51 x 51 eigenvalue problem (the independence
+    test's) took about 90 ms a call with OpenBLAS's threads competing with XLA's or
+    another process' for two cores, 0.3 ms on one thread (issue 70)."""
+    pools = _blas_pools()
+    return contextlib.nullcontext() if pools is None else pools.limit(limits=1,
+                                                                       user_api="blas")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -303,7 +330,30 @@ def validate(y, yhat, mask=None, *, num_params: int = 0, u=None, max_lag: int = 
         **_criteria(loss, d, num),
         fit_percent=fit_percent(y, yhat, mask),
         fit_per_experiment=per_experiment,
-        autocorrelation=residual_autocorrelation(e, mask, max_lag=max_lag),
-        cross_correlation=None if u is None else residual_input_correlation(
-            e, u, mask, max_lag=max_lag),
+        autocorrelation=_once(residual_autocorrelation, (e, mask), max_lag),
+        cross_correlation=None if u is None else _once(residual_input_correlation,
+                                                       (e, u, mask), max_lag),
     )
+
+
+_TESTS: collections.OrderedDict = collections.OrderedDict()  # the last `_KEPT` tests
+_KEPT = 32
+
+
+def _once(test, arrays, max_lag):
+    """`test(*arrays, max_lag=)`, computed once for the same residuals (and input and
+    mask): `identify` validates each residual series twice, the fit's own report and the
+    assessment's with the parameters counted (issue 70: 12 tests, 6 of them repeats).
+    The last `_KEPT` results are kept, keyed on the arrays' bytes."""
+    digest = hashlib.blake2b(digest_size=16)
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        digest.update(f"{a.dtype}{a.shape}".encode())
+        digest.update(a.tobytes())
+    key = (test.__name__, int(max_lag), digest.digest())
+    if key not in _TESTS:
+        _TESTS[key] = test(*arrays, max_lag=max_lag)
+        if len(_TESTS) > _KEPT:
+            _TESTS.popitem(last=False)
+    _TESTS.move_to_end(key)
+    return _TESTS[key]

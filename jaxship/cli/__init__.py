@@ -13,7 +13,6 @@ import time
 import warnings
 
 import jax
-import matplotlib
 
 from .. import (  # noqa: E402
     FitError,
@@ -23,7 +22,7 @@ from .. import (  # noqa: E402
 )
 from ..identification import FitDivergedError  # noqa: E402
 from . import autopilot, discover, identify, reproduce, simulate, vessels  # noqa: E402
-from ._common import one_line  # noqa: E402
+from ._common import CLOCK, one_line  # noqa: E402
 from ._files import discard_open_stages  # noqa: E402
 
 
@@ -86,6 +85,7 @@ def main(argv=None) -> int:
         compile_for_small_programs()
     jax.config.update("jax_enable_x64", True)
     enable_compilation_cache()  # second runs skip compilation ($JAXSHIP_CACHE_DIR moves it)
+    CLOCK.mark("parsing")
     try:
         with warnings.catch_warnings(record=True) as caught:  # the filters as they are
             try:
@@ -119,17 +119,21 @@ def _tell(caught):
               f"{meaning}", file=sys.stderr)
 
 
-def run() -> None:
-    """The console entry point (`_jaxship_cli.run` calls it after the imports): `main`,
-    then exit with its status. After Ctrl-C (or SIGTERM, handled alike) the process
-    ends with status 130 (143) without the interpreter's teardown, which crashed
+def run(started: float | None = None) -> None:
+    """The console entry point (`_jaxship_cli.run` calls it after the imports, with the
+    `time.perf_counter()` of its first line, `started`, from which `CLOCK` times the
+    imports): `main`, then exit with its status. After Ctrl-C (or SIGTERM, handled alike)
+    the process ends with status 130 (143) without the interpreter's teardown, which crashed
     (SIGSEGV) while XLA's threads were still running; and since an interrupt raised
     inside a garbage-collection callback is swallowed, a watchdog ends the process
     `GRACE` seconds after the signal whatever the main thread is doing. Results are
     committed whole or not at all (`staged_folder`), so ending there loses nothing."""
     # the command writes files and never opens a window; set here, not on import, so a
     # notebook that calls `main` keeps its own backend (its inline figures)
-    matplotlib.use("Agg")
+    os.environ["MPLBACKEND"] = "Agg"  # read when matplotlib is imported (figures only)
+    if started is not None:
+        CLOCK.last = started
+    CLOCK.mark("imports")
     _listen_for_interrupts()
     for signum in ENDINGS:
         signal.signal(signum, _interrupt)
@@ -141,6 +145,8 @@ def run() -> None:
     _RETURNED.set()
     if _INTERRUPTED.is_set():
         _end(128 + _SIGNAL[0])
+    CLOCK.mark("summary")
+    CLOCK.report()
     sys.exit(status)
 
 

@@ -6,6 +6,7 @@ import os
 import pathlib
 import sys
 import tempfile
+import time
 
 from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
 
@@ -140,13 +141,40 @@ def note(sentence: str) -> None:
     print(f"jaxship: note: {sentence}", file=sys.stderr)
 
 
+class StageClock:
+    """The wall time of the command's stages (imports, reading, each `Progress` stage,
+    figures, writing), printed on stderr at the end when $JAXSHIP_TIMES is set
+    (`benchmarks/latency.py` reads them): `mark(stage)` charges the time since the last
+    mark to `stage`."""
+
+    def __init__(self):
+        self.last, self.seconds = time.perf_counter(), {}
+
+    def mark(self, stage: str):
+        now = time.perf_counter()
+        self.seconds[stage] = self.seconds.get(stage, 0.0) + now - self.last
+        self.last = now
+
+    def report(self):
+        if os.environ.get("JAXSHIP_TIMES"):
+            for stage, seconds in self.seconds.items():
+                print(f"jaxship: time: {stage} {seconds:.4f}", file=sys.stderr)
+
+
+CLOCK = StageClock()
+
+
 class ProgressBar:
-    """Turns `identify`'s `Progress` reports into tqdm bars on stderr."""
+    """Turns `identify`'s `Progress` reports into tqdm bars on stderr (and `CLOCK`'s
+    stages: the time up to a stage's first report is the stage before it)."""
 
     def __init__(self, enabled):
-        self.enabled, self.bar = enabled, None
+        self.enabled, self.bar, self.stage = enabled, None, None
 
     def __call__(self, event):
+        if event.stage != self.stage:
+            CLOCK.mark(self.stage or "before the fit")
+            self.stage = event.stage
         if not self.enabled:
             return
         if event.stage != "fit":

@@ -5,7 +5,6 @@
 import json
 import pathlib
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 import jaxship as js
@@ -74,6 +73,8 @@ def _figure_name(i: int) -> str:
 
 def save_discovery_figures(report, train, holdout, folder: pathlib.Path) -> list[pathlib.Path]:
     """Residuals before and after on the held-out records (or the training records)."""
+    import matplotlib.pyplot as plt  # with the figures only (issue 70)
+
     folder.mkdir(parents=True, exist_ok=True)
     records = holdout if holdout else train
     channels = tuple(report.channels)

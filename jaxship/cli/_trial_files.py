@@ -4,7 +4,6 @@ figures (the trial itself is the library's, `jaxship.StandardTrial`)."""
 import json
 import pathlib
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from .. import Experiment, StandardTrial, simulate, write_trial_csv
@@ -18,6 +17,8 @@ def simulate_to_folder(
     with `spiral.png` (the r-delta curve) for a spiral and `imo_criteria.png` (and the
     rows under "imo_criteria" in `indices.json`) for a trial that an IMO criterion
     checks."""
+    import matplotlib.pyplot as plt  # with the figures only (issue 70)
+
     spec = StandardTrial.parse(spec) if isinstance(spec, str) else spec
     manoeuvre, x0 = spec.sized(vessel, speed=speed, rpm=rpm, duration=duration, dt=dt)
     traj = simulate(vessel, manoeuvre, x0, simulator=spec.simulator)
@@ -64,6 +65,8 @@ def simulate_steering_to_folder(model, spec, out, *, dt, duration, title="") -> 
     """Run `spec` on the steering `model` from rest (`jaxship.simulate`'s closed loop on
     its heading and yaw rate), its time scale `duration / 35` (a zig-zag's 35 L/U),
     and write `trial.csv` (t, delta, r, psi), `indices.json` and `trial.png` to `out`."""
+    import matplotlib.pyplot as plt  # with the figures only (issue 70)
+
     manoeuvre, _ = spec.sized(model, duration=duration, dt=dt, time_scale=duration / 35)
     traj = simulate(model, manoeuvre, simulator=spec.simulator)
     if not bool(traj.success):

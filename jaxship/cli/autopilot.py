@@ -6,7 +6,6 @@ import json
 import pathlib
 import sys
 
-import matplotlib.pyplot as plt
 from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without ipywidgets)
 
 import jaxship as js
@@ -103,6 +102,8 @@ def _stage_bar(args):
 
 def run(args) -> int:
     # every check before the long work; nothing is written until the runs are done
+    import matplotlib.pyplot as plt  # with the figures only (issue 70)
+
     by_rpm, values, auto, step, damping, omega = _numbers(args)
     vessel = read_vessel_option(args.vessel, vessel_only=True).model
     check_operating_point(vessel, args.vessel, [] if by_rpm else values,

@@ -12,6 +12,7 @@ from .. import VESSELS, identify
 from ..identification import AUTO, CANDIDATES, MODELS, fit_settings, read_experiments
 from ..plotting import identification_figure_names, save_identification_figures
 from ._common import (
+    CLOCK,
     VELOCITIES,
     ProgressBar,
     add_sample_interval,
@@ -139,17 +140,20 @@ def run(args) -> int:
         names = identification_figure_names(
             [e.name for e in train], None if held_out is None else [e.name for e in held_out])
         check_writes(args.out, tuple(f"figures/{name}" for name in names))
+    CLOCK.mark("reading")
+    progress = ProgressBar(not args.quiet)
     result = identify(model, train, validate=held_out, name=name,
                       horizon=... if args.horizon is None else chosen.horizon,
                       sample_interval=args.sample_interval, free=args.free,
                       rudder=args.rudder, channels=args.channels, initial=args.initial,
-                      max_steps=args.max_steps, progress=ProgressBar(not args.quiet),
-                      prior=args.prior)
+                      max_steps=args.max_steps, progress=progress, prior=args.prior)
+    CLOCK.mark(progress.stage or "identify")
     written = ["result.json"]
     with staged_folder(args.out) as stage:
         if not args.no_figures:
             paths = save_identification_figures(result, stage / "figures")
             written.append(f"figures/ ({len(paths)} figures)")
+            CLOCK.mark("figures")
         (stage / "result.json").write_text(result.to_json() + "\n")
         # `--vessel out/vessel.toml` later; a vessel file holds no effects (result.json does)
         if isinstance(result.model, js.AbstractVessel) and not isinstance(
@@ -158,6 +162,7 @@ def run(args) -> int:
                            source=f"jaxship identify --model {result.model_name} "
                            f"({result.fit.code_name})")
             written.append("vessel.toml")
+    CLOCK.mark("writing")
     head, *lines = result.summary().splitlines()
     undetermined = result.fit.code == js.RESULTS.undetermined
     if undetermined:  # the optimiser converged, on data that are noise to the model

@@ -6,8 +6,6 @@ import math
 import pathlib
 import sys
 
-import matplotlib.pyplot as plt
-
 from .. import AbstractVessel, StandardTrial, froude_scale
 from ..identification import unconverged_fit
 from ..indices import check_imo
@@ -110,6 +108,8 @@ def run_imo(args, chosen, vessel, *, speed, rpm) -> int:
     """`--manoeuvre imo`: the trials of `StandardTrial.imo`, the criteria with margins and bands
     (`jaxship.indices.check_imo`);
     writes `criteria.md`, `indices.json`, `imo_criteria.png` and one figure a trial."""
+    import matplotlib.pyplot as plt  # with the figures only (issue 70)
+
     if args.duration is not None or args.dt is not None:
         raise ValueError("--manoeuvre imo runs each trial for its own duration and sample "
                          "interval; leave out --duration and --dt.")

@@ -1,11 +1,11 @@
 """Autopilot figures: heading, error and rudder of closed-loop runs."""
 
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from ._common import (
     _y_range,
+    plt,
 )
 
 

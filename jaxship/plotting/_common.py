@@ -8,6 +8,19 @@ import numpy as np
 _REFERENCE_COLOR = "tab:orange"
 
 
+class _Pyplot:
+    """`matplotlib.pyplot`, imported on first use (0.3-1 s): importing the figures costs
+    nothing, so `jaxship identify --no-figures` never loads matplotlib (issue 70)."""
+
+    def __getattr__(self, name):
+        import matplotlib.pyplot
+
+        return getattr(matplotlib.pyplot, name)
+
+
+plt = _Pyplot()
+
+
 def _title(fig, text, *, size=14.0):
     """`fig.suptitle(text)` wrapped to the figure's width, so that it is never clipped."""
     if not text:

@@ -4,7 +4,6 @@ correlation."""
 import textwrap
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from ._common import (
@@ -14,6 +13,7 @@ from ._common import (
     _range,
     _range_text,
     _title,
+    plt,
 )
 
 

@@ -2,8 +2,9 @@
 the thesis states."""
 
 
-import matplotlib.pyplot as plt
 import numpy as np
+
+from ._common import plt
 
 
 def _thesis_marks(ax, bands=(), lines=()):

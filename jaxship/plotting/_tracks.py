@@ -2,11 +2,9 @@
 spirals and the IMO criteria table."""
 
 import textwrap
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
-import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.patches import Polygon
 
 from .._analysis._indices import StoppingIndices, TurningIndices, ZigZagIndices
 from ._common import (
@@ -21,7 +19,12 @@ from ._common import (
     _range,
     _range_text,
     _title,
+    plt,
 )
+
+
+if TYPE_CHECKING:  # the annotations only: matplotlib is imported with the first figure
+    from matplotlib.axes import Axes
 
 
 def _run_samples(run):
@@ -57,6 +60,8 @@ def _draw_outlines(ax, t, s, *, count, length, beam, scale, color):
     along = (path if path[last] > 0 else t - t[0])[: last + 1]
     targets = np.linspace(along[0], along[-1], count)
     picks = np.unique(np.searchsorted(along, targets).clip(0, last))
+    from matplotlib.patches import Polygon  # with the figure, not on import
+
     for i in picks:
         ax.add_patch(Polygon(_ship_polygon(s["x"][i], s["y"][i], s["psi"][i], length, beam,
                                            scale), closed=True, facecolor=color, alpha=0.25,
@@ -290,11 +295,11 @@ def plot_trajectory(traj, *, length=None, title="", others=(), labels=None, beam
 class _TrajectoryAxes(NamedTuple):
     """`plot_trajectory`'s axes: the track on the left, four time histories on the right."""
 
-    track: plt.Axes
-    heading: plt.Axes
-    rudder: plt.Axes
-    rate: plt.Axes
-    speed: plt.Axes
+    track: "Axes"
+    heading: "Axes"
+    rudder: "Axes"
+    rate: "Axes"
+    speed: "Axes"
 
 
 def _check_reference(reference, indices) -> None:

@@ -3,7 +3,6 @@ sentences that explain the differences, the sections of `report.md` and their fi
 (`jaxship.cli.reproduction.reproduce` runs the study and calls these)."""
 
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 import jaxship as js
@@ -168,6 +167,8 @@ def header(run, quick, per_rate, stages):
 
 
 def trials_section(indices, out, design):
+    import matplotlib.pyplot as plt  # with the figures only (issue 70)
+
     runs = {(spec, rpm): traj for _, spec, rpm, _, traj in design.values()}
     cols = [("max_yaw_rate_deg_s", "max r [deg/s]"), ("min_speed_m_s", "min U [m/s]"),
             ("max_speed_m_s", "max U [m/s]"), ("tactical_diameter_m", "tactical diam. [m]"),
@@ -353,6 +354,8 @@ def study_families(study):
 
 
 def _fit_figure(study, experiments, family, path):
+    import matplotlib.pyplot as plt  # with the figures only (issue 70)
+
     e = experiments[thesis.record_name(thesis.SHOWN[family], 500.0)]
     panels = {}
     for case, where in (("single", "single 40 deg / 500 rpm record"),
@@ -474,6 +477,8 @@ def _closed_loop_sentence(model, family, rows, fit, median, vessel_pid):
 
 
 def _heading_figure(study, model, figs, path):
+    import matplotlib.pyplot as plt  # with the figures only (issue 70)
+
     evaluations = study["evaluations"]
     runs, t, desired = [], None, None
     for key, label in [(f"{model}/{f}", f"{chapter5.MODEL_NAMES[model]} from the "
@@ -547,6 +552,8 @@ def discovery_section(data):
 
 
 def discovery_figure(report, holdout, path):
+    import matplotlib.pyplot as plt  # with the figures only (issue 70)
+
     estimator = js.PredictionError(horizon=None, channels=tuple(report.channels))
     before = js.predict(report.model_before, holdout, estimator=estimator)
     after = js.predict(report.model_after, holdout, estimator=estimator)
