@@ -15,6 +15,9 @@ from jaxship.cli import main
 
 
 GOLDEN = json.loads((pathlib.Path(__file__).parent / "golden" / "autopilot.json").read_text())
+# fields added since the golden file, each with its issue: the heading error over the
+# window's last tenth, which the settling check (issue 72) judges
+ADDED = {"end_error_deg"}
 
 
 @pytest.fixture(scope="module")
@@ -41,7 +44,7 @@ def _command(fit, out, *extra):
 def _same(now, before, where=""):
     """Equal to the last bit but for floats within 1e-12 relative (their JSON text)."""
     if isinstance(before, dict):
-        assert set(now) == set(before), where
+        assert set(now) - ADDED == set(before), where
         for k in before:
             _same(now[k], before[k], f"{where}/{k}")
     elif isinstance(before, list):
