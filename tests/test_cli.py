@@ -98,6 +98,32 @@ def test_each_command_chooses_its_compiler_setting(tmp_path, capsys, monkeypatch
     capsys.readouterr()
 
 
+@pytest.mark.parametrize("args, named, near", [
+    (["simulate", "--manouvre", "zigzag:20/20"], "--manouvre", "--manoeuvre"),
+    (["identify", "x.csv", "--modle=nomoto1"], "--modle", "--model"),
+    (["reproduce", "--quik"], "--quik", "--quick"),
+])
+def test_a_misspelt_option_is_named_before_any_missing_one(capsys, args, named, near):
+    """Issue 72: argparse alone says only that the required `--manoeuvre` is missing."""
+    with pytest.raises(SystemExit) as exit_:
+        main(args)
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert f"unrecognized option {named} (did you mean {near}?)" in err
+    assert "required" not in err
+
+
+def test_an_abbreviated_option_and_reproduce_quiet_are_accepted(capsys):
+    """A unique prefix stays an option (argparse's abbreviations); reproduce has `--quiet`
+    as the other long commands (issue 72)."""
+    with pytest.raises(SystemExit) as exit_:
+        main(["simulate", "--manoeuv", "nonsense", "--help"])
+    assert exit_.value.code == 0
+    with pytest.raises(SystemExit):
+        main(["reproduce", "--help"])
+    assert "--quiet" in capsys.readouterr().out
+
+
 def test_version(capsys):
     with pytest.raises(SystemExit) as stop:
         main(["--version"])

@@ -33,7 +33,8 @@ import scipy  # scipy.signal loads on first use (an import-time saving)
 from .._foundation._contract import rebuild
 from .._foundation._params import as_arrays
 from .._simulation._data import Dataset
-from ._fit import PredictionError, _predict, _predict_jit, _prepare
+from ._fit import PredictionError, _predict, _predict_jit
+from ._prepare import prepare_fit
 from ._result import FitResult
 from ._step import MAX_SUBSTEPS, stable_substeps
 from ._windows import to_timeline
@@ -164,7 +165,7 @@ class _Runs:
             raise ValueError(f"`estimator` must be a PredictionError (its replay of the "
                              f"records), got {type(estimator).__name__}.")
         model = as_arrays(result.model if isinstance(result, FitResult) else result)
-        ds, windows, self.layout = _prepare(model, dataset, estimator)
+        ds, windows, self.layout = prepare_fit(model, dataset, estimator)
         needed = min(stable_substeps(model, windows, refuse=False), MAX_SUBSTEPS)
         if needed > windows.substeps:
             windows = dataclasses.replace(windows, substeps=needed)

@@ -23,13 +23,11 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
-from .._foundation._contract import AbstractModel, rebuild
+from .._foundation._contract import rebuild
 from .._foundation._covariance import (
     RobustErrors,
     cluster_from_windows,
-    effective_parameters,
     hac_from_windows,
-    information_share,
     least_squares_covariance,
     parameter_report,
 )
@@ -41,7 +39,6 @@ from .._simulation._data import Dataset
 from .._simulation._integrate import Simulator, integrate, replay_policy
 from ._excitation import excitation_flags
 from ._initial import EstimatedStarts, MeasuredStates
-from ._kalman import SmoothedStates
 from ._linear import LinearStart
 from ._lm import (
     RESULTS,
@@ -53,11 +50,12 @@ from ._lm import (
     solve_least_squares,
     value_and_jacfwd,
 )
-from ._prior import PRIOR_PASSES, PRIOR_RTOL, Prior, prior_report
+from ._prepare import prepare_fit, start_strategy
+from ._prior import PRIOR_PASSES, PRIOR_RTOL, GaussianPrior, Prior, posterior_fields
 from ._result import FitError, FitResult, Prediction, Validation, assemble_result
 from ._step import MAX_SUBSTEPS, stable_substeps
 from ._verdict import final_verdict
-from ._windows import CHANNEL_NAMES, Windows, as_dataset, build_windows, check_data, to_timeline
+from ._windows import Windows, to_timeline
 
 
 # windows needed for window-clustered standard errors (Cameron & Miller 2015 advise
@@ -170,7 +168,7 @@ class PredictionError(AbstractEstimator):
     def predict(self, model, dataset) -> "Prediction":
         """The windows of `fit` (a free simulation of each record for `horizon=None`),
         integrated with the step that follows the model's fastest mode, as in `fit`."""
-        ds, windows, layout = _prepare(model, dataset, self)
+        ds, windows, layout = prepare_fit(model, dataset, self)
         model = as_arrays(model)
         needed = min(stable_substeps(model, windows, refuse=False), MAX_SUBSTEPS)
         if needed > windows.substeps:
@@ -216,6 +214,13 @@ def _predict(model, w: Windows, offsets=None):
 
 
 _predict_jit = eqx.filter_jit(lambda model, w: _predict(model, w))
+
+
+def _start_residuals(model, w: Windows) -> np.ndarray:
+    """The weighted residuals of `model` at the windows' valid samples (NumPy)."""
+    pred = np.asarray(_predict_jit(as_arrays(model), w), dtype=np.float64)
+    resid = np.asarray(w.weights)[:, None, None, None] * (w.targets - pred)
+    return resid[np.broadcast_to(np.asarray(w.mask), resid.shape)]
 
 
 def _residuals(model, w: Windows, offsets=None):
@@ -358,9 +363,9 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
     """`PredictionError.fit`: windows, Levenberg-Marquardt, the report."""
     if estimator.start is not None:
         model = estimator.start(model, dataset, free, estimator.rudder)
-    ds, windows, layout = _prepare(model, dataset, estimator)
+    ds, windows, layout = prepare_fit(model, dataset, estimator)
     specs = resolve_free(model, free)
-    starts = _starts(estimator.initial)
+    starts = start_strategy(estimator.initial)
     starts.check(layout["lengths"])
     base = as_arrays(model)
     needed = stable_substeps(base, windows)
@@ -374,7 +379,8 @@ def _fit_prediction_error(estimator, model, dataset, free, progress) -> FitResul
         offset_scale = jnp.asarray(offset_scale, dtype=float)
     z0 = jnp.asarray(np.concatenate([z0, offsets0]), dtype=float)
     solver = estimator.solver
-    prior = _GaussianPrior.build(estimator.prior, specs, model, windows)
+    prior = GaussianPrior.build(estimator.prior, specs, model,
+                                lambda: _start_residuals(model, windows))
     with reporting_steps(progress, f"fitting {type(model).__name__}",
                          int(estimator.max_steps)) as (step, finish):
         z, windows, optimum, prior = _optimise(
@@ -424,60 +430,6 @@ def _optimise(z0, problem, offset_scale, solver, report=None):
     return z, windows, _Optimum(p, pred, jac, result, total), prior
 
 
-@dataclasses.dataclass(frozen=True)
-class _GaussianPrior:
-    """A `Prior` resolved for a fit: the means and standard deviations (d,) of the free
-    parameters (sd inf: none), the number of columns of the Jacobian (with estimated
-    window starts, which have no prior) and the noise variance of the weighted residuals
-    that weighs it (`_prior.py`)."""
-
-    prior: Prior
-    names: tuple[str, ...]
-    mean: np.ndarray
-    sd: np.ndarray
-    columns: int
-    variance: float
-
-    @classmethod
-    def build(cls, prior, specs, model, windows) -> "_GaussianPrior | None":
-        """None without a prior (or with no finite scale), else the start's: the variance
-        of the start's weighted residuals (1, the measured spread, where not finite)."""
-        if prior is None:
-            return None
-        if not isinstance(prior, Prior):
-            raise ValueError(f"`prior` must be a jaxship.strategies.Prior, got "
-                             f"{type(prior).__name__}.")
-        names = tuple(s.name for s in specs)
-        mean, sd = prior.resolve(names, [s.start for s in specs], model)
-        if not np.isfinite(sd).any():
-            return None
-        if math.prod(windows.targets.shape[1:]) < len(specs):
-            raise ValueError(f"a prior on {len(specs)} coefficients needs at least as many "
-                             "predicted samples.")
-        pred = np.asarray(_predict_jit(as_arrays(model), windows), dtype=np.float64)
-        resid = np.asarray(windows.weights)[:, None, None, None] * (windows.targets - pred)
-        mask = np.broadcast_to(np.asarray(windows.mask), resid.shape)
-        variance = float(np.mean(resid[mask] ** 2))
-        return cls(prior, names, mean, sd, len(specs),
-                   variance if np.isfinite(variance) else 1.0)
-
-    def precision(self, columns: int) -> np.ndarray:
-        """The prior's precision in the residuals' scale, sigma^2 / sd^2, for `columns`
-        columns (0 for those beyond the free parameters)."""
-        out = np.zeros(columns)
-        out[: self.columns] = self.variance / self.sd**2
-        return out
-
-    def arrays(self):
-        return (jnp.asarray(self.mean, dtype=float),
-                jnp.asarray(np.sqrt(self.precision(self.columns)), dtype=float))
-
-    def noise_variance(self, rows, jrows) -> float:
-        """$\\hat\\sigma^2 = \\sum\\varepsilon^2 / (N - d_\\text{eff})$ at this MAP."""
-        d_eff = effective_parameters(jrows, self.precision(jrows.shape[1]))
-        return float(np.sum(rows**2)) / max(rows.size - d_eff, 1.0)
-
-
 def _rows(problem, pred, jac):
     """`(rows, jrows, groups, columns)`: the weighted residuals (N,) of the windows'
     samples, channel by channel, their Jacobian (N, d + estimated window starts), the
@@ -494,61 +446,6 @@ def _rows(problem, pred, jac):
     jrows = np.concatenate([jac[c][mask][:, columns] for c in range(len(channels))])
     groups = np.concatenate([np.full(int(mask.sum()), c) for c in range(len(channels))])
     return rows, jrows, groups, columns
-
-
-def _starts(initial) -> MeasuredStates | EstimatedStarts:
-    """The start strategy of `initial`: smoothed states (a list) start as measured ones."""
-    return MeasuredStates() if isinstance(initial, (list, tuple)) else initial
-
-
-def _prepare(model, dataset, estimator):
-    """Check the model, data and estimator and build the windows: `(ds, windows,
-    layout)`, shared by `fit` and `predict`."""
-    if not isinstance(model, AbstractModel):
-        raise ValueError(f"`model` must be a jaxship steering model (AbstractSteeringModel) "
-                         f"or vessel (AbstractVessel), got {type(model).__name__}.")
-    ds = as_dataset(dataset)
-    channels = model.default_channels if estimator.channels is None else tuple(
-        estimator.channels)
-    for c in channels:
-        if c not in CHANNEL_NAMES:
-            raise ValueError(f"unknown output channel {c!r}; choose from {CHANNEL_NAMES}.")
-        try:
-            model.channel_index(c)
-        except ValueError:
-            raise ValueError(f"unknown output channel {c!r} for {type(model).__name__}, whose "
-                             f"outputs are psi, r and its states.") from None
-    check_data(ds, estimator.rudder, channels)
-    if estimator.wind and not model.wind_loads:
-        raise ValueError(f"`wind=True` is for vessels and steering models with a wind "
-                         f"effect (jaxship.effects.ApparentWind); {type(model).__name__} "
-                         "has no wind loads.")
-    servo = estimator.rudder == "delta_c"
-    smoothed = isinstance(estimator.initial, (list, tuple))
-    starts = _smoothed_starts(ds, estimator.initial) if smoothed else None
-    needed = [c for c in model.start_channels if starts is None or c not in starts]
-    needed += ["delta"] if servo and model.has_servo else []
-    needed += ["wind_speed", "wind_dir"] if estimator.wind else []
-    for i, name in enumerate(ds.names):
-        missing = [c for c in needed if c not in ds.experiment_channels[i]]
-        if missing:
-            raise ValueError(
-                f"experiment {name!r} (dataset entry {i}): no measured {missing[0]!r}; "
-                f"{type(model).__name__} restarts every window from the measured "
-                f"{', '.join(needed)} (and `wind=True` replays the measured wind), so these "
-                "must be measured (or smoothed: `initial=jaxship.smooth_states(...)`; or fit "
-                "a steering model instead).")
-    if not isinstance(estimator.simulator, Simulator):
-        raise ValueError(f"`simulator` must be a jaxship.Simulator, got "
-                         f"{type(estimator.simulator).__name__}.")
-    if not (smoothed or isinstance(estimator.initial, (MeasuredStates, EstimatedStarts))):
-        raise ValueError(f"`initial` must be MeasuredStates(), EstimatedStarts() or a list of "
-                         f"SmoothedStates, got {estimator.initial!r}.")
-    windows, layout = build_windows(ds, horizon=estimator.horizon, channels=channels,
-                                    weights=estimator.weights, rudder=estimator.rudder,
-                                    simulator=estimator.simulator, starts=starts,
-                                    hold=estimator.hold, wind=bool(estimator.wind))
-    return ds, windows, layout
 
 
 def _jacobian_scales(specs, model, windows):
@@ -575,28 +472,6 @@ def _jacobian(p, model, transform, windows):
     """Forward-mode Jacobian (C, E, W, L, d) of the weighted residuals with respect to
     the physical parameters p."""
     return jax.jacfwd(lambda q: _residuals(rebuild(model, transform.names, q), windows))(p)
-
-
-def _smoothed_starts(ds, smoothed) -> dict:
-    """`{"r": (E, N), "psi": (E, N)}` window starts from `SmoothedStates` (one per
-    experiment of `ds`, e.g. from `jaxship.smooth_states`), and `"u"`, `"v"` where
-    they are smoothed states (a vessel's)."""
-    smoothed = list(smoothed)
-    if len(smoothed) != ds.num_experiments or not all(isinstance(s, SmoothedStates)
-                                                      for s in smoothed):
-        raise ValueError(f"`initial` as smoothed states needs one SmoothedStates per "
-                         f"experiment ({ds.num_experiments}), got {len(smoothed)} items.")
-    out = {}
-    both = lambda name: all(name in s.names for s in smoothed)
-    for name in ("r", "psi") + tuple(c for c in ("u", "v") if both(c)):
-        a = np.array(getattr(ds, name), dtype=np.float64)
-        for i, s in enumerate(smoothed):
-            if s.mean.shape[0] != ds.lengths[i]:
-                raise ValueError(f"smoothed states {i} have {s.mean.shape[0]} samples, "
-                                 f"experiment {ds.names[i]!r} has {ds.lengths[i]}.")
-            a[i, :ds.lengths[i]] = s.state(name)
-        out[name] = a
-    return out
 
 
 def _verdict(result, specs, p, rows, jac, pred, targets, mask) -> RESULTS:
@@ -636,7 +511,7 @@ class _Problem(NamedTuple):
     windows: object
     layout: dict
     starts: object
-    prior: _GaussianPrior | None = None
+    prior: GaussianPrior | None = None
 
 
 class _Optimum(NamedTuple):
@@ -680,7 +555,7 @@ def _report(problem: _Problem, optimum: _Optimum) -> FitResult:
     full, null = (nan, []) if blown else least_squares_covariance(
         jrows, rows, groups, prior_precision=precision)
     covariance = full[:d, :d]
-    posterior = _posterior(prior, precision, jrows, values, blown)
+    posterior = posterior_fields(prior, precision, jrows, values, blown)
     null = [v[:d] / np.linalg.norm(v[:d]) for v in null if np.linalg.norm(v[:d]) > 1e-3]
     flags, no_excitation = excitation_flags(ds, estimator.rudder, rows.size, columns.shape[0])
 
@@ -722,19 +597,3 @@ def _report(problem: _Problem, optimum: _Optimum) -> FitResult:
         weights={c: float(w) for c, w in zip(channels, weights)},
         window_samples=layout["lengths"], horizon=estimator.horizon,
         **{k: v for k, v in posterior.items() if k != "robust"})
-
-
-def _posterior(prior, precision, jrows, values, blown) -> dict:
-    """With a prior: the `FitResult` fields `effective_params` (the trace of the hat
-    matrix, window starts counted in full), `prior` (per coefficient its prior, estimate
-    and the data's share of its information) and `prior_settings`, and `robust`, the
-    prior's `(precision, variance)` for the robust covariances. Without one: {}."""
-    if prior is None:
-        return {}
-    d = prior.columns
-    nan = np.full(d, np.nan)
-    share = nan if blown else information_share(jrows, precision)[:d]
-    d_eff = math.nan if blown else effective_parameters(jrows, precision)
-    return {"effective_params": d_eff, "robust": (precision, prior.variance),
-            "prior": prior_report(prior.names, prior.mean, prior.sd, values, share),
-            "prior_settings": prior.prior.to_dict() | {"noise_variance": prior.variance}}

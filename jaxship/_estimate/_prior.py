@@ -24,12 +24,15 @@ information is $1 - [(J^TJ + P)^{-1}]_{ii} P_{ii}$, one minus the posterior vari
 the prior variance (0: the prior alone, 1: the data alone).
 """
 
+import dataclasses
 import math
 
 import equinox as eqx
+import jax.numpy as jnp
 import numpy as np
 
 from .._foundation._contract import get_path
+from .._foundation._covariance import effective_parameters, information_share
 
 
 # the noise variance's fixed point: refits until it changes by less than this, at most
@@ -104,3 +107,72 @@ def prior_report(names, mean, sd, values, share) -> dict:
     return {n: {"prior_mean": float(m), "prior_std": float(s), "value": float(v),
                 "data_share": float(np.clip(c, 0.0, 1.0))}
             for n, m, s, v, c in zip(names, mean, sd, values, share)}
+
+
+@dataclasses.dataclass(frozen=True)
+class GaussianPrior:
+    """A `Prior` resolved for a fit: the means and standard deviations (d,) of the free
+    parameters (sd inf: none), the number of columns of the Jacobian (with estimated
+    window starts, which have no prior) and the noise variance of the weighted residuals
+    that weighs it (`_prior.py`)."""
+
+    prior: Prior
+    names: tuple[str, ...]
+    mean: np.ndarray
+    sd: np.ndarray
+    columns: int
+    variance: float
+
+    @classmethod
+    def build(cls, prior, specs, model, start_residuals) -> "GaussianPrior | None":
+        """None without a prior (or with no finite scale), else the start's: the variance
+        of the start's weighted residuals `start_residuals()` (1, the measured spread,
+        where not finite)."""
+        if prior is None:
+            return None
+        if not isinstance(prior, Prior):
+            raise ValueError(f"`prior` must be a jaxship.strategies.Prior, got "
+                             f"{type(prior).__name__}.")
+        names = tuple(s.name for s in specs)
+        mean, sd = prior.resolve(names, [s.start for s in specs], model)
+        if not np.isfinite(sd).any():
+            return None
+        resid = start_residuals()
+        if resid.size < len(specs):
+            raise ValueError(f"a prior on {len(specs)} coefficients needs at least as many "
+                             "predicted samples.")
+        variance = float(np.mean(resid**2))
+        return cls(prior, names, mean, sd, len(specs),
+                   variance if np.isfinite(variance) else 1.0)
+
+    def precision(self, columns: int) -> np.ndarray:
+        """The prior's precision in the residuals' scale, sigma^2 / sd^2, for `columns`
+        columns (0 for those beyond the free parameters)."""
+        out = np.zeros(columns)
+        out[: self.columns] = self.variance / self.sd**2
+        return out
+
+    def arrays(self):
+        return (jnp.asarray(self.mean, dtype=float),
+                jnp.asarray(np.sqrt(self.precision(self.columns)), dtype=float))
+
+    def noise_variance(self, rows, jrows) -> float:
+        """$\\hat\\sigma^2 = \\sum\\varepsilon^2 / (N - d_\\text{eff})$ at this MAP."""
+        d_eff = effective_parameters(jrows, self.precision(jrows.shape[1]))
+        return float(np.sum(rows**2)) / max(rows.size - d_eff, 1.0)
+
+
+def posterior_fields(prior, precision, jrows, values, blown) -> dict:
+    """With a prior: the `FitResult` fields `effective_params` (the trace of the hat
+    matrix, window starts counted in full), `prior` (per coefficient its prior, estimate
+    and the data's share of its information) and `prior_settings`, and `robust`, the
+    prior's `(precision, variance)` for the robust covariances. Without one: {}."""
+    if prior is None:
+        return {}
+    d = prior.columns
+    nan = np.full(d, np.nan)
+    share = nan if blown else information_share(jrows, precision)[:d]
+    d_eff = math.nan if blown else effective_parameters(jrows, precision)
+    return {"effective_params": d_eff, "robust": (precision, prior.variance),
+            "prior": prior_report(prior.names, prior.mean, prior.sd, values, share),
+            "prior_settings": prior.prior.to_dict() | {"noise_variance": prior.variance}}

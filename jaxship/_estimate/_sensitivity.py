@@ -17,8 +17,9 @@ import numpy as np
 
 from .._foundation._contract import get_path, rebuild
 from .._simulation._simulate import _as_arrays as as_arrays
-from ._fit import _prepare, _residuals
+from ._fit import _residuals
 from ._lm import blockwise_jacfwd, value_and_jacfwd
+from ._prepare import prepare_fit
 from ._step import MAX_SUBSTEPS, stable_substeps
 
 
@@ -77,7 +78,7 @@ def sensitivities(model, dataset, estimator, names, probes=None,
     the parameters `"start[k]"` (appended to `names`). The integration step follows
     the fastest mode of the model and of each probe, as in `fit`."""
     probes = dict(probes or {})
-    ds, windows, layout = _prepare(model, dataset, estimator)
+    ds, windows, layout = prepare_fit(model, dataset, estimator)
     base = as_arrays(model)
     names = tuple(names)
     probed = [rebuild(base, (k,), (float(v),)) for k, v in probes.items()]

@@ -3,6 +3,7 @@ Each command is one module of this package, owning its parser (`register`) and i
 function (`run`); `main` registers them and turns errors into exit statuses."""
 
 import argparse
+import difflib
 import gc
 import multiprocessing
 import os
@@ -80,6 +81,7 @@ def main(argv=None) -> int:
     for command_parser in sub.choices.values():
         raw = issubclass(command_parser.formatter_class, argparse.RawDescriptionHelpFormatter)
         command_parser.formatter_class = RawHelpFormatter if raw else HelpFormatter
+    _refuse_unknown_options(sub, sys.argv[1:] if argv is None else list(argv))
     args = parser.parse_args(argv)
     if args.small_programs(args):
         compile_for_small_programs()
@@ -105,6 +107,23 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         _say(_SIGNAL[0])
         return 128 + _SIGNAL[0]
+
+
+def _refuse_unknown_options(sub, argv):
+    """A misspelt `--option` refused by name, with the nearest known one: argparse checks
+    the required options first and would only say that `--manoeuvre` is missing."""
+    command = next((a for a in argv if not a.startswith("-")), None)
+    if command not in sub.choices:
+        return  # argparse's own message
+    known = [o for o in sub.choices[command]._option_string_actions if o.startswith("--")]
+    for token in argv[argv.index(command) + 1:]:
+        if token == "--":
+            break
+        name = token.split("=", 1)[0]
+        if name.startswith("--") and not any(o.startswith(name) for o in known):
+            near = difflib.get_close_matches(name, known, n=1)
+            sub.choices[command].error(f"unrecognized option {name}"
+                                       + (f" (did you mean {near[0]}?)" if near else ""))
 
 
 def _tell(caught):

@@ -12,7 +12,7 @@ thesis vessel, written up as `report.md` with the thesis' numbers beside ours.
    with reference feed-forward from each merged model, run on the vessel at 300 and 400 rpm;
    our residuals next to the thesis' Tables 5.2-5.7 (`autopilot.json`).
 4. **Discovery** (`jaxship.discover`): a synthetic Nomoto case with cubic yaw damping
-   hidden, as the discovery tests use it (`jaxship.cli.reproduction.discovery_case`;
+   hidden, as the discovery tests use it (`jaxship.thesis.discovery_case`;
    `discovery.json`).
 
 The trials are those of chapter 4's experiment design (`thesis.simulate_design`), so

@@ -513,7 +513,7 @@ def discovery_section(data):
              f"{case['truth']}; the cubic yaw damping is hidden from the start model "
              f"({case['start']}). Training records: {', '.join(case['train'])}; held out: "
              f"{', '.join(case['holdout'])} (rudder rate 2.3 deg/s, noise: heading 0.1 deg, "
-             f"yaw rate 0.05 deg/s; `jaxship.cli.reproduction.discovery_case`, "
+             f"yaw rate 0.05 deg/s; `jaxship.thesis.discovery_case`, "
              f"seed {case['seed']}). "
              f"`jaxship.discover` with at most {case['max_effects']} effect(s) took "
              f"{case['seconds']:.0f} s.\n"]
