@@ -212,7 +212,7 @@ def test_assert_max_traces_for_new_parameter_and_data_values():
         model = Nomoto1(K=K, T=10.0)
         tf = Transform.from_specs(resolve_free(model))
         z0 = jnp.asarray(tf.to_unconstrained([K, 10.0]))
-        counted(z0, as_arrays(model), tf, windows, None, PredictionError().solver, 64)
+        counted(z0, _fit._Args(as_arrays(model), tf, windows), PredictionError().solver, 64)
 
 
 # -- bad data -------------------------------------------------------------------------

@@ -38,12 +38,16 @@ def test_esso_osaka_split():
 def test_hsva_nomoto_generalises_to_held_out_zigzags():
     """Nomoto 1 and 2 by output error on three HSVA zig-zags predict four others by
     simulation better than the mean (fit > 0) in yaw rate, and Nomoto 2 fits the
-    training data at least as well as Nomoto 1 (it contains it)."""
+    training data at least as well as Nomoto 1 (it contains it). Nomoto 2's pole and zero
+    T2 and T3 (about 1.5 and 1.7 s) nearly cancel: their robust (HAC) standard errors are
+    about ten times their values, so that fit is poorly determined in them alone (issue 72)."""
     train, test = hsva_split()
     assert len(train) == 3 and len(test) == 4
     report = identify_kvlcc2_hsva()
     n1, n2 = report.models
-    assert n1.result.success and n2.result.success
+    assert n1.result.success
+    assert n2.result.result == js.RESULTS.poorly_determined
+    assert [f.split(" ")[0] for f in n2.result.parameters.undetermined] == ["T2", "T3"]
     assert n2.result.cost <= n1.result.cost * (1 + 1e-6)
     for m in report.models:
         assert m.validation["simulation"].metrics["r"].fit_percent > 50.0

@@ -163,7 +163,11 @@ def test_a_failed_fit_in_the_study_leaves_the_others(monkeypatch):
     rows = {r["family"]: r for r in study["table"]}
     assert rows["zigzag"]["success"] is False and "diverged" in rows["zigzag"]["error"]
     assert rows["zigzag"]["fit"] is None and study["models"]["merged/nomoto/zigzag"] is None
-    assert rows["turning"]["success"] and rows["turning"]["fit"] is not None
+    # the turning fit is returned; it is not a success (issue 72): one 40 deg turn leaves
+    # T = 28 s (the vessel's is about 3 s) with a robust standard error of 79 %
+    assert rows["turning"]["fit"] is not None and rows["turning"]["success"] is False
+    T = study["parameters"]["merged/nomoto/turning"]["T"]
+    assert T["std_robust"] > 0.5 * T["value"] > 0
     K = study["parameters"]["merged/nomoto/turning"]["K"]  # -67.6 %: as in fig. 4.20
     assert K["value"] > 0 and K["unit"] == "1/s"  # issue 31: value, std and unit
     assert 0 < K["std"] < K["value"] and K["std_robust"] > 0

@@ -54,7 +54,7 @@ from ._prepare import prepare_fit, start_strategy
 from ._prior import PRIOR_PASSES, PRIOR_RTOL, GaussianPrior, Prior, posterior_fields
 from ._result import FitError, FitResult, Prediction, Validation, assemble_result
 from ._step import MAX_SUBSTEPS, stable_substeps
-from ._verdict import final_verdict
+from ._verdict import final_verdict, optimiser_verdict
 from ._windows import Windows, to_timeline
 
 
@@ -238,6 +238,18 @@ def _split(q, transform, w, offset_scale):
     return q[:d], jnp.reshape(q[d:], shape) * offset_scale
 
 
+class _Args(NamedTuple):
+    """The residual function's arguments: the model as arrays, the transform of its free
+    parameters, the windows, the start offsets' scale (None: measured starts) and the
+    prior's arrays `(mean, sigma / sd)` of its residual rows (None: no prior)."""
+
+    model: object
+    transform: Transform
+    windows: Windows
+    offset_scale: object = None
+    prior: object = None
+
+
 def _residual_fn(z, args):
     model, transform, w, offset_scale, prior = args
     p, offsets = _split(z, transform, w, offset_scale)
@@ -252,12 +264,11 @@ def _residual_fn(z, args):
 
 
 @eqx.filter_jit
-def _solve(z0, model, transform, windows, offset_scale, solver, max_steps, prior=None,
-           chunk=None):
+def _solve(z0, args: _Args, solver, max_steps, chunk=None):
     """LM from z0; the estimate z, result, steps, the physical parameters and start
     offsets q, the predictions (C, E, W, L) and the Jacobian with respect to q (and
-    with a `Chunk`, `resume` and `stopped`: `solve_least_squares`). `prior`: None, or
-    the arrays `(mean, sigma / sd)` of a Gaussian prior's residual rows."""
+    with a `Chunk`, `resume` and `stopped`: `solve_least_squares`)."""
+    _, transform, windows, offset_scale, prior = args
 
     def physical(z):
         p, offsets = _split(z, transform, windows, offset_scale)
@@ -272,26 +283,25 @@ def _solve(z0, model, transform, windows, offset_scale, solver, max_steps, prior
             solver = eqx.tree_at(lambda s: s.descent, solver,
                                  BlockDampedNewtonDescent(*shared_and_blocks))
     z, result, steps, q, residual, jac, *part = solve_least_squares(
-        _residual_fn, solver, z0, (model, transform, windows, offset_scale, prior), max_steps,
-        physical, jacobian, chunk)
+        _residual_fn, solver, z0, args, max_steps, physical, jacobian, chunk)
     if prior is not None:  # the windows' channels, without the prior's
         residual, jac = residual[:-1], jac[:-1]
     pred = windows.targets - residual / windows.weights[:, None, None, None]
     return (z, result, steps, q[: len(transform.names)], pred, jac, *part)
 
 
-def _solve_reporting(z0, model, transform, windows, offset_scale, solver, max_steps,
-                     prior, report):
+def _solve_reporting(z0, args: _Args, solver, max_steps, report):
     """`_solve` in parts of at most `PROGRESS_STEPS` steps (`Chunk`), `report(steps,
     cost)` after each: the same steps, iterates and outcome, and no host callback in
     the compiled programs (one for the first part, one for the others)."""
     if max_steps == 0 or not isinstance(solver, LevenbergMarquardt):
-        return _solve(z0, model, transform, windows, offset_scale, solver, max_steps, prior)
+        return _solve(z0, args, solver, max_steps)
+    windows = args.windows
     z, resume, total = z0, None, 0
     while True:
         chunk = Chunk(resume, jnp.asarray(min(PROGRESS_STEPS, max_steps - total)))
-        z, result, steps, q, pred, jac, resume, stopped = _solve(
-            z, model, transform, windows, offset_scale, solver, max_steps, prior, chunk)
+        z, result, steps, q, pred, jac, resume, stopped = _solve(z, args, solver, max_steps,
+                                                                 chunk)
         total += int(steps)
         residual = np.asarray(windows.weights)[:, None, None, None] * (
             np.asarray(windows.targets) - np.asarray(pred))  # NumPy: no XLA program
@@ -406,13 +416,12 @@ def _optimise(z0, problem, offset_scale, solver, report=None):
     max_steps, total = int(problem.estimator.max_steps), 0
     for _ in range(1 if prior is None else PRIOR_PASSES):
         for _ in range(3):  # and the estimate's: refitted with the steps it needs
-            arrays = None if prior is None else prior.arrays()
+            args = _Args(base, transform, windows, offset_scale,
+                         None if prior is None else prior.arrays())
             if report is None:
-                solved = _solve(z0, base, transform, windows, offset_scale, solver,
-                                max_steps, arrays)
+                solved = _solve(z0, args, solver, max_steps)
             else:  # steps counted on from the runs before
-                solved = _solve_reporting(z0, base, transform, windows, offset_scale, solver,
-                                          max_steps, arrays,
+                solved = _solve_reporting(z0, args, solver, max_steps,
                                           lambda k, cost, t=total: report(t + k, cost))
             z, result, num_steps, p, pred, jac = solved
             total += int(num_steps)
@@ -474,30 +483,6 @@ def _jacobian(p, model, transform, windows):
     return jax.jacfwd(lambda q: _residuals(rebuild(model, transform.names, q), windows))(p)
 
 
-def _verdict(result, specs, p, rows, jac, pred, targets, mask) -> RESULTS:
-    """The optimiser's code, unless the fit blew up (predictions not finite, or a
-    thousand times the measured range of a channel) or stopped as converged without
-    moving from a start where the cost is not stationary: the largest cosine between
-    the residuals and a Jacobian column (the scaled gradient) above 1e-3. "Not moved":
-    within 1e-10 of the start, or a few roundings of the float type of the estimates `p`
-    (float32 stores a start of 1e-12 as 9.99999996e-13)."""
-    values = np.asarray(p, dtype=np.float64)
-    eps = float(np.finfo(np.asarray(p).dtype).eps)
-    size = [np.max(np.abs(t[mask])) + np.std(t[mask]) for t in targets]
-    blown = [np.max(np.abs(np.where(mask, p, 0.0))) > 1e3 * (s + 1e-9)
-             for p, s in zip(pred, size)]
-    if not np.all(np.isfinite(rows)) or not np.all(np.isfinite(jac)) or any(blown):
-        return RESULTS.simulation_blew_up
-    start = np.array([s.start for s in specs], dtype=np.float64)
-    unmoved = np.all(np.abs(values - start) <= max(1e-10, 4 * eps) * np.abs(start))
-    if result == RESULTS.successful and unmoved and rows.size:  # stopped as if converged
-        norms = np.linalg.norm(jac, axis=0) * np.linalg.norm(rows)
-        cosine = np.abs(rows @ jac) / np.where(norms > 0, norms, np.inf)
-        if np.max(cosine, initial=0.0) > 1e-3:
-            return RESULTS.did_not_move
-    return result
-
-
 class _Problem(NamedTuple):
     """A prediction-error fit as posed: the start model, its data and estimator, the free
     parameters and their transform, the windows (as last solved) and their layout, the
@@ -544,7 +529,7 @@ def _report(problem: _Problem, optimum: _Optimum) -> FitResult:
     weights = layout["weights"]
     resid = weights[:, None, None, None] * (targets - pred)
     code = as_code(result)
-    result = _verdict(code, specs, p, rows, jrows[:, :d], pred, targets, mask)
+    result = optimiser_verdict(code, specs, p, rows, jrows[:, :d], pred, targets, mask)
     if prior is not None and result == RESULTS.did_not_move:
         result = code  # a narrow prior centred on the start holds the estimate there
     blown = result == RESULTS.simulation_blew_up  # nothing below means anything: NaN

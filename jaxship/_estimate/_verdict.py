@@ -32,6 +32,30 @@ NOISE_LEVEL = 0.95
 NOISE_FIT_PERCENT = 5.0
 
 
+def optimiser_verdict(result, specs, p, rows, jac, pred, targets, mask) -> RESULTS:
+    """The optimiser's code, unless the fit blew up (predictions not finite, or a
+    thousand times the measured range of a channel) or stopped as converged without
+    moving from a start where the cost is not stationary: the largest cosine between
+    the residuals and a Jacobian column (the scaled gradient) above 1e-3. "Not moved":
+    within 1e-10 of the start, or a few roundings of the float type of the estimates `p`
+    (float32 stores a start of 1e-12 as 9.99999996e-13)."""
+    values = np.asarray(p, dtype=np.float64)
+    eps = float(np.finfo(np.asarray(p).dtype).eps)
+    size = [np.max(np.abs(t[mask])) + np.std(t[mask]) for t in targets]
+    blown = [np.max(np.abs(np.where(mask, p, 0.0))) > 1e3 * (s + 1e-9)
+             for p, s in zip(pred, size)]
+    if not np.all(np.isfinite(rows)) or not np.all(np.isfinite(jac)) or any(blown):
+        return RESULTS.simulation_blew_up
+    start = np.array([s.start for s in specs], dtype=np.float64)
+    unmoved = np.all(np.abs(values - start) <= max(1e-10, 4 * eps) * np.abs(start))
+    if result == RESULTS.successful and unmoved and rows.size:  # stopped as if converged
+        norms = np.linalg.norm(jac, axis=0) * np.linalg.norm(rows)
+        cosine = np.abs(rows @ jac) / np.where(norms > 0, norms, np.inf)
+        if np.max(cosine, initial=0.0) > 1e-3:
+            return RESULTS.did_not_move
+    return result
+
+
 def final_verdict(out: FitResult, model, free) -> FitResult:
     """`at_bound` when an estimate ended within 1e-4 of its bound span (or scale) from a
     bound, the optimiser having converged or crawled to its step limit; for a converged
