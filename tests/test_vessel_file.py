@@ -261,6 +261,20 @@ def test_the_vessel_file_as_text_and_as_a_dict_reads_back_bit_for_bit():
         js.load_vessel(tomllib.loads(text.replace('model = "MMGVessel"', 'model = "Tug"')))
 
 
+def test_save_vessel_text_loads_back_and_saving_refuses_what_loading_would():
+    """Issue 72: `load_vessel(save_vessel(v))` is a round trip (it answered "File name too
+    long"), and `save_vessel` refuses a mass of nan or -5 before writing, naming the field."""
+    vessel = js.get_vessel("mariner")
+    back = js.load_vessel(js.save_vessel(vessel))
+    assert all(np.float64(a).tobytes() == np.float64(b).tobytes()
+               for a, b in zip(jax.tree.leaves(vessel), jax.tree.leaves(back)))
+    with pytest.raises(ValueError, match="the text given is not a vessel file"):
+        js.load_vessel("model = \nMariner\n")
+    for bad, message in ((math.nan, "field 'm' is nan"), (-5.0, "field 'm' = -5.0 is out")):
+        with pytest.raises(ValueError, match=f"cannot save Mariner: {message}"):
+            js.save_vessel(eqx.tree_at(lambda v: v.m, vessel, bad))
+
+
 def test_parameters_by_name_on_every_model():
     """`parameter_names`, `get_parameter` and `with_parameters` address a vessel's, a
     steering model's and an effect's parameters alike (`"<effect id>.<field>"`)."""

@@ -327,6 +327,10 @@ def save_vessel(vessel: AbstractVessel | MainParticulars, path=None, *, source: 
     dict `load_vessel` also reads). A ship's `MainParticulars` are written as the table
     [particulars], which `load_vessel` turns into `MMGVessel.from_particulars`."""
     text = vessel_text(vessel, source=source)
+    try:  # saving refuses what loading would refuse (a mass of nan or -5, ...)
+        vessel_from_dict(tomllib.loads(text))
+    except ValueError as error:
+        raise ValueError(f"cannot save {type(vessel).__name__}: {error}") from None
     if path is None:
         return text
     path = pathlib.Path(path)
@@ -335,10 +339,16 @@ def save_vessel(vessel: AbstractVessel | MainParticulars, path=None, *, source: 
 
 
 def _read(source, parse):
-    """`parse` of the vessel file at `source` (a path) or of its parsed content (a dict);
-    errors name the file."""
+    """`parse` of the vessel file at `source` (a path), of its parsed content (a dict) or
+    of its text (a string of several lines, as `save_vessel(v)` returns it); errors name
+    the file."""
     if isinstance(source, dict):
         return parse(source)
+    if isinstance(source, str) and "\n" in source:
+        try:
+            return parse(tomllib.loads(source))
+        except tomllib.TOMLDecodeError as error:
+            raise ValueError(f"the text given is not a vessel file (TOML): {error}.") from None
     path = pathlib.Path(source)
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
@@ -355,9 +365,10 @@ def _read(source, parse):
 
 
 def load_vessel(source) -> AbstractVessel:
-    """The vessel of the vessel file at `source` (a path; see `save_vessel`), or of a
-    vessel file's content already parsed (a dict, as `tomllib` reads it); a file with
-    the table [particulars] gives `MMGVessel.from_particulars` of them. **Raises**
+    """The vessel of the vessel file at `source` (a path; see `save_vessel`), of its text
+    (`save_vessel(v)`'s), or of its content already parsed (a dict, as `tomllib` reads
+    it); a file with the table [particulars] gives `MMGVessel.from_particulars` of them.
+    **Raises**
     `ValueError`, one line naming the file and the field: not TOML, an unknown or
     missing field, a wrong unit, a value out of its physical range."""
     return _read(source, vessel_from_dict)
