@@ -1,8 +1,8 @@
 """What `jaxship.identify` is built of, for a notebook that looks inside it or changes a
 part: the catalogue of identifiable models (`MODELS`, `ModelEntry`), the candidates of
 `"auto"` (`CANDIDATES`), a preset's fit settings (`fit_settings`), the reading and
-checking of records (`read_experiments`, `check_froude`), the assessment (`Assessment`)
-and the identification report read back (`read_report`, `read_result`,
+checking of records (`read_experiments`, `check_froude`, `same_records`), the assessment
+(`Assessment`) and the identification report read back (`read_report`, `read_result`,
 `model_from_report`, `linear_candidate`, `unconverged_fit`):
 
     import jaxship as js
@@ -30,6 +30,7 @@ from ._workflow._identify import (
     read_experiments as read_experiments,
     read_report as read_report,
     read_result as read_result,
+    same_records as same_records,
     unconverged_fit as unconverged_fit,
 )
 
@@ -45,6 +46,7 @@ __all__ = [
     "Settings",
     "read_experiments",
     "check_froude",
+    "same_records",
     "preset_length",
     "logs_wind",
     "Assessment",

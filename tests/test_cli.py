@@ -403,6 +403,24 @@ def test_discover_names_the_files_it_skips_even_when_quiet(record, tmp_path, cap
     assert "training records resampled to every k-th sample (0.5 s -> 1 s)" in err
 
 
+def test_discover_says_a_held_out_record_is_a_training_one(record, tmp_path, capsys,
+                                                           monkeypatch):
+    """Issue 72: `discover --holdout` of a training file was accepted with no note, where
+    `identify --validate` has one; the note is said before any fit, even when quiet."""
+    copy = tmp_path / "copy.csv"
+    copy.write_text(pathlib.Path(record).read_text())
+
+    def stop(*args, **kwargs):
+        raise ValueError("stopped after reading")
+
+    monkeypatch.setattr("jaxship.cli._discovery.identify", stop)
+    assert main(["discover", record, "--holdout", str(copy), "--model", "nomoto1", "--quiet",
+                 "--out", str(tmp_path / "d")]) == 2
+    err = capsys.readouterr().err
+    assert f"the held-out record {copy} holds the samples of the training record" in err
+    assert "(--holdout records not used in the fit for one)" in err
+
+
 def test_identify_resamples_the_records_it_is_told_to(record, tmp_path, capsys):
     """`--sample-interval 2` on a record at 0.5 s fits every 4th sample, and says so."""
     out = tmp_path / "out"

@@ -16,6 +16,7 @@ from ..identification import (
     logs_wind,
     preset_length,
     read_experiments,
+    same_records,
 )
 from ._common import check_writes
 from ._files import staged_folder
@@ -46,6 +47,8 @@ def run_discovery(train_paths, holdout_paths, *, model, out: pathlib.Path,
     # a held-out record named as a training one (two `trial.csv`) is told apart by its folder
     holdout = read_experiments(holdout_paths, role="held-out", taken=[e.name for e in train],
                                **reading) if holdout_paths else None
+    for line in same_records(train, holdout or [], role="held-out", option="--holdout"):
+        reading["note"](line)
     check_writes(pathlib.Path(out), tuple(f"figures/{_figure_name(i)}"
                                           for i in range(len(holdout or train))))
     name = settings.name or "vessel"  # a vessel of one's own

@@ -11,6 +11,7 @@ from .data import (
     check_froude as check_froude,
     preset_length as preset_length,
     read_experiments as read_experiments,
+    same_records as same_records,
 )
 from .load import load_model as load_model
 from .registry import (

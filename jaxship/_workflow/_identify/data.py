@@ -132,11 +132,12 @@ def _resampled(experiments, interval: float, role: str, note) -> list[js.Experim
     return [e.decimate(k) if k > 1 else e for e, k in zip(experiments, factors)]
 
 
-def same_records(train, held_out) -> list[str]:
-    """A sentence for each validation record that is a training record (the same
-    samples): its fit % is no held-out check."""
-    return [f"the validation record {source(e)} holds the samples of the training record "
-            f"{source(f)}: its fit % is no held-out check (--validate records not used in "
+def same_records(train, held_out, *, role: str = "validation",
+                 option: str = "--validate") -> list[str]:
+    """A sentence for each held-out record (`role`, given by `option`) that is a training
+    record (the same samples): its score is no held-out check."""
+    return [f"the {role} record {source(e)} holds the samples of the training record "
+            f"{source(f)}: its score is no held-out check ({option} records not used in "
             "the fit for one)."
             for e in held_out for f in train
             if e.channels == f.channels and e.num_samples == f.num_samples
