@@ -1,9 +1,10 @@
 """What `jaxship.identify` is built of, for a notebook that looks inside it or changes a
 part: the catalogue of identifiable models (`MODELS`, `ModelEntry`), the candidates of
 `"auto"` (`CANDIDATES`), a preset's fit settings (`fit_settings`), the reading and
-checking of records (`read_experiments`, `check_froude`, `same_records`), the assessment
-(`Assessment`) and the identification report read back (`read_report`, `read_result`,
-`model_from_report`, `linear_candidate`, `unconverged_fit`):
+checking of records (`read_experiments`, `check_froude`, `same_records`), the plausibility
+of identified values (`implausible`, `rudder_in_rad`), the assessment (`Assessment`) and
+the identification report read back (`read_report`, `read_result`, `model_from_report`,
+`linear_candidate`, `unconverged_fit`):
 
     import jaxship as js
     ident = js.identify("nomoto1", "zigzags/", horizon=10.0)
@@ -33,6 +34,11 @@ from ._workflow._identify import (
     same_records as same_records,
     unconverged_fit as unconverged_fit,
 )
+from ._workflow._identify.plausibility import (
+    implausible as implausible,
+    nomoto_indices as nomoto_indices,
+    rudder_in_rad as rudder_in_rad,
+)
 
 
 __all__ = [
@@ -47,6 +53,9 @@ __all__ = [
     "read_experiments",
     "check_froude",
     "same_records",
+    "implausible",
+    "nomoto_indices",
+    "rudder_in_rad",
     "preset_length",
     "logs_wind",
     "Assessment",

@@ -193,6 +193,16 @@ def test_simulate_rejects_nonsense_before_simulating(tmp_path, capsys, args, mes
     assert not (tmp_path / "a").exists()
 
 
+def test_a_propeller_rate_too_slow_to_steer_is_refused(tmp_path, capsys):
+    """Issue 72: ten times the service rate was refused, 1 % of it ran with a saturation
+    warning only (rpm given as rev/s)."""
+    assert main(["simulate", "--vessel", "thesis", "--manoeuvre", "turn:35", "--rpm", "5",
+                 "--out", str(tmp_path / "o")]) == 2
+    assert ("--rpm 5: less than a tenth of the service propeller rate of thesis (500 rpm)"
+            in _error_line(capsys))
+    assert not (tmp_path / "o").exists()
+
+
 def test_simulate_failure_leaves_the_output_folder_untouched(tmp_path, capsys):
     """A run that fails after the simulation (too short for turning indices) writes
     nothing: a new folder is removed again, an old one keeps its files, no temporary

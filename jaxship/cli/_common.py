@@ -25,7 +25,9 @@ def one_line(error) -> str:
 
 def check_operating_point(vessel, name, speeds, rpms):
     """Approach speeds [m/s] and propeller rates [rpm] a vessel can sail at: at most 10
-    times its service speed and rate, and a rate only where it has a propeller model."""
+    times its service speed and rate, a rate at least a tenth of the service rate (dead
+    slow ahead is about a third of it: below a tenth the rudder has no steerage way), and
+    a rate only where it has a propeller model."""
     nominal = float(vessel.nominal_speed)
     for speed in speeds:
         if speed > 10 * nominal:
@@ -40,6 +42,10 @@ def check_operating_point(vessel, name, speeds, rpms):
         if rpm > 10 * service:
             raise ValueError(f"--rpm {rpm:g}: more than 10 times the service propeller rate "
                              f"of {name} ({service:.4g} rpm).")
+        if rpm < 0.1 * service:
+            raise ValueError(f"--rpm {rpm:g}: less than a tenth of the service propeller rate "
+                             f"of {name} ({service:.4g} rpm), too slow to steer; is it in "
+                             "rev/s rather than rpm?")
 
 
 def add_sample_interval(parser) -> None:

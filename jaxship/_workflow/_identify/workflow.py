@@ -35,6 +35,7 @@ from .data import (
     same_records,
     valid_samples,
 )
+from .plausibility import implausible, rudder_in_rad
 from .registry import MODELS, model_key, start_entry
 from .result import Identification
 from .selection import AUTO, CANDIDATES, choose, with_selection
@@ -195,6 +196,7 @@ def _identify(records, model: str | None, start, asked: _Options,
                                             (start, method, neutral), notes)
     caught.extend(_convergence_problems(result, options.max_steps))
     caught.extend(result.flags)
+    caught.extend(_implausible(result.model, records, start, name))
     blocks = _assessments(result, entry, records, options, fitting, wind, notes)
     _frozen_notes(result, notes)
     return Identification(
@@ -203,6 +205,18 @@ def _identify(records, model: str | None, start, asked: _Options,
         validation=blocks[2], options=options.to_json(), notes=tuple(notes),
         warnings=tuple(caught),
     )
+
+
+def _implausible(model, records, start, name) -> list[str]:
+    """`plausibility`'s warnings: a training record's rudder that looks like rad labelled
+    deg, and the model's Nomoto indices against those of ships (made nondimensional by
+    the ship's length, where the preset or vessel gives one, and the mean measured u)."""
+    out = [w for w in map(rudder_in_rad, records.train) if w is not None]
+    length = float(start.length) if isinstance(start, js.AbstractVessel) else \
+        preset_length(name)
+    speeds = [np.asarray(e.u) for e in records.train if e.has("u")]
+    speed = float(np.mean(np.concatenate(speeds))) if speeds else None
+    return out + list(implausible(model, length=length, speed=speed))
 
 
 def _chosen(records, options: _Options, progress) -> Identification:

@@ -1,0 +1,62 @@
+"""Issue 72, point 2: identified values checked against what ships can do. Each unit slip
+or sign of the issue's list gives a warning naming it, on the measured Esso Osaka
+zig-zags (records jaxship did not simulate) and on the published Nomoto sets, which give
+none."""
+
+import equinox as eqx
+import numpy as np
+import pytest
+
+import jaxship as js
+from jaxship.identification import implausible, rudder_in_rad
+
+
+DATA = js.shared_data_dir()
+needs_esso = pytest.mark.skipif(DATA is None or not (DATA / "esso_osaka_frt").is_dir(),
+                                reason="Esso Osaka data (shared/data/esso_osaka_frt) absent")
+
+
+@pytest.mark.parametrize("model, length, speed", [
+    (js.Nomoto2(K=0.185, T1=118.0, T2=7.8, T3=18.5), 161.0, 7.7),  # MSS cargo ship
+    (js.Nomoto1(K=-0.019, T=-153.7), 350.0, 8.1),  # MSS tanker: course-unstable
+    (js.Nomoto1(K=0.185, T=3.02), 4.0, 0.93),  # the thesis vessel
+    (js.Nomoto1(K=0.171, T=7.63), None, None),  # Esso Osaka, no length given
+    (js.NonlinearNomoto(K=0.19, T=3.2, n3=17.0, n1=0.98), 4.0, 0.93),
+])
+def test_published_ships_are_plausible(model, length, speed):
+    assert implausible(model, length=length, speed=speed) == ()
+
+
+@pytest.mark.parametrize("model, length, speed, said", [
+    (js.Nomoto1(K=-0.185, T=3.02), None, None, "turns against its rudder"),
+    (js.Nomoto1(K=0.185 / 57.3, T=3.02), None, None, "r in rad/s labelled deg/s"),
+    (js.Nomoto1(K=0.185 * 57.3, T=3.02), 4.0, 0.93, "the rudder in rad labelled deg"),
+    (js.Nomoto1(K=0.171e-3, T=7630.0), None, None, "is t in ms labelled s"),
+    (js.Nomoto1(K=0.185e-3, T=3020.0), 4.0, 0.93, "|T'| = 702"),
+    (js.NonlinearNomoto(K=-0.19, T=3.2, n3=17.0, n1=0.98), None, None, "against its rudder"),
+])
+def test_slips_and_signs_are_named(model, length, speed, said):
+    assert any(said in line for line in implausible(model, length=length, speed=speed))
+
+
+def test_other_models_are_not_judged():
+    assert implausible(js.get_vessel("mariner")) == ()
+
+
+@needs_esso
+def test_a_mislabelled_or_flipped_rudder_on_measured_zigzags_is_said():
+    """The first three Esso Osaka zig-zags: as logged, no warning of plausibility; the
+    rudder negated (a public data set's convention, positive to port) or in rad labelled
+    deg, `identify` warns, naming the cause."""
+    files = sorted((DATA / "esso_osaka_frt" / "zigzag").glob("*.csv"))[:3]
+    records = js.identification.read_experiments(files)
+    as_logged = js.identify("nomoto1", records, horizon=10.0)
+    assert not [w for w in as_logged.warnings if "rudder" in w or "range of ships" in w]
+    flipped = js.identify("nomoto1", [eqx.tree_at(lambda e: e.delta, e, -e.delta)
+                                      for e in records], horizon=10.0)
+    assert flipped.model.K < 0
+    assert any("turns against its rudder" in w for w in flipped.warnings)
+    rad = [eqx.tree_at(lambda e: e.delta, e, np.radians(e.delta)) for e in records]
+    assert all(rudder_in_rad(e) for e in rad) and not any(map(rudder_in_rad, records))
+    assert sum("is the rudder in rad labelled deg?" in w
+               for w in js.identify("nomoto1", rad, horizon=10.0).warnings) == 3
