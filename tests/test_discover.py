@@ -231,7 +231,11 @@ def test_a_base_model_that_blows_up_on_the_held_out_records_exits_3(tmp_path, ca
                  str(tmp_path / "d"), "--quiet"]) == 3
     err = capsys.readouterr().err
     assert "blows up on the held-out records" in err and "non-finite values" in err, err
-    assert len(err.strip().splitlines()) == 1, err
+    # the reason in one line; before it, the note that the held-out record is the
+    # training one (issue 72)
+    note, error = err.strip().splitlines()
+    assert note.startswith("jaxship: note: the held-out record") and "no held-out" in note
+    assert error.startswith("jaxship: error: ") and "blows up" in error, err
     assert not (tmp_path / "d").exists()
     with pytest.raises(js.FitError, match="train on records that cover them"):
         js.discover(js.Nomoto1(K=0.05, T=20.0), js.read_trial_csv(record),
