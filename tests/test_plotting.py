@@ -333,6 +333,11 @@ def test_identification_figures_leave_room_for_their_legends_and_titles():
     fig = plot_residuals(assessment(), title="x " * 120)
     assert_legends_clear(fig)
     assert_inside(fig)
+    fig = plot_parameter_correlation(["K", "a parameter of a long name"], np.eye(2),
+                                     title="x " * 40)
+    assert_inside(fig)
+    labels = [t.get_window_extent() for t in fig.axes[0].get_yticklabels()]
+    assert min(box.x0 for box in labels) >= 0  # the names are not cut off
 
 
 def pixels(fig):

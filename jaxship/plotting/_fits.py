@@ -179,8 +179,7 @@ def plot_parameter_correlation(names, correlation, *, title: str = "parameter co
     **Returns:** the matplotlib `Figure`."""
     corr = np.asarray(correlation, dtype=np.float64)
     d = len(names)
-    fig, ax = plt.subplots(figsize=(max(1.2 * d + 2.5, 6.0), 1.0 * d + 2.0),
-                           layout="constrained")
+    fig, ax = plt.subplots(figsize=(max(1.2 * d + 2.5, 6.0), 1.0 * d + 2.0), layout="none")
     cmap = plt.get_cmap("RdBu_r").with_extremes(bad="0.8")
     image = ax.imshow(np.ma.masked_invalid(corr), vmin=-1, vmax=1, cmap=cmap)
     for i in range(d):
@@ -190,8 +189,13 @@ def plot_parameter_correlation(names, correlation, *, title: str = "parameter co
                     color="w" if np.isfinite(corr[i, j]) and abs(corr[i, j]) > 0.6 else "k")
     ax.set_xticks(range(d), names, rotation=45, ha="right")
     ax.set_yticks(range(d), names)
+    head = _title(fig, title, size=12.0)
+    # the names' width on the left, their height below, the colour bar's labels on the right
+    _fixed_layout(fig, (1, 1), right=0.15,
+                  left=0.3 + max((_inches(t, fig)[0] for t in ax.get_yticklabels()), default=0),
+                  bottom=0.3 + max((_inches(t, fig)[1] for t in ax.get_xticklabels()), default=0),
+                  top=0.02 * fig.get_figheight() + 0.3 + (_inches(head, fig)[1] if head else 0))
     fig.colorbar(image, ax=ax, shrink=0.8, label="correlation")
-    _title(fig, title, size=12.0)
     return fig
 
 
