@@ -322,15 +322,18 @@ def assert_inside(fig):
         box = artist.get_window_extent()
         assert box.x0 >= 0 and box.y0 >= 0 and box.x1 <= fig.bbox.x1, artist
         assert box.y1 <= fig.bbox.y1, artist
+    for ax in fig.axes:  # the y axes' labels, of any width, not cut off
+        assert ax.yaxis.get_tightbbox().x0 >= 0, ax.get_ylabel()
 
 
 def test_identification_figures_leave_room_for_their_legends_and_titles():
-    fig = plot_comparison(assessment("a record with a name of sixty characters, 012345678"),
-                          0, title="x " * 120, reference={"r": (85.0, 93.1)},
+    small = assessment("a record with a name of sixty characters, 012345678")
+    small.data.r, small.predictions["r"] = small.data.r / 80, small.predictions["r"] / 80
+    fig = plot_comparison(small, 0, title="x " * 120, reference={"r": (85.0, 93.1)},
                           reference_label="a reference of a long name")
     assert_legends_clear(fig)
     assert_inside(fig)
-    fig = plot_residuals(assessment(), title="x " * 120)
+    fig = plot_residuals(small, title="x " * 120)
     assert_legends_clear(fig)
     assert_inside(fig)
     fig = plot_parameter_correlation(["K", "a parameter of a long name"], np.eye(2),

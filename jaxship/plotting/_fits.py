@@ -93,7 +93,7 @@ def _draw_comparison(fig, assessment, index, *, title="", reference=None,
         ax.grid(True, alpha=0.3)
     head = _title(fig, title or f"{ds.names[index]}: measured and model", size=12.0)
     # the legends' width on the right, the title's height on top
-    _fixed_layout(fig, (len(axes), 1), left=0.85,
+    _fixed_layout(fig, (len(axes), 1),
                   right=0.25 + max(_inches(legend, fig)[0] for legend in legends),
                   top=0.02 * fig.get_figheight() + _inches(head, fig)[1] + 0.15,
                   bottom=0.55, hspace=0.15)
@@ -168,7 +168,7 @@ def _draw_residuals(fig, assessment, *, title=""):
     head = _title(fig, title or f"{kind} errors")
     # room for the title on top, the axes' titles above them, the legend below
     titles = max(_inches(ax.title, fig)[1] for ax in axes.flat) + 0.12
-    _fixed_layout(fig, axes.shape, left=0.85, right=0.2, wspace=0.65, hspace=0.6 + titles,
+    _fixed_layout(fig, axes.shape, right=0.2, hspace=0.6 + titles,
                   top=0.02 * fig.get_figheight() + _inches(head, fig)[1] + 0.1 + titles,
                   bottom=0.6 + (0.0 if legend is None else _inches(legend, fig)[1] + 0.1))
 
@@ -191,7 +191,7 @@ def plot_parameter_correlation(names, correlation, *, title: str = "parameter co
     ax.set_yticks(range(d), names)
     head = _title(fig, title, size=12.0)
     # the names' width on the left, their height below, the colour bar's labels on the right
-    _fixed_layout(fig, (1, 1), right=0.15,
+    _fixed_layout(fig, (1, 1), right=0.15, wspace=0.0,
                   left=0.3 + max((_inches(t, fig)[0] for t in ax.get_yticklabels()), default=0),
                   bottom=0.3 + max((_inches(t, fig)[1] for t in ax.get_xticklabels()), default=0),
                   top=0.02 * fig.get_figheight() + 0.3 + (_inches(head, fig)[1] if head else 0))
