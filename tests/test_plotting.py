@@ -312,6 +312,73 @@ def test_comparison_fit_in_the_legend_and_a_title_that_fits():
     assert box.x0 >= 0 and box.x1 <= fig.bbox.x1  # not clipped
 
 
+def assert_inside(fig):
+    """Every legend and title of `fig` lies inside the figure (its fixed layout leaves room
+    for them)."""
+    fig.canvas.draw()
+    texts = [*fig.legends, *(ax.get_legend() for ax in fig.axes if ax.get_legend()),
+             *(ax.title for ax in fig.axes), fig._suptitle]
+    for artist in texts:
+        box = artist.get_window_extent()
+        assert box.x0 >= 0 and box.y0 >= 0 and box.x1 <= fig.bbox.x1, artist
+        assert box.y1 <= fig.bbox.y1, artist
+    for ax in fig.axes:  # the y axes' labels, of any width, not cut off
+        assert ax.yaxis.get_tightbbox().x0 >= 0, ax.get_ylabel()
+
+
+def test_identification_figures_leave_room_for_their_legends_and_titles():
+    small = assessment("a record with a name of sixty characters, 012345678")
+    small.data.r, small.predictions["r"] = small.data.r / 80, small.predictions["r"] / 80
+    fig = plot_comparison(small, 0, title="x " * 120, reference={"r": (85.0, 93.1)},
+                          reference_label="a reference of a long name")
+    assert_legends_clear(fig)
+    assert_inside(fig)
+    fig = plot_residuals(small, title="x " * 120)
+    assert_legends_clear(fig)
+    assert_inside(fig)
+    fig = plot_parameter_correlation(["K", "a parameter of a long name"], np.eye(2),
+                                     title="x " * 40)
+    assert_inside(fig)
+    labels = [t.get_window_extent() for t in fig.axes[0].get_yticklabels()]
+    assert min(box.x0 for box in labels) >= 0  # the names are not cut off
+
+
+def pixels(fig):
+    fig.canvas.draw()
+    return np.asarray(fig.canvas.buffer_rgba()).copy()
+
+
+def test_a_figure_drawn_again_is_a_new_figure():
+    """`save_identification_figures` draws the figures of one shape into one figure object,
+    emptied each time (issue 70): the pixels are a new figure's."""
+    from jaxship.plotting._common import _emptied
+    from jaxship.plotting._fits import (
+        _comparison_figure,
+        _draw_comparison,
+        _draw_residuals,
+        _residual_figure,
+    )
+
+    first, second = assessment(), assessment()
+    first.metrics["r"] = SimpleNamespace(**{**vars(first.metrics["r"]),
+                                            "cross_correlation": None})
+    # a shorter record of smaller values: the axes' limits shrink
+    second.kind, second.data.names, second.data.t = "prediction", ["c", "d"], second.data.t / 2
+    second.data.r, second.data.psi = second.data.r / 10, second.data.psi / 10
+    second.predictions = {c: p / 10 for c, p in second.predictions.items()}
+    fig = _comparison_figure(2)
+    _draw_comparison(fig, first, 0, title="first")
+    pixels(fig)
+    _draw_comparison(_emptied(fig), second, 1, title="second")
+    new = plot_comparison(second, 1, title="second")
+    np.testing.assert_array_equal(pixels(fig), pixels(new))
+    fig = _residual_figure(2)
+    _draw_residuals(fig, first, title="first")
+    pixels(fig)
+    _draw_residuals(_emptied(fig), second, title="second")
+    np.testing.assert_array_equal(pixels(fig), pixels(plot_residuals(second, title="second")))
+
+
 def test_parameter_correlation_heat_map():
     corr = np.array([[1.0, 0.9, np.nan], [0.9, 1.0, -0.2], [np.nan, -0.2, 1.0]])
     fig = plot_parameter_correlation(["a", "b", "c"], corr, title="correlation")

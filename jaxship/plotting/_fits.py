@@ -8,6 +8,9 @@ import numpy as np
 
 from ._common import (
     _REFERENCE_COLOR,
+    _emptied,
+    _fixed_layout,
+    _inches,
     _legend_below,
     _legend_beside,
     _range,
@@ -46,13 +49,26 @@ def plot_comparison(assessment, index: int = 0, *, title: str = "", reference=No
     Each channel in `predictions` (heading and yaw rate in degrees) and the replayed
     rudder, legends beside the axes. **Returns:** the matplotlib `Figure`.
     """
+    fig = _comparison_figure(len(assessment.predictions))
+    _draw_comparison(fig, assessment, index, title=title, reference=reference,
+                     reference_label=reference_label)
+    return fig
+
+
+def _comparison_figure(channels: int):
+    rows = channels + 1
+    return plt.subplots(rows, 1, figsize=(11, 2.4 * rows), sharex=True, layout="none")[0]
+
+
+def _draw_comparison(fig, assessment, index, *, title="", reference=None,
+                     reference_label="reference"):
+    """`plot_comparison` drawn into `fig`, a new or emptied `_comparison_figure`."""
     reference = dict(reference or {})
     ds = assessment.data
     n = ds.lengths[index]
     t = np.asarray(ds.t, dtype=np.float64)[index, :n]
     channels = list(assessment.predictions)
-    fig, axes = plt.subplots(len(channels) + 1, 1, figsize=(11, 2.4 * (len(channels) + 1)),
-                             sharex=True, layout="constrained")
+    axes = fig.axes
     mask = np.asarray(assessment.mask)[index, :n]
     for ax, c in zip(axes, channels):
         label, unit, factor = _channel_axes(c)
@@ -68,16 +84,19 @@ def plot_comparison(assessment, index: int = 0, *, title: str = "", reference=No
                     label=f"{reference_label}: fit " + _range_text(low, high,
                                                                     lambda v: f"{v:.1f} %"))
         ax.set(ylabel=f"{label} [{unit}]")
-        _legend_beside(ax)
     rudder = np.rad2deg(np.asarray(getattr(ds, assessment.rudder), dtype=np.float64)[index, :n])
     axes[-1].step(t, rudder, where="post", color="tab:blue", lw=1.0,
                   label=f"rudder ({assessment.rudder})")
     axes[-1].set(ylabel="rudder [deg]", xlabel="time [s]")
-    _legend_beside(axes[-1])
+    legends = [_legend_beside(ax) for ax in axes]
     for ax in axes:
         ax.grid(True, alpha=0.3)
-    _title(fig, title or f"{ds.names[index]}: measured and model", size=12.0)
-    return fig
+    head = _title(fig, title or f"{ds.names[index]}: measured and model", size=12.0)
+    # the legends' width on the right, the title's height on top
+    _fixed_layout(fig, (len(axes), 1),
+                  right=0.25 + max(_inches(legend, fig)[0] for legend in legends),
+                  top=0.02 * fig.get_figheight() + _inches(head, fig)[1] + 0.15,
+                  bottom=0.55, hspace=0.15)
 
 
 def _correlation_axes(ax, corr, label, dt=None):
@@ -111,11 +130,21 @@ def plot_residuals(assessment, *, title: str = ""):
     **Arguments:** `assessment` as in `plot_comparison`; `title`.
     **Returns:** the matplotlib `Figure`.
     """
+    fig = _residual_figure(len(assessment.metrics))
+    _draw_residuals(fig, assessment, title=title)
+    return fig
+
+
+def _residual_figure(channels: int):
+    return plt.subplots(channels, 3, figsize=(15, 3.4 * channels), layout="none")[0]
+
+
+def _draw_residuals(fig, assessment, *, title=""):
+    """`plot_residuals` drawn into `fig`, a new or emptied `_residual_figure`."""
     ds = assessment.data
     dt = _sample_interval(ds)
     channels = list(assessment.metrics)
-    fig, axes = plt.subplots(len(channels), 3, figsize=(15, 3.4 * len(channels)),
-                             squeeze=False, layout="constrained")
+    axes = np.reshape(fig.axes, (len(channels), 3))
     for row, c in zip(axes, channels):
         label, unit, factor = _channel_axes(c)
         measured = np.asarray(getattr(ds, c), dtype=np.float64)
@@ -134,11 +163,14 @@ def plot_residuals(assessment, *, title: str = ""):
             row[2].axis("off")
         for ax in row:
             ax.grid(True, alpha=0.3)
-    if len(ds.names) <= 8:
-        _legend_below(fig, [axes[0, 0]], ncols=4)
+    legend = _legend_below(fig, [axes[0, 0]], ncols=4) if len(ds.names) <= 8 else None
     kind = "prediction" if assessment.kind == "prediction" else "simulation"
-    _title(fig, title or f"{kind} errors")
-    return fig
+    head = _title(fig, title or f"{kind} errors")
+    # room for the title on top, the axes' titles above them, the legend below
+    titles = max(_inches(ax.title, fig)[1] for ax in axes.flat) + 0.12
+    _fixed_layout(fig, axes.shape, right=0.2, hspace=0.6 + titles,
+                  top=0.02 * fig.get_figheight() + _inches(head, fig)[1] + 0.1 + titles,
+                  bottom=0.6 + (0.0 if legend is None else _inches(legend, fig)[1] + 0.1))
 
 
 def plot_parameter_correlation(names, correlation, *, title: str = "parameter correlation"):
@@ -147,8 +179,7 @@ def plot_parameter_correlation(names, correlation, *, title: str = "parameter co
     **Returns:** the matplotlib `Figure`."""
     corr = np.asarray(correlation, dtype=np.float64)
     d = len(names)
-    fig, ax = plt.subplots(figsize=(max(1.2 * d + 2.5, 6.0), 1.0 * d + 2.0),
-                           layout="constrained")
+    fig, ax = plt.subplots(figsize=(max(1.2 * d + 2.5, 6.0), 1.0 * d + 2.0), layout="none")
     cmap = plt.get_cmap("RdBu_r").with_extremes(bad="0.8")
     image = ax.imshow(np.ma.masked_invalid(corr), vmin=-1, vmax=1, cmap=cmap)
     for i in range(d):
@@ -158,8 +189,13 @@ def plot_parameter_correlation(names, correlation, *, title: str = "parameter co
                     color="w" if np.isfinite(corr[i, j]) and abs(corr[i, j]) > 0.6 else "k")
     ax.set_xticks(range(d), names, rotation=45, ha="right")
     ax.set_yticks(range(d), names)
+    head = _title(fig, title, size=12.0)
+    # the names' width on the left, their height below, the colour bar's labels on the right
+    _fixed_layout(fig, (1, 1), right=0.15, wspace=0.0,
+                  left=0.3 + max((_inches(t, fig)[0] for t in ax.get_yticklabels()), default=0),
+                  bottom=0.3 + max((_inches(t, fig)[1] for t in ax.get_xticklabels()), default=0),
+                  top=0.02 * fig.get_figheight() + 0.3 + (_inches(head, fig)[1] if head else 0))
     fig.colorbar(image, ax=ax, shrink=0.8, label="correlation")
-    _title(fig, title, size=12.0)
     return fig
 
 
@@ -182,6 +218,10 @@ def _fit_figure_name(label: str, i: int, name: str) -> str:
     return f"fit_{label}_{i:02d}_{_file_part(name)}.png"
 
 
+# zlib's fastest level: the same pixels, a third less time to write, files 10 % larger
+_FAST_PNG = {"compress_level": 1}
+
+
 def save_identification_figures(result, folder, *, dpi: int = 100) -> list:
     """Write the figures of a result of the `identify` command into `folder`
     and return their paths:
@@ -192,39 +232,50 @@ def save_identification_figures(result, folder, *, dpi: int = 100) -> list:
       autocorrelation and rudder cross-correlation tests; `residuals_validation.png`:
       the same for the simulation errors on the held-out records;
     - `correlation.png`: the parameter correlation heat map.
+
+    The figures of one shape are drawn into one figure object, emptied between them: the
+    same pixels as new figures in less time (issue 70).
     """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    written = []
+    written, figures = [], {}
 
-    def save(fig, name):
-        path = folder / name
-        fig.savefig(path, dpi=dpi)
-        plt.close(fig)
-        written.append(path)
+    def save(draw, make, shape, name, **kwargs):
+        # one figure of each shape, emptied and drawn again: its axes and ticks kept
+        key = (make, shape)
+        fig = _emptied(figures[key]) if key in figures else figures.setdefault(key, make(shape))
+        draw(fig, **kwargs)
+        fig.savefig(folder / name, dpi=dpi, pil_kwargs=_FAST_PNG)
+        written.append(folder / name)
 
     model = type(result.model).__name__
     blocks = [("train", result.train_simulation)]
     if result.validation is not None:
         blocks.append(("validation", result.validation))
-    for label, block in blocks:
-        for i, name in enumerate(block.names):
-            save(plot_comparison(block, i, title=f"{model} on {label} record {name} "
-                                                 "(simulation from the measured start)"),
-                 _fit_figure_name(label, i, name))
-    horizon = result.train.horizon
-    what = "simulation" if horizon is None else f"{horizon:g} s prediction"
-    save(plot_residuals(result.train, title=f"{model}: {what} errors on the training records"),
-         "residuals_train.png")
-    if result.validation is not None:
-        save(plot_residuals(result.validation,
-                            title=f"{model}: simulation errors on the validation records"),
-             "residuals_validation.png")
+    try:
+        for label, block in blocks:
+            for i, name in enumerate(block.names):
+                save(_draw_comparison, _comparison_figure, len(block.predictions),
+                     _fit_figure_name(label, i, name), assessment=block, index=i,
+                     title=f"{model} on {label} record {name} (simulation from the "
+                           "measured start)")
+        horizon = result.train.horizon
+        what = "simulation" if horizon is None else f"{horizon:g} s prediction"
+        save(_draw_residuals, _residual_figure, len(result.train.metrics), "residuals_train.png",
+             assessment=result.train, title=f"{model}: {what} errors on the training records")
+        if result.validation is not None:
+            save(_draw_residuals, _residual_figure, len(result.validation.metrics),
+                 "residuals_validation.png", assessment=result.validation,
+                 title=f"{model}: simulation errors on the validation records")
+    finally:
+        for fig in figures.values():
+            plt.close(fig)
     report = result.fit.parameters
-    save(plot_parameter_correlation(report.names, report.correlation,
-                                    title=f"{model}: correlation of the estimates"),
-         "correlation.png")
-    return written
+    fig = plot_parameter_correlation(report.names, report.correlation,
+                                     title=f"{model}: correlation of the estimates")
+    fig.savefig(folder / "correlation.png", dpi=dpi, pil_kwargs=_FAST_PNG)
+    plt.close(fig)
+    return written + [folder / "correlation.png"]
 
 
 # ---------------------------------------------------------------------------------------
