@@ -84,6 +84,31 @@ def test_a_bad_vessel_file_is_one_line_and_exit_2(old, new, message, tmp_path, c
     assert not out.exists()
 
 
+# issue 72: values no ship has, each refused naming the field and the likely slip
+IMPLAUSIBLE = [
+    ('nominal_n = { value = 8.333333333333334, unit = "rev/s" }',
+     'nominal_n = { value = 500, unit = "rev/s" }', "is beyond any propeller's rate"),
+    ("n_propellers = 2.0", "n_propellers = -2.0", "a ship has at least one propeller"),
+    ('xg = { value = -0.018, unit = "m" }', 'xg = { value = -18, unit = "m" }',
+     "the centre of gravity lies outside the hull"),
+    ('stall_angle = { value = 0.8726646259971648, unit = "rad" }',
+     'stall_angle = { value = 50, unit = "rad" }', "between 0 and 90 deg (in rad: is it in deg?)"),
+    ('n_rdot = { value = -196.48104824758687, unit = "kg m^2" }',
+     'n_rdot = { value = 196.48104824758687, unit = "kg m^2" }', "an added mass"),
+]
+
+
+@pytest.mark.parametrize("old, new, message", IMPLAUSIBLE, ids=[b[2] for b in IMPLAUSIBLE])
+def test_a_vessel_no_ship_can_be_is_refused_naming_the_field(old, new, message, tmp_path):
+    text = vessel_text(js.get_vessel("thesis"))
+    assert old in text
+    path = tmp_path / "bad.toml"
+    path.write_text(text.replace(old, new, 1))
+    with pytest.raises(ValueError, match=re.escape(message)) as error:
+        js.load_vessel(path)
+    assert str(path) in str(error.value) and "\n" not in str(error.value)
+
+
 def test_degrees_and_rpm_are_read_in_a_file(tmp_path):
     text = vessel_text(js.get_vessel("esso_osaka"))
     text = text.replace('max_angle = { value = 0.6108652381980153, unit = "rad" }',

@@ -60,7 +60,13 @@ PARTICULARS = "particulars"
 POSITIVE |= {f"{PARTICULARS}.{k}" for k in (
     "length", "breadth", "draft", "speed", "propeller_diameter", "rudder_area", "rudder_span",
     "rudder_rate", "gyration_ratio", "rho", "viscosity")}
-ANGLE_LIMITS = {"rudder.max_angle", f"{PARTICULARS}.rudder_max_angle"}  # within (0, 90] deg
+ANGLE_LIMITS = {"rudder.max_angle", f"{PARTICULARS}.rudder_max_angle",  # within (0, 90] deg
+                "stall_angle"}
+# added masses are positive: M_A = -diag(X_udot, Y_vdot, N_rdot) (Fossen 2011, sec. 6.3)
+NOT_POSITIVE = {"x_udot", "y_vdot", "n_rdot"}
+# a propeller's rate [rev/s]: model propellers run at 5-30 (the KVLCC2 7 m model 11.9, the
+# thesis' 4 m model 8.3), full-scale ones at 1-3; beyond 50 (3,000 rpm) it is rpm as rev/s
+MAX_PROPELLER_RATE = 50.0
 
 
 def _unit(info) -> str:
@@ -148,9 +154,11 @@ def _value(name, entry, unit, bounds=(-math.inf, math.inf)) -> float:
         raise ValueError(f"field '{name}' is {value!r}: give a finite number.")
     if (name in POSITIVE and not value > 0) or (name in NON_NEGATIVE and value < 0) \
             or not lower <= value <= upper or name in ANGLE_LIMITS and \
-            not 0 < value <= math.pi / 2:
-        what = ("between 0 and 90 deg" if name in ANGLE_LIMITS else "positive"
-                if name in POSITIVE else "not negative" if name in NON_NEGATIVE
+            not 0 < value <= math.pi / 2 or name in NOT_POSITIVE and value > 0:
+        what = ("between 0 and 90 deg (in rad: is it in deg?)" if name in ANGLE_LIMITS
+                else "positive" if name in POSITIVE else "not negative"
+                if name in NON_NEGATIVE else "not positive (an added mass -X_udot, -Y_vdot "
+                "or -N_rdot is positive)" if name in NOT_POSITIVE
                 else f"between {lower:g} and {upper:g}")
         shown = f"{value!r} {unit}".strip()
         raise ValueError(f"field '{name}' = {shown} is out of its physical range: it must be "
@@ -252,7 +260,29 @@ def vessel_from_dict(data: dict) -> AbstractVessel:
             kwargs[name] = tuple(_number(f"field '{name}'", v) for v in entry)
         else:
             kwargs[name] = _value(name, entry, _unit(info), (info.lower, info.upper))
+    _check_ship(kwargs, {n: _unit(i) for n, i in params.items() if i is not None})
     return cls(**kwargs)
+
+
+def _check_ship(values, units) -> None:
+    """Checks across fields: the centre of gravity inside the hull, |x_G| <= L/2 (0.5 in
+    the prime system), at least one propeller, and a nominal propeller rate below
+    `MAX_PROPELLER_RATE`."""
+    for name in ("xg", "x_g"):
+        if name in values and "length" in values:
+            half = 0.5 if units.get(name) == "-" else 0.5 * values["length"]
+            if abs(values[name]) > half:
+                raise ValueError(f"field '{name}' = {values[name]:g} {units.get(name, '')}: "
+                                 f"the centre of gravity lies outside the hull (|x_G| at most "
+                                 f"L/2 = {half:g}).")
+    if values.get("n_propellers", 1.0) < 1:
+        raise ValueError(f"field 'n_propellers' = {values['n_propellers']:g}: a ship has at "
+                         "least one propeller.")
+    if values.get("nominal_n", 0.0) > MAX_PROPELLER_RATE:
+        raise ValueError(f"field 'nominal_n' = {values['nominal_n']:g} rev/s ("
+                         f"{60 * values['nominal_n']:g} rpm) is beyond any propeller's rate "
+                         f"({MAX_PROPELLER_RATE:g} rev/s): is it rpm? Give "
+                         "{ value = ..., unit = \"rpm\" }.")
 
 
 def _comments(cls) -> dict:
