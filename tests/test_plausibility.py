@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship.identification import implausible, rudder_in_rad
+from jaxship.identification import implausible, rudder_in_rad, wind_too_strong
 
 
 DATA = js.shared_data_dir()
@@ -60,3 +60,15 @@ def test_a_mislabelled_or_flipped_rudder_on_measured_zigzags_is_said():
     assert all(rudder_in_rad(e) for e in rad) and not any(map(rudder_in_rad, records))
     assert sum("is the rudder in rad labelled deg?" in w
                for w in js.identify("nomoto1", rad, horizon=10.0).warnings) == 3
+
+
+def test_a_wind_beyond_hurricane_force_is_said():
+    """Issue 72: a logged wind of 250 m/s was not flagged; the Esso Osaka model's own
+    logged wind (a few m/s) is not."""
+    t = np.arange(0.0, 10.0, 0.5)
+    calm = js.Experiment(t, 0.1 * np.ones_like(t), psi=0.01 * t, wind_speed=np.full_like(t, 8.0),
+                         wind_dir=np.zeros_like(t), name="calm")
+    storm = eqx.tree_at(lambda e: e.wind_speed, calm, np.full_like(t, 250.0))
+    assert wind_too_strong(calm) is None
+    assert "reaches 250 m/s, beyond hurricane force" in wind_too_strong(storm)
+    assert "knots or km/h" in wind_too_strong(storm)

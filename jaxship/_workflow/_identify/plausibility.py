@@ -1,4 +1,5 @@
-"""What ships can do, checked on an identified steering model and on a record's rudder:
+"""What ships can do, checked on an identified steering model and on a record's rudder
+and wind:
 a value outside the range is a warning naming the likely unit slip or sign, never a
 silent success (issue 72).
 
@@ -33,6 +34,9 @@ T_MAX = 1000.0
 # a rudder of at most 35 deg logged in rad and read as deg peaks below 0.61 "deg"
 RUDDER_IN_RAD = np.radians(np.radians(35.0))
 TURNED = np.radians(10.0)  # ... while the heading turns this much: a manoeuvre, not drift
+# a logged wind [m/s] beyond hurricane force (Beaufort 12 from 32.7 m/s, WMO No. 8) with a
+# margin: no trial sails in it, and a wind in knots or km/h reads 1.9 or 3.6 times higher
+MAX_WIND = 40.0
 
 
 def nomoto_indices(model) -> tuple[float, float] | None:
@@ -98,3 +102,14 @@ def rudder_in_rad(experiment) -> str | None:
     return (f"{experiment.name}: the rudder never exceeds {np.degrees(np.max(delta)):.3g} deg "
             f"while the heading turns {np.degrees(turned):.0f} deg: is the rudder in rad "
             "labelled deg?")
+
+
+def wind_too_strong(experiment) -> str | None:
+    """A sentence when a record's logged wind exceeds `MAX_WIND`; None otherwise."""
+    if not experiment.has("wind_speed"):
+        return None
+    peak = float(np.nanmax(np.abs(np.asarray(experiment.wind_speed, dtype=np.float64))))
+    if not peak > MAX_WIND:
+        return None
+    return (f"{experiment.name}: the logged wind reaches {peak:.4g} m/s, beyond hurricane "
+            f"force (Beaufort 12 from 32.7 m/s): is wind_speed in knots or km/h?")
