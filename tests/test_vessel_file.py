@@ -168,6 +168,20 @@ def test_imo_check_of_a_preset_and_a_steering_model_refused(tmp_path, capsys):
     assert {"criteria.md", "imo_criteria.png", "turn35.png", "stop.png"} <= {
         p.name for p in out.iterdir()}
     assert "| criterion | value | limit | margin" in printed
+    assert "notes" not in indices and "Note:" not in (out / "criteria.md").read_text()
+
+
+def test_imo_check_below_the_resolutions_test_speed_says_so(tmp_path, capsys):
+    """Issue 72, point 5: MSC.137(76) tests at no less than 90 % of the service speed; an
+    approach at 1.2 m/s of the thesis vessel's 1.54 m/s is said on stderr, in criteria.md
+    and in indices.json."""
+    out = tmp_path / "imo"
+    assert main(["simulate", "--vessel", "thesis", "--manoeuvre", "imo", "--speed", "1.2",
+                 "--out", str(out)]) == 0
+    said = "the approach speed 1.2 m/s is 78 % of the service speed 1.54 m/s"
+    assert said in capsys.readouterr().err
+    assert said in (out / "criteria.md").read_text()
+    assert said in json.loads((out / "indices.json").read_text())["notes"][0]
 
 
 def test_imo_band_from_the_standard_errors_of_a_result(tmp_path, capsys):

@@ -18,6 +18,9 @@ from ._trials import StandardTrial, _cut_at_stop, _size, initial_state, length_o
 DRAWS = 64  # parameter draws of the band
 LEVEL = 0.9  # the band: the central 90 % of the draws' values
 SEED = 0
+# MSC.137(76), 4.2.1: the trials at a test speed of at least 90 % of the ship's speed at
+# 85 % of its maximum engine output (taken as the vessel's nominal, service speed)
+TEST_SPEED_SHARE = 0.9
 
 
 @dataclasses.dataclass(frozen=True)
@@ -25,20 +28,23 @@ class ImoCheck:
     """The IMO check of `check_imo`: the criteria `rows` (`CriterionRow`: value, limit,
     met), the `runs` `{trial as written: (manoeuvre, trajectory, marks)}` and the band:
     `bands` `{criterion: (low, high)}`, `passed` `{criterion: fraction of the draws that
-    meet it}`, `draws` (how many, how many ran, from what). `str()` is `table()`."""
+    meet it}`, `draws` (how many, how many ran, from what) and `notes` (e.g. an approach
+    below the resolution's test speed). `str()` is `table()`."""
 
     rows: list
     runs: dict
     bands: dict
     passed: dict
     draws: dict
+    notes: tuple = ()
 
     def to_dict(self) -> dict:
         rows = [row.to_dict() | {"margin": row.limit - row.value,
                                  "band": list(self.bands.get(row.criterion, ())) or None,
                                  "passed_in_draws": self.passed.get(row.criterion)}
                 for row in self.rows]
-        return {"imo_criteria": rows, "uncertainty": self.draws}
+        return {"imo_criteria": rows, "uncertainty": self.draws} | (
+            {"notes": list(self.notes)} if self.notes else {})
 
     def table(self) -> str:
         """The criteria as a markdown table: value, limit, margin, band, met."""
@@ -60,7 +66,8 @@ class ImoCheck:
         what the band was drawn from."""
         return (f"# IMO MSC.137(76) criteria: {title}\n\n{self.table()}\nBand: the central "
                 f"{self.draws['level']:.0%} of {self.draws['used']} of {self.draws['draws']} "
-                f"parameter draws from {self.draws['from']}.\n")
+                f"parameter draws from {self.draws['from']}.\n"
+                + "".join(f"\nNote: {n}\n" for n in self.notes))
 
 
 def parameter_draws(report, rng) -> tuple[tuple, np.ndarray, str]:
@@ -116,6 +123,11 @@ def check_imo(model, *, identification=None, speed=None, rpm=None) -> ImoCheck:
     runs, batch, rows = {}, {}, []
     x0 = initial_state(model, speed=speed, rpm=rpm)
     tau = length_over_speed(model, x0)
+    approach, service = float(np.hypot(x0.u, x0.v)), float(model.nominal_speed)
+    notes = () if approach >= TEST_SPEED_SHARE * service else (
+        f"the approach speed {approach:.3g} m/s is {100 * approach / service:.0f} % of the "
+        f"service speed {service:.3g} m/s; MSC.137(76) 4.2.1 tests at no less than "
+        f"{100 * TEST_SPEED_SHARE:.0f} % of it, so these criteria are not the resolution's.",)
     for trial in StandardTrial.imo(model):
         manoeuvre, traj = _size(trial, model, x0, tau, duration=None, dt=None)
         traj = js.simulate(model, manoeuvre, x0, simulator=StandardTrial.simulator) \
@@ -136,7 +148,7 @@ def check_imo(model, *, identification=None, speed=None, rpm=None) -> ImoCheck:
             passed[criterion] = float(np.mean(met))
     info = {"draws": DRAWS if names else 0, "used": used, "level": LEVEL, "from": how,
             "parameters": list(names), "seed": SEED}
-    return ImoCheck(rows, runs, bands, passed, info)
+    return ImoCheck(rows, runs, bands, passed, info, notes)
 
 
 def _drawn_criteria(vessel, names, draws, batch, *, speed, rpm):

@@ -117,6 +117,8 @@ def run_imo(args, chosen, vessel, *, speed, rpm) -> int:
                for spec in StandardTrial.imo(vessel)]
     check_out(args.out, writes=("criteria.md", "indices.json", "imo_criteria.png", *figures))
     check = check_imo(vessel, identification=chosen.report, speed=speed, rpm=rpm)
+    for text in check.notes:
+        print(f"jaxship: warning: {text}", file=sys.stderr)
     with staged_folder(args.out) as stage:
         (stage / "criteria.md").write_text(check.to_markdown(chosen.label))
         (stage / "indices.json").write_text(json.dumps(check.to_dict(), indent=2) + "\n")
