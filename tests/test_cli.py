@@ -1162,7 +1162,10 @@ def test_a_horizon_beyond_the_records_is_said(record, tmp_path, capsys):
                  "--quiet", "--out", str(tmp_path / "out")]) == 0
     out = capsys.readouterr().out
     assert "--horizon 10000 s) is not shorter than any training record" in out, out
-    assert "output error" in out
+    # issue 72: it said "(--horizon none)", whose fit estimates the first state
+    assert "output error from each record's measured first state" in out
+    options = json.loads((tmp_path / "out" / "result.json").read_text())["options"]
+    assert options["initial"] == "measured"
 
 
 def test_validating_on_the_training_record_is_said(record, tmp_path, capsys):

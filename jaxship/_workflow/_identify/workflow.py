@@ -346,9 +346,12 @@ def _fitted_channels(records, options, notes) -> tuple[str, ...]:
     channels, default_channels = options.channels, options.default_channels
     longest = max(e.duration for e in records.train)
     if options.horizon is not None and options.horizon >= longest:
+        start = ("from each record's measured first state (--horizon none estimates that "
+                 "state too: --initial estimate)" if options.initial == "measured" else
+                 "from an estimated first state, as --horizon none")
         notes.append(f"the horizon (--horizon {options.horizon:g} s) is not shorter than any "
                      f"training record (the longest: {longest:.4g} s): each record is one "
-                     "window, so the fit is output error (--horizon none).")
+                     f"window, so the fit is output error {start}.")
     if default_channels:  # a default u or v that never varies (e.g. no surge dynamics)
         constant = [c for c in channels
                     if c in ("u", "v") and np.ptp(valid_samples(records.train_ds, c)) == 0]
