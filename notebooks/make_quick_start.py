@@ -31,7 +31,7 @@ autopilot = js.design_autopilot(fit, plant=ship, speeds=[U])  # the command's ru
 print(f"K_p = {float(autopilot.kp):.3g}, K_i = {float(autopilot.ki):.3g} 1/s, "
       f"K_d = {float(autopilot.kd):.3g} s")
 evaluation = js.evaluate_autopilot(fit, ship, speeds=[U])  # PID +- feed-forward, closed loop
-print(evaluation.summary())"""
+display(Markdown(evaluation.summary()))"""
 
 CELLS = [
     new_markdown_cell("""# Quick start: a turning circle and a zig-zag
