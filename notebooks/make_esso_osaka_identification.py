@@ -75,7 +75,11 @@ long run."""),
     # them 20 s ahead better in psi, r and v (not in u: the fit trades surge accuracy
     # over short windows for the steering channels, 78.7 % against the preset's 87.8 %)
     fitted = esso.models[0]
-    assert fitted.result.success, fitted.result.message
+    # the optimiser converged, but by their robust (HAC) errors these runs leave y_r (61 %)
+    # and gamma_p (110 %) undetermined: the fit says so, poorly_determined (issue 72)
+    assert fitted.result.result == js.RESULTS.poorly_determined, fitted.result.message
+    assert [f.split(" ")[0] for f in fitted.result.parameters.undetermined] == ["y_r",
+                                                                                 "gamma_p"]
     for key, channels in (("simulation", ("psi", "r", "u", "v")),
                           ("T_p = 20 s", ("psi", "r", "v"))):
         for c in channels:

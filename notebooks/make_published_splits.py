@@ -73,7 +73,8 @@ if os.environ.get("CI") and not HAVE:
 # what benchmarks/published_splits.py recorded (in a checkout of the repository)
 RECORDED = pathlib.Path.cwd().parent / "benchmarks" / "results" / "published_splits.json"
 recorded = json.loads(RECORDED.read_text()) if RECORDED.is_file() else None
-print("recorded results:", RECORDED if recorded else "absent (not a checkout)")"""),
+print("recorded results:", "../benchmarks/results/published_splits.json" if recorded
+      else "absent (not a checkout)")"""),
     new_markdown_cell("## The splits"),
     new_code_cell("""rows = ["| paper | set | runs |", "|---|---|---|"]
 for paper, split in SPLITS.items():
@@ -97,7 +98,9 @@ print("jaxship identify's defaults for esso_osaka:", js.VESSELS["esso_osaka"].fi
     reader = protocol.Reader()
     fitted, code = protocol.identify(reader, SPLITS["Miyauchi 2022"]["Train-R"], None)
     print(f"exit {code}, {time.perf_counter() - t0:.0f} s")
-    assert code == 0"""),
+    # exit 3: the optimiser converged, but by their robust (HAC) errors the training runs
+    # leave some coefficients undetermined, which the fit now says (issue 72)
+    assert code == 3"""),
     new_markdown_cell("""## Every test run of both papers, free simulation
 
 The r cut is the reduction of the yaw-rate RMSE against the stronger lab column on that
