@@ -8,14 +8,13 @@ import numpy as np
 import pytest
 
 from jaxship._foundation._covariance import (
-    RobustErrors,
     bartlett_long_run,
     cluster_from_windows,
     hac_covariance,
     hac_from_windows,
     least_squares_covariance,
-    parameter_report,
 )
+from jaxship._foundation._parameter_report import RobustErrors, parameter_report
 from jaxship._foundation._validate import (
     Z99,
     chi2_quantile_99,

@@ -26,7 +26,7 @@ import optimistix as optx
 import scipy  # scipy.signal loads on first use (an import-time saving)
 
 from .._foundation._contract import parameter_fields
-from .._foundation._covariance import parameter_report
+from .._foundation._parameter_report import parameter_report
 from .._models._armax_model import ARMAX_NAMES, ARMAX_ORDERS, ARMAXModel
 from ._discrete import continuous_parameters
 from ._excitation import excitation_flags

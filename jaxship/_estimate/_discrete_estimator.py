@@ -17,7 +17,7 @@ import numpy as np
 import optimistix as optx
 
 from .._foundation._contract import parameter_fields
-from .._foundation._covariance import parameter_report
+from .._foundation._parameter_report import parameter_report
 from .._models._effects import AugmentedSteering, YawCubicDamping
 from .._models._holds import ZeroOrderHold
 from .._models._steering.nomoto import Nomoto1, Nomoto2, NonlinearNomoto

@@ -25,12 +25,11 @@ import optimistix as optx
 
 from .._foundation._contract import rebuild
 from .._foundation._covariance import (
-    RobustErrors,
     cluster_from_windows,
     hac_from_windows,
     least_squares_covariance,
-    parameter_report,
 )
+from .._foundation._parameter_report import RobustErrors, parameter_report
 from .._foundation._params import Transform, as_arrays, resolve_free
 from .._foundation._progress import ProgressCallback, reporting_steps
 from .._foundation._sharding import sharded_vmap

@@ -12,7 +12,8 @@ import numpy as np
 import optimistix as optx
 
 from .._foundation._contract import rebuild
-from .._foundation._covariance import least_squares_covariance, parameter_report
+from .._foundation._covariance import least_squares_covariance
+from .._foundation._parameter_report import parameter_report
 from .._foundation._params import Transform, as_arrays, resolve_free
 from .._models._holds import FirstOrderHold, ZeroOrderHold
 from .._models._steering._base import AbstractSteeringModel

@@ -10,8 +10,8 @@ import equinox as eqx
 import numpy as np
 
 from .._foundation._contract import get_path, parameter_fields
-from .._foundation._covariance import ParameterReport
 from .._foundation._frames import fit_to_dataframe
+from .._foundation._parameter_report import ParameterReport
 from .._foundation._validate import ValidationReport, _to_plain, validate
 from ._lm import RESULTS, SolverOutcome
 

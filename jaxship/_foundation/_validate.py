@@ -1,6 +1,6 @@
 """Validation figures of an identified model: loss, FPE, AIC/BIC, fit %, residual
-whiteness and residual-input independence (parameter uncertainty and
-identifiability: `jaxship._foundation._covariance`).
+whiteness and residual-input independence (parameter uncertainty:
+`jaxship._foundation._covariance`; identifiability: `_parameter_report`).
 
 Definitions follow the thesis (seed 000, eq. 3.18-3.23) and Ljung (1999), *System
 Identification*, 2nd ed., ch. 16. Everything here is host-side NumPy (float64): these
