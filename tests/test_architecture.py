@@ -739,7 +739,8 @@ def test_every_outcome_carries_a_result_code():
         assert isinstance(vars(result).get("success") or getattr(result, "success"), property)
     verdict = {f.name: f.type for f in dataclasses.fields(js.DiscoveryReport)}["verdict"]
     assert "Verdict" in str(verdict)
-    assert set(js.Verdict._name_to_item) == {"missing_effect", "nothing_missing"}
+    assert set(js.Verdict._name_to_item) == {"missing_effect", "nothing_missing",
+                                             "cannot_judge"}
 
 
 MAX_LINES, MAX_PARAMETERS = 80, 8

@@ -9,6 +9,7 @@ turning circles (another manoeuvre type)."""
 
 import dataclasses
 import json
+import types
 
 import numpy as np
 import pytest
@@ -696,7 +697,8 @@ def test_an_interrupted_discover_command_leaves_the_earlier_results(tmp_path, ca
         (folder / "residuals.png").write_bytes(b"partial")
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(js, "discover", lambda *args, **kwargs: None)
+    monkeypatch.setattr(js, "discover", lambda *args, **kwargs: types.SimpleNamespace(
+        disagreement={"before": {}}))  # a report whose figures are drawn
     monkeypatch.setattr(command, "save_discovery_figures", half_written)
     assert main(["discover", str(record), "--model", "nomoto1", "--out", str(out),
                  "--quiet"]) == 130
@@ -835,14 +837,63 @@ def test_a_report_says_first_when_the_base_model_does_not_describe_the_records(m
 
 
 @pytest.mark.parametrize("duration", [0.2, 1.0])
-def test_a_record_too_short_to_judge_is_refused_not_nothing_missing(duration):
-    """Issue 57 case 4: `discover` on one record of 0.2 s or 1 s said "nothing missing";
-    its base fit leaves K and T undetermined (only K/T shows in so short a turn), so no
-    missing effect can be judged: a `FitError` saying so (the command's exit 3)."""
+def test_a_record_too_short_to_judge_is_called_so_not_nothing_missing(duration):
+    """Issue 57 case 4 and issue 72: `discover` on one record of 0.2 s or 1 s said
+    "nothing missing". No effect has a 60 s prediction window to show in so short a
+    record: the verdict is `cannot_judge`, "too short to judge", nothing scored."""
     truth = js.Nomoto1(K=0.06, T=25.0)
     delta = np.full(int(round(duration / 0.1)) + 1, 10 * DEG)
     tr = js.simulate(truth, js.Replay(delta, dt=0.1))
     short = js.Experiment(np.asarray(tr.t), delta, psi=np.asarray(tr.state.psi),
                           r=np.asarray(tr.state.r), name="short")
-    with pytest.raises(js.FitError, match="cannot tell whether an effect is missing"):
-        js.discover(js.Nomoto1(K=0.05, T=20.0), [short])
+    report = js.discover(js.Nomoto1(K=0.05, T=20.0), [short])
+    assert report.verdict == js.Verdict.cannot_judge and report.verdict_name == "cannot_judge"
+    assert "too short to judge" in report.why and f"lasts {duration:g} s" in report.why
+    assert report.scores == {} and report.effects == () and report.disagreement == {}
+    assert report.to_markdown().splitlines()[2].startswith("**Verdict: cannot judge.** The "
+                                                           "training records are too short")
+    assert report.to_dict()["verdict"] == "cannot_judge"
+
+
+def test_discover_on_records_of_two_ships_cannot_judge_and_exits_3(tmp_path, capsys):
+    """Issue 72, broken case 6: a thesis and a Mariner zig-zag with base model nomoto1 gave
+    "nothing missing", exit 0, with training fits of 18 % and -94 %. The base model's
+    r fit on the Mariner record, over its own prediction windows, is -253 %: the
+    verdict is `cannot_judge`, the report says why and where, and the command exits 3
+    with its results written (the exit-3 promise)."""
+    for vessel, duration in (("thesis", "200"), ("mariner", "400")):
+        assert main(["simulate", "--vessel", vessel, "--manoeuvre", "zigzag:20/20",
+                     "--duration", duration, "--out", str(tmp_path / vessel)]) == 0
+    capsys.readouterr()
+    out = tmp_path / "d"
+    assert main(["discover", str(tmp_path / "thesis" / "trial.csv"),
+                 str(tmp_path / "mariner" / "trial.csv"), "--model", "nomoto1", "--out",
+                 str(out), "--quiet"]) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("jaxship: error: the base model does not describe the "
+                              "training records"), err
+    assert "mariner/trial r -" in err[-1] and "thesis/trial" not in err[-1], err
+    written = json.loads((out / "discovery.json").read_text())
+    assert written["verdict"] == "cannot_judge" and written["effects"] == []
+    assert written["why"] == err[-1].removeprefix("jaxship: error: ")
+    assert (out / "report.md").read_text().splitlines()[2].startswith(
+        "**Verdict: cannot judge.** The base model does not describe")
+    assert sorted(p.name for p in (out / "figures").iterdir()) == ["residuals_00.png",
+                                                                   "residuals_01.png"]
+
+
+def test_discover_on_a_three_row_record_writes_its_report_and_exits_3(tmp_path, capsys):
+    """Issue 72: a 3-row record ended in exit 3 with nothing written, though exit 3
+    promises results written. It is too short to judge: the report is written."""
+    assert main(["simulate", "--vessel", "thesis", "--manoeuvre", "zigzag:20/20",
+                 "--duration", "20", "--out", str(tmp_path / "z")]) == 0
+    lines = (tmp_path / "z" / "trial.csv").read_text().splitlines()
+    (tmp_path / "three.csv").write_text("\n".join(lines[:4]) + "\n")
+    capsys.readouterr()
+    assert main(["discover", str(tmp_path / "three.csv"), "--model", "nomoto1", "--out",
+                 str(tmp_path / "d"), "--quiet"]) == 3
+    err = capsys.readouterr().err
+    assert "too short to judge: the longest lasts 0.2 s" in err, err
+    assert json.loads((tmp_path / "d" / "discovery.json").read_text())["verdict"] == \
+        "cannot_judge"
+    assert not (tmp_path / "d" / "figures").exists()

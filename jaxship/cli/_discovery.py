@@ -61,9 +61,11 @@ def run_discovery(train_paths, holdout_paths, *, model, out: pathlib.Path,
     start = identify(model, train, name=name if settings.name else None).model
     report = js.discover(start, train, holdout, options=options, progress=progress)
     with staged_folder(pathlib.Path(out)) as stage:  # all or nothing
-        figures = save_discovery_figures(report, train, holdout, stage / "figures")
+        # records that cannot judge: the figures where the disagreement could be located
+        figures = save_discovery_figures(report, train, holdout, stage / "figures") \
+            if report.disagreement else []
         text = report.to_markdown()
-        text += "\n## Figures\n\n" + "\n".join(f"![{p.stem}](figures/{p.name})"
+        text += "\n## Figures\n\n" * bool(figures) + "\n".join(f"![{p.stem}](figures/{p.name})"
                                                 for p in figures)
         (stage / "discovery.json").write_text(json.dumps(report.to_dict(), indent=2) + "\n")
         (stage / "report.md").write_text(text + "\n")

@@ -1,6 +1,7 @@
 """`jaxship discover`: find, name and add the effect a model is missing."""
 
 import pathlib
+import sys
 
 from .. import DiscoveryOptions
 from ._common import (
@@ -54,5 +55,9 @@ def run(args) -> int:
                                         note=note),
                            progress=ProgressBar(not args.quiet))
     print(report.to_markdown())
-    print(f"wrote {args.out}/discovery.json, {args.out}/report.md, {args.out}/figures/")
+    print(f"wrote {args.out}/discovery.json, {args.out}/report.md"
+          + f", {args.out}/figures/" * (args.out / "figures").is_dir())
+    if report.why:  # Verdict.cannot_judge: results written, the reason on stderr
+        print(f"jaxship: error: {report.why}", file=sys.stderr)
+        return 3
     return 0

@@ -88,13 +88,17 @@ class Verdict(eqx.Enumeration):
                       "likelihood-ratio, held-out and plausibility tests (see `effects`)")
     nothing_missing = ("no candidate of the catalogue passed the tests: nothing it holds is "
                        "missing from the model (see `rejected` and `scores`)")
+    cannot_judge = ("the training records cannot judge whether an effect is missing: too "
+                    "short, or the base model does not describe them (see `why`); no "
+                    "candidate was scored")
 
 
 class DiscoveryReport(eqx.Module):
     """The outcome of `discover`.
 
-    - `verdict`: the `Verdict` code, `Verdict.missing_effect` or `Verdict.nothing_missing`
-      (`verdict_name`: its name, as in the JSON);
+    - `verdict`: the `Verdict` code, `Verdict.missing_effect`, `Verdict.nothing_missing`
+      or `Verdict.cannot_judge` (`verdict_name`: its name, as in the JSON), and `why`:
+      the sentence saying why the records cannot judge (empty otherwise);
     - `effects`: the accepted effects in order (`CandidateOutcome`s with empty `why`);
     - `rejected`: candidates refitted or scored that did not pass (`CandidateOutcome`s
       with their reasons in `why`; a joint step's set as one entry, its ids joined by
@@ -127,11 +131,13 @@ class DiscoveryReport(eqx.Module):
     alpha: float
     channels: tuple
     disagreement: dict
+    why: str | None = None
 
     @property
     def verdict_name(self) -> str:
-        """`"missing_effect"` or `"nothing_missing"`."""
-        return "missing_effect" if self.verdict == Verdict.missing_effect else "nothing_missing"
+        """`"missing_effect"`, `"nothing_missing"` or `"cannot_judge"`."""
+        return next(name for name in ("missing_effect", "nothing_missing", "cannot_judge")
+                    if self.verdict == getattr(Verdict, name))
 
     @property
     def named(self) -> tuple[str, ...]:
@@ -147,7 +153,7 @@ class DiscoveryReport(eqx.Module):
         keys = ("verdict", "effects", "rejected", "scores", "train_cost_before",
                 "train_cost_after", "holdout_cost_before", "holdout_cost_after",
                 "holdout_fit_percent_before", "holdout_fit_percent_after",
-                "holdout_indices", "alpha", "disagreement")
+                "holdout_indices", "alpha", "disagreement", "why")
         plain = {k: getattr(self, k) for k in keys} | {"verdict": self.verdict_name}
         return _plain(plain | {"channels": list(self.channels)})
 
@@ -169,6 +175,8 @@ class DiscoveryReport(eqx.Module):
                                  f"{p.interval[0]:.4g} to {p.interval[1]:.4g} | {unit} | "
                                  f"{e.score:.3g} | {e.likelihood_ratio:.3g} | "
                                  f"{e.p_value:.2g} | {e.delta_bic:.1f} | {twins or '-'} |")
+        elif self.why:
+            lines.append(f"**Verdict: cannot judge.** {self.why[:1].upper()}{self.why[1:]}")
         else:
             best = max(self.scores.items(), key=lambda kv: kv[1].score, default=None)
             lines.append("**Verdict: nothing missing.** No candidate passed the calibrated "
@@ -176,9 +184,11 @@ class DiscoveryReport(eqx.Module):
             if best:
                 lines.append(f"The largest robust score was {best[1].score:.3g} "
                              f"({best[0]}), against a threshold of {best[1].threshold:.3g}.")
-        lines += _where(self.disagreement["before"], self.disagreement["after"])
-        lines += ["", "## Candidates at the base fit", "",
-                  "| candidate | robust score | naive score | threshold |", "|---|---|---|---|"]
+        if self.disagreement:
+            lines += _where(self.disagreement["before"], self.disagreement["after"])
+        if self.scores:
+            lines += ["", "## Candidates at the base fit", "", "| candidate | robust score | "
+                      "naive score | threshold |", "|---|---|---|---|"]
         for k, s in sorted(self.scores.items(), key=lambda kv: -kv[1].score):
             lines.append(f"| {k} | {s.score:.3g} | {s.score_naive:.3g} | {s.threshold:.3g} |")
         if self.rejected:
