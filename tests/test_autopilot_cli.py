@@ -246,6 +246,15 @@ def _bad_cases(tmp_path, identified):
         # determine) asked for a run of 1e14 s and ended in an out-of-memory traceback
         (["--model", str(crafted("slow", {"parameters": {"K": 0.2, "T": 1e12}})), "--vessel",
           "thesis", "--rpm", "300"] + out, "samples of 0.1 s (at most 1e+06): omega_n = 1.25e-12"),
+        # issue 72: K < 0 first asked for --natural-frequency; K = 1e-9 (T = 1.8 s) blamed
+        # "so long a yaw time constant": each now names its cause first
+        (["--model", str(crafted("against", {"parameters": {"K": -0.05, "T": 1.8}})),
+          "--vessel", "thesis", "--rpm", "300"] + out,
+         "error: the Nomoto1 model turns the ship against its rudder"),
+        (["--model", str(crafted("deaf", {"parameters": {"K": 1e-9, "T": 1.8}})),
+          "--vessel", "thesis", "--rpm", "300"] + out,
+         "error: the Nomoto1 model barely answers its rudder: its steady yaw rate per radian "
+         "of rudder, 1/d = 1e-09 1/s"),
         (model + ["--vessel", "thesis", "--rpm", "300", "--out", str(a_file)], "is a file"),
         (model + ["--vessel", "thesis", "--rpm", "300", "--out", str(a_file / "sub")],
          "is a file"),

@@ -275,6 +275,18 @@ def reference_rudder_frequency(m: float, d: float, step: float, max_angle: float
     return low
 
 
+def steered_inertia(model, *, speed: float, n: float) -> tuple[float, float]:
+    """`(m, d)` of `jaxship.yaw_inertia`; `ValueError` where m <= 0: the model turns the
+    ship against its rudder (K < 0 for Nomoto's), and no design can steer it."""
+    m, d = (float(x) for x in js.yaw_inertia(model, speed=speed, n=n))
+    if not m > 0:
+        raise ValueError(f"the {type(model).__name__} model turns the ship against its rudder "
+                         f"at {speed:.3g} m/s (yaw inertia m = {m:.3g}; K < 0 for Nomoto's): "
+                         "no autopilot design. Is the rudder of its records signed the other "
+                         "way (positive to port)?")
+    return m, d
+
+
 def natural_frequency_for(model, plant, *, speed: float, n: float,
                           step: float = 45.0) -> tuple[float, str]:
     """`(omega_n, basis)`: the controller's natural frequency [rad/s] from the model's
@@ -284,8 +296,8 @@ def natural_frequency_for(model, plant, *, speed: float, n: float,
     model) and at most what keeps the reference's feed-forward rudder for the `step`
     [deg] within half the rudder's angle and rate limits (`reference_rudder_frequency`,
     the reference at 0.4 omega_n), with the sentence saying which bound holds."""
-    m, d = (float(x) for x in js.yaw_inertia(model, speed=speed, n=n))
-    if not (m > 0 and d != 0 and math.isfinite(m / d)):
+    m, d = steered_inertia(model, speed=speed, n=n)
+    if not (d != 0 and math.isfinite(m / d)):
         raise ValueError(f"the {type(model).__name__} model has no yaw time constant at "
                          f"{speed:.3g} m/s (m = {m:.3g}, d = {d:.3g}); give "
                          "--natural-frequency.")
@@ -299,6 +311,14 @@ def natural_frequency_for(model, plant, *, speed: float, n: float,
               f"({math.degrees(float(plant.rudder.max_angle)):.3g} deg, "
               f"{math.degrees(float(plant.rudder.max_rate)):.3g} deg/s)": rudder}
     limited, w = min(bounds.items(), key=lambda item: item[1])
+    if w < 1e-3 * bounds["1.25 / T"]:  # the rudder bound, a thousand times below 1.25 / T
+        raise ValueError(f"the {type(model).__name__} model barely answers its rudder: its "
+                         f"steady yaw rate per radian of rudder, 1/d = {1 / d:.3g} 1/s at "
+                         f"{speed:.3g} m/s, keeps the feed-forward of the {step:g} deg step "
+                         f"within half the rudder's limits only at omega_n = {w:.3g} rad/s, "
+                         f"against 1.25 / T = {BANDWIDTH_TIMES_T / T:.3g} rad/s from its yaw "
+                         f"time constant T = {T:.3g} s. Check the model's gain K (its units?), "
+                         "or give --natural-frequency.")
     return w, (f"omega_n = {w:.4g} rad/s from the model's yaw time constant T = {T:.4g} s at "
                f"{speed:.3g} m/s ({limited}; at most 0.5 / T_servo = {0.5 / servo:.3g} "
                f"rad/s and {rudder:.3g} rad/s for the rudder), the reference and timing in "
@@ -323,11 +343,7 @@ def design_controllers(model, plant, design: AutopilotDesign = AutopilotDesign()
               max_rate=float(plant.rudder.max_rate), interval=design.interval, speed=speed,
               n=n, subtract_damping=design.subtract_damping)
     for each in (model, feedback):
-        m = float(js.yaw_inertia(each, speed=speed, n=n)[0])
-        if not m > 0:
-            raise ValueError(f"the {type(each).__name__} model turns the ship against its "
-                             f"rudder at {speed:.3g} m/s (yaw inertia m = {m:.3g}): no "
-                             "autopilot design.")
+        steered_inertia(each, speed=speed, n=n)
     inverse = js.Feedforward(model, steady_gain=steady_gain)
     return {"pid+ff": design_pid(feedback, feedforward=inverse, **kw),
             "pid": design_pid(feedback, feedforward=False, **kw)}
