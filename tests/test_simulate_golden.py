@@ -82,3 +82,24 @@ def test_simulate_of_a_standard_trial_is_the_commands_trial(spec, tmp_path):
     indices = {k: None if isinstance(v, float) and not math.isfinite(v) else v
                for k, v in trial.indices(manoeuvre, traj).items()}  # as indices.json
     assert indices == {k: v for k, v in golden["indices"].items() if k != "imo_criteria"}
+
+
+def test_a_band_from_draws_that_mostly_blew_up_is_not_given(tmp_path):
+    """Issue 72: a result.json with a std of 1e6 dropped 34 of 64 draws, and the band
+    then excluded the fitted value (advance 3.50 L, band 0.23-0.29 L) with no warning.
+    Under half the draws running: no band, and a note saying why; otherwise every draw
+    left out and every value outside its own band is noted."""
+    report = json.loads(pathlib.Path(cases.thesis_result(tmp_path)).read_text())
+    vessel = js.get_vessel("thesis")
+    rpm = 60.0 * float(vessel.nominal_n)
+    wide = json.loads(json.dumps(report))
+    for entry in wide["parameters"].values():
+        entry["std"] = 1e6
+    check = js.indices.check_imo(vessel, identification=wide, rpm=rpm)
+    assert check.draws["used"] < 32 and check.bands == {}, check.to_dict()
+    assert any(n.startswith("only ") and "no band is given" in n for n in check.notes)
+    assert "no band is given" in check.to_markdown("wide")
+    fine = js.indices.check_imo(vessel, identification=report, rpm=rpm)
+    assert fine.bands and all(lo <= row.value <= hi for row in fine.rows
+                              for lo, hi in [fine.bands[row.criterion]]), fine.notes
+    assert not any("band" in n for n in fine.notes)

@@ -148,7 +148,29 @@ def check_imo(model, *, identification=None, speed=None, rpm=None) -> ImoCheck:
             passed[criterion] = float(np.mean(met))
     info = {"draws": DRAWS if names else 0, "used": used, "level": LEVEL, "from": how,
             "parameters": list(names), "seed": SEED}
+    if names:
+        bands, passed, said = _trusted_bands(rows, bands, passed, used)
+        notes += said
     return ImoCheck(rows, runs, bands, passed, info, notes)
+
+
+def _trusted_bands(rows, bands, passed, used) -> tuple[dict, dict, tuple[str, ...]]:
+    """`(bands, passed, notes)`: no band where fewer than half the draws ran every trial
+    (those that ran are a biased half: the standard errors reach where the model blows
+    up), and a note for draws left out and for a value outside its own band."""
+    if used < DRAWS / 2:
+        return {}, {}, (f"only {used} of {DRAWS} parameter draws ran every trial (the others "
+                        "blew up): the standard errors reach where the model cannot run, so "
+                        "no band is given; identify on records that determine the model.",)
+    notes = (f"{DRAWS - used} of {DRAWS} parameter draws blew up in a trial and are left out "
+             f"of the bands, drawn from the {used} that ran.",) if used < DRAWS else ()
+    outside = [f"{row.criterion} ({row.value:.3g} {row.unit})" for row in rows
+               if row.criterion in bands
+               and not bands[row.criterion][0] <= row.value <= bands[row.criterion][1]]
+    if outside:
+        notes += (f"the fitted value lies outside its own {LEVEL:.0%} band for "
+                  f"{', '.join(outside)}: the draws do not describe the fit there.",)
+    return bands, passed, notes
 
 
 def _drawn_criteria(vessel, names, draws, batch, *, speed, rpm):
