@@ -4,6 +4,7 @@ not write are removed."""
 
 import json
 import os
+import pathlib
 import signal
 import subprocess
 import sys
@@ -298,6 +299,26 @@ def test_concurrent_runs_on_one_folder_take_turns_and_never_mix(tmp_path):
     assert sorted(written) == sorted(read_manifest(tmp_path)) == sorted(
         ["trial.csv", "indices.json", "trial.png", "figures/a.png"])
     assert not list(tmp_path.glob(".jaxship.*"))
+
+
+def test_a_killed_run_not_yet_reaped_leaves_nothing_for_the_next(tmp_path):
+    """Issue 72: a run SIGKILLed while holding the lock in its commit left its stage and
+    backup folders hidden in --out until a third run: its parent had not reaped it, and
+    a zombie passed for alive. The next run finishes or undoes its commit and removes
+    its folders at once."""
+    write(tmp_path, OLD)
+    run = subprocess.Popen([sys.executable, "-c", KILLED_COMMIT, _files.__file__,
+                            str(tmp_path), "3", json.dumps(NEW)])
+    stat = pathlib.Path(f"/proc/{run.pid}/stat")
+    for _ in range(600):  # killed by itself mid-commit, and left unreaped
+        if stat.exists() and stat.read_text().rsplit(")", 1)[1].split()[0] == "Z":
+            break
+        time.sleep(0.1)
+    assert (tmp_path / _files.JOURNAL).exists() and list(tmp_path.glob(".jaxship.*.old.*"))
+    write(tmp_path, {"result.json": "newer"})
+    assert files(tmp_path) == {"result.json": "newer"}
+    assert not list(tmp_path.glob(".jaxship.*")), list(tmp_path.iterdir())
+    assert run.wait(timeout=60) == -signal.SIGKILL
 
 
 def test_a_killed_holder_of_the_lock_leaves_it_free(tmp_path):

@@ -236,10 +236,17 @@ def _remove_stale(out: pathlib.Path):
 
 
 def _alive(pid: int) -> bool:
+    """Whether process `pid` runs: a killed process that its parent has not yet reaped
+    (a zombie, Linux's /proc state Z) no longer does, and its leftovers go now, not a
+    run later."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except PermissionError:  # another user's process
         return True
-    return True
+    try:
+        stat = pathlib.Path(f"/proc/{pid}/stat").read_text()
+    except OSError:  # no /proc (macOS): a zombie counts as alive until reaped
+        return True
+    return stat[stat.rindex(")") + 2:][:1] != "Z"
