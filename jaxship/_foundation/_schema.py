@@ -7,6 +7,7 @@ unit is the likely cause, the unit; it comes before any work (issue 72)."""
 import dataclasses
 import json
 import math
+import numbers
 import pathlib
 
 
@@ -76,7 +77,7 @@ class Field:
     slip outside it ("is it rpm?"), whether it is `required`, may be `null`, may be a
     non-finite number as JSON writes one (`nonfinite`: null, "inf", "-inf"); a table's
     `fields` (a spec) or `each` (a `Field` for every value), a list's `each`; `label`:
-    how a refusal names it ("{path}", "{key}")."""
+    how a refusal names it ("{path}", "{key}", "{parent}": the key of the table it is in)."""
 
     kind: str | tuple = "number"
     unit: str = ""
@@ -123,15 +124,18 @@ def shown(value) -> str:
 def number(value, field: Field = Field(), name: str = "field") -> float:
     """`value` as a float checked against `field` (no boolean, finite unless
     `field.nonfinite`, within its range); `name` is how the refusal names it."""
-    if field.nonfinite and value in (None, "inf", "-inf"):
+    if field.nonfinite and (value is None or isinstance(value, str) and value in ("inf", "-inf")):
         return math.nan if value is None else float(value)
-    if isinstance(value, bool):
+    if isinstance(value, bool) and not field.nonfinite:
         raise ValueError(f"{name} is {shown(value)}, a boolean, not a number.")
-    if not isinstance(value, (int, float)):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ValueError(f"{name} is {shown(value)}, not a number.")
-    if field.kind == "integer" and not float(value).is_integer():
+    try:
+        value = float(value)
+    except OverflowError:  # an integer beyond any float
+        value = math.copysign(math.inf, value)
+    if field.kind == "integer" and math.isfinite(value) and not value.is_integer():
         raise ValueError(f"{name} is {value!r}, not a whole number.")
-    value = float(value)
     if not (math.isfinite(value) or field.nonfinite):
         raise ValueError(f"{name} is {value!r}: give a finite number.")
     if math.isfinite(value) and not (field.low < value if field.above else field.low <= value) \
@@ -143,7 +147,7 @@ def number(value, field: Field = Field(), name: str = "field") -> float:
     return value
 
 
-def check(spec: dict, data, path: str = "", *, file: str = "") -> None:
+def check(spec: dict, data, path: str = "", *, file: str = "", parent: str = "") -> None:
     """Check the parsed mapping `data` against `spec` (`{name: Field}`): a one-line
     `ValueError` `"<file>: field '<path.name>' ..."` at the first field that is missing,
     of the wrong kind or shape, non-finite or out of its range. Fields not in `spec` are
@@ -153,26 +157,30 @@ def check(spec: dict, data, path: str = "", *, file: str = "") -> None:
             where = f"{path}.{name}" if path else name
             if name not in data:
                 if field.required:
-                    raise ValueError(f"{field.label.format(path=where, key=name)} is missing.")
+                    raise ValueError(f"{_name(field, where, name, parent)} is missing.")
                 continue
-            _value(field, data[name], where, name, data)
+            _value(field, data[name], where, name, data, parent)
     except ValueError as error:
         raise ValueError(f"{file}: {error}" if file else str(error)) from None
 
 
-def _value(field: Field, value, where: str, key: str, siblings) -> None:
-    name = field.label.format(path=where, key=key)
+def _name(field: Field, where: str, key: str, parent: str) -> str:
+    return field.label.format(path=where, key=key, parent=parent)
+
+
+def _value(field: Field, value, where: str, key: str, siblings, parent: str) -> None:
+    name = _name(field, where, key, parent)
     if value is None and field.null:
         return
     kinds = field.kind if isinstance(field.kind, tuple) else (field.kind,)
     if "table" in kinds and isinstance(value, dict):
         if field.fields is not None:
-            check(field.fields, value, where)
+            check(field.fields, value, where, parent=key)
         for k, v in value.items() if field.each is not None else ():
-            _value(field.each, v, f"{where}.{k}", k, value)
+            _value(field.each, v, f"{where}.{k}", k, value, key)
     elif "list" in kinds and isinstance(value, list):
         for i, v in enumerate(value if field.each is not None else ()):
-            _value(field.each, v, f"{where}[{i}]", str(i), value)
+            _value(field.each, v, f"{where}[{i}]", str(i), value, key)
     elif "string" in kinds and isinstance(value, str):
         pass
     elif "matrix" in kinds:
