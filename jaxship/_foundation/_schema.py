@@ -133,7 +133,7 @@ def number(value, field: Field = Field(), name: str = "field") -> float:
     try:
         value = float(value)
     except OverflowError:  # an integer beyond any float
-        value = math.copysign(math.inf, value)
+        value = math.inf if value > 0 else -math.inf
     if field.kind == "integer" and math.isfinite(value) and not value.is_integer():
         raise ValueError(f"{name} is {value!r}, not a whole number.")
     if not (math.isfinite(value) or field.nonfinite):

@@ -246,7 +246,7 @@ def vessel_from_dict(data: dict) -> AbstractVessel:
     a value outside its physical range."""
     if not isinstance(data, dict) or "model" not in data:
         raise ValueError(f"missing field 'model' (the vessel class: {', '.join(CLASSES)}).")
-    cls = CLASSES.get(data["model"])
+    cls = CLASSES.get(data["model"]) if isinstance(data["model"], str) else None
     if cls is None:
         raise ValueError(f"field 'model': unknown vessel class {data['model']!r}; choose "
                          f"one of {', '.join(CLASSES)}.")
