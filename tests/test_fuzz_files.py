@@ -12,8 +12,7 @@ import tomllib
 
 import numpy as np
 import pytest
-from hypothesis import example, given, settings
-from hypothesis import strategies as st
+from hypothesis import example, given, settings, strategies as st
 
 import jaxship as js
 from jaxship._models._vessel.file import MAX_MAGNITUDE

@@ -55,10 +55,10 @@ def nomoto_indices(model) -> tuple[float, float] | None:
 
 def implausible(model, *, length: float | None = None,
                 speed: float | None = None) -> tuple[str, ...]:
-    """A sentence for each index of `model` (`nomoto_indices`) outside what ships do:
-    a rudder offset beyond `MAX_RUDDER`, K < 0 with T > 0, and |K'|, |T'| (with the ship's `length` [m] and mean `speed`
-    [m/s]) or |K T| outside `K_PRIME`, `T_PRIME`, `KT`, and |T| beyond `T_MAX`, each
-    naming the likely cause."""
+    """A sentence for each value of `model` outside what ships do: a rudder offset beyond
+    `MAX_RUDDER`, and of its indices (`nomoto_indices`) K < 0 with T > 0, |K'|, |T'|
+    (with the ship's `length` [m] and mean `speed` [m/s]) or |K T| outside `K_PRIME`,
+    `T_PRIME`, `KT`, and |T| beyond `T_MAX`, each naming the likely cause."""
     out = [f"the rudder offset {name} = {np.degrees(value):.4g} deg is beyond any rudder's "
            f"range ({np.degrees(MAX_RUDDER):g} deg): is it in deg labelled rad?"
            for name, value in _offsets(model) if not abs(value) <= MAX_RUDDER]
@@ -94,7 +94,7 @@ def implausible(model, *, length: float | None = None,
 
 def _offsets(model):
     """`(name, value)` of a model's rudder offsets (`delta0`, `<effect>.delta0`)."""
-    names = model.parameter_names() if hasattr(model, "parameter_names") else ()
+    names = model.parameter_names() if isinstance(model, js.AbstractModel) else ()
     return [(n, float(model.get_parameter(n))) for n in names if n.split(".")[-1] == "delta0"]
 
 

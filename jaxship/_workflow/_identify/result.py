@@ -18,7 +18,6 @@ import jaxship as js
 
 from ..._foundation._schema import Field, check, read_text
 from ..._models._vessel.file import vessel_to_dict
-
 from .assessment import Assessment
 from .registry import model_key
 
