@@ -153,12 +153,18 @@ def test_a_mutated_vessel_text_reads_or_is_refused_in_one_line(text, edits):
 
 
 @pytest.fixture(scope="module")
-def results(tmp_path_factory) -> list[dict]:
-    """A real Nomoto 1 identification (a short simulated zig-zag) as its result.json
-    dict, and a hand-made KVLCC2 result with two estimates, their std and correlation."""
+def identification():
+    """A real Nomoto 1 identification of a short simulated zig-zag."""
     traj = js.simulate(js.Nomoto1(K=0.05, T=10.0),
                        js.ZigZag(math.radians(10), math.radians(10), duration=120.0, dt=1.0))
-    ident = js.identify("nomoto1", [js.Experiment.from_trajectory(traj)], max_steps=20)
+    return js.identify("nomoto1", [js.Experiment.from_trajectory(traj)], max_steps=20)
+
+
+@pytest.fixture(scope="module")
+def results(identification) -> list[dict]:
+    """The identification's result.json dict, and a hand-made KVLCC2 result with two
+    estimates, their std and correlation."""
+    ident = identification
     vessel = js.get_vessel("kvlcc2")
     kvlcc2 = {"model": "kvlcc2", "data": {"train": [{"dt_s": 0.5, "duration_s": 100.0}]},
               "parameters": {"n_r": {"value": float(vessel.n_r), "std": 1e-4},
@@ -187,3 +193,21 @@ def test_results_fuzz(results, tmp_path):
             _judged(model)
 
     check()
+
+
+def test_saving_refuses_what_loading_would_and_leaves_the_file(identification, tmp_path,
+                                                               monkeypatch):
+    """`Identification.save` checks its dict by the reader's schema before writing: a
+    boolean value or a 1 x 1 correlation for two names is refused, the old file stays."""
+    path = tmp_path / "result.json"
+    assert js.load_model(identification.save(path)) == identification.model
+    good = identification.to_dict()
+    path.write_text("the old one")
+    for damage, message in ((("parameters", "K", "value"), True),
+                            (("correlation", "matrix"), [[1.0]])):
+        bad = copy.deepcopy(good)
+        _get(bad, damage[:-1])[damage[-1]] = message
+        monkeypatch.setattr(type(identification), "to_dict", lambda self, bad=bad: bad)
+        with pytest.raises(ValueError, match="cannot save the nomoto1 result: "):
+            identification.save(path)
+        assert path.read_text() == "the old one"
