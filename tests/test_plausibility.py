@@ -72,3 +72,43 @@ def test_a_wind_beyond_hurricane_force_is_said():
     assert wind_too_strong(calm) is None
     assert "reaches 250 m/s, beyond hurricane force" in wind_too_strong(storm)
     assert "knots or km/h" in wind_too_strong(storm)
+
+
+def _zigzag_rows() -> dict:
+    """A 20/20 zig-zag of the thesis vessel's Nomoto 1 (K 0.185 1/s, T 3.02 s) in SI."""
+    traj = js.simulate(js.Nomoto1(K=0.185, T=3.02),
+                       js.ZigZag(np.radians(20), np.radians(20), duration=60.0, dt=0.5))
+    e = js.Experiment.from_trajectory(traj)
+    return {"t": np.asarray(e.t), "delta": np.asarray(e.delta), "psi": np.asarray(e.psi),
+            "r": np.asarray(e.r)}
+
+
+# issue 72, "Broken 4": one motion channel, so no cross-channel check sees the slip;
+# each column is written as the slip writes it, under the label that hides it
+MISLABELS = {
+    "r in rad/s labelled deg/s, no psi": {"t [s]": ("t", 1.0), "delta [deg]": ("delta", 57.2958),
+                                          "r [deg/s]": ("r", 1.0)},
+    "t in ms labelled s, psi only": {"t [s]": ("t", 1000.0), "delta [deg]": ("delta", 57.2958),
+                                     "psi [deg]": ("psi", 57.2958)},
+    "the rudder in rad labelled deg": {"t [s]": ("t", 1.0), "delta [deg]": ("delta", 1.0),
+                                       "psi [deg]": ("psi", 57.2958)},
+}
+
+
+@pytest.mark.parametrize("case", list(MISLABELS))
+def test_a_single_channel_unit_slip_is_flagged_or_refused(case, tmp_path):
+    """Each slip ends refused or with a plausibility warning (`implausible`,
+    `rudder_in_rad`), never a silent success."""
+    rows = _zigzag_rows()
+    columns = MISLABELS[case]
+    path = tmp_path / "zz.csv"
+    np.savetxt(path, np.column_stack([rows[k] * f for k, f in columns.values()]),
+               delimiter=",", header=",".join(columns), comments="")
+    try:
+        ident = js.identify("nomoto1", path)
+    except ValueError as error:
+        assert "\n" not in str(error)
+        return
+    said = [w for w in ident.warnings if "range of ships" in w or "labelled" in w]
+    assert said and (implausible(ident.model) or "rudder in rad" in " ".join(said)), \
+        (ident.model, ident.warnings)

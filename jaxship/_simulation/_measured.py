@@ -12,15 +12,14 @@ from pathlib import Path
 
 import numpy as np
 
+from .._foundation._schema import UTF16_MARKS, check_path, not_text
 from ._consistency import unwrap_heading
 from ._data import OVER_GROUND, Experiment
 from ._readers import (
     _HEADER,
-    UTF16_MARKS,
     _check_delimiter,
     _check_rows,
     _check_time,
-    _not_text,
     _open_text,
     _parse_numbers,
     _read_csv,
@@ -137,7 +136,7 @@ def _text_lines(path: Path, encoding: str):
             for line in f:
                 yield line.rstrip("\r\n")
         except UnicodeDecodeError:
-            raise _not_text(path, encoding) from None
+            raise not_text(path, encoding) from None
 
 
 def _numeric_lines(path, lines, first_line, ncol, split, layout):
@@ -314,14 +313,7 @@ def read_measured(path, **kwargs) -> Experiment:
     names HSVA) -> `read_hsva_kvlcc2`; a CSV with Esso Osaka headers (`psi_hat [rad]`)
     -> `read_esso_osaka`; any other CSV -> `read_trial_csv`. Keyword arguments go to
     the chosen reader."""
-    path = Path(path)
-    if path.is_dir():
-        raise ValueError(f"{path} is a folder; pass one measurement file.")
-    if not path.exists():
-        raise ValueError(f"{path}: no such file.")
-    if not path.is_file():  # reading a FIFO or a device could block
-        raise ValueError(f"{path} is not a regular file (a pipe or a device); pass a "
-                         "measurement file.")
+    path = check_path(path, "one measurement file")
     try:
         with open(path, "rb") as f:
             first, number = b"", 0

@@ -40,6 +40,7 @@ from pathlib import Path
 import equinox as eqx
 import numpy as np
 
+from .._foundation._schema import not_text, open_text
 from .._foundation._state import Trajectory
 from ._consistency import check_consistency, unwrap_heading
 from ._data import CHANNELS, OVER_GROUND, Experiment, sampling_tolerance
@@ -105,38 +106,8 @@ _DELIMITERS = {";": "semicolons", "\t": "tabs", "|": "vertical bars"}
 
 
 def _open_text(path: Path, encoding: str):
-    """`path` opened for reading text; a missing, unreadable or folder path is a
-    one-line `ValueError`."""
-    if path.is_dir():
-        raise ValueError(f"{path} is a folder; pass one measurement file.")
-    if path.exists() and not path.is_file():  # reading a FIFO or a device could block
-        raise ValueError(f"{path} is not a regular file (a pipe or a device); pass a "
-                         "measurement file.")
-    try:
-        return open(path, newline="", encoding=encoding)
-    except OSError as error:
-        raise ValueError(f"{path}: cannot read the file ({error.strerror or error}).") from None
-
-
-UTF16_MARKS = (b"\xff\xfe", b"\xfe\xff")  # the byte-order marks of UTF-16 text
-
-
-def _not_text(path: Path, encoding: str) -> ValueError:
-    """The error for a file that is not `encoding` text, naming the first bad line."""
-    try:
-        data = path.read_bytes()
-        data.decode(encoding)
-    except UnicodeDecodeError as error:
-        if data.startswith(UTF16_MARKS):
-            return ValueError(f"{path}: the file is UTF-16 text; save it as UTF-8 (or ASCII) "
-                              "text.")
-        line = data.count(b"\n", 0, error.start) + 1
-        return ValueError(f"{path}: line {line} is not {encoding.split('-sig')[0].upper()} text "
-                          f"(byte 0x{data[error.start]:02x}); save the file as UTF-8 or ASCII "
-                          "text.")
-    except OSError as error:
-        return ValueError(f"{path}: cannot read the file ({error.strerror or error}).")
-    return ValueError(f"{path}: not {encoding} text; save the file as UTF-8 or ASCII text.")
+    """`path` opened for reading CSV text (`open_text`'s refusals)."""
+    return open_text(path, "one measurement file", encoding=encoding, newline="")
 
 
 def _csv_records(path: Path, encoding: str):
@@ -148,7 +119,7 @@ def _csv_records(path: Path, encoding: str):
             for fields in reader:
                 yield reader.line_num, fields
         except UnicodeDecodeError:
-            raise _not_text(path, encoding) from None
+            raise not_text(path, encoding) from None
         except csv.Error as error:
             raise ValueError(f"{path}: line {reader.line_num + 1}: not a readable CSV record "
                              f"({error}).") from None

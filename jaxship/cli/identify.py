@@ -154,7 +154,7 @@ def run(args) -> int:
             paths = save_identification_figures(result, stage / "figures")
             written.append(f"figures/ ({len(paths)} figures)")
             CLOCK.mark("figures")
-        (stage / "result.json").write_text(result.to_json() + "\n")
+        (stage / "result.json").write_text(result.checked_json() + "\n")
         # `--vessel out/vessel.toml` later; a vessel file holds no effects (result.json does)
         if isinstance(result.model, js.AbstractVessel) and not isinstance(
                 result.model, js.effects.AugmentedVessel):

@@ -21,6 +21,7 @@ import re
 import tomllib
 
 from ..._foundation._contract import parameter_fields
+from ..._foundation._schema import Field, number, read_text
 from .._actuators import RudderServo, Shaft
 from .._environment import FossenWindLoads
 from .._fujiwara_wind import FujiwaraWindLoads
@@ -121,49 +122,60 @@ def _wind_from_dict(entry):
     return cls(**{k: _value(f"{WIND}.{k}", entry[k], info.unit) for k, info in fields.items()})
 
 
-def _number(text, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f"{text} is {value!r}, not a number.")
-    return float(value)
+# no coefficient of a ship reaches this in SI units: the largest ship built (Seawise Giant,
+# 458 m, 6.6e8 kg displacement) has a yaw inertia below 1e13 kg m^2
+MAX_MAGNITUDE = 1e15
+
+
+def _number(where, value) -> float:
+    """A dimensionless coefficient of a list (`_field`'s checks, without a range)."""
+    return number(value, _field(where, "-"), f"field '{where}'")
+
+
+def _field(name, unit, bounds=(-math.inf, math.inf)) -> Field:
+    """The schema `Field` of the vessel file's field `name` [`unit`], its physical range
+    `bounds` narrowed by `POSITIVE`, `NON_NEGATIVE`, `ANGLE_LIMITS`, `NOT_POSITIVE` and
+    `MAX_MAGNITUDE`."""
+    low, high = max(bounds[0], -MAX_MAGNITUDE), min(bounds[1], MAX_MAGNITUDE)
+    unit = "" if unit == "-" else unit
+    likely = "is it in another unit?" if (low, high) == (-MAX_MAGNITUDE, MAX_MAGNITUDE) else ""
+    if name in ANGLE_LIMITS:
+        return Field(unit=unit, low=0.0, high=math.pi / 2, above=True,
+                     says="between 0 and 90 deg", likely="in rad: is it in deg?")
+    if name in POSITIVE:
+        return Field(unit=unit, low=0.0, high=high, above=True, says="positive")
+    if name in NON_NEGATIVE:
+        return Field(unit=unit, low=0.0, high=high, says="not negative")
+    if name in NOT_POSITIVE:
+        return Field(unit=unit, low=low, high=0.0, says="not positive",
+                     likely="an added mass -X_udot, -Y_vdot or -N_rdot is positive")
+    return Field(unit=unit, low=low, high=high, likely=likely)
 
 
 def _value(name, entry, unit, bounds=(-math.inf, math.inf)) -> float:
     """The SI value of the field `name` from its `entry` (a number, or `{value, unit}`),
-    checked against its `unit` and physical range."""
+    checked against its `unit` and physical range (`_field`)."""
     if isinstance(entry, dict):
         extra = set(entry) - {"value", "unit"}
         if extra or "value" not in entry or "unit" not in entry:
             raise ValueError(f"field '{name}': write {{ value = ..., unit = \"{unit or '-'}\" }}"
-                             f" (got the keys {', '.join(sorted(entry))}).")
-        given, value = entry["unit"], _number(f"field '{name}'", entry["value"])
+                             f" (got the keys {', '.join(sorted(map(str, entry)))}).")
+        given, value = entry["unit"], number(entry["value"], Field(nonfinite=True),
+                                             f"field '{name}'")
     else:
-        given, value = unit or "-", _number(f"field '{name}'", entry)
+        given, value = unit or "-", number(entry, Field(nonfinite=True), f"field '{name}'")
         if unit:
             raise ValueError(f"field '{name}': give its unit, {{ value = {value!r}, unit = "
                              f"\"{unit}\" }}.")
-    if given in OTHER_UNITS.get(unit, {}):
+    if isinstance(given, str) and given in OTHER_UNITS.get(unit, {}):
         value *= OTHER_UNITS[unit][given]
     elif given != (unit or "-"):
         known = [unit or "-", *OTHER_UNITS.get(unit, {})]
         raise ValueError(f"field '{name}': unit {given!r} is wrong; give it in "
                          f"{' or '.join(repr(u) for u in known)}.")
-    lower, upper = bounds
-    if name in POSITIVE:
-        lower = max(lower, 0.0)
-    if not (math.isfinite(value) or name in UNBOUNDED_OK and value == math.inf):
-        raise ValueError(f"field '{name}' is {value!r}: give a finite number.")
-    if (name in POSITIVE and not value > 0) or (name in NON_NEGATIVE and value < 0) \
-            or not lower <= value <= upper or name in ANGLE_LIMITS and \
-            not 0 < value <= math.pi / 2 or name in NOT_POSITIVE and value > 0:
-        what = ("between 0 and 90 deg (in rad: is it in deg?)" if name in ANGLE_LIMITS
-                else "positive" if name in POSITIVE else "not negative"
-                if name in NON_NEGATIVE else "not positive (an added mass -X_udot, -Y_vdot "
-                "or -N_rdot is positive)" if name in NOT_POSITIVE
-                else f"between {lower:g} and {upper:g}")
-        shown = f"{value!r} {unit}".strip()
-        raise ValueError(f"field '{name}' = {shown} is out of its physical range: it must be "
-                         f"{what}.")
-    return value
+    if name in UNBOUNDED_OK and value == math.inf:
+        return value
+    return number(value, _field(name, unit or "-", bounds), f"field '{name}'")
 
 
 def _fields(cls, data: dict, expected: dict, where: str = "") -> dict:
@@ -220,7 +232,7 @@ def particulars_from_dict(data: dict) -> MainParticulars:
         if name not in params:  # k_t
             if not isinstance(entry, list) or len(entry) != 3:
                 raise ValueError(f"field '{where}' must be a list of 3 numbers, [k_0, k_1, k_2].")
-            kwargs[name] = tuple(_number(f"field '{where}'", v) for v in entry)
+            kwargs[name] = tuple(_number(where, v) for v in entry)
         else:
             info = params[name]
             kwargs[name] = _value(where, entry, _unit(info), (info.lower, info.upper))
@@ -234,7 +246,7 @@ def vessel_from_dict(data: dict) -> AbstractVessel:
     a value outside its physical range."""
     if not isinstance(data, dict) or "model" not in data:
         raise ValueError(f"missing field 'model' (the vessel class: {', '.join(CLASSES)}).")
-    cls = CLASSES.get(data["model"])
+    cls = CLASSES.get(data["model"]) if isinstance(data["model"], str) else None
     if cls is None:
         raise ValueError(f"field 'model': unknown vessel class {data['model']!r}; choose "
                          f"one of {', '.join(CLASSES)}.")
@@ -257,7 +269,7 @@ def vessel_from_dict(data: dict) -> AbstractVessel:
         elif info is None:  # a tuple of dimensionless coefficients
             if not isinstance(entry, list):
                 raise ValueError(f"field '{name}' must be a list of numbers.")
-            kwargs[name] = tuple(_number(f"field '{name}'", v) for v in entry)
+            kwargs[name] = tuple(_number(name, v) for v in entry)
         else:
             kwargs[name] = _value(name, entry, _unit(info), (info.lower, info.upper))
     _check_ship(kwargs, {n: _unit(i) for n, i in params.items() if i is not None})
@@ -381,11 +393,7 @@ def _read(source, parse):
             raise ValueError(f"the text given is not a vessel file (TOML): {error}.") from None
     path = pathlib.Path(source)
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as error:
-        raise ValueError(f"cannot read {path}: {error.strerror or error}.") from None
-    except UnicodeDecodeError:
-        raise ValueError(f"{path} is not a text file; give a vessel file (TOML).") from None
+        data = tomllib.loads(read_text(path, "a vessel file (TOML)"))
     except tomllib.TOMLDecodeError as error:
         raise ValueError(f"{path} is not a vessel file (TOML): {error}.") from None
     try:

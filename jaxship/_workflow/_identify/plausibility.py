@@ -33,6 +33,8 @@ KT = (0.05, 200.0)  # |K T| = |K' T'|, no length or speed needed
 T_MAX = 1000.0
 # a rudder of at most 35 deg logged in rad and read as deg peaks below 0.61 "deg"
 RUDDER_IN_RAD = np.radians(np.radians(35.0))
+# no rudder turns beyond 35 deg each side (SOLAS II-1 reg. 29.3.2), nor is offset beyond it
+MAX_RUDDER = np.radians(35.0)
 TURNED = np.radians(10.0)  # ... while the heading turns this much: a manoeuvre, not drift
 # a logged wind [m/s] beyond hurricane force (Beaufort 12 from 32.7 m/s, WMO No. 8) with a
 # margin: no trial sails in it, and a wind in knots or km/h reads 1.9 or 3.6 times higher
@@ -53,15 +55,17 @@ def nomoto_indices(model) -> tuple[float, float] | None:
 
 def implausible(model, *, length: float | None = None,
                 speed: float | None = None) -> tuple[str, ...]:
-    """A sentence for each index of `model` (`nomoto_indices`) outside what ships do:
-    K < 0 with T > 0, and |K'|, |T'| (with the ship's `length` [m] and mean `speed`
-    [m/s]) or |K T| outside `K_PRIME`, `T_PRIME`, `KT`, and |T| beyond `T_MAX`, each
-    naming the likely cause."""
+    """A sentence for each value of `model` outside what ships do: a rudder offset beyond
+    `MAX_RUDDER`, and of its indices (`nomoto_indices`) K < 0 with T > 0, |K'|, |T'|
+    (with the ship's `length` [m] and mean `speed` [m/s]) or |K T| outside `K_PRIME`,
+    `T_PRIME`, `KT`, and |T| beyond `T_MAX`, each naming the likely cause."""
+    out = [f"the rudder offset {name} = {np.degrees(value):.4g} deg is beyond any rudder's "
+           f"range ({np.degrees(MAX_RUDDER):g} deg): is it in deg labelled rad?"
+           for name, value in _offsets(model) if not abs(value) <= MAX_RUDDER]
     indices = nomoto_indices(model)
     if indices is None:
-        return ()
+        return tuple(out)
     K, T = indices
-    out = []
     if K < 0 < T:
         out.append(f"K = {K:.4g} 1/s is negative with a stable T = {T:.4g} s: the fitted ship "
                    "turns against its rudder. Is the rudder signed the other way (positive "
@@ -86,6 +90,12 @@ def implausible(model, *, length: float | None = None,
         out.append(f"|{name}| = {value:.3g}{where} is outside the range of ships, {low:g} "
                    f"to {high:g} (K = {K:.4g} 1/s, T = {T:.4g} s): is it {cause}?")
     return tuple(out)
+
+
+def _offsets(model):
+    """`(name, value)` of a model's rudder offsets (`delta0`, `<effect>.delta0`)."""
+    names = model.parameter_names() if isinstance(model, js.AbstractModel) else ()
+    return [(n, float(model.get_parameter(n))) for n in names if n.split(".")[-1] == "delta0"]
 
 
 def rudder_in_rad(experiment) -> str | None:

@@ -16,6 +16,8 @@ import numpy as np
 
 import jaxship as js
 
+from ..._foundation._schema import Field, check, read_text
+from ..._models._vessel.file import vessel_to_dict
 from .assessment import Assessment
 from .registry import model_key
 
@@ -141,10 +143,23 @@ class Identification:
 
     def save(self, path) -> pathlib.Path:
         """Write `to_json()` to the file `path` (the `result.json` that `jaxship identify`
-        writes; `load_model(path)` gives the fitted model back). Returns the path."""
+        writes; `load_model(path)` gives the fitted model back), after `checked_json`:
+        a result that loading would refuse is refused before the file is touched.
+        Returns the path."""
         path = pathlib.Path(path)
-        path.write_text(self.to_json() + "\n", encoding="utf-8")
+        path.write_text(self.checked_json() + "\n", encoding="utf-8")
         return path
+
+    def checked_json(self) -> str:
+        """`to_json()`, refused where loading would refuse its fields (`check_fields`: a
+        non-finite or boolean value, a std or correlation of the wrong shape; the fitted
+        vessel's ranges are `save_vessel`'s in `to_dict`): saving writes nothing a reader
+        cannot read back. **Raises** `ValueError` (one line)."""
+        try:
+            check_fields(self.to_dict())
+        except ValueError as error:
+            raise ValueError(f"cannot save the {self.model_name} result: {error}") from None
+        return self.to_json()
 
 
 def _constants(model) -> dict:
@@ -198,74 +213,47 @@ def _with_effects(model, names):
 _ROSS_SCALES = re.compile(r"L = (\S+) m, U0 = (\S+) m/s, n0 = (\S+) rev/s")
 
 
-def _number(name, value) -> float:
-    if isinstance(value, bool):  # JSON's true is no number (as the vessel file reads it)
-        raise ValueError(f"parameter {name} is {json.dumps(value)}, a boolean, not a number.")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"parameter {name} is {value!r}, not a number.") from None
-    if not math.isfinite(number):
-        raise ValueError(f"parameter {name} is {value!r}, not a finite number.")
-    return number
-
-
-def _json_number(value) -> bool:
-    """Whether `value` is a number as `to_json` writes one: an int or float (no
-    boolean), or a non-finite one as `_json_floats` writes it (null, "inf", "-inf")."""
-    return value is None or value in ("inf", "-inf") or (
-        isinstance(value, (int, float)) and not isinstance(value, bool))
-
-
-def _kind(value) -> str:
-    return {dict: "an object", list: "a list", str: "a string", bool: "a boolean",
-            type(None): "null"}.get(type(value), "a number")
+_NUMBER = Field(label="parameter {key}")  # a value: finite, no boolean
+_TABLE = Field("table", required=False, null=True)
+# the fields of an identify report that rebuild its model or draw from its covariance
+RESULT = {
+    "model": Field("string"),
+    "model_class": Field("string", required=False),
+    "data": dataclasses.replace(_TABLE, each=Field("list", null=True, each=Field("table"))),
+    "parameters": Field("table", each=Field(("number", "table"), label="parameter {key}", fields={
+        "value": Field(label="parameter {parent}"),
+        "std": Field(low=0.0, nonfinite=True, required=False, says="not negative"),
+        "start": Field(nonfinite=True, required=False)})),
+    "frozen": dataclasses.replace(_TABLE, each=_NUMBER),
+    "constants": dataclasses.replace(_TABLE, each=_NUMBER),
+    "effects": Field("list", required=False, null=True, each=Field("string")),
+    "vessel": _TABLE,
+    "notes": Field("list", required=False, null=True),
+    "fit": dataclasses.replace(_TABLE, fields={"code": Field(("string", "integer"),
+                                                             required=False)}),
+    "correlation": dataclasses.replace(_TABLE, fields={
+        "names": Field("list", each=Field("string")),
+        "matrix": Field("matrix", size="names", nonfinite=True, required=False, null=True)}),
+    "selection": _TABLE,
+    "options": _TABLE,
+}
 
 
 def check_fields(report: dict) -> None:
     """A one-line `ValueError` naming the field where an identify report (the parsed
-    `result.json`) has a field of the wrong type or shape, before any work: `data` an
-    object of lists of records, each parameter's `std` a number, `correlation` an object
-    of `names` (parameter names) and a square `matrix` of numbers, one row per name;
-    each parameter's value a finite number (no boolean)."""
-    data = report.get("data")
-    if data is not None and not isinstance(data, dict):
-        raise ValueError(f"field 'data' is {_kind(data)}, not an object "
-                         "({\"train\": [records], \"validation\": [records]}).")
-    for key, records in (data or {}).items():
-        if records is not None and not (isinstance(records, list)
-                                        and all(isinstance(r, dict) for r in records)):
-            raise ValueError(f"field 'data.{key}' is not a list of records (objects).")
-    for name, entry in report["parameters"].items():
-        _number(name, entry.get("value") if isinstance(entry, dict) else entry)
-        std = entry.get("std") if isinstance(entry, dict) else None
-        if not _json_number(std):
-            raise ValueError(f"field 'parameters.{name}.std' is {json.dumps(std)}, not a "
-                             "number.")
-    correlation = report.get("correlation")
-    if correlation is None:
-        return
-    if not isinstance(correlation, dict):
-        raise ValueError(f"field 'correlation' is {_kind(correlation)}, not an object "
-                         "({\"names\": [...], \"matrix\": [[...]]}).")
-    names, matrix = correlation.get("names"), correlation.get("matrix")
-    if not isinstance(names, list) or not all(n in report["parameters"] for n in names):
-        raise ValueError("field 'correlation.names' is not a list of the parameters' names.")
-    size = len(names)
-    if matrix is None:
-        return
-    if not (isinstance(matrix, list) and len(matrix) == size
-            and all(isinstance(row, list) and len(row) == size for row in matrix)):
-        first = matrix[0] if isinstance(matrix, list) and matrix else None
-        shape = (f"{len(matrix)} x {len(first) if isinstance(first, list) else 0}"
-                 if isinstance(matrix, list) else _kind(matrix))
-        raise ValueError(f"field 'correlation.matrix' is {shape}, not {size} x {size} for its "
-                         f"{size} names.")
-    for i, row in enumerate(matrix):
-        for j, value in enumerate(row):
-            if not _json_number(value):
-                raise ValueError(f"field 'correlation.matrix' row {i + 1}, column {j + 1} is "
-                                 f"{json.dumps(value)}, not a number.")
+    `result.json`) breaks `RESULT`, before any work: each parameter's value a finite
+    number (no boolean) and its `std` a number, `data` an object of lists of records,
+    `correlation` an object of `names` (distinct parameter names) and a square `matrix`
+    of numbers, one row per name."""
+    for key, kind in (("frozen", dict), ("constants", dict), ("notes", list)):
+        if report.get(key) is not None and not isinstance(report[key], kind):
+            raise ValueError(f"'{key}' in the identify result is a {type(report[key]).__name__}, "
+                             f"not a {kind.__name__}.")
+    check(RESULT, report)
+    names = (report.get("correlation") or {}).get("names") or []
+    if len(set(names)) != len(names) or not all(n in report["parameters"] for n in names):
+        raise ValueError("field 'correlation.names' is not a list of the parameters' distinct "
+                         "names.")
 
 
 def model_from_report(report: dict):
@@ -285,7 +273,7 @@ def model_from_report(report: dict):
             "model" not in report:
         raise ValueError("not an identify result: no 'model' and 'parameters' (write one "
                          "with `jaxship identify`).")
-    check_fields(report)
+    check_fields(report)  # every value below is a finite number from here on
     own_vessel = isinstance(report.get("vessel"), dict)
     try:
         name = model_key(report["model"])
@@ -294,15 +282,9 @@ def model_from_report(report: dict):
             raise ValueError(f"unknown model {report['model']!r} in the identify result.") \
                 from None
         name = str(report["model"])
-    for key, kind in (("frozen", dict), ("constants", dict), ("notes", list)):
-        if report.get(key) is not None and not isinstance(report[key], kind):
-            raise ValueError(f"'{key}' in the identify result is a {type(report[key]).__name__}, "
-                             f"not a {kind.__name__}.")
-    values = {}
-    for key, entry in report["parameters"].items():
-        values[key] = _number(key, entry.get("value") if isinstance(entry, dict) else entry)
-    for key, value in (report.get("frozen") or {}).items():
-        values[key] = _number(key, value)
+    values = {key: float(entry["value"] if isinstance(entry, dict) else entry)
+              for key, entry in report["parameters"].items()}
+    values |= {key: float(value) for key, value in (report.get("frozen") or {}).items()}
     if name == "armax":
         raise ValueError("armax is a discrete model of the yaw rate: it has no yaw equation "
                          "to design an autopilot on; identify a steering model.")
@@ -324,8 +306,12 @@ def model_from_report(report: dict):
         if not found:
             raise ValueError("the RossAutopilot result has no reference scales ('constants'); "
                              "re-run `jaxship identify` to write them.")
-        constants = dict(zip(("length", "speed", "rate"), found[0].groups()))
-    constants = {k: _number(k, v) for k, v in (constants or {}).items()}
+        try:
+            constants = dict(zip(("length", "speed", "rate"), map(float, found[0].groups())))
+        except ValueError:
+            raise ValueError("the RossAutopilot result's reference scales are no numbers; "
+                             "re-run `jaxship identify` to write them.") from None
+    constants = {k: float(v) for k, v in (constants or {}).items()}
     own = {k: v for k, v in values.items() if "." not in k}
     try:
         model = cls(**constants, **own)
@@ -340,6 +326,15 @@ def _set_values(model, values: dict, name: str):
     unknown = [k for k in values if k not in model.parameter_names()]
     if unknown:
         raise ValueError(f"the {name} model has no coefficient {unknown[0]!r}.")
+    base = getattr(model, "base", model)
+    if isinstance(base, js.AbstractVessel):  # a vessel's values: the vessel file's ranges
+        data = vessel_to_dict(base)
+        for key, value in values.items():
+            if isinstance(data.get(key), dict):
+                data[key] = {**data[key], "value": value}
+            elif isinstance(data.get(key), float):
+                data[key] = value
+        js.load_vessel(data)
     return model.with_parameters(values)
 
 
@@ -383,21 +378,14 @@ def read_report(path) -> dict:
     path = pathlib.Path(path)
     if path.is_dir():
         path = path / "result.json"
-    if path.exists() and not path.is_file():  # reading a FIFO or a device could block
-        raise ValueError(f"{path} is not a regular file (a pipe or a device); give the "
-                         "result.json that `jaxship identify` wrote.")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise ValueError(f"cannot read {path}: {error.strerror or error}.") from None
-    except UnicodeDecodeError as error:
-        raise ValueError(f"{path} is not a text file (byte {error.start} is not UTF-8); "
-                         "give the result.json that `jaxship identify` wrote.") from None
+    text = read_text(path, "the result.json that `jaxship identify` wrote")
     try:
         return json.loads(text)
     except json.JSONDecodeError as error:
         raise ValueError(f"{path} is not valid JSON ({error.msg}, line {error.lineno}).") \
             from None
+    except ValueError as error:  # an integer of more than 4300 digits
+        raise ValueError(f"{path} is not valid JSON ({error}).") from None
     except RecursionError:
         raise ValueError(f"{path} is nested too deeply to be an identify result.") from None
 
