@@ -190,7 +190,10 @@ from ._workflow._identify import (  # noqa: E402
     identify as identify,
     load_model as load_model,
 )
-from ._workflow._trials import StandardTrial as StandardTrial  # noqa: E402
+from ._workflow._trials import (  # noqa: E402
+    StandardTrial as StandardTrial,
+    check_operating_point as check_operating_point,
+)
 
 
 # The public names, grouped by layer as in docs/architecture.md (`# -- layer`); a
@@ -270,6 +273,7 @@ __all__ = [
     "Replay",
     # manoeuvres: Standard trials
     "StandardTrial",
+    "check_operating_point",
     # manoeuvres: Controllers
     "AbstractController",
     "Controlled",

@@ -198,7 +198,7 @@ def test_a_propeller_rate_too_slow_to_steer_is_refused(tmp_path, capsys):
     warning only (rpm given as rev/s)."""
     assert main(["simulate", "--vessel", "thesis", "--manoeuvre", "turn:35", "--rpm", "5",
                  "--out", str(tmp_path / "o")]) == 2
-    assert ("--rpm 5: less than a tenth of the service propeller rate of thesis (500 rpm)"
+    assert ("rpm 5: less than a tenth of the service propeller rate of thesis (500 rpm)"
             in _error_line(capsys))
     assert not (tmp_path / "o").exists()
 
@@ -1178,3 +1178,24 @@ def test_validating_on_the_training_record_is_said(record, tmp_path, capsys):
     said = capsys.readouterr().out
     assert f"the validation record {copy} holds the samples of the training record" in said
     assert "no held-out check" in json.loads((out / "result.json").read_text())["notes"][0]
+
+
+def test_the_operating_point_check_is_the_librarys_and_its_verbs_apply_it():
+    """Issue 72 and the library-first rule: the command's check of speeds and propeller
+    rates is `js.check_operating_point`, and `check_imo`, `StandardTrial.sized` and
+    `evaluate_autopilot` apply it themselves."""
+    thesis, mariner = js.get_vessel("thesis"), js.get_vessel("mariner")
+    js.check_operating_point(thesis, rpms=[300.0, 500.0], speeds=[1.5])
+    with pytest.raises(ValueError, match=r"^rpm 5: less than a tenth of the service "
+                       r"propeller rate of RossVessel \(500 rpm\)"):
+        js.check_operating_point(thesis, rpms=[5.0])
+    with pytest.raises(ValueError, match="more than 10 times the service speed of mariner"):
+        js.check_operating_point(mariner, speeds=[1e6], name="mariner")
+    with pytest.raises(ValueError, match="no propeller model"):
+        js.check_operating_point(mariner, rpms=[60.0])
+    with pytest.raises(ValueError, match="rpm 5: less than a tenth"):
+        js.indices.check_imo(thesis, rpm=5.0)
+    with pytest.raises(ValueError, match="rpm 5: less than a tenth"):
+        js.StandardTrial.parse("turn:35").sized(thesis, rpm=5.0)
+    with pytest.raises(ValueError, match="rpm 5: less than a tenth"):
+        js.evaluate_autopilot(js.Nomoto1(K=0.3, T=1.8), thesis, rpm=[5.0])

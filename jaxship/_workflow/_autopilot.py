@@ -447,6 +447,7 @@ def operating_points(plant, *, rpm=None, speeds=None) -> tuple:
         raise ValueError(f"{'rpm' if rpm is not None else 'speeds'} must be positive numbers, "
                          f"got {values}.")
     key = "rpm" if rpm is not None else "speed"
+    js.check_operating_point(plant, **{f"{key}s": values})
     points = [operating_point(plant, **{key: x}) for x in values]
     mean = float(np.mean(values))
     u0, n0 = operating_point(plant, **{key: mean})

@@ -17,6 +17,7 @@ from ._autopilot import (
 )
 from ._autopilot_source import chosen_text, resolve
 from ._autopilot_steady_turn import feedforward_gain_text
+from ._trials import check_operating_point
 from ._autopilot_text import (
     evaluation_report,
     gains_table,
@@ -144,6 +145,8 @@ def evaluate_autopilot(source, plant, *, rpm=None, speeds=None,
     `--steady-turn trial`) or False (the model's own, thesis eq. 5.2/5.6). `progress`: a
     callable taking a message (each stage), or None."""
     resolved = resolve(source)
+    check_operating_point(plant, rpms=() if rpm is None else rpm,  # before any work
+                          speeds=() if speeds is None else speeds)
     if design is None:
         design = AutopilotDesign.auto(resolved.models, plant, rpm=rpm, speeds=speeds)
     evaluation = evaluate(resolved.models, plant, rpm=rpm, speeds=speeds, design=design,

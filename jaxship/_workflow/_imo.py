@@ -12,7 +12,14 @@ import numpy as np
 import jaxship as js
 
 from ._identify.result import check_fields
-from ._trials import StandardTrial, _cut_at_stop, _size, initial_state, length_over_speed
+from ._trials import (
+    StandardTrial,
+    _cut_at_stop,
+    _size,
+    check_operating_point,
+    initial_state,
+    length_over_speed,
+)
 
 
 DRAWS = 64  # parameter draws of the band
@@ -120,6 +127,7 @@ def check_imo(model, *, identification=None, speed=None, rpm=None) -> ImoCheck:
     report = identification.to_dict() if callable(getattr(identification, "to_dict", None)) \
         else identification
     names, draws, how = parameter_draws(report, np.random.default_rng(SEED))  # read first
+    check_operating_point(model, speeds=[speed] if speed else [], rpms=[rpm] if rpm else [])
     runs, batch, rows = {}, {}, []
     x0 = initial_state(model, speed=speed, rpm=rpm)
     tau = length_over_speed(model, x0)

@@ -116,6 +116,8 @@ class StandardTrial:
         and `duration`; `x0` is then None (at rest) and only the kinds of
         `steering_kinds` run."""
         if isinstance(model, AbstractVessel):
+            check_operating_point(model, speeds=[speed] if speed else [],
+                                  rpms=[rpm] if rpm else [])
             x0 = initial_state(model, speed=speed, rpm=rpm)
             tau = length_over_speed(model, x0)
         elif self.kind not in self.steering_kinds or time_scale is None or duration is None:
@@ -385,6 +387,33 @@ def _default_dt(tau):
     exponent = np.floor(np.log10(raw))
     mantissa = max(m for m in (1, 2, 5) if m * 10**exponent <= raw * 1.0000001)
     return float(mantissa * 10**exponent)
+
+
+def check_operating_point(vessel, *, speeds=(), rpms=(), name: str | None = None) -> None:
+    """`ValueError` (one line, naming the vessel `name`) for approach speeds [m/s] and
+    propeller rates [rpm] the vessel cannot sail at: above 10 times its service speed or
+    rate, a rate below a tenth of the service rate (dead slow ahead is about a third of
+    it: below a tenth the rudder has no steerage way; rpm given as rev/s?), or a rate
+    where it has no propeller model (the net surge force does not change with n)."""
+    name = name or type(vessel).__name__
+    nominal = float(vessel.nominal_speed)
+    for speed in speeds:
+        if speed > 10 * nominal:
+            raise ValueError(f"speed {speed:g} m/s: more than 10 times the service speed of "
+                             f"{name} ({nominal:.3g} m/s); give an approach speed in m/s.")
+    thrust = lambda n: float(vessel.forces(nominal, 0.0, 0.0, 0.0, n)[0])  # v = r = delta = 0
+    if rpms and thrust(1.0) == thrust(0.0):
+        raise ValueError(f"rpm: {name} has no propeller model, so the propeller rate does "
+                         "nothing; give a speed instead.")
+    service = 60.0 * float(vessel.nominal_n)
+    for rpm in rpms:
+        if rpm > 10 * service:
+            raise ValueError(f"rpm {rpm:g}: more than 10 times the service propeller rate of "
+                             f"{name} ({service:.4g} rpm).")
+        if rpm < 0.1 * service:
+            raise ValueError(f"rpm {rpm:g}: less than a tenth of the service propeller rate of "
+                             f"{name} ({service:.4g} rpm), too slow to steer; is it in rev/s "
+                             "rather than rpm?")
 
 
 def initial_state(vessel, *, speed=None, rpm=None):

@@ -13,39 +13,8 @@ from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without i
 from ._files import read_manifest
 
 
-def surge_force(vessel, u, n):
-    """Net surge force [N] of `vessel` in straight motion at speed `u` [m/s] and
-    propeller rate `n` [rev/s] (`AbstractVessel.forces` at v = r = delta = 0)."""
-    return vessel.forces(u, 0.0, 0.0, 0.0, n)[0]
-
-
 def one_line(error) -> str:
     return " ".join(str(error).split())
-
-
-def check_operating_point(vessel, name, speeds, rpms):
-    """Approach speeds [m/s] and propeller rates [rpm] a vessel can sail at: at most 10
-    times its service speed and rate, a rate at least a tenth of the service rate (dead
-    slow ahead is about a third of it: below a tenth the rudder has no steerage way), and
-    a rate only where it has a propeller model."""
-    nominal = float(vessel.nominal_speed)
-    for speed in speeds:
-        if speed > 10 * nominal:
-            raise ValueError(f"--speed {speed:g} m/s: more than 10 times the service speed "
-                             f"of {name} ({nominal:.3g} m/s); give an approach speed in m/s.")
-    if rpms and float(surge_force(vessel, nominal, 1.0)
-                      - surge_force(vessel, nominal, 0.0)) == 0.0:
-        raise ValueError(f"--rpm: {name} has no propeller model, so the propeller rate "
-                         "does nothing; give --speed instead.")
-    service = 60.0 * float(vessel.nominal_n)
-    for rpm in rpms:
-        if rpm > 10 * service:
-            raise ValueError(f"--rpm {rpm:g}: more than 10 times the service propeller rate "
-                             f"of {name} ({service:.4g} rpm).")
-        if rpm < 0.1 * service:
-            raise ValueError(f"--rpm {rpm:g}: less than a tenth of the service propeller rate "
-                             f"of {name} ({service:.4g} rpm), too slow to steer; is it in "
-                             "rev/s rather than rpm?")
 
 
 def add_sample_interval(parser) -> None:

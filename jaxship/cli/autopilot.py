@@ -12,7 +12,7 @@ import jaxship as js
 
 from ..identification import read_result, unconverged_fit
 from ..plotting import plot_autopilot
-from ._common import check_operating_point, check_out, numbers
+from ._common import check_out, numbers
 from ._files import staged_folder
 from ._vessel import VESSEL_HELP, read_vessel_option
 
@@ -106,8 +106,8 @@ def run(args) -> int:
 
     by_rpm, values, auto, step, damping, omega = _numbers(args)
     vessel = read_vessel_option(args.vessel, vessel_only=True).model
-    check_operating_point(vessel, args.vessel, [] if by_rpm else values,
-                          values if by_rpm else [])
+    js.check_operating_point(vessel, speeds=[] if by_rpm else values,
+                             rpms=values if by_rpm else [], name=args.vessel)
     _, report = read_result(args.model)
     unfit = unconverged_fit(report, args.model)
     check_out(args.out, inputs=[args.model], writes=("autopilot.json", "report.md", "figures/",

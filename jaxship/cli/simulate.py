@@ -6,11 +6,11 @@ import math
 import pathlib
 import sys
 
-from .. import AbstractVessel, StandardTrial, froude_scale
+from .. import AbstractVessel, StandardTrial, check_operating_point, froude_scale
 from ..identification import unconverged_fit
 from ..indices import check_imo
 from ..plotting import plot_imo_criteria, plot_trajectory
-from ._common import check_operating_point, check_out, note, positive
+from ._common import check_out, note, positive
 from ._files import staged_folder
 from ._trial_files import simulate_steering_to_folder, simulate_to_folder
 from ._vessel import VESSEL_HELP, read_vessel_option
@@ -72,7 +72,8 @@ def run_vessel(args, chosen) -> int:
             raise ValueError(f"--manoeuvre {args.manoeuvre}: the rudder angle {angle:g} deg is "
                              f"beyond the rudder limit of {args.vessel} ({limit:g} deg); give "
                              f"at most {limit:g}.")
-    check_operating_point(vessel, args.vessel, [speed] if speed else [], [rpm] if rpm else [])
+    check_operating_point(vessel, speeds=[speed] if speed else [],
+                          rpms=[rpm] if rpm else [], name=args.vessel)
     tau = float(vessel.length) / (speed or float(vessel.nominal_speed))  # time scale L/U [s]
     if dt is not None and dt > tau:
         raise ValueError(f"--dt {dt:g} s is longer than the time scale L/U = {tau:.3g} s of "
