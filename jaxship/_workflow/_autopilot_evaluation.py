@@ -17,7 +17,6 @@ from ._autopilot import (
 )
 from ._autopilot_source import chosen_text, resolve
 from ._autopilot_steady_turn import feedforward_gain_text
-from ._trials import check_operating_point
 from ._autopilot_text import (
     evaluation_report,
     gains_table,
@@ -25,6 +24,7 @@ from ._autopilot_text import (
     runs_table,
     tuning_text,
 )
+from ._trials import check_operating_point
 
 
 def design_autopilot(model, *, plant=None, rpm=None, speeds=None,
