@@ -29,8 +29,9 @@ from ._files import discard_open_stages  # noqa: E402
 
 EXIT_STATUS = """exit status: 0 done; 2 bad input (arguments, records, an --out that cannot be
 written: one line on stderr, nothing written); 1 a file-system failure while writing;
-3 the fit did not converge, blew up, never moved, ended on a parameter bound, or a closed
-loop blew up (results written, the reason on stderr) or diverged (nothing written); 130
+3 the fit did not converge, blew up, never moved, ended on a parameter bound or left a
+parameter undetermined, a closed loop blew up or did not settle, or discover's records
+cannot judge (results written, the reason on stderr), or a fit diverged (nothing written); 130
 interrupted (Ctrl-C), 143 terminated (SIGTERM): earlier results left as they were.
 JAXSHIP_CACHE_DIR: where compiled programs are kept for later runs (default
 ~/.cache/jaxship/jax; "off" disables)."""
