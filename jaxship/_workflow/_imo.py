@@ -46,7 +46,8 @@ class ImoCheck:
     notes: tuple = ()
 
     def to_dict(self) -> dict:
-        rows = [row.to_dict() | {"margin": row.limit - row.value,
+        rows = [row.to_dict() | {"margin": row.limit - row.value if np.isfinite(row.value)
+                                 else None,
                                  "band": list(self.bands.get(row.criterion, ())) or None,
                                  "passed_in_draws": self.passed.get(row.criterion)}
                 for row in self.rows]
@@ -60,10 +61,12 @@ class ImoCheck:
         for row in self.rows:
             lo, hi = self.bands.get(row.criterion, (None, None))
             band = "-" if lo is None else f"{lo:.2f} to {hi:.2f} {row.unit}"
-            lines.append(f"| {row.criterion} | {row.value:.2f} {row.unit} | {row.limit:.2f} "
-                         f"{row.unit} | {row.limit - row.value:+.2f} {row.unit} | {band} | "
-                         f"{'yes' if row.passed else 'NO'} |")
-        return "\n".join(lines) + "\n"
+            value, margin = (f"{row.value:.2f} {row.unit}", f"{row.limit - row.value:+.2f} "
+                             f"{row.unit}") if np.isfinite(row.value) else ("-", "-")
+            lines.append(f"| {row.criterion} | {value} | {row.limit:.2f} {row.unit} | {margin} "
+                         f"| {band} | {'yes' if row.passed else 'NO'} |")
+        return "\n".join(lines + [f"\n{row.criterion}: {row.note}." for row in self.rows
+                                   if row.note]) + "\n"
 
     def __str__(self) -> str:
         return self.table()
@@ -173,7 +176,7 @@ def _trusted_bands(rows, bands, passed, used) -> tuple[dict, dict, tuple[str, ..
     notes = (f"{DRAWS - used} of {DRAWS} parameter draws blew up in a trial and are left out "
              f"of the bands, drawn from the {used} that ran.",) if used < DRAWS else ()
     outside = [f"{row.criterion} ({row.value:.3g} {row.unit})" for row in rows
-               if row.criterion in bands
+               if row.criterion in bands and np.isfinite(row.value)
                and not bands[row.criterion][0] <= row.value <= bands[row.criterion][1]]
     if outside:
         notes += (f"the fitted value lies outside its own {LEVEL:.0%} band for "
@@ -203,7 +206,7 @@ def _drawn_criteria(vessel, names, draws, batch, *, speed, rpm):
             traj = jax.tree.map(lambda a, k=k: a[k], trajs)
             marks = trial.marks(manoeuvre, traj) if traj.success else None
             rows = trial.criteria(v, traj, marks)
-            ran[k] &= bool(rows)
+            ran[k] &= bool(rows) and all(np.isfinite(row.value) for row in rows)
             for row in rows:
                 found.setdefault(row.criterion, {})[k] = (row.value, row.passed)
     keep = [k for k in np.flatnonzero(ran)]

@@ -16,6 +16,7 @@ import numpy as np
 import jaxship as js
 
 from .. import AbstractVessel, Simulator, simulate, straight_run, straight_state
+from .._analysis._indices.criteria import CRITERIA, CriterionRow, criterion_limits
 from .._models._vessel._base import surge_force
 
 
@@ -180,25 +181,30 @@ class StandardTrial:
     def criteria(self, vessel, traj, marks) -> list:
         """The IMO MSC.137(76) 5.3 criteria that this trial checks (a 35 deg turn, a 10/10
         or 20/20 zig-zag, the stop) from its `marks`, as `CriterionRow`s
-        (`js.indices.imo_criteria` at the approach speed of `traj`); [] for the others."""
-        if marks is None:
-            return []
+        (`js.indices.imo_criteria` at the approach speed of `traj`); [] for the others. A
+        criterion the run could not measure (no marks; a 10/10 zig-zag whose ship never
+        checks its swing against the counter-rudder) is listed, not met, with the reason."""
         angle = abs(self.values[0]) if self.values else None
-        kwargs = {}
-        if self.kind == "turn" and angle == 35:
-            kwargs["turning35"] = marks
-        elif self.kind == "zigzag" and angle == self.values[1] == 10:
-            if len(marks.overshoots) < 2:
-                return []
-            kwargs["zigzag10"] = marks
-        elif self.kind == "zigzag" and angle == self.values[1] == 20:
-            kwargs["zigzag20"] = marks
-        elif self.kind == "stop":
-            kwargs["stopping"] = marks
-        if not kwargs:
+        key = {("turn", 35): "turning35", ("stop", None): "stopping"}.get((self.kind, angle))
+        if self.kind == "zigzag" and angle == self.values[1] in (10, 20):
+            key = f"zigzag{angle:g}"
+        if key is None:
             return []
-        speed = float(np.hypot(traj.state.u[0], traj.state.v[0]))
-        return js.indices.imo_criteria(float(vessel.length), speed, **kwargs)
+        length, speed = float(vessel.length), float(np.hypot(traj.state.u[0], traj.state.v[0]))
+        limits = criterion_limits(length, speed)
+        if marks is None:
+            why = (f"not measured: the {self} run gave none of its indices (the heading never "
+                   "reached a switch, or the run is too short for them)")
+            return [CriterionRow.not_measured(c, *limits[c], why) for c in CRITERIA[key]]
+        if key == "zigzag10" and len(marks.overshoots) < 2:
+            why = (f"not measured: the ship never checked its swing against the 10 deg "
+                   f"counter-rudder ({len(marks.overshoots)} of the 2 overshoots measured)")
+            first = [CriterionRow(CRITERIA[key][0], float(np.degrees(marks.overshoots[0])),
+                                  *limits[CRITERIA[key][0]], False)] if marks.overshoots else []
+            first = [dataclasses.replace(r, passed=r.value <= r.limit) for r in first]
+            return first + [CriterionRow.not_measured(c, *limits[c], why)
+                            for c in CRITERIA[key][len(first):]]
+        return js.indices.imo_criteria(length, speed, **{key: marks})
 
 
 def _check_values(trial, text):

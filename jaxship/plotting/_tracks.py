@@ -496,8 +496,10 @@ def plot_imo_criteria(rows, *, title="IMO MSC.137(76) manoeuvrability criteria",
     cells = []
     for row in rows:
         band = bands.get(row.criterion)
-        cells.append([row.criterion, f"{row.value:.2f} {row.unit}",
-                      f"<= {row.limit:.2f} {row.unit}", f"{row.limit - row.value:+.2f}"]
+        measured = np.isfinite(row.value)  # else not measured (`CriterionRow.note`)
+        cells.append([row.criterion, f"{row.value:.2f} {row.unit}" if measured else
+                      "not measured", f"<= {row.limit:.2f} {row.unit}",
+                      f"{row.limit - row.value:+.2f}" if measured else "-"]
                      + ([f"{band[0]:.2f} to {band[1]:.2f}" if band else "-"] if bands else [])
                      + ["pass" if row.passed else "FAIL"])
     widths = [0.46, 0.12, 0.14, 0.1] + ([0.16] if bands else []) + [0.08]

@@ -1,6 +1,7 @@
 """IMO MSC.137(76) manoeuvring criteria and their table (`imo_criteria`, `format_table`)."""
 
 import dataclasses
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -34,16 +35,50 @@ def imo_overshoot_limits_deg(l_over_v):
 
 @dataclasses.dataclass(frozen=True)
 class CriterionRow:
-    """One IMO criterion: `value` and `limit` in `unit` (`"L"`: ship lengths, `"deg"`)."""
+    """One IMO criterion: `value` and `limit` in `unit` (`"L"`: ship lengths, `"deg"`);
+    a criterion the trial could not measure has `value` nan, is not `passed`, and
+    `note` says why (`not_measured`)."""
 
     criterion: str
     value: float
     limit: float
     unit: str
     passed: bool
+    note: str = ""
+
+    @classmethod
+    def not_measured(cls, criterion: str, limit: float, unit: str, why: str) -> "CriterionRow":
+        """The row of a criterion that the trial could not measure, for the reason `why`:
+        not met (a ship that cannot be measured on a trial does not meet it)."""
+        return cls(criterion, math.nan, float(limit), unit, False, why)
 
     def to_dict(self) -> dict:
-        return dataclasses.asdict(self)
+        """The row as JSON has it: a value not measured is null, with its `note`."""
+        row = dataclasses.asdict(self)
+        if not row.pop("note"):
+            return row
+        return row | {"value": self.value if math.isfinite(self.value) else None,
+                      "note": self.note}
+
+
+# the criteria each trial checks (MSC.137(76) 5.3), in the order `imo_criteria` gives them
+CRITERIA = {
+    "turning35": ("turning: advance, 35 deg turn", "turning: tactical diameter, 35 deg turn"),
+    "zigzag10": ("yaw checking: 1st overshoot, 10/10 zig-zag",
+                 "course keeping: 2nd overshoot, 10/10 zig-zag"),
+    "zigzag20": ("yaw checking: 1st overshoot, 20/20 zig-zag",),
+    "stopping": ("stopping: track reach, full astern",),
+}
+
+
+def criterion_limits(length: float, speed: float, stopping_limit: float = 15.0) -> dict:
+    """`{criterion: (limit, unit)}` of every IMO MSC.137(76) 5.3 criterion for a ship of
+    `length` [m] tested at `speed` [m/s] (`CRITERIA`; the overshoots' limits by
+    `imo_overshoot_limits_deg`)."""
+    os1, os2, os20 = imo_overshoot_limits_deg(float(length) / float(speed))
+    limits = ((4.5, "L"), (5.0, "L"), (os1, "deg"), (os2, "deg"), (os20, "deg"),
+              (float(stopping_limit), "L"))
+    return dict(zip((c for names in CRITERIA.values() for c in names), limits))
 
 
 def _worst(results, name, kind, attribute):
@@ -95,8 +130,8 @@ def imo_criteria(length, speed, *, turning35=None, zigzag10=None, zigzag20=None,
     if turning35 is not None:
         adv = _worst(turning35, "turning35", TurningIndices, lambda i: i.advance)
         tac = _worst(turning35, "turning35", TurningIndices, lambda i: i.tactical_diameter)
-        add("turning: advance, 35 deg turn", adv / length, 4.5, "L")
-        add("turning: tactical diameter, 35 deg turn", tac / length, 5.0, "L")
+        add(CRITERIA["turning35"][0], adv / length, 4.5, "L")
+        add(CRITERIA["turning35"][1], tac / length, 5.0, "L")
     if initial_turning is not None:
         for i in initial_turning if isinstance(initial_turning, Sequence) else [initial_turning]:
             if isinstance(i, InitialTurningIndices) and abs(i.heading_change * _DEG - 10) > 0.5:
@@ -107,20 +142,20 @@ def imo_criteria(length, speed, *, turning35=None, zigzag10=None, zigzag20=None,
     if zigzag10 is not None:
         _check_switch(zigzag10, "zigzag10", 10.0)
         first = _worst(zigzag10, "zigzag10", ZigZagIndices, lambda i: i.overshoots[0])
-        add("yaw checking: 1st overshoot, 10/10 zig-zag", first * _DEG, os1, "deg")
+        add(CRITERIA["zigzag10"][0], first * _DEG, os1, "deg")
         if all(len(z.overshoots) >= 2 for z in (
                 zigzag10 if isinstance(zigzag10, Sequence) else [zigzag10])):
             second = _worst(zigzag10, "zigzag10", ZigZagIndices, lambda i: i.overshoots[1])
-            add("course keeping: 2nd overshoot, 10/10 zig-zag", second * _DEG, os2, "deg")
+            add(CRITERIA["zigzag10"][1], second * _DEG, os2, "deg")
         else:
             raise ValueError("`zigzag10` needs a second overshoot: simulate longer.")
     if zigzag20 is not None:
         _check_switch(zigzag20, "zigzag20", 20.0)
         first = _worst(zigzag20, "zigzag20", ZigZagIndices, lambda i: i.overshoots[0])
-        add("yaw checking: 1st overshoot, 20/20 zig-zag", first * _DEG, os20, "deg")
+        add(CRITERIA["zigzag20"][0], first * _DEG, os20, "deg")
     if stopping is not None:
         reach = _worst(stopping, "stopping", StoppingIndices, lambda i: i.track_reach)
-        add("stopping: track reach, full astern", reach / length, float(stopping_limit), "L")
+        add(CRITERIA["stopping"][0], reach / length, float(stopping_limit), "L")
     return rows
 
 
@@ -128,8 +163,8 @@ def format_table(rows: Sequence[CriterionRow], *, digits=2) -> str:
     """Markdown table of `imo_criteria` rows: criterion, value, limit, pass/fail."""
     lines = ["| criterion | value | limit | result |", "| --- | ---: | ---: | :---: |"]
     for row in rows:
-        lines.append(
-            f"| {row.criterion} | {row.value:.{digits}f} {row.unit} | "
-            f"{row.limit:.{digits}f} {row.unit} | {'pass' if row.passed else 'FAIL'} |"
-        )
+        value = f"{row.value:.{digits}f} {row.unit}" if math.isfinite(row.value) else \
+            "not measured"
+        lines.append(f"| {row.criterion} | {value} | {row.limit:.{digits}f} {row.unit} | "
+                     f"{'pass' if row.passed else 'FAIL'} |")
     return "\n".join(lines)
