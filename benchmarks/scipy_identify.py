@@ -106,7 +106,9 @@ def whiteness(e):
     return dict(statistic=float(q), threshold_99=float(limit), passed=bool(q < limit))
 
 
-def identify(train, held_out):
+def fit(train):
+    """`(report, (e, jac))`: the LM fit on `train`, its standard errors and the training
+    residuals' whiteness (what `jaxship.fit` returns, without the simulations)."""
     y = {c: np.concatenate([rec[c] for rec in train]) for c in ("psi", "r", "delta")}
     dt = np.concatenate([np.append(np.diff(rec["t"]), np.nan) for rec in train])
     starts, idx, mask = windows(train)
@@ -136,15 +138,21 @@ def identify(train, held_out):
                   cost=sol.cost, nfev=sol.nfev, status=sol.status, start=start.tolist(),
                   weights=weights.tolist(),
                   whiteness_train={c: whiteness(e[i]) for i, c in enumerate(("psi", "r"))})
+    return report, (e, jac)
+
+
+def identify(train, held_out):
+    report, errors = fit(train)
+    sol_x = np.array([report["K"], report["T"]])
     sims = {}
     for label, records in (("train_simulation", train), ("validation", held_out)):
-        sims[label] = [simulate(sol.x, rec) for rec in records]
+        sims[label] = [simulate(sol_x, rec) for rec in records]
         report[label] = {c: dict(
             fit_percent=fit_percent([rec[c] for rec in records], [s[i] for s in sims[label]]),
             whiteness=whiteness(np.concatenate([rec[c] - s[i] for rec, s
                                                 in zip(records, sims[label])])))
             for i, c in enumerate(("psi", "r"))}
-    return report, sims, (e, jac)
+    return report, sims, errors
 
 
 def figures(folder, train, held_out, sims, errors):

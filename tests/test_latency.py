@@ -129,3 +129,32 @@ def test_a_second_run_of_the_identify_example_compiles_nothing(tmp_path):
         runs.append(json.loads(done.stdout.strip().splitlines()[-1]))
     assert runs[0]["code"] == 0 and any("_solve" in m for m in runs[0]["misses"])
     assert runs[1]["misses"] == [], runs[1]["misses"]
+
+
+def test_a_second_run_of_the_simulate_and_autopilot_examples_compiles_nothing(tmp_path):
+    """The README's `simulate` and `autopilot` rows, each run twice in new processes
+    sharing a compilation cache: the second run of each compiles nothing (issue 70's
+    goal for every README example; `identify`'s is the test above, `discover` and
+    `reproduce` are left to `benchmarks/cli.py`'s second-run column)."""
+    from jaxship.cli import main
+
+    assert main(["simulate", "--vessel", "thesis", "--manoeuvre", "zigzag:20/20", "--rpm",
+                 "400", "--out", str(tmp_path / "trial")]) == 0
+    assert main(["identify", str(tmp_path / "trial" / "trial.csv"), "--model", "nomoto1",
+                 "--no-figures", "--quiet", "--out", str(tmp_path / "fit")]) == 0
+    examples = {
+        "simulate": ["simulate", "--vessel", "mariner", "--manoeuvre", "zigzag:20/20",
+                     "--out", str(tmp_path / "zz")],
+        "autopilot": ["autopilot", "--model", str(tmp_path / "fit" / "result.json"),
+                      "--vessel", "thesis", "--rpm", "300", "400", "--quiet", "--out",
+                      str(tmp_path / "ap")]}
+    env = dict(os.environ, JAXSHIP_CACHE_DIR=str(tmp_path / "cache"))
+    for name, argv in examples.items():
+        runs = []
+        for _ in range(2):
+            done = subprocess.run([sys.executable, "-c", _COUNT, *argv], capture_output=True,
+                                  text=True, cwd=ROOT, timeout=900, env=env)
+            assert done.returncode == 0, (name, done.stderr)
+            runs.append(json.loads(done.stdout.strip().splitlines()[-1]))
+        assert runs[0]["code"] == 0 and runs[0]["misses"], (name, runs[0])
+        assert runs[1]["misses"] == [], (name, runs[1]["misses"])

@@ -19,8 +19,9 @@ def stable_substeps(model, windows, refuse: bool = True) -> int:
     $\\lceil \\rho\\,dt / 2.5 \\rceil$, $\\rho$ the largest eigenvalue modulus of the
     field's Jacobian at the first window start (`ValueError` beyond `MAX_SUBSTEPS`, with
     `refuse`)."""
-    start = jax.tree.map(lambda a: a[0, 0], windows.start)  # the first window's start
-    inputs = {k: a[0, 0, 0] for k, a in windows.records.items()}
+    # the first window's start and inputs, indexed on the host (no dispatch per leaf)
+    start = jax.tree.map(lambda a: np.asarray(a)[0, 0], windows.start)
+    inputs = {k: np.asarray(a)[0, 0, 0] for k, a in windows.records.items()}
     rho = float(_fastest_rate(model, start, inputs, windows.servo))
     dt = float(np.max(np.asarray(windows.dt)))
     needed = max(1, math.ceil(rho * dt / 2.5)) if math.isfinite(rho) else MAX_SUBSTEPS + 1
