@@ -78,3 +78,23 @@ def test_the_kvlcc2_drift_is_recovered_from_the_track_without_a_logged_v():
     smoothed = smoothed_vessel_states(js.get_vessel("kvlcc2"), records)
     for s, e in zip(smoothed, holdout):
         assert np.sqrt(np.mean((s.state("v") - e.v) ** 2)) < 0.1 * np.std(e.v), e.name
+
+
+@needs_esso
+def test_discover_judges_measured_zigzags_of_one_ship():
+    """Issue 72's `cannot_judge` on records jaxship did not simulate: the base Nomoto 1
+    fitted, as `discover` fits it, to two measured Esso Osaka zig-zags describes both
+    (psi and r fits over its 60 s windows 59-86 %, measured 2026-12-07), so
+    `not_described` stays silent and the records are judged, not refused."""
+    from jaxship._analysis._discover._workflow import FIT_SOLVER, not_described, too_short
+
+    files = sorted((DATA / "esso_osaka_frt" / "zigzag").glob("*.csv"))[:2]
+    records = [js.read_measured(p).decimate(5) for p in files]
+    records = [js.Experiment(e.t, e.delta, psi=e.psi, r=e.r, name=e.name) for e in records]
+    estimator = js.PredictionError(horizon=60.0, initial=js.EstimatedStarts(),
+                                   solver=FIT_SOLVER)
+    base = js.fit(js.identify("nomoto1", records).model, records, estimator=estimator)
+    fits = [float(f) for c in ("psi", "r") for f in base.metrics[c].fit_per_experiment]
+    assert min(fits) > 40.0, fits
+    assert not_described(base, [e.name for e in records]) == ""
+    assert too_short(js.Dataset.from_experiments(records), 60.0) == ""
