@@ -123,9 +123,11 @@ def test_a_refit_that_fails_numerically_rejects_that_candidate_not_the_run(monke
     monkeypatch.setattr(_search, "fit", failing)
     report = run(effects.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
     failed = [r for r in report.rejected if r.id in one_class]
-    assert failed and failed[0].why == (
-        "the refit failed numerically (LinAlgError: SVD did not converge)",)
+    assert failed and failed[0].why == (  # issue 71: tried from every start, then not judged
+        "not judged: the refit failed numerically (LinAlgError: SVD did not converge), from "
+        "every start (warm, staged)",)
     assert not one_class & set(report.named)
+    assert set(report.not_judged) & one_class and "**Not judged: " in report.to_markdown()
     assert report.to_markdown() and json.dumps(report.to_dict())
 
 
@@ -207,8 +209,10 @@ def test_a_held_out_prediction_that_blows_up_rejects_that_candidate(monkeypatch)
     report = run_case((effects.RudderOffset(delta0=1.0 * DEG),), 3,
                       options=js.DiscoveryOptions(max_effects=1))[0]
     failed = [r for r in report.rejected if r.id in offset and r.iteration == 1]
-    assert failed and failed[0].why == ("a prediction with it is not finite (channel 'r': "
-                                        "non-finite values at 12 valid samples.)",)
+    assert failed and failed[0].why == (  # issue 71: tried from every start, then not judged
+        "not judged: a prediction with it is not finite (channel 'r': non-finite values at 12 "
+        "valid samples.), from every start (warm, staged)",)
+    assert failed[0].start == "staged"
     assert not offset & set(report.named)
 
 
@@ -979,7 +983,7 @@ def test_an_offset_and_a_current_are_both_named_on_an_independent_generators_rec
     NumPy, `solve_ivp`, its own servo and 0.1 s autopilot hold; u, v over ground): both
     are named, nothing else, with the truth within 3 standard errors. Before the staged
     restart the current's warm refit predicted non-finite values on the held-out turns
-    and nothing was named (measured 2026-11-27, seed 1000)."""
+    and nothing was named (measured 2026-12-07, seed 1000)."""
     truth = {"rudder_offset.delta0": 1.5 * DEG, "current.north": 0.3, "current.east": -0.4}
     generator = generator_from_effects((effects.RudderOffset(delta0=1.5 * DEG),
                                         effects.UniformCurrent(north=0.3, east=-0.4)))
