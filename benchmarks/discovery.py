@@ -20,6 +20,12 @@ nulls, wrong names <= 5 %, both of two effects >= 80 %. Issue 60: two effects bo
 >= 90 %, spurious <= 5 %, truth within 3 SE >= 90 %; three effects all named >= 75 %.
 
     python benchmarks/discovery.py --seeds 20
+    python benchmarks/discovery.py --generator mariner-scipy --seeds 20   # issue 71
+
+`--generator NAME` runs instead the Mariner scenarios (null, a 1.5 deg offset, a (0.3,
+-0.4) m/s current, both; u, v over ground, 400 s records) on the records of `jaxship`
+(`vessel_records`) or `mariner-scipy` (`jaxship/studies/generators.py`: the published
+equations in NumPy, `solve_ivp`, its own servo and autopilot hold).
 """
 
 import argparse
@@ -42,6 +48,7 @@ from jaxship.studies.discovery import (
     vessel_records,
     wind_records,
 )
+from jaxship.studies.generators import generator_from_effects, mariner_scipy_records
 
 
 DEG = np.pi / 180
@@ -108,6 +115,34 @@ VESSEL_SCENARIOS = {
 }
 
 
+# issue 71: the Mariner scenarios on records of a generator (`--generator`): jaxship's own
+# (`vessel_records`, over ground) or the independent one (`jaxship/studies/generators.py`:
+# the MSS equations in NumPy, solve_ivp, its own servo and autopilot hold), 400 s records
+GENERATOR_SCENARIOS = {
+    "null": ((), {}),
+    "offset 1.5 deg": ((effects.RudderOffset(delta0=1.5 * DEG),),
+                       {"rudder_offset.delta0": 1.5 * DEG}),
+    "current (0.3, -0.4) m/s": ((effects.UniformCurrent(north=0.3, east=-0.4),),
+                                {"current.north": 0.3, "current.east": -0.4}),
+    "offset 1.5 deg + current (0.3, -0.4) m/s": (
+        (effects.RudderOffset(delta0=1.5 * DEG), effects.UniformCurrent(north=0.3, east=-0.4)),
+        {"rudder_offset.delta0": 1.5 * DEG, "current.north": 0.3, "current.east": -0.4}),
+}
+
+
+def generator_case(generator):
+    """`run(effects, seed) -> (report, seconds)`: discovery from the Mariner preset on the
+    records of `generator` ("jaxship" or "mariner-scipy") with `effects` hidden."""
+    def run(hidden, seed):
+        if generator == "jaxship":
+            return run_vessel_case(hidden, 1000 + seed)
+        train, holdout = mariner_scipy_records(generator_from_effects(hidden), 1000 + seed)
+        began = time.perf_counter()
+        report = js.discover(js.get_vessel("mariner"), train, holdout)
+        return report, time.perf_counter() - began
+    return run
+
+
 def time_mariner():
     """One discovery on Mariner-size records (4 + 3 records of 800 s at 2 Hz, 8 channels,
     a hidden 0.5 deg rudder offset): `jaxship.discover` from the preset, then the
@@ -150,11 +185,35 @@ def main():
                         help="instead: time one discovery on Mariner records (4 + 3 records of "
                              "800 s at 2 Hz, 8 channels) with a hidden 0.5 deg rudder offset, "
                              "by the library and by the `jaxship discover` command")
+    parser.add_argument("--generator", choices=("jaxship", "mariner-scipy"), default=None,
+                        help="instead: the Mariner scenarios (null, offset, current, both; u, "
+                             "v over ground) on records of this generator: jaxship's own or "
+                             "the independent one of jaxship/studies/generators.py")
     args = parser.parse_args()
     jax.config.update("jax_enable_x64", True)
     if args.mariner:
         time_mariner()
         return
+    if args.generator:
+        cases = {name: (hidden, truth, generator_case(args.generator))
+                 for name, (hidden, truth) in GENERATOR_SCENARIOS.items()}
+    else:
+        cases = ordinary_cases()
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
+    rows = [scenario(name, *cases[name], seeds) for name in cases
+            if not args.only or name in args.only]
+    print(f"\n{f'generator {args.generator}: ' if args.generator else ''}"
+          "| scenario | detected (null: silent) % | wrong name % | missed % | median rel. "
+          "error % | truth within 3 SE % | s per run |\n|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r[0]} | {r[1]:.0f} | {r[2]:.0f} | {r[3]:.0f} | {r[4]:.2f} | {r[5]:.0f} | "
+              f"{r[6]:.1f} |")
+    print(f"\n{args.seeds} seeds per scenario (from {1000 + args.first_seed}); "
+          f"{time.strftime('%Y-%m-%d')}.")
+
+
+def ordinary_cases() -> dict:
+    """The scenarios of issues 11 and 60 (jaxship's records): `{name: (effects, truth, run)}`."""
     cases = {name: (effects, truth, lambda e, seed, c=colour: run_case(e, 1000 + seed,
                                                                         disturbance_std=c))
              for name, (effects, colour, truth) in SCENARIOS.items()}
@@ -163,16 +222,7 @@ def main():
               for name, (effects, truth) in WIND_SCENARIOS.items()}
     cases |= {name: (effects, truth, lambda e, seed: run_vessel_case(e, 1000 + seed))
               for name, (effects, truth) in VESSEL_SCENARIOS.items()}
-    seeds = range(args.first_seed, args.first_seed + args.seeds)
-    rows = [scenario(name, *cases[name], seeds) for name in cases
-            if not args.only or name in args.only]
-    print("\n| scenario | detected (null: silent) % | wrong name % | missed % | median rel. "
-          "error % | truth within 3 SE % | s per run |\n|---|---|---|---|---|---|---|")
-    for r in rows:
-        print(f"| {r[0]} | {r[1]:.0f} | {r[2]:.0f} | {r[3]:.0f} | {r[4]:.2f} | {r[5]:.0f} | "
-              f"{r[6]:.1f} |")
-    print(f"\n{args.seeds} seeds per scenario (from {1000 + args.first_seed}); "
-          f"{time.strftime('%Y-%m-%d')}.")
+    return cases
 
 
 def scenario(name, effects, truth, run, seeds):

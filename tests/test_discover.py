@@ -20,12 +20,13 @@ from jaxship._analysis._discover import _search as discover_search
 from jaxship._analysis._discover._holdout import cost_rise, record_indices
 from jaxship._analysis._discover._locate import locate_disagreement
 from jaxship._analysis._discover._plausible import rudder_equivalent
-from jaxship._analysis._discover._report import CandidateOutcome
+from jaxship._analysis._discover._report import CandidateOutcome, Verdict
 from jaxship._analysis._discover._workflow import heldout_rise
 from jaxship._estimate._sensitivity import sensitivities
 from jaxship._estimate._windows import as_dataset
 from jaxship.cli import main
 from jaxship.cli._files import MANIFEST, staged_folder
+from jaxship.studies.generators import generator_from_effects, mariner_scipy_records
 from jaxship.studies.discovery import (
     condition_records,
     covered,
@@ -122,9 +123,11 @@ def test_a_refit_that_fails_numerically_rejects_that_candidate_not_the_run(monke
     monkeypatch.setattr(_search, "fit", failing)
     report = run(effects.RudderOffset(delta0=1.0 * DEG), seed=1018, disturbance=1.0 * DEG)
     failed = [r for r in report.rejected if r.id in one_class]
-    assert failed and failed[0].why == (
-        "the refit failed numerically (LinAlgError: SVD did not converge)",)
+    assert failed and failed[0].why == (  # issue 71: tried from every start, then not judged
+        "not judged: the refit failed numerically (LinAlgError: SVD did not converge), from "
+        "every start (warm, staged)",)
     assert not one_class & set(report.named)
+    assert set(report.not_judged) & one_class and "**Not judged: " in report.to_markdown()
     assert report.to_markdown() and json.dumps(report.to_dict())
 
 
@@ -206,8 +209,10 @@ def test_a_held_out_prediction_that_blows_up_rejects_that_candidate(monkeypatch)
     report = run_case((effects.RudderOffset(delta0=1.0 * DEG),), 3,
                       options=js.DiscoveryOptions(max_effects=1))[0]
     failed = [r for r in report.rejected if r.id in offset and r.iteration == 1]
-    assert failed and failed[0].why == ("a prediction with it is not finite (channel 'r': "
-                                        "non-finite values at 12 valid samples.)",)
+    assert failed and failed[0].why == (  # issue 71: tried from every start, then not judged
+        "not judged: a prediction with it is not finite (channel 'r': non-finite values at 12 "
+        "valid samples.), from every start (warm, staged)",)
+    assert failed[0].start == "staged"
     assert not offset & set(report.named)
 
 
@@ -897,3 +902,96 @@ def test_discover_on_a_three_row_record_writes_its_report_and_exits_3(tmp_path, 
     assert json.loads((tmp_path / "d" / "discovery.json").read_text())["verdict"] == \
         "cannot_judge"
     assert not (tmp_path / "d" / "figures").exists()
+
+
+def _report_with(**fields):
+    """A nothing-missing report of a Nomoto model with `fields` replaced."""
+    model = js.Nomoto1(K=0.05, T=20.0)
+    report = js.DiscoveryReport(
+        verdict=Verdict.nothing_missing, effects=(), rejected=(), scores={}, model_before=model,
+        model_after=model, train_cost_before=2.0, train_cost_after=2.0,
+        holdout_cost_before=None, holdout_cost_after=None, holdout_fit_percent_before=None,
+        holdout_fit_percent_after=None, holdout_indices={}, alpha=0.01, channels=("psi", "r"),
+        disagreement={})
+    return dataclasses.replace(report, **fields)
+
+
+def _judging(attempt):
+    """A `Search` stand-in for `Search.judge` whose `attempt(..., start)` is given."""
+    return types.SimpleNamespace(attempt=attempt, say=lambda message: None)
+
+
+def test_a_refit_that_fails_numerically_is_tried_again_from_the_staged_start():
+    """Issue 71: a current whose warm refit predicts non-finite values is refitted from
+    the staged start before it is judged, and its record says so; one that fails from
+    every start is "not judged", with the reason, not rejected by a gate."""
+    sc = types.SimpleNamespace(entry={"current": (types.SimpleNamespace(name="uniform current"),)})
+    score = types.SimpleNamespace(statistic=500.0)
+    tried = []
+
+    def attempt(path, sc, keys, s, limit, iteration, p_value, start):
+        tried.append(start)
+        if start == "warm":
+            raise discover_search.NonFiniteError("channel 'psi': non-finite values")
+        fit = types.SimpleNamespace(code=discover_search.RESULTS.successful)
+        return [CandidateOutcome("current", "uniform current", iteration, 500.0,
+                                 start=start)], fit, None, False
+
+    records, trial, _, _ = discover_search.Search.judge(_judging(attempt), None, sc,
+                                                         ("current",), score, 12.0, 1)
+    assert tried == ["warm", "staged"] and trial is not None
+    assert records[0].accepted and records[0].start == "staged"
+
+    def always(path, sc, keys, s, limit, iteration, p_value, start):
+        fit = types.SimpleNamespace(code=discover_search.RESULTS.nonlinear_max_steps_reached,
+                                    message="stopped at the maximum number of steps")
+        return [CandidateOutcome("current", "uniform current", iteration, 500.0)], fit, None, \
+            False
+
+    records, trial, _, _ = discover_search.Search.judge(_judging(always), None, sc,
+                                                         ("current",), score, 12.0, 1)
+    assert trial is None and records[0].why[0].startswith(discover_search.NOT_JUDGED)
+    assert "from every start (warm, staged)" in records[0].why[0]
+
+
+def test_nothing_is_named_in_place_of_a_higher_scoring_candidate_not_judged():
+    """Issue 71: while a candidate that scores higher could not be judged, a lesser one
+    that passes is not named (it may stand in for it); one that scores higher still is;
+    the report lists the candidate not judged and its verdict says so."""
+    judged = discover_search.NOT_JUDGED + "a prediction with it is not finite, from every start"
+    search = types.SimpleNamespace(rejected=[CandidateOutcome("current", "uniform current", 1,
+                                                              500.0, (judged,))])
+    sc = types.SimpleNamespace(scores={k: types.SimpleNamespace(statistic=v) for k, v in
+                                       (("current", 500.0), ("rudder_offset", 80.0),
+                                        ("heading_sensor_bias", 900.0))})
+    offset = ([CandidateOutcome("rudder_offset", "rudder offset", 1, 80.0)], "fit", None)
+    compass = ([CandidateOutcome("heading_sensor_bias", "compass bias", 1, 900.0)], "fit", None)
+    kept = discover_search.Search.unless_outscored(search, [offset, compass], sc)
+    assert [row[0][0].id for row in kept] == ["heading_sensor_bias"]
+    withheld = search.rejected[-1]
+    assert withheld.id == "rudder_offset" and "not named while current" in withheld.why[0]
+    report = _report_with(rejected=tuple(search.rejected))
+    assert report.not_judged == ("current",)
+    assert "**Not judged: current.**" in report.to_markdown()
+    assert report.to_dict()["not_judged"] == ["current"]
+
+
+@pytest.mark.slow
+def test_an_offset_and_a_current_are_both_named_on_an_independent_generators_records():
+    """Issue 71: a 1.5 deg rudder offset and a (0.3, -0.4) m/s current hidden in records of
+    the independent Mariner (`jaxship.studies.generators`: the published equations in
+    NumPy, `solve_ivp`, its own servo and 0.1 s autopilot hold; u, v over ground): both
+    are named, nothing else, with the truth within 3 standard errors. Before the staged
+    restart the current's warm refit predicted non-finite values on the held-out turns
+    and nothing was named (measured 2026-12-07, seed 1000)."""
+    truth = {"rudder_offset.delta0": 1.5 * DEG, "current.north": 0.3, "current.east": -0.4}
+    generator = generator_from_effects((effects.RudderOffset(delta0=1.5 * DEG),
+                                        effects.UniformCurrent(north=0.3, east=-0.4)))
+    train, holdout = mariner_scipy_records(generator, 1000)
+    report = js.discover(js.get_vessel("mariner"), train, holdout)
+    assert sorted(report.named) == ["current", "rudder_offset"], report.to_markdown()
+    assert report.not_judged == ()
+    estimates = {n: p for e in report.effects for n, p in e.parameters.items()}
+    for name, value in truth.items():
+        assert np.sign(estimates[name].value) == np.sign(value), estimates[name]
+        assert estimates[name].covers(value), (name, estimates[name])

@@ -75,6 +75,9 @@ class CandidateOutcome(eqx.Module):
     rudder_equivalent_deg: float | dict | None = None
     equivalent_to: tuple[Equivalent, ...] = ()
     jointly_with: tuple[str, ...] = ()  # the others accepted with it by the joint step
+    # the start of its refit (issue 71): "warm" (the path's fit, the new terms at their
+    # probe values) or "staged" (the new terms fitted alone first); None: not refitted
+    start: str | None = None
 
     @property
     def accepted(self) -> bool:
@@ -140,6 +143,13 @@ class DiscoveryReport(eqx.Module):
                     if self.verdict == getattr(Verdict, name))
 
     @property
+    def not_judged(self) -> tuple[str, ...]:
+        """The ids of candidates whose refit failed numerically from every start and
+        that were not named later (issue 71): the verdict does not cover them."""
+        ids = [r.id for r in self.rejected if r.why and r.why[0].startswith("not judged: ")]
+        return tuple(dict.fromkeys(k for k in ids if k not in self.named))
+
+    @property
     def named(self) -> tuple[str, ...]:
         """The ids of the accepted effects, in order."""
         return tuple(e.id for e in self.effects)
@@ -154,7 +164,8 @@ class DiscoveryReport(eqx.Module):
                 "train_cost_after", "holdout_cost_before", "holdout_cost_after",
                 "holdout_fit_percent_before", "holdout_fit_percent_after",
                 "holdout_indices", "alpha", "disagreement", "why")
-        plain = {k: getattr(self, k) for k in keys} | {"verdict": self.verdict_name}
+        plain = {k: getattr(self, k) for k in keys} | {"verdict": self.verdict_name,
+                                                       "not_judged": list(self.not_judged)}
         return _plain(plain | {"channels": list(self.channels)})
 
     def to_markdown(self) -> str:
@@ -175,6 +186,10 @@ class DiscoveryReport(eqx.Module):
                                  f"{p.interval[0]:.4g} to {p.interval[1]:.4g} | {unit} | "
                                  f"{e.score:.3g} | {e.likelihood_ratio:.3g} | "
                                  f"{e.p_value:.2g} | {e.delta_bic:.1f} | {twins or '-'} |")
+            staged = [e.id for e in self.effects if e.start == "staged"]
+            if staged:
+                lines += ["", f"Refitted from the staged start (their own parameters first, "
+                              f"the warm start having failed numerically): {', '.join(staged)}."]
         elif self.why:
             lines.append(f"**Verdict: cannot judge.** {self.why[:1].upper()}{self.why[1:]}")
         else:
@@ -184,6 +199,10 @@ class DiscoveryReport(eqx.Module):
             if best:
                 lines.append(f"The largest robust score was {best[1].score:.3g} "
                              f"({best[0]}), against a threshold of {best[1].threshold:.3g}.")
+        if self.not_judged:
+            lines += ["", f"**Not judged: {', '.join(self.not_judged)}.** Their refits failed "
+                      "numerically from every start (see Rejected): the verdict does not say "
+                      "whether they are missing."]
         if self.disagreement:
             lines += _where(self.disagreement["before"], self.disagreement["after"])
         if self.scores:
@@ -196,6 +215,7 @@ class DiscoveryReport(eqx.Module):
             lines += [f"- iteration {r.iteration}, {r.id}: {'; '.join(r.why)}"
                       + (f" (held-out cost with it {r.holdout_cost:.4g})"
                          if r.holdout_cost is not None else "")
+                      + (f" (refit from the {r.start} start)" if r.start else "")
                       for r in self.rejected]
         lines += ["", "## The gap", "",
                   f"Training cost {self.train_cost_before:.5g} -> {self.train_cost_after:.5g}."]

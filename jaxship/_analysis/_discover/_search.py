@@ -85,6 +85,19 @@ FLIP_Z = 3.0
 # refit outcomes the gates judge themselves (a bound: the edge gate; an undetermined
 # combination: the confidence-interval gate)
 _JUDGED_BY_GATES = (RESULTS.successful, RESULTS.at_bound, RESULTS.poorly_determined)
+# refits that failed numerically (issue 71: stopped at their step limit, diverged, blew
+# up): tried again from the next start
+_NUMERICAL = (RESULTS.max_steps_reached, RESULTS.nonlinear_max_steps_reached,
+              RESULTS.nonlinear_divergence, RESULTS.nonfinite, RESULTS.simulation_blew_up)
+# the starts a candidate's refit is tried from, in order, until one does not fail
+# numerically (issue 71): "warm", the path's fit with the new terms at their probe
+# values; "staged", the new terms' own parameters fitted first with every other held at
+# the path's fit (their size as the data suggest it: a current from the drift of the
+# track against the through-water prediction, an offset from the rudder at which the
+# ship holds its course), then all together from there
+STARTS = ("warm", "staged")
+# the reason of a candidate whose refit failed numerically from every start: not judged
+NOT_JUDGED = "not judged: "
 
 
 @dataclasses.dataclass(frozen=True)
@@ -249,7 +262,27 @@ class Search:
         size = min(self.options.top, self.options.max_effects - len(path.names))
         if not passed and size > 1:
             passed = self.joint(path, sc, size, iteration)
-        return [self.eliminate(self.child(path, *row, sc), iteration) for row in passed]
+        return [self.eliminate(self.child(path, *row, sc), iteration)
+                for row in self.unless_outscored(passed, sc)]
+
+    def unless_outscored(self, passed, sc) -> list:
+        """`passed` less the sets that a candidate not judged this step (`NOT_JUDGED`)
+        outscores (issue 71): a candidate that would explain more was never judged, so
+        a lesser one may be standing in for it. Their records are rejected, saying so."""
+        unjudged = {r.id: sc.scores[r.id].statistic for r in self.rejected
+                    if r.why and r.why[0].startswith(NOT_JUDGED) and r.id in sc.scores}
+        kept = []
+        for records, trial, after in passed:
+            ids = {r.id for r in records}
+            above = sorted(k for k, score in unjudged.items()
+                           if k not in ids and score > max(r.score for r in records))
+            if not above:
+                kept.append((records, trial, after))
+                continue
+            why = (f"not named while {', '.join(above)}, which scores higher, could not be "
+                   "judged (its refit failed numerically from every start)",)
+            self.rejected.extend(dataclasses.replace(r, why=why) for r in records)
+        return kept
 
     def child(self, path, records, trial, after, sc) -> Path:
         self.say(f"accepted {' + '.join(r.id for r in records)}")
@@ -382,21 +415,33 @@ class Search:
         return []
 
     def judge(self, path, sc, keys, s, limit, iteration, p_value=None):
-        """Refit `path` with the candidates `keys` (one, or a joint union) from their probe
-        values and apply the gates (module text) against the score threshold `limit`.
-        Returns (one record per candidate, with `why` where the refit fails a gate; the
-        fit; its held-out check; whether that check alone failed). A refit that fails
-        numerically rejects these candidates, not the run."""
-        try:
-            return self.attempt(path, sc, keys, s, limit, iteration, p_value)
-        except (np.linalg.LinAlgError, OverflowError, FloatingPointError) as error:
-            why = (f"the refit failed numerically ({type(error).__name__}: {error})",)
-        except NonFiniteError as error:
-            why = (f"a prediction with it is not finite ({error})",)
-        return [CandidateOutcome(k, sc.entry[k][0].name, iteration, s.statistic, why)
-                for k in keys], None, None, False
+        """Refit `path` with the candidates `keys` (one, or a joint union) and apply the
+        gates (module text) against the score threshold `limit`. Returns (one record per
+        candidate, with `why` where the refit fails a gate; the fit; its held-out check;
+        whether that check alone failed). A refit that fails numerically (an error, a
+        prediction that is not finite, or a stop at its step limit) is tried again from
+        the next of `STARTS` before it is judged; one that fails from every start is
+        "not judged" (`NOT_JUDGED`), not rejected by a gate, and rejects neither the run
+        nor the candidate's effect. Each record says which start its refit used."""
+        for start in STARTS:
+            try:
+                records, trial, after, veto = self.attempt(path, sc, keys, s, limit,
+                                                           iteration, p_value, start)
+            except (np.linalg.LinAlgError, OverflowError, FloatingPointError) as error:
+                why = f"the refit failed numerically ({type(error).__name__}: {error})"
+            except NonFiniteError as error:
+                why = f"a prediction with it is not finite ({error})"
+            else:
+                if trial.code not in _NUMERICAL:
+                    return records, trial, after, veto
+                why = f"the refit did not converge ({trial.message})"
+            self.say(f"iteration {iteration}: {' + '.join(keys)} from the {start} start: "
+                     f"{why}")
+        why = (f"{NOT_JUDGED}{why}, from every start ({', '.join(STARTS)})",)
+        return [CandidateOutcome(k, sc.entry[k][0].name, iteration, s.statistic, why,
+                                 start=start) for k in keys], None, None, False
 
-    def attempt(self, path, sc, keys, s, limit, iteration, p_value):
+    def attempt(self, path, sc, keys, s, limit, iteration, p_value, how="warm"):
         base, effects = split(path.fit.model)
         start = augment(base, *self.ordered(effects + tuple(sc.entry[k][1] for k in keys)))
         for k in keys:
@@ -404,6 +449,8 @@ class Search:
                 start = set_value(start, f"{k}.{field}", value)
         free = sum((sc.names[k] for k in keys), ())
         theta = self.theta(path)
+        if how == "staged":  # the new terms' own size from the data first, the rest held
+            start = self.refit(start, free).model
         trial = self.refit(start, theta + free)
         lr = 2 * (path.fit.cost - trial.cost) / sc.sigma2 / max(s.inflation, 1.0)
         z = float(scipy.stats.norm.isf(sc.level / 2))
@@ -437,7 +484,7 @@ class Search:
             id=k, name=sc.entry[k][0].name, parameters=params[k], **shared,
             rudder_equivalent_deg=float(np.degrees(sizes[k][0])) if sizes[k] else None,
             equivalent_to=tuple(Equivalent(j, sc.entry[j][0].separate) for j in sc.classes[k]),
-            jointly_with=tuple(j for j in keys if j != k)) for k in keys]
+            jointly_with=tuple(j for j in keys if j != k), start=how) for k in keys]
         return records, trial, after, others == 0 and len(why) == 1
 
     @staticmethod
