@@ -26,7 +26,6 @@ from jaxship._estimate._sensitivity import sensitivities
 from jaxship._estimate._windows import as_dataset
 from jaxship.cli import main
 from jaxship.cli._files import MANIFEST, staged_folder
-from jaxship.studies.generators import generator_from_effects, mariner_scipy_records
 from jaxship.studies.discovery import (
     condition_records,
     covered,
@@ -39,6 +38,7 @@ from jaxship.studies.discovery import (
     vessel_records,
     wind_records,
 )
+from jaxship.studies.generators import generator_from_effects, mariner_scipy_records
 
 
 DEG = np.pi / 180

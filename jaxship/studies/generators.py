@@ -39,6 +39,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
+
 DEG = math.pi / 180
 
 # Chislett & Strom-Tejsen (1965) via MSS mariner.m: nondimensional (prime system) mass,
