@@ -39,6 +39,8 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
+import jaxship as js  # the records only (`Experiment`): no model code of jaxship's
+
 
 DEG = math.pi / 180
 
@@ -189,7 +191,6 @@ def logged(generator, clean, rng, *, noise=NOISE, name="record"):
     """The record a user's logger writes of `clean` (`MarinerScipy.run`): u, v over
     ground, the gyro's r, the servo's rudder without the offset, and noise (module
     text). A `jaxship.Experiment` with `over_ground` semantics."""
-    import jaxship as js  # records only: no model code
 
     t, psi = clean["t"], clean["psi"]
     north, east = generator.current
