@@ -751,19 +751,27 @@ def test_help_shows_defaults_and_which_options_are_required(capsys):
     assert "(default: None)" not in " ".join(seen.values())
 
 
-GC_INTERRUPT = """
-import gc, os, signal, sys, time
+SWALLOWED_INTERRUPT = """
+import gc, os, signal, sys, time, weakref
 from jaxship import cli
-signal.signal(signal.SIGINT, cli._interrupt)
+cli._handle_interrupts()
 
-def callback(phase, info):  # Ctrl-C arriving while a garbage-collection callback runs
-    if phase == "start" and not cli._INTERRUPTED.is_set():
+def ctrl_c_now():  # Ctrl-C arriving while a callback whose exceptions Python swallows runs
+    if not cli._INTERRUPTED.is_set():
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(0.01)  # the handler runs here, inside the callback
 
-gc.callbacks.append(callback)
+class Thing:
+    pass
+
 try:
-    gc.collect()
+    if sys.argv[1] == "gc":  # XLA's garbage-collection callback
+        gc.callbacks.append(lambda phase, info: phase == "start" and ctrl_c_now())
+        gc.collect()
+    else:  # a weakref callback (WeakKeyDictionary's, as in CI's stop 74)
+        thing = Thing()
+        ref = weakref.ref(thing, lambda ref: ctrl_c_now())
+        del thing
     time.sleep(2.0)
     print("went on")
 except KeyboardInterrupt:
@@ -772,17 +780,19 @@ os._exit(0)  # before the watchdog
 """
 
 
-def test_ctrl_c_inside_a_garbage_collection_callback_is_not_swallowed():
+@pytest.mark.parametrize("where", ["gc", "weakref"])
+def test_ctrl_c_inside_a_callback_is_not_swallowed(where):
     """The trust audit (case 7): a SIGINT that landed in XLA's garbage-collection callback
     was swallowed ("Exception ignored in: <function _xla_gc_callback ...>
-    KeyboardInterrupt", with a traceback) and the run went on. The handler now raises it
-    again once the main thread is out of the callback."""
+    KeyboardInterrupt", with a traceback) and the run went on; CI's stop 74 met the same in
+    a weakref callback. `sys.unraisablehook` now raises it again once the main thread is
+    out of the callback, and prints nothing."""
     import subprocess
     import sys
 
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    run = subprocess.run([sys.executable, "-c", GC_INTERRUPT], capture_output=True, text=True,
-                         env=env, timeout=120)
+    run = subprocess.run([sys.executable, "-c", SWALLOWED_INTERRUPT, where],
+                         capture_output=True, text=True, env=env, timeout=120)
     assert run.stdout.strip() == "interrupted", (run.stdout, run.stderr)
     assert "Exception ignored" not in run.stderr and "Traceback" not in run.stderr, run.stderr
 

@@ -4,7 +4,6 @@ function (`run`); `main` registers them and turns errors into exit statuses."""
 
 import argparse
 import difflib
-import gc
 import multiprocessing
 import os
 import signal
@@ -154,9 +153,7 @@ def run(started: float | None = None) -> None:
     if started is not None:
         CLOCK.last = started
     CLOCK.mark("imports")
-    _listen_for_interrupts()
-    for signum in ENDINGS:
-        signal.signal(signum, _interrupt)
+    _handle_interrupts()
     try:
         status = main()
     except KeyboardInterrupt:  # raised before `main` reached its own handler (parsing)
@@ -191,6 +188,15 @@ def _listen_for_interrupts():
     threading.Thread(target=listen, daemon=True).start()
 
 
+def _handle_interrupts():
+    """Ctrl-C and SIGTERM: the watchdog, `_interrupt` as their handler, and
+    `_raise_again` for an interrupt Python swallowed."""
+    _listen_for_interrupts()
+    for signum in ENDINGS:
+        signal.signal(signum, _interrupt)
+    sys.unraisablehook = _raise_again
+
+
 def _interrupt(signum, frame):
     if _RAISED.is_set():
         return  # a second Ctrl-C: the watchdog is already on its way
@@ -200,23 +206,20 @@ def _interrupt(signum, frame):
     if _RETURNED.is_set():  # in the interpreter's teardown, where raising would kill
         _say(_SIGNAL[0])  # the process by the signal
         _end(128 + _SIGNAL[0])
-    if _swallowed(frame):  # raise it again once the main thread is out of there
-        threading.Timer(0.05, os.kill, (os.getpid(), signum)).start()
-        return
     _RAISED.set()
     raise KeyboardInterrupt
 
 
-def _swallowed(frame) -> bool:
-    """Whether an exception raised at `frame` would be swallowed: inside a garbage-
-    collection callback (XLA has one) or a finaliser, where Python prints "Exception
-    ignored in ..." with a traceback and goes on."""
-    callbacks = {getattr(callback, "__code__", None) for callback in gc.callbacks}
-    while frame is not None:
-        if frame.f_code in callbacks or frame.f_code.co_name == "__del__":
-            return True
-        frame = frame.f_back
-    return False
+def _raise_again(unraisable):
+    """`sys.unraisablehook`: an interrupt raised where Python swallows exceptions (a
+    garbage-collection callback, as XLA has; a weakref callback; a finaliser), which it
+    would print as "Exception ignored in ..." with a traceback and go on from, is raised
+    again once the main thread is out of there. Anything else is printed as usual."""
+    if not (isinstance(unraisable.exc_value, KeyboardInterrupt) and _INTERRUPTED.is_set()):
+        sys.__unraisablehook__(unraisable)
+        return
+    _RAISED.clear()
+    threading.Timer(0.05, os.kill, (os.getpid(), _SIGNAL[0])).start()
 
 
 def _watchdog(signum):
