@@ -78,7 +78,7 @@ def simulate_batch(
       leading batch axis on their array leaves (build them with `stack`, or with
       arrays in place of numbers, e.g. `straight_state(speeds)`). A steering model
       takes no `aux` here: its replays run in calm water with zero speeds. With the
-      default `RK4()`, a batch of 256 runs or more (`WRITTEN_OUT_BATCH`) takes its
+      default `RK4()`, a batch of 32 runs or more (`WRITTEN_OUT_BATCH`) takes its
       stages written out (see `RK4`).
     - `in_axes`: which of `(model, manoeuvre, x0, environment)` are batched: `0` for
       a leading batch axis, `None` for shared by all runs, as in `jax.vmap`; each entry

@@ -27,10 +27,13 @@ from .._foundation._state import Switched
 from .._models._manoeuvres import interpolate
 
 
-# the batch size from which `simulate_batch` writes out `RK4`'s stages (`rolled=None`): a
-# batch of 64 KVLCC2 turning circles compiled 0.5 s faster rolled but ran 0.13 s slower,
-# so from about 256 runs one call of the written-out stages takes less time
-WRITTEN_OUT_BATCH = 256
+# the batch size from which `simulate_batch` writes out `RK4`'s stages (`rolled=None`).
+# Written out, 64 Mariner 600 s zig-zags ran at 78 % of a hand-written scan against 49 %
+# rolled, and compiled in 1.07 s against 0.96 s (`benchmarks/simulation.py`, 2026-12-07);
+# 64 KVLCC2 turning circles compiled 0.5 s slower and ran 0.13 s faster. A sweep runs its
+# program more than once, and the compilation cache (on in the command) compiles it once
+# per installation, so from 32 runs the faster runs win
+WRITTEN_OUT_BATCH = 32
 
 
 class RK4(dfx.AbstractSolver):
