@@ -464,29 +464,46 @@ def _assessments(result, entry, records, options, fitting, wind, notes):
                           records.train_ds, rudder, (result.predictions, result.predicted),
                           (result.metrics[channels[0]].num_params, max_lag),
                           start="estimated" if options.initial == "estimate" else "measured")
-    report(Progress("validate", "simulating the training records"))
+    report(Progress("validate", "simulating the training records"
+                    + (" and the validation records" if records.valid_ds is not None else "")))
 
     def measured(ds):  # psi and r always exist (derived if need be); other outputs if measured
         return tuple(c for c in entry.channels if c in ("psi", "r") or c in ds.channels)
 
-    predictions, mask = simulate(result.model, records.train_ds, rudder,
-                                 measured(records.train_ds), substeps=options.substeps,
-                                 wind=wind)
-    train_sim = assess("simulation", None, records.train_ds, rudder, (predictions, mask),
+    valid_ds = records.valid_ds
+    held_wind = wind and valid_ds is not None and logs_wind(valid_ds)
+    runs = [(records.train_ds, records.train, wind)] + (
+        [] if valid_ds is None else [(valid_ds, records.held_out, held_wind)])
+    simulated = _simulated(result.model, runs, simulate, rudder, measured, options.substeps)
+    train_sim = assess("simulation", None, records.train_ds, rudder, simulated[0],
                        (d, max_lag), notes)
-    valid_block, valid_ds = None, records.valid_ds
-    if valid_ds is not None:
-        report(Progress("validate", "simulating the validation records"))
-        held_wind = wind and logs_wind(valid_ds)
-        if wind and not held_wind:
-            notes.append("the validation records do not all log the wind: simulated in calm "
-                         "air.")
-        predictions, mask = simulate(result.model, valid_ds, rudder, measured(valid_ds),
-                                     substeps=options.substeps, wind=held_wind)
-        valid_block = assess("simulation", None, valid_ds, rudder, (predictions, mask),
-                             (d, max_lag), notes)
+    if wind and valid_ds is not None and not held_wind:
+        notes.append("the validation records do not all log the wind: simulated in calm air.")
+    valid_block = None if valid_ds is None else assess(
+        "simulation", None, valid_ds, rudder, simulated[1], (d, max_lag), notes)
     report(Progress("validate", "validation", done=True))
     return train_block, train_sim, valid_block
+
+
+def _simulated(model, runs, simulate, rudder, measured, substeps):
+    """The output-error simulation `(predictions, mask)` of each `(dataset, experiments,
+    wind)` of `runs`: in one call where they simulate the same channels in the same air
+    (one compiled program for records of every length), else one call each."""
+    same = len({(measured(ds), wind) for ds, _, wind in runs}) == 1
+    if len(runs) > 1 and same:
+        both = js.Dataset.from_experiments([e for _, experiments, _ in runs
+                                            for e in experiments])
+        predictions, mask = simulate(model, both, rudder, measured(runs[0][0]),
+                                     substeps=substeps, wind=runs[0][2])
+        parts, first = [], 0
+        for ds, _, _ in runs:
+            rows = slice(first, first + ds.num_experiments)
+            cut = lambda a: np.asarray(a)[rows, : ds.num_samples]
+            parts.append(({c: cut(a) for c, a in predictions.items()}, cut(mask)))
+            first += ds.num_experiments
+        return parts
+    return [simulate(model, ds, rudder, measured(ds), substeps=substeps, wind=wind)
+            for ds, _, wind in runs]
 
 
 def _frozen_notes(result, notes) -> None:
