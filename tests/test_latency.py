@@ -2,7 +2,9 @@
 figures; a fit's progress reaches the caller without a host callback in the compiled
 program (the same iterates, and a program JAX's persistent cache can keep), so a second
 run of the README's identify example compiles nothing (counted with JAX's own log of
-persistent-cache misses). Timings are `benchmarks/latency.py`'s, never asserted here."""
+persistent-cache misses) and traces its LM and prediction programs only once per
+installation (`jax.export`, `_foundation/_exported.py`). Timings are
+`benchmarks/latency.py`'s, never asserted here."""
 
 import json
 import os
@@ -97,17 +99,21 @@ def test_progress_reports_parts_of_the_same_run(monkeypatch, max_steps, options)
 _COUNT = """
 import json, logging, sys
 import jax
-misses = []
-class Misses(logging.Handler):
+misses, traced = [], []
+class Log(logging.Handler):
     def emit(self, record):
-        if record.getMessage().startswith("PERSISTENT COMPILATION CACHE MISS"):
+        message = record.getMessage()
+        if message.startswith("PERSISTENT COMPILATION CACHE MISS"):
             misses.append(record.args[0])
-logger = logging.getLogger("jax._src.compiler")
-logger.setLevel(logging.DEBUG)
-logger.addHandler(Misses())
+        elif message.startswith("Finished tracing "):  # "Finished tracing NAME for jit"
+            traced.append(message.split()[2])
+for name in ("jax._src.compiler", "jax._src.dispatch"):
+    logger = logging.getLogger(name)
+    logger.setLevel(logging.DEBUG)
+    logger.addHandler(Log())
 from jaxship.cli import main
 code = main(sys.argv[1:])
-print(json.dumps({"code": code, "misses": misses}))
+print(json.dumps({"code": code, "misses": misses, "traced": traced}))
 """
 
 
@@ -127,8 +133,14 @@ def test_a_second_run_of_the_identify_example_compiles_nothing(tmp_path):
                               text=True, cwd=ROOT, timeout=900, env=env)
         assert done.returncode == 0, done.stderr
         runs.append(json.loads(done.stdout.strip().splitlines()[-1]))
-    assert runs[0]["code"] == 0 and any("_solve" in m for m in runs[0]["misses"])
+    assert runs[0]["code"] == 0 and runs[0]["misses"], runs[0]
     assert runs[1]["misses"] == [], runs[1]["misses"]
+    # point 2: the LM and prediction programs are traced once per installation (the
+    # first run exports them), and the second run loads them
+    programs = {"_solve", "_predict_jit"}
+    assert programs <= set(runs[0]["traced"]), runs[0]["traced"]
+    assert not programs & set(runs[1]["traced"]), runs[1]["traced"]
+    assert len(list((tmp_path / "cache" / "exported").glob("*.jaxexport"))) >= 2
 
 
 def test_a_second_run_of_the_simulate_and_autopilot_examples_compiles_nothing(tmp_path):

@@ -30,6 +30,7 @@ from .._foundation._covariance import (
     least_squares_covariance,
 )
 from .._foundation._parameter_report import RobustErrors, parameter_report
+from .._foundation._exported import persistent
 from .._foundation._params import Transform, as_arrays, resolve_free
 from .._foundation._progress import ProgressCallback, reporting_steps
 from .._foundation._sharding import sharded_vmap
@@ -212,7 +213,11 @@ def _predict(model, w: Windows, offsets=None):
     return jnp.moveaxis(out, -1, 0)
 
 
-_predict_jit = eqx.filter_jit(lambda model, w: _predict(model, w))
+@persistent  # traced and lowered once per installation
+@eqx.filter_jit
+def _predict_jit(model, w: Windows):
+    """`_predict` compiled."""
+    return _predict(model, w)
 
 
 def _start_residuals(model, w: Windows) -> np.ndarray:
@@ -262,6 +267,7 @@ def _residual_fn(z, args):
     return jnp.concatenate([out, slab.reshape((1,) + out.shape[1:])])
 
 
+@persistent  # traced and lowered once per installation
 @eqx.filter_jit
 def _solve(z0, args: _Args, solver, max_steps, chunk=None):
     """LM from z0; the estimate z, result, steps, the physical parameters and start
