@@ -104,3 +104,23 @@ def test_the_key_follows_static_arguments_and_shapes_and_a_trace_falls_back(stor
     traced = jax.jit(lambda x: scaled(x, 5.0))(jnp.ones(2))
     np.testing.assert_array_equal(traced, np.full(2, 5.0))
     assert len(list(store.glob("*.jaxexport"))) == 3
+
+
+def test_a_store_that_cannot_be_written_costs_nothing_but_time(tmp_path):
+    """The store's folder is a file: the program is exported and called all the same,
+    and nothing is written."""
+    import equinox as eqx
+
+    blocked = tmp_path / "not-a-folder"
+    blocked.write_text("mine")
+    _exported.use_store(blocked)
+    try:
+        @_exported.persistent
+        @eqx.filter_jit
+        def shifted(x, by):
+            return x + by
+
+        np.testing.assert_array_equal(shifted(jnp.zeros(2), 1.5), np.full(2, 1.5))
+    finally:
+        _exported.use_store(None)
+    assert blocked.read_text() == "mine" and sorted(tmp_path.iterdir()) == [blocked]

@@ -29,8 +29,8 @@ from .._foundation._covariance import (
     hac_from_windows,
     least_squares_covariance,
 )
-from .._foundation._parameter_report import RobustErrors, parameter_report
 from .._foundation._exported import persistent
+from .._foundation._parameter_report import RobustErrors, parameter_report
 from .._foundation._params import Transform, as_arrays, resolve_free
 from .._foundation._progress import ProgressCallback, reporting_steps
 from .._foundation._sharding import sharded_vmap

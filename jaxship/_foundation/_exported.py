@@ -23,6 +23,7 @@ import tempfile
 import equinox as eqx
 import jax
 
+
 try:  # equinox's sentinel for absent fields, inside its modules' tree definitions
     from equinox._module._flatten import MISSING as _EQX_MISSING
 except ImportError:  # another equinox layout: nothing to translate
@@ -117,13 +118,24 @@ def _export(fn, treedef, static, leaves, path: pathlib.Path):
         checks = [jax.export.DisabledSafetyCheck.custom_call(t) for t in sorted(targets)]
         exported = jax.export.export(jitted, disabled_checks=checks)(*leaves)
         blob = _dumps((bytes(exported.serialize()), out["static"], out["treedef"]))
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile(dir=path.parent, delete=False) as file:
-            file.write(blob)
-        os.replace(file.name, path)
     except Exception:
         return None
+    _write(path, blob)
     return exported, out["static"], out["treedef"]
+
+
+def _write(path: pathlib.Path, blob: bytes) -> None:
+    """`blob` to `path` whole or not at all (a folder that cannot be written: nothing)."""
+    temporary = None
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=path.parent, delete=False) as file:
+            temporary = file.name
+            file.write(blob)
+        os.replace(temporary, path)
+    except OSError:
+        if temporary is not None:
+            pathlib.Path(temporary).unlink(missing_ok=True)
 
 
 def _read(path: pathlib.Path):
