@@ -9,6 +9,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
+from .._foundation._exported import persistent
 from .._foundation._kinematics import ssa
 from .._foundation._results import RESULTS, raise_unless_successful
 from .._foundation._state import ShipState, from_vector
@@ -166,6 +167,7 @@ def _setup(plant, speeds, rpm, duration, dt, disturbance, simulator):
             simulator.steps_per_sample(dt))
 
 
+@persistent  # traced once per installation
 @eqx.filter_jit
 def _closed_loop(plant, batch, x0, dt, num, simulator, steps):
     one = lambda autopilot, state0: _run(plant, autopilot, state0, dt, num, simulator, steps)

@@ -23,6 +23,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._foundation._contract import rebuild
+from .._foundation._exported import persistent
 from .._foundation._params import as_arrays, resolve_free
 from .._models._holds import FirstOrderHold
 from .._models._manoeuvres import AbstractManoeuvre, Replay
@@ -180,6 +181,7 @@ def fisher_information(model: AbstractSteeringModel, manoeuvre, noise_std, *,
                         delta)
 
 
+@persistent  # traced once per installation
 @eqx.filter_jit
 def _jacobian(model, names, values, delta, dt, outputs, substeps):
     def sim(theta):

@@ -481,6 +481,7 @@ def _jacobian_scales(specs, model, windows):
         if zero[i] else s for i, s in enumerate(specs))
 
 
+@persistent  # traced once per installation
 @eqx.filter_jit
 def _jacobian(p, model, transform, windows):
     """Forward-mode Jacobian (C, E, W, L, d) of the weighted residuals with respect to

@@ -16,6 +16,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._foundation._contract import get_path, rebuild
+from .._foundation._exported import persistent
 from .._simulation._simulate import _as_arrays as as_arrays
 from ._fit import _residuals
 from ._lm import blockwise_jacfwd, value_and_jacfwd
@@ -57,6 +58,7 @@ def _evaluate(q, model, names, windows, shape):
     return _residuals(rebuild(model, names, q[:d]), windows, offsets)
 
 
+@persistent  # traced once per installation
 @eqx.filter_jit
 def _residual_jacobian(q, model, names, windows, shape):
     f = lambda x: _evaluate(x, model, names, windows, shape)

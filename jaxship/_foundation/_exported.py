@@ -13,6 +13,7 @@ plain `fn(*args)`: the store only ever saves time."""
 import functools
 import hashlib
 import importlib.metadata
+import inspect
 import io
 import os
 import pathlib
@@ -43,19 +44,26 @@ def use_store(folder: pathlib.Path | None) -> None:
 def persistent(fn):
     """`fn` (an `equinox.filter_jit` function), its program exported to the store on
     its first call with each static configuration and argument shapes, and loaded from
-    there by later processes."""
+    there by later processes. `__wrapped__` is `fn`'s own Python function."""
+    raw = getattr(fn, "__wrapped__", fn)
+    signature = inspect.signature(raw)
 
     @functools.wraps(fn)
     def call(*args, **kwargs):
         folder = _FOLDER[0]
-        if folder is None or kwargs:
+        if folder is None:
             return fn(*args, **kwargs)
+        bound = signature.bind(*args, **kwargs)
+        bound.apply_defaults()  # every argument by position, as the key sees it
+        if bound.kwargs:  # keyword-only arguments: not for the store
+            return fn(*args, **kwargs)
+        args = bound.args
         dynamic, static = eqx.partition(args, eqx.is_array)
         leaves, treedef = jax.tree.flatten(dynamic)
         if any(isinstance(leaf, jax.core.Tracer) for leaf in leaves):
             return fn(*args)
         try:
-            key = _key(fn, treedef, static, leaves)
+            key = _key(raw, treedef, static, leaves)
         except Exception:  # a static argument that does not pickle
             return fn(*args)
         program = _LOADED.get(key) or _read(folder / f"{key}.jaxexport") \
@@ -67,6 +75,7 @@ def persistent(fn):
         return eqx.combine(jax.tree.unflatten(out_treedef, exported.call(*leaves)),
                            out_static)
 
+    call.__wrapped__ = raw
     return call
 
 
@@ -113,10 +122,15 @@ def _export(fn, treedef, static, leaves, path: pathlib.Path):
     flat.__name__ = flat.__qualname__ = fn.__name__  # as JAX's logs name its trace
     try:
         jitted = jax.jit(flat)
-        # the store is keyed on the exact jaxlib, so its own custom calls (LAPACK) are safe
-        targets = set(re.findall(r"custom_call @([\w.]+)", jitted.lower(*leaves).as_text()))
-        checks = [jax.export.DisabledSafetyCheck.custom_call(t) for t in sorted(targets)]
-        exported = jax.export.export(jitted, disabled_checks=checks)(*leaves)
+        try:
+            exported = jax.export.export(jitted)(*leaves)
+        except ValueError as error:  # custom calls without compatibility guarantees:
+            if "custom call" not in str(error):  # the store is keyed on the exact
+                raise  # jaxlib, so its own (LAPACK) are safe
+            text = jitted.lower(*leaves).as_text()
+            checks = [jax.export.DisabledSafetyCheck.custom_call(t)
+                      for t in sorted(set(re.findall(r"custom_call @([\w.]+)", text)))]
+            exported = jax.export.export(jitted, disabled_checks=checks)(*leaves)
         blob = _dumps((bytes(exported.serialize()), out["static"], out["treedef"]))
     except Exception:
         return None

@@ -11,6 +11,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._foundation._exported import persistent
 from .._foundation._results import raise_unless_successful
 from .._foundation._state import (
     STATE_FIELDS,
@@ -144,6 +145,7 @@ def vessel_field(vessel, environment, *, wind=True, rudder_rate=None):
     return field_with_effects if vessel.effect_state_size else field
 
 
+@persistent  # traced once per installation
 @eqx.filter_jit
 def _simulate(vessel, manoeuvre, x0, environment, simulator, steps, wind=True, per_field=False):
     """The jitted body of `simulate`.

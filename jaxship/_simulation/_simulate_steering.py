@@ -16,6 +16,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
+from .._foundation._exported import persistent
 from .._foundation._params import as_arrays
 from .._foundation._state import Command, ShipState, Trajectory
 from .._models._manoeuvres import Replay, ZigZag
@@ -121,6 +122,7 @@ def steering_trajectory(manoeuvre, psi, r, internal, delta, ordered, result,
     )
 
 
+@persistent  # traced once per installation
 @eqx.filter_jit
 def _replay(model, manoeuvre, x0, aux, simulator, steps):
     """The jitted body of a steering model's replay of a rudder record."""
@@ -136,6 +138,7 @@ def _replay(model, manoeuvre, x0, aux, simulator, steps):
                                {k: records[k] for k in ("u", "v", "n")})
 
 
+@persistent  # traced once per installation
 @eqx.filter_jit
 def _steer(model, manoeuvre, x0, simulator, steps):
     """The jitted body of a steering model through a closed-loop manoeuvre: the rudder

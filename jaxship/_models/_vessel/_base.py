@@ -10,6 +10,7 @@ import numpy as np
 from jaxtyping import Array
 
 from ..._foundation._contract import AbstractModel
+from ..._foundation._exported import persistent
 from ..._foundation._state import (
     STATE_FIELDS,
     Command,
@@ -287,6 +288,7 @@ def _straight_runs(vessel, speed, n, psi) -> ShipState:
     return straight_state(speed, n, psi)
 
 
+@persistent  # traced once per installation
 @eqx.filter_jit
 def _solve_straight_runs(vessel, speed, n, iterations=40):
     """Newton's iteration on the surge force X(u, n) = 0 for every value at once (a
@@ -322,6 +324,7 @@ def _f(x):
     return jnp.asarray(x, dtype=float)
 
 
+@persistent  # traced once per installation
 @eqx.filter_jit
 def _surge_and_slope(vessel, u, n, wrt: str):
     """`surge_force(vessel, u, n)` and its derivative with respect to `wrt` ("u" or
