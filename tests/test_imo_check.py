@@ -72,3 +72,18 @@ def test_a_10_10_zigzag_with_one_overshoot_gives_the_first_and_says_why_not_the_
     assert math.isnan(one[1].value) and not one[1].passed and one[1].limit == both[1].limit
     assert one[1].note == ("not measured: the ship never checked its swing against the 10 deg "
                            "counter-rudder (1 of the 2 overshoots measured)")
+
+
+def test_a_value_on_a_band_of_zero_width_is_within_it_to_rounding():
+    """A criterion the drawn parameters do not move (the stop's track reach under drawn
+    yaw derivatives) has a band of zero width; the fitted value may differ from it in its
+    last digit (another compiled program) and is still within it; a real miss is not."""
+    import numpy as np
+
+    from jaxship._workflow._imo import _within
+
+    band = 1.1799228658693657
+    assert _within(np.nextafter(band, 2.0), band, band)
+    assert _within(band, band, band)
+    assert not _within(band * (1 + 1e-6), band, band)
+    assert not _within(3.50, 0.23, 0.29)  # issue 72's advance outside its band

@@ -37,8 +37,8 @@ def enable_compilation_cache(path: str | os.PathLike | None = None, *,
     `jaxship simulate --vessel kvlcc2 --manoeuvre turn:35` took 4.42 s instead of 5.18 s,
     means of 6 alternated runs, 2026-11-28). Returns the folder, or None where the cache
     is disabled (by `$JAXSHIP_CACHE_DIR`) or the folder cannot be created (then nothing
-    changes: a missing cache only costs time). The fit's traced programs are kept too,
-    in `exported/` there (`_exported`: traced and lowered once per installation). This
+    changes: a missing cache only costs time). The traced programs are kept too, in
+    `exported/` there (`_exported`: traced and lowered once per installation). This
     sets JAX's global configuration: call it from an application or a notebook, not
     from a library."""
     folder = compilation_cache_dir() if path is None else pathlib.Path(path).expanduser()
