@@ -5,14 +5,16 @@ Run: python benchmarks/published_splits.py [--select-only] [--sets Train-R ...]
      python benchmarks/published_splits.py --tables   (the tables of the results file)
 
 1. **Selection** (`select`). Each candidate setting of the fit (free set, prediction
-   horizon, sample interval, wind-load model: `FACTORS`) is scored by leave-one-run-out
-   cross-validation on Miyauchi's Train-R, the training set the preset's defaults come
-   from: `jaxship identify` on three of its four runs, a free simulation of the fourth
-   (`free_run_score`, 10 Hz), the r RMSE divided by the lab simulator's on that run,
-   averaged over the four folds. A coordinate search starts from the command's settings
-   and tries each factor's values in turn, keeping the best, pass after pass until a
-   pass changes nothing. Every candidate's score is
-   printed; the run reader refuses every test run's name while this runs (`Reader`).
+   horizon, sample interval, wind-load model, the scale of a prior on the lab's
+   coefficients, from none to 0, the lab's coefficients unfitted: `FACTORS`) is scored
+   by leave-one-run-out cross-validation on Miyauchi's Train-R, the training set the
+   preset's defaults come from: `jaxship identify` on three of its four runs, a free
+   simulation of the fourth (`free_run_score`, 10 Hz), the r RMSE divided by the lab
+   simulator's on that run, averaged over the four folds. A coordinate search starts
+   from the command's settings and tries each factor's values in turn, keeping the best,
+   pass after pass until a pass changes nothing, so the free set and the prior are
+   chosen together. Every candidate's score is printed; the run reader refuses every
+   test run's name while this runs (`Reader`).
 2. **Headline** (`headline`). `jaxship identify --model esso_osaka` with no option (its
    defaults are the selection: `jaxship.VESSELS["esso_osaka"].fit_settings`, checked
    against the results file by `tests/test_published_splits.py`) on each training set of

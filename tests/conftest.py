@@ -6,6 +6,7 @@ import jax
 import pytest
 
 import jaxship as js
+from jaxship._foundation import _exported
 
 
 jax.config.update("jax_enable_x64", True)
@@ -15,6 +16,12 @@ jax.config.update("jax_enable_x64", True)
 os.environ.setdefault("JAXSHIP_CACHE_DIR", str(pathlib.Path(__file__).parent.parent
                                               / ".pytest_cache" / "jax-compilation"))
 js.enable_compilation_cache()
+# ... but not the exported-program store in this process (`_foundation/_exported.py`):
+# exporting costs about 60 ms a new program on top of its compilation, and nearly every
+# test program is new in a fresh clone (CI's clean-clone run took 32.7 min with it,
+# 26.0 min before it). Its own tests (`test_exported.py`) turn it on; the command's
+# subprocesses keep it through `$JAXSHIP_CACHE_DIR`.
+_exported.use_store(None)
 
 
 # the fast tier's addition: LLVM's optimisation at level 1 (XLA's default 3). Its tests

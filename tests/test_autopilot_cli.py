@@ -214,6 +214,8 @@ def _bad_cases(tmp_path, identified):
         (model + ["--vessel", "thesis", "--rpm", "fast"] + out, "not a number"),
         # the trust audit: these ran, blew up and exited 0 with a table of "-"
         (model + ["--vessel", "thesis", "--speed", "1e6"] + out, "10 times the service speed"),
+        (model + ["--vessel", "thesis", "--speed", "0.05"] + out,
+         "less than a tenth of the service speed"),
         (model + ["--vessel", "thesis", "--rpm", "1e9"] + out, "10 times the service propeller"),
         (model + ["--vessel", "thesis", "--rpm", "300", "--speed", "1.0"] + out, "one of them"),
         # a vessel without a propeller holds only its nominal speed: 5 m/s on the Mariner

@@ -169,6 +169,8 @@ def _error_line(capsys):
     (["--manoeuvre", "turn:35", "--speed", "-1"], "--speed -1: must be a positive number"),
     (["--manoeuvre", "turn:35", "--speed", "0"], "--speed 0: must be a positive number"),
     (["--manoeuvre", "turn:35", "--speed", "1e6"], "more than 10 times the service speed"),
+    # the audit of 2026-12-07: a speed too slow to steer was accepted where the rpm was not
+    (["--manoeuvre", "turn:35", "--speed", "0.05"], "less than a tenth of the service speed"),
     (["--manoeuvre", "turn:35", "--rpm", "-1"], "--rpm -1: must be a positive number"),
     (["--manoeuvre", "turn:35", "--rpm", "100"], "mariner has no propeller model"),
     (["--manoeuvre", "turn:400"], "rudder angle 400 deg is beyond 90 deg"),

@@ -159,3 +159,22 @@ def test_cli_identify_with_a_prior(tmp_path, capsys):
                        "--out", str(tmp_path / "inf"), "--no-figures", "--quiet"], capsys)
     report = json.loads((tmp_path / "inf" / "result.json").read_text())
     assert code == 0 and "prior_scale" not in report["options"] and "prior" not in report["fit"]
+
+
+def test_a_presets_prior_is_its_protocols_choice_unless_one_is_given():
+    """Issue 69, point 2: the esso_osaka preset's fit settings hold the prior's scale the
+    leave-one-run-out protocol chose (`benchmarks/results/published_splits.json`,
+    `tests/test_published_splits.py`); `identify` takes it where no prior is given (its
+    note says so), a given scale wins, None or inf is no prior, and a model without fit
+    settings has none."""
+    chosen = js.VESSELS["esso_osaka"].fit_settings.prior
+    assert chosen is not None and chosen > 0
+    fit_settings = js.identification.fit_settings
+    default = fit_settings("esso_osaka")
+    assert default.prior == chosen and f"--prior {chosen}" in default.note
+    for given in (None, 0.3):
+        settings = fit_settings("esso_osaka", prior=given)
+        assert settings.prior == given and "--prior" not in settings.note
+    assert fit_settings("nomoto1").prior is None
+    assert fit_settings("nomoto1", prior=0.3).prior == 0.3
+    assert fit_settings(js.get_vessel("esso_osaka"), name="esso_osaka").prior == chosen

@@ -130,6 +130,7 @@ def test_the_presets_defaults_are_the_recorded_selection():
     fujiwara = js.wind_loads.FujiwaraWindLoads.esso_osaka()
     wind = {"jaxship": None, "fujiwara": fujiwara}[chosen["wind"]]
     assert settings.wind_model == wind
+    assert settings.prior == chosen.get("prior")  # issue 69: the prior's scale (None: none)
     assert results["selection"]["training_set"] == ["Miyauchi 2022", "Train-R"]
 
 
@@ -183,8 +184,10 @@ def test_identify_takes_the_presets_chosen_settings(tmp_path, monkeypatch, capsy
 
     def fake_identify(model, train, **kwargs):  # the library's settings of the call
         chosen = js.identification.fit_settings(
-            model, **{k: kwargs[k] for k in ("name", "horizon", "sample_interval", "free")})
-        seen.update(horizon=chosen.horizon, free=chosen.free, start=chosen.start, train=train)
+            model, **{k: kwargs[k] for k in ("name", "horizon", "sample_interval", "free",
+                                             "prior")})
+        seen.update(horizon=chosen.horizon, free=chosen.free, start=chosen.start, train=train,
+                    prior=chosen.prior)
         raise StopBeforeFit  # stop before any fit
 
     monkeypatch.setattr(command, "identify", fake_identify)
@@ -195,6 +198,7 @@ def test_identify_takes_the_presets_chosen_settings(tmp_path, monkeypatch, capsy
     with pytest.raises(StopBeforeFit):
         main(args)
     assert seen["horizon"] == settings.horizon and seen["free"] == settings.free
+    assert seen["prior"] == settings.prior
     assert seen["start"].wind_model == settings.wind_model
     dt = np.diff(seen["train"][0].t)
     assert np.allclose(dt, settings.sample_interval)
@@ -202,8 +206,8 @@ def test_identify_takes_the_presets_chosen_settings(tmp_path, monkeypatch, capsy
         main(args + ["--horizon", "10", "--free", "+k_x_reverse"])
     assert seen["horizon"] == 10.0 and seen["free"] == settings.free + ("k_x_reverse",)
     with pytest.raises(StopBeforeFit):
-        main(args + ["--free", "y_v,n_r"])
-    assert seen["free"] == ("y_v", "n_r")
+        main(args + ["--free", "y_v,n_r", "--prior", "inf"])
+    assert seen["free"] == ("y_v", "n_r") and seen["prior"] in (None, "inf")
 
 
 

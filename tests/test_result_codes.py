@@ -179,7 +179,8 @@ def test_the_readmes_esso_osaka_fit_is_poorly_determined(tmp_path, capsys):
     """Issue 72, point 7: `identify --model esso_osaka` on the README's measured
     zig-zags exited 0, "successful", with five coefficients poorly determined by their
     robust errors (x_0f, n_r, c_d, c_ry, c_rn on 2026-12 data): now poorly_determined,
-    exit 3, the results written."""
+    exit 3, the results written. Issue 69: the fit takes the preset's prior (scale 0.1,
+    the protocol's choice), which leaves two (x_0f 64 %, y_r 222 %, 2026-12-07)."""
     from jaxship.cli import main
 
     root = js.shared_data_dir()
@@ -192,4 +193,5 @@ def test_the_readmes_esso_osaka_fit_is_poorly_determined(tmp_path, capsys):
                  "--quiet"]) == 3
     result = json.loads((out / "result.json").read_text())
     assert result["fit"]["code"] == "poorly_determined"
+    assert result["options"]["prior_scale"] == js.VESSELS["esso_osaka"].fit_settings.prior
     assert any("robust (HAC) standard error" in f for f in result["identifiability"]["flags"])

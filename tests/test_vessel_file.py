@@ -349,8 +349,38 @@ def _damaged_results():
                             "parameter n_r is true, a boolean, not a number"),
         "a boolean std": (("parameters", "n_r", "std"), True,
                           "field 'parameters.n_r.std' is true, not a number"),
+        # found by the audit of 2026-12-07: a traceback from `simulate`'s steering path
+        "a record's dt as text": (("data", "train", 0, "dt_s"), "a",
+                                  "field 'data.train[0].dt_s' is \"a\", not a number"),
+        "a record's dt as a boolean": (("data", "train", 0, "dt_s"), True,
+                                       "field 'data.train[0].dt_s' is true, a boolean"),
+        "a negative duration": (("data", "train", 0, "duration_s"), -5.0,
+                                "field 'data.train[0].duration_s' = -5.0 s is out of its "
+                                "physical range"),
     }
     return good, damages
+
+
+@pytest.mark.parametrize("record", [{"dt_s": 1e-9, "duration_s": 120.0},
+                                    {"dt_s": 1.0, "duration_s": 1e12}])
+def test_a_steering_results_trial_too_long_to_hold_is_refused(record, tmp_path, capsys):
+    """`simulate --vessel result.json` of a steering model takes its trial's step and
+    length from the result's first training record: a hand-edited one that asks for more
+    than `MAX_SAMPLES` samples is refused in one line (the audit of 2026-12-07: an
+    out-of-memory traceback), naming where the values came from."""
+    traj = js.simulate(js.Nomoto1(K=0.05, T=10.0),
+                       js.ZigZag(math.radians(10), math.radians(10), duration=120.0, dt=1.0))
+    report = js.identify("nomoto1", [js.Experiment.from_trajectory(traj)],
+                         max_steps=20).to_dict()
+    report["data"]["train"][0].update(record)
+    result = tmp_path / "result.json"
+    result.write_text(json.dumps(report))
+    out = tmp_path / "zz"
+    assert main(["simulate", "--vessel", str(result), "--manoeuvre", "zigzag:20/20",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "more than 5e+06" in err and "the result's first training record" in err, err
+    assert "\n" not in err and not out.exists()
 
 
 @pytest.mark.parametrize("case", list(_damaged_results()[1]))

@@ -398,8 +398,8 @@ def _default_dt(tau):
 def check_operating_point(vessel, *, speeds=(), rpms=(), name: str | None = None) -> None:
     """`ValueError` (one line, naming the vessel `name`) for approach speeds [m/s] and
     propeller rates [rpm] the vessel cannot sail at: above 10 times its service speed or
-    rate, a rate below a tenth of the service rate (dead slow ahead is about a third of
-    it: below a tenth the rudder has no steerage way; rpm given as rev/s?), or a rate
+    rate, a speed or rate below a tenth of the service one (dead slow ahead is about a
+    third of it: below a tenth the rudder has no steerage way; rpm given as rev/s?), or a rate
     where it has no propeller model (the net surge force does not change with n)."""
     name = name or type(vessel).__name__
     nominal = float(vessel.nominal_speed)
@@ -407,6 +407,10 @@ def check_operating_point(vessel, *, speeds=(), rpms=(), name: str | None = None
         if speed > 10 * nominal:
             raise ValueError(f"speed {speed:g} m/s: more than 10 times the service speed of "
                              f"{name} ({nominal:.3g} m/s); give an approach speed in m/s.")
+        if speed < 0.1 * nominal:
+            raise ValueError(f"speed {speed:g} m/s: less than a tenth of the service speed of "
+                             f"{name} ({nominal:.3g} m/s), too slow to steer; give an approach "
+                             "speed in m/s.")
     thrust = lambda n: float(vessel.forces(nominal, 0.0, 0.0, 0.0, n)[0])  # v = r = delta = 0
     if rpms and thrust(1.0) == thrust(0.0):
         raise ValueError(f"rpm: {name} has no propeller model, so the propeller rate does "

@@ -57,7 +57,7 @@ def register(sub) -> None:
                        "start (--model's preset, --vessel's file or result.json), with a "
                        "standard deviation of SCALE times each start value (e.g. 0.3): the "
                        "fit is the maximum a posteriori estimate; inf or none: no prior "
-                       "(default)")
+                       "(default: none; a preset's own where it has one)")
     ident.add_argument("--validate", nargs="+", type=pathlib.Path, default=None,
                        metavar="TEST", help="held-out records to validate on")
     ident.add_argument("--out", required=True, type=pathlib.Path, help="output folder")
@@ -118,7 +118,8 @@ def settings(args):
     model, name = start_model(args)
     horizon = ... if args.horizon is None else _horizon(args.horizon)
     return model, name, fit_settings(model, name=name, horizon=horizon,
-                                     sample_interval=args.sample_interval, free=args.free)
+                                     sample_interval=args.sample_interval, free=args.free,
+                                     prior=... if args.prior is None else args.prior)
 
 
 def run(args) -> int:
@@ -146,7 +147,8 @@ def run(args) -> int:
                       horizon=... if args.horizon is None else chosen.horizon,
                       sample_interval=args.sample_interval, free=args.free,
                       rudder=args.rudder, channels=args.channels, initial=args.initial,
-                      max_steps=args.max_steps, progress=progress, prior=args.prior)
+                      max_steps=args.max_steps, progress=progress,
+                      prior=... if args.prior is None else args.prior)
     CLOCK.mark(progress.stage or "identify")
     written = ["result.json"]
     with staged_folder(args.out) as stage:

@@ -167,6 +167,12 @@ def run_steering(args, chosen) -> int:
     if dt is None or duration is None or duration < 2 * dt:
         raise ValueError("give --dt and --duration (longer than two samples): the result "
                          "names no training record to take them from.")
+    if duration / dt > MAX_SAMPLES:
+        given = "--duration/--dt" if args.dt and args.duration else \
+            "--duration/--dt (default: the result's first training record)"
+        raise ValueError(f"{given}: {duration / dt:.3g} samples ({duration:.4g} s at "
+                         f"{dt:.3g} s), more than {MAX_SAMPLES:.0e}; give a larger --dt or a "
+                         "shorter --duration.")
     check_out(args.out, writes=("trial.csv", "indices.json", "trial.png"))
     with staged_folder(args.out) as stage:
         indices = simulate_steering_to_folder(chosen.model, spec, stage, dt=dt,

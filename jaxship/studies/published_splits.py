@@ -160,13 +160,18 @@ EXTRA_FREE = ("i_zz_j_zz", "k_x")  # the yaw inertia and the race factor of the 
 
 # the command's settings before any choice (`jaxship identify`'s own defaults, but at the
 # interval and horizon the fits of the published-splits work used): the search's start
-START = {"free": "default", "horizon": 60.0, "sample_interval": 0.5, "wind": "jaxship"}
+START = {"free": "default", "horizon": 60.0, "sample_interval": 0.5, "wind": "jaxship",
+         "prior": None}
 # the values tried for each factor, in the order the coordinate search visits them
 FACTORS = {
     "free": ("default", "default + i_zz_j_zz, k_x"),
     "horizon": (30.0, 60.0, 120.0),
     "sample_interval": (0.5, 1.0),
     "wind": ("jaxship", "fujiwara", "none"),
+    # issue 69: a Gaussian prior centred on the lab's coefficients, its standard deviation
+    # relative to each (`jaxship.identify(prior=)`); None: no prior, 0: the lab's
+    # coefficients themselves (no fit), so the choice matches or beats both
+    "prior": (None, 1.0, 0.3, 0.1, 0.03, 0.0),
 }
 
 
@@ -228,13 +233,17 @@ def identify(reader, names, setting=None) -> tuple:
     `esso_osaka` preset with its own settings when `setting` is None, else from the lab's
     coefficients with every option of `setting` given."""
     paths = [reader.path(n) for n in names]
+    prior = None if setting is None else setting.get("prior")
+    if prior == 0:  # the lab's coefficients, no fit
+        return lab(setting["wind"]), 0
     if setting is None:
         result = js.identify("esso_osaka", paths)
     else:
         free = js.default_free(js.get_vessel("esso_osaka")) + (
             EXTRA_FREE if setting["free"] != "default" else ())
         result = js.identify(lab(setting["wind"]), paths, horizon=setting["horizon"],
-                             sample_interval=setting["sample_interval"], free=free)
+                             sample_interval=setting["sample_interval"], free=free,
+                             prior=prior)
     determined = result.fit.success and result.fit.code != js.RESULTS.undetermined
     return result.model, 0 if determined else 3
 
@@ -257,7 +266,8 @@ def cv_score(reader, names, setting, *, say) -> dict:
 
 
 def key(setting) -> str:
-    return ", ".join(f"{k} {v}" for k, v in setting.items())
+    """The candidate's name: its factors' values (no prior, the search's start, unnamed)."""
+    return ", ".join(f"{k} {v}" for k, v in setting.items() if v is not None)
 
 
 def select(reader, names, *, say, known=None, evaluate=cv_score) -> dict:

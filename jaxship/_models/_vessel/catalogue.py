@@ -11,14 +11,17 @@ from . import esso_osaka, mariner, mmg, nomoto, ross, sway_yaw
 class FitSettings:
     """The settings `jaxship identify --model <preset>` uses when none is given: the
     prediction `horizon` [s], the records' `sample_interval` [s], the `free`
-    coefficients and the `wind_model` the fit starts with (None: the preset's own), as a
-    protocol on training runs only chose them (`source`)."""
+    coefficients, the `wind_model` the fit starts with (None: the preset's own) and the
+    `prior`'s scale (a Gaussian prior centred on the preset's coefficients, its standard
+    deviation relative to each; None: no prior), as a protocol on training runs only
+    chose them (`source`)."""
 
     horizon: float | None
     sample_interval: float | None
     free: tuple[str, ...]
     wind_model: object
     source: str
+    prior: float | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -44,7 +47,8 @@ ESSO_OSAKA_FIT = FitSettings(
           "gamma_p", "i_zz_j_zz", "k_x"),
     wind_model=FujiwaraWindLoads.esso_osaka(),  # Fujiwara et al. (1998), the lab's geometry
     source="leave-one-run-out cross-validation on Miyauchi 2022 Train-R, "
-           "benchmarks/published_splits.py")
+           "benchmarks/published_splits.py",
+    prior=0.1)  # issue 69: the lab's coefficients as a prior, 10 % standard deviation
 
 VESSELS = {
     "thesis": Preset(ross.thesis_vessel),

@@ -219,7 +219,12 @@ _TABLE = Field("table", required=False, null=True)
 RESULT = {
     "model": Field("string"),
     "model_class": Field("string", required=False),
-    "data": dataclasses.replace(_TABLE, each=Field("list", null=True, each=Field("table"))),
+    # each record's sample interval and length, which `simulate` takes for a steering
+    # model's trial: positive seconds
+    "data": dataclasses.replace(_TABLE, each=Field("list", null=True, each=Field(
+        "table", fields={"dt_s": Field(unit="s", low=0.0, above=True, required=False),
+                         "duration_s": Field(unit="s", low=0.0, above=True,
+                                             required=False)}))),
     "parameters": Field("table", each=Field(("number", "table"), label="parameter {key}", fields={
         "value": Field(label="parameter {parent}"),
         "std": Field(low=0.0, nonfinite=True, required=False, says="not negative"),

@@ -21,8 +21,9 @@ class Settings(NamedTuple):
     choice; None: a vessel of one's own), `horizon` [s] (None: output error),
     `sample_interval` [s] (None: as recorded), `free` (None: the model's default set;
     a text `"+NAME,..."`: names added to it, `added_free`),
-    `start` (the model to start from; None: the catalogue's start values) and `note`
-    (the preset's settings used, in one sentence; None when none was)."""
+    `start` (the model to start from; None: the catalogue's start values), `note`
+    (the preset's settings used, in one sentence; None when none was) and `prior` (the
+    prior's relative scale, `identify`'s `prior`; None: no prior)."""
 
     name: str | None
     horizon: float | None
@@ -30,6 +31,7 @@ class Settings(NamedTuple):
     free: tuple[str, ...] | None
     start: object
     note: str | None
+    prior: float | None = None
 
 
 def _is_preset(name, start) -> bool:
@@ -73,27 +75,30 @@ def added_free(free, default, start) -> tuple[str, ...] | None:
 
 
 def fit_settings(model, *, name: str | None = None, horizon=..., sample_interval=None,
-                 free=None) -> Settings:
+                 free=None, prior=...) -> Settings:
     """The `Settings` `identify(model, ..., name=name, horizon=horizon, ...)` fits with:
     the options given, else the preset's `fit_settings` where the fit starts from a
     preset that has them, the preset itself (its name, or its unchanged instance with its
     `name`); then the preset starts with the settings' wind loads. `horizon=...`: not
-    given (None is output error). A `free` text starting with `+` adds to the preset's
-    set (its `default_free` where it has no settings). **Raises** `ValueError` for an
-    unknown model name."""
+    given (None is output error), and so for `prior` (None is no prior). A `free` text
+    starting with `+` adds to the preset's set (its `default_free` where it has no
+    settings). **Raises** `ValueError` for an unknown model name."""
     name, start = _start(model, name)
+    given_prior = prior is not ...
     if name == AUTO:
         return Settings(AUTO, None if horizon is ... else horizon, sample_interval, free,
-                        None, None)
+                        None, None, prior if given_prior else None)
     settings = js.VESSELS[name].fit_settings if _is_preset(name, start) else None
     given_horizon = horizon is not ...
     if settings is None:  # a "+" set is resolved once the start is known (`added_free`)
         return Settings(name, horizon if given_horizon else None, sample_interval,
-                        free_names(free, None), start, None)
+                        free_names(free, None), start, None, prior if given_prior else None)
     used = [text for given, text in (
         (given_horizon, f"--horizon {settings.horizon:g}"),
         (sample_interval is not None, f"--sample-interval {settings.sample_interval:g}"),
-        (free is not None, "--free " + ",".join(settings.free))) if not given]
+        (free is not None, "--free " + ",".join(settings.free)),
+        (given_prior or settings.prior is None, f"--prior {settings.prior}"))
+        if not given]
     if settings.wind_model is not None:  # the chosen wind loads
         start = eqx.tree_at(lambda v: v.wind_model, js.get_vessel(name), settings.wind_model)
         used.append(f"wind loads {type(settings.wind_model).__name__}")
@@ -101,7 +106,8 @@ def fit_settings(model, *, name: str | None = None, horizon=..., sample_interval
                                   f"({settings.source}).")
     return Settings(name, horizon if given_horizon else settings.horizon,
                     settings.sample_interval if sample_interval is None else sample_interval,
-                    free_names(free, settings.free), start, note)
+                    free_names(free, settings.free), start, note,
+                    prior if given_prior else settings.prior)
 
 
 def _start(model, name) -> tuple[str | None, object]:

@@ -75,7 +75,7 @@ def identify(model, train, *, validate=None, horizon=..., free=None,
              rudder: str = "delta", channels=None, initial=None,
              max_steps: int = 256, progress: Callable[[Progress], None] | None = None,
              name: str | None = None, substeps: int = 1,
-             prior: float | None = None) -> Identification:
+             prior=...) -> Identification:
     """Estimate a steering model or a vessel from training records and validate it, as
     `jaxship identify` does (the command calls this).
 
@@ -121,13 +121,15 @@ def identify(model, train, *, validate=None, horizon=..., free=None,
       values), with a standard deviation of `prior` times each start value's magnitude
       (`jaxship.strategies.Prior(scale=prior)`): the fit returns the maximum a posteriori
       estimate, charged for its effective number of parameters; result.json records the
-      prior and per coefficient its data share. None or `math.inf` (default): no prior.
+      prior and per coefficient its data share. None or `math.inf`: no prior; `...`
+      (default): the preset's own where the fit starts from a preset that has
+      `fit_settings`, else no prior.
     - `progress`: a callable receiving `Progress` reports, or None (quiet).
     - `name`: the catalogue name a `model` object is fitted as (a preset's name for its
       vessel, `nomoto1-norrbin` for a `NonlinearNomoto`); None: a vessel of one's own,
       a steering model's class's entry.
 
-    The preset's `fit_settings` (horizon, sample interval, free set, wind loads) apply
+    The preset's `fit_settings` (horizon, sample interval, free set, wind loads, prior) apply
     where the fit starts from the preset itself (its name, or its unchanged instance with
     `name`) and the option is not given; a note says which were used. Start values: the
     entry's `start` (linear least squares by `initial_estimate`, or a nested fit); if it
@@ -151,7 +153,7 @@ def identify(model, train, *, validate=None, horizon=..., free=None,
     options.
     """
     settings = fit_settings(model, name=name, horizon=horizon,
-                            sample_interval=sample_interval, free=free)
+                            sample_interval=sample_interval, free=free, prior=prior)
     notes = [] if settings.note is None else [settings.note]
     reading = dict(note=notes.append, sample_interval=settings.sample_interval,
                    over_ground=over_ground(velocities))
@@ -159,7 +161,7 @@ def identify(model, train, *, validate=None, horizon=..., free=None,
     validate = None if validate is None else as_experiments(validate, "validation", **reading)
     options = _Options(settings.horizon, rudder, channels, _initial(initial), max_steps, substeps,
                        settings.free, default_channels=channels is None,
-                       prior=prior_scale(prior))
+                       prior=prior_scale(settings.prior))
     if settings.name == AUTO:  # each candidate fitted, one chosen (`selection`)
         result = _chosen((train, validate), options, progress)
     else:
