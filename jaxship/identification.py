@@ -2,9 +2,10 @@
 part: the catalogue of identifiable models (`MODELS`, `ModelEntry`), the candidates of
 `"auto"` (`CANDIDATES`), a preset's fit settings (`fit_settings`), the reading and
 checking of records (`read_experiments`, `check_froude`, `same_records`), the plausibility
-of identified values and records (`implausible`, `rudder_in_rad`, `wind_too_strong`),
-the assessment (`Assessment`) and the identification report read back (`read_report`,
-`read_result`, `model_from_report`, `linear_candidate`, `unconverged_fit`):
+of identified values and records (`implausible`, `propeller_rate_slip`, `rudder_in_rad`,
+`wind_too_strong`), the assessment (`Assessment`) and the identification report read
+back (`read_report`, `read_result`, `model_from_report`, `linear_candidate`,
+`unconverged_fit`):
 
     import jaxship as js
     ident = js.identify("nomoto1", "zigzags/", horizon=10.0)
@@ -37,6 +38,7 @@ from ._workflow._identify import (
 from ._workflow._identify.plausibility import (
     implausible as implausible,
     nomoto_indices as nomoto_indices,
+    propeller_rate_slip as propeller_rate_slip,
     rudder_in_rad as rudder_in_rad,
     wind_too_strong as wind_too_strong,
 )
@@ -57,6 +59,7 @@ __all__ = [
     "implausible",
     "nomoto_indices",
     "rudder_in_rad",
+    "propeller_rate_slip",
     "wind_too_strong",
     "preset_length",
     "logs_wind",

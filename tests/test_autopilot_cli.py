@@ -687,11 +687,39 @@ def test_a_loop_that_never_settles_is_not_settled_and_exits_3(tmp_path, capsys):
     out = tmp_path / "run"
     assert main(["autopilot", "--model", str(model), "--vessel", "thesis", "--rpm", "350",
                  "--natural-frequency", "0.3", "--out", str(out), "--quiet"]) == 3
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "did not settle (code not_settled)" in err, err
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "did not settle (code not_settled)" in err[-1], err
+    # and first, that no ship has such a K (the audit of 2026-12-07)
+    assert all(line.startswith("jaxship: warning: ") for line in err[:-1]), err
+    assert any("|K T| = 1.8e-09" in line for line in err[:-1]), err
     runs = json.loads((out / "autopilot.json").read_text())["runs"]
     assert {r["code"] for r in runs} == {"not_settled"}
     assert all(r["end_error_deg"] > 0.05 * 45.0 for r in runs)
+
+
+@pytest.mark.parametrize("k_scale, t_scale, said", [
+    (1000.0, 1.0, "the rudder in rad labelled deg"), (1e-3, 1000.0, "is t in ms labelled s")])
+def test_a_hand_edited_result_beyond_what_ships_do_is_said(identified, tmp_path, capsys,
+                                                           k_scale, t_scale, said):
+    """The audit of 2026-12-07: `identify` warns of an implausible K or T, but a
+    result.json edited by hand afterwards went into `autopilot` and `simulate` with no
+    word. Both now check it by `implausible`'s ranges, before the work, against the
+    plant's length and service speed where they have one. (K times 57.3 alone, the
+    audit's case, stays inside them on the thesis vessel: K' = 37, the range ends at 40.)"""
+    report = json.loads(pathlib.Path(identified).read_text())
+    report["parameters"]["K"]["value"] *= k_scale
+    report["parameters"]["T"]["value"] *= t_scale
+    name = "K" if t_scale == 1.0 else "T"
+    edited = tmp_path / "edited.json"
+    edited.write_text(json.dumps(report))
+    main(["autopilot", "--model", str(edited), "--vessel", "thesis", "--rpm", "400",
+          "--out", str(tmp_path / "ap"), "--quiet"])
+    first = capsys.readouterr().err.strip().splitlines()[0]
+    assert first.startswith(f"jaxship: warning: {edited}: ") and said in first, first
+    main(["simulate", "--vessel", str(edited), "--manoeuvre", "zigzag:20/20", "--out",
+          str(tmp_path / "zz")])
+    err = capsys.readouterr().err
+    assert f"jaxship: warning: {edited}: " in err and (name == "K" or said in err), err
 
 
 def test_a_ship_that_turns_away_is_not_settled():

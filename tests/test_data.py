@@ -224,22 +224,22 @@ ERROR_CASES = {
     # the trust audit: degrees labelled rad gave K 57 times too small, with exit 0
     "rudder in degrees labelled rad": (
         "t [s],delta [rad],psi [rad]\n0.0,0,0\n0.5,20,0.01\n",
-        r"bad\.csv: column 'delta \[rad\]', row 2 \(line 3\): 1146 deg is beyond a rudder "
+        r"bad\.csv: column 'delta \[rad\]', row 2 \(line 3\): 1146 deg is beyond the rudder "
         r"angle of any ship \(at most 90 deg\); is the column in deg rather than rad\?",
     ),
     "yaw rate in degrees labelled rad/s": (
         "t [s],delta [deg],r [rad/s]\n0.0,0,0\n0.5,20,1.5\n",
-        r"column 'r \[rad/s\]', row 2 \(line 3\): 85\.94 deg/s is beyond a ship's yaw rate.*"
+        r"column 'r \[rad/s\]', row 2 \(line 3\): 85\.94 deg/s is beyond the yaw rate.*"
         r"in deg/s rather than rad/s",
     ),
     "propeller rate in rpm labelled rps": (
         "t [s],delta [deg],psi [deg],n [rps]\n0.0,0,0,120\n0.5,20,1,120\n",
-        r"column 'n \[rps\]', row 1 \(line 2\): 7200 rpm is beyond a propeller rate.*rpm "
+        r"column 'n \[rps\]', row 1 \(line 2\): 7200 rpm is beyond the propeller rate.*rpm "
         r"rather than rps",
     ),
     "speed in knots or km/h": (
         "t [s],delta [deg],psi [deg],u [m/s]\n0.0,0,0,72\n0.5,20,1,72\n",
-        r"column 'u \[m/s\]', row 1 \(line 2\): 72 m/s is beyond a ship's speed.*check the "
+        r"column 'u \[m/s\]', row 1 \(line 2\): 72 m/s is beyond the speed.*check the "
         r"column's unit",
     ),
     "time not increasing": (

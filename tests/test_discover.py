@@ -875,12 +875,12 @@ def test_discover_on_records_of_two_ships_cannot_judge_and_exits_3(tmp_path, cap
                  str(tmp_path / "mariner" / "trial.csv"), "--model", "nomoto1", "--out",
                  str(out), "--quiet"]) == 3
     err = capsys.readouterr().err.strip().splitlines()
-    assert err[-1].startswith("jaxship: error: the base model does not describe the "
+    assert err[-1].startswith("jaxship: cannot judge: the base model does not describe the "
                               "training records"), err
     assert "mariner/trial r -" in err[-1] and "thesis/trial" not in err[-1], err
     written = json.loads((out / "discovery.json").read_text())
     assert written["verdict"] == "cannot_judge" and written["effects"] == []
-    assert written["why"] == err[-1].removeprefix("jaxship: error: ")
+    assert written["why"] == err[-1].removeprefix("jaxship: cannot judge: ")
     assert (out / "report.md").read_text().splitlines()[2].startswith(
         "**Verdict: cannot judge.** The base model does not describe")
     assert sorted(p.name for p in (out / "figures").iterdir()) == ["residuals_00.png",

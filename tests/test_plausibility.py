@@ -8,7 +8,12 @@ import numpy as np
 import pytest
 
 import jaxship as js
-from jaxship.identification import implausible, rudder_in_rad, wind_too_strong
+from jaxship.identification import (
+    implausible,
+    propeller_rate_slip,
+    rudder_in_rad,
+    wind_too_strong,
+)
 
 
 DATA = js.shared_data_dir()
@@ -37,6 +42,33 @@ def test_published_ships_are_plausible(model, length, speed):
 ])
 def test_slips_and_signs_are_named(model, length, speed, said):
     assert any(said in line for line in implausible(model, length=length, speed=speed))
+
+
+def test_a_fit_that_found_no_rudder_response_names_no_unit():
+    """The audit of 2026-12-07: Nomoto 1 fitted to a course-unstable ship's zig-zags
+    (`sea_swift`) ran T to 1.2e12 s with K T far below the ships' range, and the warnings
+    asked "is t in ms labelled s?" and "is it the rudder in rad labelled deg?". No single
+    slip moves T and K T both: one sentence says so, and names no unit."""
+    said = implausible(js.Nomoto1(K=1e-14, T=1.2e12), length=90.0, speed=8.0)
+    assert len(said) == 1 and "no single unit slip" in said[0], said
+    assert "labelled" not in said[0] and "course-unstable" in said[0]
+
+
+def test_a_propeller_rate_in_rev_s_labelled_rpm_is_said():
+    """The audit of 2026-12-07: a record whose n column in rev/s was labelled rpm (8.33
+    "rpm" against the thesis vessel's 500) fitted with no word. Under a tenth of the
+    service rate it is said; the service rate itself, no n, or a vessel without a
+    propeller rate say nothing."""
+    thesis = js.get_vessel("thesis")
+    t = np.arange(0.0, 10.0, 0.5)
+    record = lambda n: js.Experiment(t, np.zeros_like(t), name="run", psi=np.zeros_like(t),
+                                     n=np.full_like(t, n))
+    said = propeller_rate_slip(record(float(thesis.nominal_n) / 60.0), thesis)
+    assert said is not None and "rev/s labelled rpm" in said and "8.33 rpm" in said, said
+    assert propeller_rate_slip(record(float(thesis.nominal_n)), thesis) is None
+    assert propeller_rate_slip(js.Experiment(t, np.zeros_like(t), psi=np.zeros_like(t)),
+                               thesis) is None
+    assert propeller_rate_slip(record(0.1), js.get_vessel("mariner")) is None
 
 
 def test_other_models_are_not_judged():
@@ -84,14 +116,28 @@ def _zigzag_rows() -> dict:
 
 
 # issue 72, "Broken 4": one motion channel, so no cross-channel check sees the slip;
-# each column is written as the slip writes it, under the label that hides it
+# each column is written as the slip writes it, under the label that hides it. Every
+# slip of one column (t in ms, an angle or rate in rad, the rudder signed the other way)
+# with either motion channel, psi or r (the audit of 2026-12-07: the issue's three cases
+# first, then the rest of the grid)
+DEG = 57.29577951308232
 MISLABELS = {
-    "r in rad/s labelled deg/s, no psi": {"t [s]": ("t", 1.0), "delta [deg]": ("delta", 57.2958),
+    "r in rad/s labelled deg/s, no psi": {"t [s]": ("t", 1.0), "delta [deg]": ("delta", DEG),
                                           "r [deg/s]": ("r", 1.0)},
-    "t in ms labelled s, psi only": {"t [s]": ("t", 1000.0), "delta [deg]": ("delta", 57.2958),
-                                     "psi [deg]": ("psi", 57.2958)},
+    "t in ms labelled s, psi only": {"t [s]": ("t", 1000.0), "delta [deg]": ("delta", DEG),
+                                     "psi [deg]": ("psi", DEG)},
     "the rudder in rad labelled deg": {"t [s]": ("t", 1.0), "delta [deg]": ("delta", 1.0),
-                                       "psi [deg]": ("psi", 57.2958)},
+                                       "psi [deg]": ("psi", DEG)},
+    "psi in rad labelled deg, no r": {"t [s]": ("t", 1.0), "delta [deg]": ("delta", DEG),
+                                      "psi [deg]": ("psi", 1.0)},
+    "t in ms labelled s, r only": {"t [s]": ("t", 1000.0), "delta [deg]": ("delta", DEG),
+                                   "r [deg/s]": ("r", DEG)},
+    "the rudder in rad labelled deg, r only": {"t [s]": ("t", 1.0), "delta [deg]": ("delta", 1.0),
+                                               "r [deg/s]": ("r", DEG)},
+    "the rudder signed the other way, psi only": {
+        "t [s]": ("t", 1.0), "delta [deg]": ("delta", -DEG), "psi [deg]": ("psi", DEG)},
+    "the rudder signed the other way, r only": {
+        "t [s]": ("t", 1.0), "delta [deg]": ("delta", -DEG), "r [deg/s]": ("r", DEG)},
 }
 
 
@@ -109,6 +155,7 @@ def test_a_single_channel_unit_slip_is_flagged_or_refused(case, tmp_path):
     except ValueError as error:
         assert "\n" not in str(error)
         return
-    said = [w for w in ident.warnings if "range of ships" in w or "labelled" in w]
+    said = [w for w in ident.warnings if "range of ships" in w or "labelled" in w
+            or "against its rudder" in w]
     assert said and (implausible(ident.model) or "rudder in rad" in " ".join(said)), \
         (ident.model, ident.warnings)

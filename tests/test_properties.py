@@ -409,3 +409,16 @@ def test_a_wrapped_heading_is_unwrapped_with_a_note(tmp_path_factory, experiment
     assert ("note" in back.meta) == bool(np.any(jumps > math.pi))
     if "note" in back.meta:
         assert "'psi [deg]'" in back.meta["note"] and "unwrapped" in back.meta["note"]
+
+
+def test_a_records_unchecked_columns_reach_result_json(tmp_path):
+    """The audit of 2026-12-07: the reader's "cannot be checked" note (a heading that
+    turns 1.5 deg) stayed in the record's metadata, and `identify`'s result.json did not
+    say it. It is now each training record's `unchecked` there."""
+    traj = js.simulate(js.Nomoto1(K=0.05, T=10.0), js.ZigZag(
+        math.radians(2), math.radians(0.5), duration=120.0, dt=0.5))
+    path = tmp_path / "small.csv"
+    js.write_trial_csv(path, js.Experiment.from_trajectory(traj))
+    record, = js.identify("nomoto1", [path]).to_dict()["data"]["train"]
+    assert "'psi [deg]', 'r [deg/s]' cannot be checked" in record["unchecked"], record
+    assert "heading turns by 1.5 deg" in record["unchecked"], record

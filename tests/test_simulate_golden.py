@@ -2,7 +2,9 @@
 into the library (issue 68; `tests/golden/simulate.json`, written at commit 91cbe21 by
 `tests/golden/simulate_cases.py`), and the library's doors give the command's numbers:
 `js.indices.check_imo` the table of `criteria.md`, `js.simulate` of a
-`js.StandardTrial` sized with no duration the command's `trial.csv`."""
+`js.StandardTrial` sized with no duration the command's `trial.csv`. One text changed
+since, by hand in the file (issue 72's audit): a check with no parameter draws says "No
+band: ..." where it said "Band: the central 90% of 0 of 0 parameter draws from none: ..."."""
 
 import hashlib
 import importlib.metadata

@@ -68,13 +68,13 @@ _DISPLAY_UNITS = {"rad": "deg", "rad/s": "deg/s", "rps": "rpm"}
 # 90 deg, a yaw rate beyond 60 deg/s (a 3 m model turns at about 10 deg/s), a speed beyond
 # 50 m/s (Fn 0.9 for a 320 m hull), a propeller beyond 3600 rpm, a wind from beyond a turn
 _PLAUSIBLE = {
-    "delta": (math.pi / 2, "a rudder angle", {"rad": "deg"}),
-    "delta_c": (math.pi / 2, "a rudder angle", {"rad": "deg"}),
-    "r": (math.radians(60.0), "a ship's yaw rate", {"rad/s": "deg/s"}),
-    "u": (50.0, "a ship's speed", {}),
-    "v": (50.0, "a ship's speed", {}),
-    "n": (60.0, "a propeller rate", {"rps": "rpm"}),
-    "wind_dir": (2 * math.pi + 1e-9, "a direction", {"rad": "deg"}),
+    "delta": (math.pi / 2, "the rudder angle", {"rad": "deg"}),
+    "delta_c": (math.pi / 2, "the rudder angle", {"rad": "deg"}),
+    "r": (math.radians(60.0), "the yaw rate", {"rad/s": "deg/s"}),
+    "u": (50.0, "the speed", {}),
+    "v": (50.0, "the speed", {}),
+    "n": (60.0, "the propeller rate", {"rps": "rpm"}),
+    "wind_dir": (2 * math.pi + 1e-9, "the direction", {"rad": "deg"}),
 }
 _HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*\[([^\]]*)\]\s*$")
 

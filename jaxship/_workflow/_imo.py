@@ -75,10 +75,12 @@ class ImoCheck:
 
     def to_markdown(self, title: str) -> str:
         """The check as `criteria.md` holds it: a heading with `title`, the table, and
-        what the band was drawn from."""
-        return (f"# IMO MSC.137(76) criteria: {title}\n\n{self.table()}\nBand: the central "
-                f"{self.draws['level']:.0%} of {self.draws['used']} of {self.draws['draws']} "
-                f"parameter draws from {self.draws['from']}.\n"
+        what the band was drawn from (no band: why)."""
+        band = (f"Band: the central {self.draws['level']:.0%} of {self.draws['used']} of "
+                f"{self.draws['draws']} parameter draws from {self.draws['from']}."
+                if self.draws["draws"] else
+                f"No band: {self.draws['from'].removeprefix('none: ')}.")
+        return (f"# IMO MSC.137(76) criteria: {title}\n\n{self.table()}\n{band}\n"
                 + "".join(f"\nNote: {n}\n" for n in self.notes))
 
 

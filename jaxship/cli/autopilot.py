@@ -10,7 +10,7 @@ from tqdm import tqdm  # the terminal bar (tqdm.auto warns in a kernel without i
 
 import jaxship as js
 
-from ..identification import read_result, unconverged_fit
+from ..identification import implausible, read_result, unconverged_fit
 from ..plotting import plot_autopilot
 from ._common import check_out, numbers
 from ._files import staged_folder
@@ -108,8 +108,13 @@ def run(args) -> int:
     vessel = read_vessel_option(args.vessel, vessel_only=True).model
     js.check_operating_point(vessel, speeds=[] if by_rpm else values,
                              rpms=values if by_rpm else [], name=args.vessel)
-    _, report = read_result(args.model)
+    model, report = read_result(args.model)
     unfit = unconverged_fit(report, args.model)
+    # a hand-edited value too (identify warned of its own): against the plant's length and
+    # service speed
+    for sentence in implausible(model, length=float(vessel.length),
+                                speed=float(vessel.nominal_speed)):
+        print(f"jaxship: warning: {args.model}: {sentence}", file=sys.stderr)
     check_out(args.out, inputs=[args.model], writes=("autopilot.json", "report.md", "figures/",
               *(f"figures/{_figure_name(v, by_rpm)}" for v in values)))
     kw = {"rpm": values} if by_rpm else {"speeds": values}

@@ -58,6 +58,6 @@ def run(args) -> int:
     print(f"wrote {args.out}/discovery.json, {args.out}/report.md"
           + f", {args.out}/figures/" * (args.out / "figures").is_dir())
     if report.why:  # Verdict.cannot_judge: results written, the reason on stderr
-        print(f"jaxship: error: {report.why}", file=sys.stderr)
+        print(f"jaxship: cannot judge: {report.why}", file=sys.stderr)
         return 3
     return 0

@@ -7,7 +7,7 @@ import pathlib
 import sys
 
 from .. import AbstractVessel, StandardTrial, check_operating_point, froude_scale
-from ..identification import unconverged_fit
+from ..identification import implausible, unconverged_fit
 from ..indices import check_imo
 from ..plotting import plot_imo_criteria, plot_trajectory
 from ._common import check_out, note, positive
@@ -42,6 +42,8 @@ def run(args) -> int:
     the reason said first, where `--vessel` is a result whose fit did not converge."""
     chosen = read_vessel_option(args.vessel)
     unfit = unconverged_fit(chosen.report, args.vessel) if chosen.report else ""
+    for sentence in implausible(chosen.model) if chosen.report else ():  # a hand edit too
+        print(f"jaxship: warning: {args.vessel}: {sentence}", file=sys.stderr)
     if unfit:
         print(f"jaxship: {unfit}", file=sys.stderr)
     trial = run_vessel if isinstance(chosen.model, AbstractVessel) else run_steering

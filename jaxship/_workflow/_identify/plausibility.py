@@ -58,7 +58,9 @@ def implausible(model, *, length: float | None = None,
     """A sentence for each value of `model` outside what ships do: a rudder offset beyond
     `MAX_RUDDER`, and of its indices (`nomoto_indices`) K < 0 with T > 0, |K'|, |T'|
     (with the ship's `length` [m] and mean `speed` [m/s]) or |K T| outside `K_PRIME`,
-    `T_PRIME`, `KT`, and |T| beyond `T_MAX`, each naming the likely cause."""
+    `T_PRIME`, `KT`, and |T| beyond `T_MAX`, each naming the likely cause; |T| beyond
+    `T_MAX` with |K T| below `KT`, which no single unit slip gives, in one sentence that
+    names no unit."""
     out = [f"the rudder offset {name} = {np.degrees(value):.4g} deg is beyond any rudder's "
            f"range ({np.degrees(MAX_RUDDER):g} deg): is it in deg labelled rad?"
            for name, value in _offsets(model) if not abs(value) <= MAX_RUDDER]
@@ -71,6 +73,15 @@ def implausible(model, *, length: float | None = None,
                    "turns against its rudder. Is the rudder signed the other way (positive "
                    "to port)? jaxship's rudder is positive where the ship turns to starboard "
                    "(r > 0): negate the rudder column.")
+    if abs(T) > T_MAX and abs(K * T) < KT[0]:
+        # no single slip gives both: t in ms keeps K T (psi logged) or raises it (r
+        # logged in deg/s), a slip of r, psi or the rudder keeps T
+        out.append(f"K = {K:.4g} 1/s and T = {T:.4g} s: T beyond any ship's ({T_MAX:g} s) "
+                   f"and K T = {abs(K * T):.3g} below the range of ships ({KT[0]:g} to "
+                   f"{KT[1]:g}), which no single unit slip gives: the records do not show "
+                   "a response to the rudder that this model can describe (a course-unstable "
+                   "ship, whose T < 0, or too little rudder).")
+        return tuple(out)
     known = length is not None and speed is not None and length > 0 and speed > 0
     checks = ([("K'", abs(K) * length / speed, K_PRIME), ("T'", abs(T) * speed / length,
                                                           T_PRIME)] if known else [])
@@ -100,18 +111,38 @@ def _offsets(model):
 
 def rudder_in_rad(experiment) -> str | None:
     """A sentence when a record's rudder stays below `RUDDER_IN_RAD` (0.61 deg) while its
-    heading turns more than `TURNED`: a rudder in rad labelled deg; None otherwise (or
-    without a heading)."""
+    heading (logged, else the trapezoidal integral of the yaw rate) turns more than
+    `TURNED`: a rudder in rad labelled deg; None otherwise (or without psi or r)."""
     delta = np.abs(np.asarray(experiment.delta, dtype=np.float64))
-    if not experiment.has("psi") or delta.size == 0:
+    if delta.size == 0 or not (experiment.has("psi") or experiment.has("r")):
         return None
-    psi = np.unwrap(np.asarray(experiment.psi, dtype=np.float64))
+    if experiment.has("psi"):
+        psi = np.unwrap(np.asarray(experiment.psi, dtype=np.float64))
+    else:
+        r, t = (np.asarray(a, dtype=np.float64) for a in (experiment.r, experiment.t))
+        psi = np.concatenate([[0.0], np.cumsum(0.5 * (r[1:] + r[:-1]) * np.diff(t))])
     turned = float(np.ptp(psi))
     if not (np.max(delta) < RUDDER_IN_RAD and turned > TURNED):
         return None
     return (f"{experiment.name}: the rudder never exceeds {np.degrees(np.max(delta)):.3g} deg "
             f"while the heading turns {np.degrees(turned):.0f} deg: is the rudder in rad "
             "labelled deg?")
+
+
+def propeller_rate_slip(experiment, vessel) -> str | None:
+    """A sentence when a record's logged propeller rate, where it turns, stays below a
+    tenth of `vessel`'s service rate (`jaxship.check_operating_point`'s bound: no
+    steerage way; rev/s labelled rpm reads 60 times too low); None otherwise, for a
+    record without n or a vessel without a propeller rate."""
+    nominal = float(getattr(vessel, "nominal_n", 0.0) or 0.0)
+    if not experiment.has("n") or not nominal > 0:
+        return None
+    peak = float(np.nanmax(np.abs(np.asarray(experiment.n, dtype=np.float64))))
+    if not 0 < peak < 0.1 * nominal:
+        return None
+    return (f"{experiment.name}: the logged propeller rate peaks at {60 * peak:.3g} rpm, "
+            f"under a tenth of the vessel's service rate ({60 * nominal:.4g} rpm): is n in "
+            "rev/s labelled rpm?")
 
 
 def wind_too_strong(experiment) -> str | None:

@@ -105,7 +105,10 @@ class Identification:
                      "dt_s": float(ds.dt[i]),
                      "duration_s": float(ds.dt[i] * (ds.lengths[i] - 1)),
                      "channels": list(ds.experiment_channels[i]),
-                     "velocities": "over ground" if ds.over_ground[i] else "through the water"}
+                     "velocities": "over ground" if ds.over_ground[i] else "through the water",
+                     # the reader's columns it could not check against each other, and why
+                     **{k: v for k, v in dict(ds.experiment_metadata[i]).items()
+                        if k == "unchecked"}}
                     for i in range(ds.num_experiments)]
 
         return _json_floats({

@@ -35,7 +35,7 @@ from .data import (
     same_records,
     valid_samples,
 )
-from .plausibility import implausible, rudder_in_rad, wind_too_strong
+from .plausibility import implausible, propeller_rate_slip, rudder_in_rad, wind_too_strong
 from .registry import MODELS, model_key, start_entry
 from .result import Identification
 from .selection import AUTO, CANDIDATES, choose, with_selection
@@ -211,11 +211,13 @@ def _identify(records, model: str | None, start, asked: _Options,
 
 def _implausible(model, records, start, name) -> list[str]:
     """`plausibility`'s warnings: a training record's rudder that looks like rad labelled
-    deg or wind beyond any trial's, and the model's Nomoto indices against those of ships
-    (made nondimensional by the ship's length, where the preset or vessel gives one, and
-    the mean measured u)."""
-    out = [w for e in records.train for w in (rudder_in_rad(e), wind_too_strong(e))
-           if w is not None]
+    deg, wind beyond any trial's or (for a vessel) a propeller rate too low to be in rpm,
+    and the model's Nomoto indices against those of ships (made nondimensional by the
+    ship's length, where the preset or vessel gives one, and the mean measured u)."""
+    vessel = start if isinstance(start, js.AbstractVessel) else None
+    out = [w for e in records.train for w in (
+        rudder_in_rad(e), wind_too_strong(e),
+        None if vessel is None else propeller_rate_slip(e, vessel)) if w is not None]
     length = float(start.length) if isinstance(start, js.AbstractVessel) else \
         preset_length(name)
     speeds = [np.asarray(e.u) for e in records.train if e.has("u")]
