@@ -218,8 +218,7 @@ def _implausible(model, records, start, name) -> list[str]:
     out = [w for e in records.train for w in (
         rudder_in_rad(e), wind_too_strong(e),
         None if vessel is None else propeller_rate_slip(e, vessel)) if w is not None]
-    length = float(start.length) if isinstance(start, js.AbstractVessel) else \
-        preset_length(name)
+    length = float(vessel.length) if vessel is not None else preset_length(name)
     speeds = [np.asarray(e.u) for e in records.train if e.has("u")]
     speed = float(np.mean(np.concatenate(speeds))) if speeds else None
     return out + list(implausible(model, length=length, speed=speed))
