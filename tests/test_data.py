@@ -768,3 +768,19 @@ def test_a_record_renamed_restated_and_checked(tmp_path):
     records, skipped = js.measurement_files(tmp_path)
     assert [p.name for p in records] == ["run.csv", "semicolons.csv"]
     assert [p.name for p in skipped] == ["open_water.csv"]
+
+
+@pytest.mark.parametrize("units", [js.strategies.DisplayUnits(), js.strategies.SIUnits()])
+def test_writing_refuses_what_reading_would_and_leaves_the_file(tmp_path, units):
+    """Issue 72 ("saving refuses what loading would refuse", the audit of 2026-12-07): a
+    rudder of 2 rad (115 deg) was written, and `read_trial_csv` then refused the file.
+    `write_trial_csv` refuses it in one line naming the channel; a file already at the
+    path is left as it was."""
+    t = np.arange(0.0, 10.0, 0.5)
+    path = tmp_path / "trial.csv"
+    path.write_text("the old one")
+    with pytest.raises(ValueError, match=r"channel 'delta' sample 0 is 114\.6 deg, beyond the "
+                       r"rudder angle of any ship \(at most 90 deg\)"):
+        js.write_trial_csv(path, js.Experiment(t, np.full_like(t, 2.0), psi=0.01 * t),
+                           units=units)
+    assert path.read_text() == "the old one"

@@ -122,15 +122,26 @@ def test_values_beyond_any_ship_are_refused_naming_the_column(tmp_path_factory, 
                                                               key, factor, units):
     """A channel the reader checks, beyond what any ship logs (degrees in a column
     labelled rad, rpm labelled rps, ...) at one random sample: refused, naming the
-    column and that row."""
+    column and that row; and `write_trial_csv` refuses to write it, naming the channel
+    and the sample (issue 72: saving refuses what loading would), writing nothing."""
     values = {k: np.array(getattr(experiment, k)) for k in experiment.channels}
     values.setdefault(key, np.zeros(experiment.num_samples))
     row = experiment.num_samples // 2
-    values[key][row] = _PLAUSIBLE[key][0] * factor
+    beyond = _PLAUSIBLE[key][0] * factor
+    values[key][row] = beyond
     path = tmp_path_factory.mktemp("beyond") / "trial.csv"
+    with pytest.raises(ValueError, match=rf"channel '{key}' sample {row} is .* beyond"):
+        js.write_trial_csv(path, js.Experiment(experiment.t, name="prop", **values), units=units)
+    assert not path.exists()
+    values[key][row] = 0.0  # written as a logger would: the value put in the file itself
     js.write_trial_csv(path, js.Experiment(experiment.t, name="prop", **values), units=units)
     header = next(h for h in path.read_text().splitlines()[0].split(",")
                   if h.split(" [")[0] == key)
+
+    def put(columns):
+        columns[header][row] = _from_si(np.array(beyond), header.split(" [")[1].rstrip("]"))
+
+    rewritten(path, put)
     with pytest.raises(ValueError, match=rf"column '{re.escape(header)}', row {row + 1} "
                                          rf"\(line {row + 2}\): .* is beyond"):
         js.read_trial_csv(path)

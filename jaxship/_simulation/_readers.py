@@ -394,7 +394,9 @@ def write_trial_csv(path, data, units: DisplayUnits | SIUnits = DisplayUnits()) 
     rev/s; times in s, lengths in m and speeds in m/s either way). Values are written with
     `repr`, the shortest text that reads back to the same float, so a write-read round
     trip is exact up to the unit conversion (a few ulp for degrees and rpm). A value
-    too large to write in display units (above about 3e306 rad) is a `ValueError`.
+    too large to write in display units (above about 3e306 rad) is a `ValueError`, and so
+    is one that `read_trial_csv` would refuse as beyond what any ship logs (`_PLAUSIBLE`):
+    nothing is written then.
 
     An experiment's measured `channels` are written (derived and zero-filled ones are
     not, so reading back recomputes them identically); a trajectory's valid samples are
@@ -423,6 +425,16 @@ def write_trial_csv(path, data, units: DisplayUnits | SIUnits = DisplayUnits()) 
                 f"channel {key!r} sample {bad[0]} is {float(getattr(data, key)[bad[0]])!r} in SI, "
                 f"which is not finite in {unit_of[key]}; write it with units=SIUnits()."
             )
+        if key in _PLAUSIBLE:  # saving refuses what reading would (issue 72)
+            limit, what, _ = _PLAUSIBLE[key]
+            beyond = np.nonzero(np.abs(np.asarray(getattr(data, key))) > limit)[0]
+            if beyond.size:
+                i, shown = int(beyond[0]), _DISPLAY_UNITS.get(unit_of[key], unit_of[key])
+                value = float(_from_si(np.abs(np.asarray(getattr(data, key)[i])), shown))
+                raise ValueError(
+                    f"channel {key!r} sample {i} is {value:.4g} {shown}, beyond {what} of any "
+                    f"ship (at most {float(_from_si(np.array(limit), shown)):.4g} {shown}): "
+                    "read_trial_csv would refuse the file, so it is not written.")
     with open(path, "w", newline="", encoding="utf-8") as f:
         writer = csv.writer(f, lineterminator="\n")
         writer.writerow([f"{k} [{unit_of[k]}]" for k in keys])
