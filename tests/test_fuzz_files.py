@@ -16,6 +16,7 @@ from hypothesis import example, given, settings, strategies as st
 
 import jaxship as js
 from jaxship._models._vessel.file import MAX_MAGNITUDE
+from jaxship.cli import main
 from jaxship.identification import implausible, nomoto_indices, read_result
 
 
@@ -191,6 +192,42 @@ def test_results_fuzz(results, tmp_path):
         assert (model is None) == (read is None), (model, read)
         if model is not None:
             _judged(model)
+
+    check()
+
+
+def test_a_mutated_steering_result_through_simulate(identification, tmp_path, capsys):
+    """The command, not only the reader (the audit of 2026-12-07 found a traceback in
+    `simulate`'s use of the result's records, which the reader fuzz never reached):
+    mutations of a Nomoto 1 result.json through `jaxship simulate --vessel result.json
+    --manoeuvre zigzag:10/10` (the trial's step and length from the result's first
+    record) end in exit 0, 2 (one line) or 3, never a traceback; exit 0 with a finite
+    trial, and a model beyond what ships do only with its warning."""
+    base = json.loads(identification.to_json())
+    path = tmp_path / "result.json"
+
+    @SETTINGS(100)
+    @given(mutated([base]))
+    @example({**base, "data": {"train": [{"dt_s": "a", "duration_s": 100.0}]}})
+    @example({**base, "data": {"train": [{"dt_s": 1e-9, "duration_s": 100.0}]}})
+    def check(report):
+        path.write_text(json.dumps(report))
+        out = tmp_path / "zz"
+        code = main(["simulate", "--vessel", str(path), "--manoeuvre", "zigzag:10/10",
+                     "--out", str(out)])
+        err = capsys.readouterr().err.strip()
+        assert code in (0, 2, 3), (code, err)
+        if code == 2:
+            assert "\n" not in err and err.startswith("jaxship: error: "), err
+        if code == 0:
+            indices = json.loads((out / "indices.json").read_text())
+            assert all(math.isfinite(v) for v in indices.values()
+                       if isinstance(v, float)), indices
+            model = js.load_model(path)
+            assert not implausible(model) or "warning" in err, err
+        if out.exists():
+            import shutil
+            shutil.rmtree(out)
 
     check()
 

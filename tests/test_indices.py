@@ -4,6 +4,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+import scipy.optimize
 
 import jaxship as js
 from jaxship._analysis._indices import (
@@ -643,3 +644,24 @@ def test_mariner_cross_check_numbers():
     assert round(l_over_v, 2) == 20.85
     rows = imo_criteria(vessel.length, float(x0.u), turning35=turn, initial_turning=initial)
     assert [row.passed for row in rows] == [True, False, True]  # fails the 5 L tactical diameter
+
+
+def test_a_steering_models_zigzag_from_rest_is_read_from_its_first_order():
+    """A steering model has no servo: run from t = 0 its rudder is at the order at the
+    first sample, and the executes were read from the first reversal, half a cycle late
+    (found by the audit of 2026-12-07: Nomoto 1, K = 0.05 1/s, T = 10 s, gave an initial
+    turning time of 38 s and the second overshoot as the first). Against the closed
+    form of T r' + r = K delta: psi = K d (t - T (1 - exp(-t/T))) to the switch, then
+    r relaxes to -K d, peaking where r = 0."""
+    K, T, d = 0.05, 10.0, np.radians(10.0)
+    trial = js.StandardTrial.parse("zigzag:10/10")
+    model = js.Nomoto1(K=K, T=T)
+    manoeuvre, _ = trial.sized(model, duration=120.0, dt=0.01, time_scale=120.0 / 35)
+    got = trial.indices(manoeuvre, js.simulate(model, manoeuvre, simulator=trial.simulator))
+    t_s = scipy.optimize.brentq(lambda t: K * d * (t - T * (1 - np.exp(-t / T))) - d, 1, 100)
+    r_s = K * d * (1 - np.exp(-t_s / T))
+    rise = T * np.log((r_s + K * d) / (K * d))  # from the switch to the peak
+    overshoot = -K * d * rise + T * (r_s + K * d) * (1 - np.exp(-rise / T))
+    np.testing.assert_allclose(got["initial_turning_time_s"], t_s, atol=0.02)
+    np.testing.assert_allclose(got["time_to_check_yaw_s"], rise, atol=0.02)
+    np.testing.assert_allclose(np.radians(got["overshoot_1_deg"]), overshoot, rtol=2e-3)

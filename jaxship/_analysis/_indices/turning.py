@@ -183,20 +183,31 @@ class ZigZagIndices:
 
 def _zigzag_executes(s, execute_times) -> list[float]:
     """The rudder executes [s]: `execute_times`, or the first departure of the rudder
-    order from the initial angle and then every reversal of its sign."""
+    order from the initial angle (the first sample where the run starts with the rudder
+    already at half its largest order or more: a steering model, which has no servo,
+    run from t = 0) and then every reversal of its sign."""
     if execute_times is not None:
         times = [float(e) for e in np.atleast_1d(execute_times)]
         if not times or np.any(np.diff(times) <= 0):
             raise ValueError("`execute_times` must be a non-empty increasing sequence.")
         return times
-    t1 = _rudder_execute(s, None)
-    order, i = s.rudder_order, int(np.searchsorted(s.t, t1))
+    order = s.rudder_order
+    t1 = float(s.t[0]) if _starts_ordered(s) else _rudder_execute(s, None)
+    i = int(np.searchsorted(s.t, t1))
     times, current = [t1], int(np.sign(order[i]))
     for j in range(i + 1, s.t.size):
         if abs(order[j]) > _TOL and np.sign(order[j]) == -current:
             times.append(float(s.t[j]))
             current = -current
     return times
+
+
+def _starts_ordered(s) -> bool:
+    """Whether the run starts with the rudder already at half its largest order or more
+    (a steering model, which has no servo, run from t = 0): executed at the first
+    sample, with no rudder before it."""
+    order = s.rudder_order
+    return order is not None and abs(order[0]) >= 0.5 * np.max(np.abs(order)) > _TOL
 
 
 def _first_side(s, t0, psi_s) -> tuple[int, float]:
@@ -206,8 +217,8 @@ def _first_side(s, t0, psi_s) -> tuple[int, float]:
         # side of the first order relative to the rudder before it (a neutral-helm offset,
         # as in the MARIN runs, must not decide it): where it has moved half its way; a
         # record that starts with the order given (the rudder already over) has no before
-        baseline = (s.delta[0] if s.delta_command is not None else
-                    s.rudder_order[0] if i > 0 else 0.0)
+        baseline = (0.0 if _starts_ordered(s) else s.delta[0] if s.delta_command is not None
+                    else s.rudder_order[0] if i > 0 else 0.0)
         moved = s.rudder_order[i:] - baseline
         k = i + int(np.argmax(np.abs(moved) >= 0.5 * np.max(np.abs(moved))))
         return int(np.sign(s.rudder_order[k])), abs(float(s.rudder_order[k]))
@@ -229,7 +240,9 @@ def zigzag_indices(traj=None, heading_switch=None, *, execute_times=None, initia
 
     - `heading_switch`: the heading change psi_s [rad] > 0 at which the rudder is reversed.
     - `execute_times`: the rudder executes [s]; by default the first departure of the
-      rudder order from the initial rudder angle and then every reversal of its sign.
+      rudder order from the initial rudder angle (the first sample where the run starts
+      with the rudder at half its largest order or more, as a steering model's from rest)
+      and then every reversal of its sign.
     - `initial_heading`: the original heading [rad]; by default the heading at the first
       execute.
 
