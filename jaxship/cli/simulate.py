@@ -42,12 +42,14 @@ def run(args) -> int:
     the reason said first, where `--vessel` is a result whose fit did not converge."""
     chosen = read_vessel_option(args.vessel)
     unfit = unconverged_fit(chosen.report, args.vessel) if chosen.report else ""
-    for sentence in implausible(chosen.model) if chosen.report else ():  # a hand edit too
-        print(f"jaxship: warning: {args.vessel}: {sentence}", file=sys.stderr)
     if unfit:
         print(f"jaxship: {unfit}", file=sys.stderr)
     trial = run_vessel if isinstance(chosen.model, AbstractVessel) else run_steering
     status = trial(args, chosen)
+    # a value beyond what ships do, a hand edit too (identify warned of its own); after
+    # the trial, so that a refusal stays one line
+    for sentence in implausible(chosen.model) if chosen.report else ():
+        print(f"jaxship: warning: {args.vessel}: {sentence}", file=sys.stderr)
     return 3 if unfit else status
 
 
