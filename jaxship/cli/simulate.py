@@ -45,10 +45,17 @@ def run(args) -> int:
     if unfit:
         print(f"jaxship: {unfit}", file=sys.stderr)
     trial = run_vessel if isinstance(chosen.model, AbstractVessel) else run_steering
-    status = trial(args, chosen)
-    # a value beyond what ships do, a hand edit too (identify warned of its own); after
-    # the trial, so that a refusal stays one line
-    for sentence in implausible(chosen.model) if chosen.report else ():
+    # a value beyond what ships do, a hand edit too (identify warned of its own): said
+    # after the trial, or in a refusal's one line, where it is the likely cause
+    said = implausible(chosen.model) if chosen.report else ()
+    try:
+        status = trial(args, chosen)
+    except ValueError as error:
+        if not said:
+            raise
+        raise ValueError(f"{error} The model is beyond what ships do ({args.vessel}): "
+                         f"{' '.join(said)}") from None
+    for sentence in said:
         print(f"jaxship: warning: {args.vessel}: {sentence}", file=sys.stderr)
     return 3 if unfit else status
 
