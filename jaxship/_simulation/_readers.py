@@ -351,21 +351,33 @@ def read_trial_csv(path, *, require_uniform: bool = False, allow_unknown: bool =
     )
 
 
+def _beyond(key, si) -> tuple[int, str, str] | None:
+    """The first sample of the SI channel `si` beyond what any ship logs (`_PLAUSIBLE`),
+    its value and the range it leaves, in display units ("114.6 deg", "the rudder angle
+    of any ship (at most 90 deg)"); None where every sample is within."""
+    limit, what, _ = _PLAUSIBLE[key]
+    beyond = np.nonzero(np.abs(np.asarray(si)) > limit)[0]
+    if not beyond.size:
+        return None
+    i = int(beyond[0])
+    si_unit = next(u for u, f in _UNITS[key].items() if f == 1.0)
+    shown = _DISPLAY_UNITS.get(si_unit, si_unit)
+    scale = lambda x: float(_from_si(np.array(x), shown))
+    return i, f"{scale(abs(si[i])):.4g} {shown}", f"{what} of any ship (at most " \
+        f"{scale(limit):.4g} {shown})"
+
+
 def _check_plausible(path, header, key, unit, si, lines):
     """A `ValueError` naming the file, column, row and likely unit where a channel is
-    beyond what any ship logs (`_PLAUSIBLE`): e.g. degrees in a column labelled rad."""
-    limit, what, likely = _PLAUSIBLE[key]
-    beyond = np.nonzero(np.abs(si) > limit)[0]
-    if not beyond.size:
+    beyond what any ship logs (`_beyond`): e.g. degrees in a column labelled rad."""
+    found = _beyond(key, si)
+    if found is None:
         return
-    i = int(beyond[0])
-    shown = _DISPLAY_UNITS.get(next(u for u, f in _UNITS[key].items() if f == 1.0))
-    scale = (lambda x: x) if shown is None else (lambda x: float(_from_si(np.array(x), shown)))
+    (i, value, range_), likely = found, _PLAUSIBLE[key][2]
     hint = (f"; is the column in {likely[unit]} rather than {unit}?" if unit in likely else
             "; check the column's unit.")
-    raise ValueError(f"{path}: column '{header}', row {i + 1} (line {lines[i]}): "
-                     f"{scale(abs(si[i])):.4g} {shown or unit} is beyond {what} of any ship "
-                     f"(at most {scale(limit):.4g} {shown or unit}){hint}")
+    raise ValueError(f"{path}: column '{header}', row {i + 1} (line {lines[i]}): {value} is "
+                     f"beyond {range_}{hint}")
 
 
 class DisplayUnits(eqx.Module):
@@ -425,16 +437,11 @@ def write_trial_csv(path, data, units: DisplayUnits | SIUnits = DisplayUnits()) 
                 f"channel {key!r} sample {bad[0]} is {float(getattr(data, key)[bad[0]])!r} in SI, "
                 f"which is not finite in {unit_of[key]}; write it with units=SIUnits()."
             )
-        if key in _PLAUSIBLE:  # saving refuses what reading would (issue 72)
-            limit, what, _ = _PLAUSIBLE[key]
-            beyond = np.nonzero(np.abs(np.asarray(getattr(data, key))) > limit)[0]
-            if beyond.size:
-                i, shown = int(beyond[0]), _DISPLAY_UNITS.get(unit_of[key], unit_of[key])
-                value = float(_from_si(np.abs(np.asarray(getattr(data, key)[i])), shown))
-                raise ValueError(
-                    f"channel {key!r} sample {i} is {value:.4g} {shown}, beyond {what} of any "
-                    f"ship (at most {float(_from_si(np.array(limit), shown)):.4g} {shown}): "
-                    "read_trial_csv would refuse the file, so it is not written.")
+        found = _beyond(key, getattr(data, key)) if key in _PLAUSIBLE else None
+        if found is not None:  # saving refuses what reading would (issue 72)
+            i, value, range_ = found
+            raise ValueError(f"channel {key!r} sample {i} is {value}, beyond {range_}: "
+                             "read_trial_csv would refuse the file, so it is not written.")
     with open(path, "w", newline="", encoding="utf-8") as f:
         writer = csv.writer(f, lineterminator="\n")
         writer.writerow([f"{k} [{unit_of[k]}]" for k in keys])
