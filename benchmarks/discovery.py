@@ -20,26 +20,34 @@ nulls, wrong names <= 5 %, both of two effects >= 80 %. Issue 60: two effects bo
 >= 90 %, spurious <= 5 %, truth within 3 SE >= 90 %; three effects all named >= 75 %.
 
     python benchmarks/discovery.py --seeds 20
-    python benchmarks/discovery.py --generator mariner-scipy --seeds 20   # issue 71
+    python benchmarks/discovery.py --generator mariner-scipy --seeds 20 --jobs 2  # issue 71
+    python benchmarks/discovery.py --generator kvlcc2-shipmmg --seeds 20 --jobs 2
 
-`--generator NAME` runs instead the Mariner scenarios (null, a 1.5 deg offset, a (0.3,
--0.4) m/s current, both; u, v over ground, 400 s records) on the records of `jaxship`
-(`vessel_records`) or `mariner-scipy` (`jaxship/studies/generators.py`: the published
-equations in NumPy, `solve_ivp`, its own servo and autopilot hold).
+`--generator NAME` runs instead issue 71's scenarios (the null; a 1.5 deg rudder offset, a
+(0.3, -0.4) m/s current or a 0.05 deg/s gyro bias; offset + current; current + a 20 % yaw
+added-inertia error; all three; u, v over ground) on the records of `jaxship`
+(`vessel_records`), `mariner-scipy` (`jaxship/studies/generators.py`: the published
+equations in NumPy, `solve_ivp`, its own servo and autopilot hold) or `kvlcc2-shipmmg`
+(`jaxship/studies/kvlcc2_shipmmg.py`: shipmmg's MMG code, Froude-scaled sizes).
 """
 
 import argparse
+import dataclasses
+import inspect
 import json
+import multiprocessing
 import pathlib
 import subprocess
 import tempfile
 import time
+from concurrent.futures import ProcessPoolExecutor
 
 import jax
 import numpy as np
 
 import jaxship as js
 from jaxship import effects
+from jaxship.strategies import Prior
 from jaxship.studies.discovery import (
     covered,
     outcome,
@@ -49,6 +57,7 @@ from jaxship.studies.discovery import (
     wind_records,
 )
 from jaxship.studies.generators import generator_from_effects, mariner_scipy_records
+from jaxship.studies.kvlcc2_shipmmg import KVLCC2Shipmmg, kvlcc2_shipmmg_records
 
 
 DEG = np.pi / 180
@@ -115,30 +124,56 @@ VESSEL_SCENARIOS = {
 }
 
 
-# issue 71: the Mariner scenarios on records of a generator (`--generator`): jaxship's own
-# (`vessel_records`, over ground) or the independent one (`jaxship/studies/generators.py`:
-# the MSS equations in NumPy, solve_ivp, its own servo and autopilot hold), 400 s records
-GENERATOR_SCENARIOS = {
-    "null": ((), {}),
-    "offset 1.5 deg": ((effects.RudderOffset(delta0=1.5 * DEG),),
-                       {"rudder_offset.delta0": 1.5 * DEG}),
-    "current (0.3, -0.4) m/s": ((effects.UniformCurrent(north=0.3, east=-0.4),),
-                                {"current.north": 0.3, "current.east": -0.4}),
-    "offset 1.5 deg + current (0.3, -0.4) m/s": (
-        (effects.RudderOffset(delta0=1.5 * DEG), effects.UniformCurrent(north=0.3, east=-0.4)),
-        {"rudder_offset.delta0": 1.5 * DEG, "current.north": 0.3, "current.east": -0.4}),
-}
+# issue 71: issue 60's single, double and triple effects and the null on records of a
+# generator (`--generator`): jaxship's own Mariner (`vessel_records`, over ground), the
+# independent Mariner (`jaxship/studies/generators.py`: the MSS equations in NumPy, solve_ivp,
+# its own servo and autopilot hold; 400 s records) or shipmmg's KVLCC2 L7 model
+# (`jaxship/studies/kvlcc2_shipmmg.py`; 150 s records), whose current and gyro bias are the
+# Mariner's Froude-scaled (speeds / sqrt(320 / 7), rates * sqrt(320 / 7))
+GENERATORS = {"jaxship": ("mariner", 1.0), "mariner-scipy": ("mariner", 1.0),
+              "kvlcc2-shipmmg": ("kvlcc2", (320.0 / 7.0) ** 0.5)}
 
 
-def generator_case(generator):
-    """`run(effects, seed) -> (report, seconds)`: discovery from the Mariner preset on the
-    records of `generator` ("jaxship" or "mariner-scipy") with `effects` hidden."""
+def generator_scenarios(froude=1.0) -> dict:
+    """`{name: (hidden effects, truth)}` of issue 71 at the Froude scale factor `froude`."""
+    north, east, bias = 0.3 / froude, -0.4 / froude, 0.05 * DEG * froude
+    offset, current = effects.RudderOffset(delta0=1.5 * DEG), effects.UniformCurrent(
+        north=north, east=east)
+    gyro, added = effects.YawRateSensorBias(bias=bias), effects.AddedMassError(s_r=0.2)
+    truth = {"rudder_offset.delta0": 1.5 * DEG, "current.north": north, "current.east": east,
+             "yaw_rate_sensor_bias.bias": bias, "added_mass_error.s_r": 0.2}
+    return {name: (hidden, {k: v for k, v in truth.items()
+                            if k.split(".")[0] in {e.id for e in hidden}})
+            for name, hidden in (
+                ("null", ()),
+                ("offset 1.5 deg", (offset,)),
+                ("current", (current,)),
+                ("gyro bias", (gyro,)),
+                ("offset + current", (offset, current)),
+                ("current + added mass s_r 0.2", (current, added)),
+                ("offset + current + added mass s_r 0.2", (offset, current, added)),
+            )}
+
+
+def generator_case(generator, prior=None):
+    """`run(effects, seed) -> (report, seconds)`: discovery from the preset on the records
+    of `generator` (a key of `GENERATORS`) with `effects` hidden; with `prior` (a relative
+    scale) every fit has a Gaussian prior centred on the preset (`Prior(scale=prior)`)."""
+    default = inspect.signature(js.discover).parameters["estimator"].default
+    estimator = None if prior is None else dataclasses.replace(default, prior=Prior(scale=prior))
+
     def run(hidden, seed):
+        options = {} if estimator is None else {"estimator": estimator}
         if generator == "jaxship":
-            return run_vessel_case(hidden, 1000 + seed)
-        train, holdout = mariner_scipy_records(generator_from_effects(hidden), 1000 + seed)
+            return run_vessel_case(hidden, 1000 + seed, **options)
+        if generator == "mariner-scipy":
+            train, holdout = mariner_scipy_records(generator_from_effects(hidden), 1000 + seed)
+        else:
+            train, holdout = kvlcc2_shipmmg_records(
+                generator_from_effects(hidden, KVLCC2Shipmmg), 1000 + seed)
         began = time.perf_counter()
-        report = js.discover(js.get_vessel("mariner"), train, holdout)
+        report = js.discover(js.get_vessel(GENERATORS[generator][0]), train, holdout,
+                             **options)
         return report, time.perf_counter() - began
     return run
 
@@ -181,35 +216,57 @@ def main():
     parser.add_argument("--first-seed", type=int, default=0,
                         help="the first seed (offset from 1000): continue an earlier run")
     parser.add_argument("--only", nargs="*", default=None, help="scenario names to run")
+    parser.add_argument("--jobs", type=int, default=1,
+                        help="cases run at once, each in its own process")
+    parser.add_argument("--prior", type=float, default=None,
+                        help="with --generator: a Gaussian prior on the base coefficients, "
+                             "centred on the preset, of this relative scale (issue 69)")
     parser.add_argument("--mariner", action="store_true",
                         help="instead: time one discovery on Mariner records (4 + 3 records of "
                              "800 s at 2 Hz, 8 channels) with a hidden 0.5 deg rudder offset, "
                              "by the library and by the `jaxship discover` command")
-    parser.add_argument("--generator", choices=("jaxship", "mariner-scipy"), default=None,
-                        help="instead: the Mariner scenarios (null, offset, current, both; u, "
-                             "v over ground) on records of this generator: jaxship's own or "
-                             "the independent one of jaxship/studies/generators.py")
+    parser.add_argument("--generator", choices=tuple(GENERATORS), default=None,
+                        help="instead: the scenarios of issue 71 (null, single, double and "
+                             "triple effects; u, v over ground) on records of this generator: "
+                             "jaxship's own Mariner, the independent Mariner of "
+                             "jaxship/studies/generators.py or shipmmg's KVLCC2 "
+                             "(pip install --no-deps shipmmg)")
     args = parser.parse_args()
     jax.config.update("jax_enable_x64", True)
     if args.mariner:
         time_mariner()
         return
-    if args.generator:
-        cases = {name: (hidden, truth, generator_case(args.generator))
-                 for name, (hidden, truth) in GENERATOR_SCENARIOS.items()}
-    else:
-        cases = ordinary_cases()
+    names = [n for n in build_cases(args.generator) if not args.only or n in args.only]
     seeds = range(args.first_seed, args.first_seed + args.seeds)
-    rows = [scenario(name, *cases[name], seeds) for name in cases
-            if not args.only or name in args.only]
+    jobs = [(args.generator, name, seed, args.prior) for name in names for seed in seeds]
+    if args.jobs > 1:
+        with ProcessPoolExecutor(args.jobs, mp_context=multiprocessing.get_context("spawn")) \
+                as pool:
+            done = list(pool.map(run_one, *zip(*jobs)))
+    else:
+        done = [run_one(*job) for job in jobs]
+    rows = [summary(name, [d for (_, n, _, _), d in zip(jobs, done) if n == name])
+            for name in names]
     print(f"\n{f'generator {args.generator}: ' if args.generator else ''}"
-          "| scenario | detected (null: silent) % | wrong name % | missed % | median rel. "
-          "error % | truth within 3 SE % | s per run |\n|---|---|---|---|---|---|---|")
+          f"{f'prior {args.prior}: ' if args.prior else ''}"
+          "| scenario | detected (null: silent) % | wrong name % | missed % | base fit blew "
+          "up % | hidden named (with anything else) % | median rel. error % | truth within "
+          "3 SE % | s per run | named beside the hidden |\n"
+          "|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        print(f"| {r[0]} | {r[1]:.0f} | {r[2]:.0f} | {r[3]:.0f} | {r[4]:.2f} | {r[5]:.0f} | "
-              f"{r[6]:.1f} |")
+        print(f"| {r[0]} | {r[1]:.0f} | {r[2]:.0f} | {r[3]:.0f} | {r[4]:.0f} | "
+              f"{r[8]:.0f} | {r[5]:.2f} | "
+              f"{r[6]:.0f} | {r[7]:.1f} | {r[9]} |")
     print(f"\n{args.seeds} seeds per scenario (from {1000 + args.first_seed}); "
           f"{time.strftime('%Y-%m-%d')}.")
+
+
+def build_cases(generator, prior=None) -> dict:
+    """`{name: (effects, truth, run)}`: the generator's scenarios or the ordinary ones."""
+    if generator:
+        return {name: (hidden, truth, generator_case(generator, prior)) for name, (hidden, truth)
+                in generator_scenarios(GENERATORS[generator][1]).items()}
+    return ordinary_cases()
 
 
 def ordinary_cases() -> dict:
@@ -225,34 +282,55 @@ def ordinary_cases() -> dict:
     return cases
 
 
-def scenario(name, effects, truth, run, seeds):
-    """One scenario over the `seeds` (a range): `(name, detected or silent %, wrong %, missed %,
-    median relative error % of the named parameters in `truth`, % of correct cases whose
-    every estimate in `truth` holds the truth within 3 standard errors, median s per run)`.
-    Detection: every hidden effect named (or its class), nothing else."""
-    counts, errors, inside, times = {}, [], [], []
-    hidden = tuple(e.id for e in effects)
-    for seed in seeds:
-        report, seconds = run(effects, seed)
-        result = outcome(report, hidden)
-        counts[result] = counts.get(result, 0) + 1
-        times.append(seconds)
-        if result == "correct":
-            for e in report.effects:
-                errors += [abs(p.value - truth[n]) / abs(truth[n])
-                           for n, p in e.parameters.items() if n in truth]
-            if covered(report, truth) is not None:
-                inside.append(covered(report, truth))
-        print(f"  {name} seed {seed}: {result}, named {report.named}, truth within 3 SE "
-              f"{covered(report, truth)}, {seconds:.0f} s", flush=True)
-    share = lambda key: 100.0 * counts.get(key, 0) / len(seeds)
-    row = (name, share("correct") if hidden else share("nothing"), share("wrong"),
-           share("missed"), np.median(errors) * 100 if errors else np.nan,
-           100.0 * np.mean(inside) if inside else np.nan, np.median(times))
-    print(f"{name:34s} {'detected' if hidden else 'silent':>8s} {row[1]:5.1f} %  "
-          f"wrong {row[2]:5.1f} %  missed {row[3]:5.1f} %  "
-          f"recovery err {row[4]:6.2f} %  within 3 SE {row[5]:5.1f} %  "
-          f"{row[6]:5.1f} s/run", flush=True)
+def run_one(generator, name, seed, prior=None) -> dict:
+    """One case (a scenario of `generator`, or an ordinary one, at `seed`): its outcome
+    ("blew up" where the fitted base model's prediction of the held-out records is not
+    finite, `FitError`), seconds, the relative errors of the named parameters in the truth
+    and whether they hold it within 3 standard errors. Runs in a worker process with
+    `--jobs`."""
+    jax.config.update("jax_enable_x64", True)
+    hidden, truth, run = build_cases(generator, prior)[name]
+    began = time.perf_counter()
+    try:
+        report, seconds = run(hidden, seed)
+    except js.FitError as error:
+        print(f"  {name} seed {seed}: blew up: {error}", flush=True)
+        return dict(result="blew up", null=not hidden, seconds=time.perf_counter() - began,
+                    errors=[], inside=None, found=False, extra=[])
+    result = outcome(report, tuple(e.id for e in hidden))
+    classes = report.names_or_classes()
+    found = all(any(e.id in c for c in classes) for e in hidden)  # whatever else is named
+    errors = [abs(p.value - truth[n]) / abs(truth[n]) for e in report.effects
+              for n, p in e.parameters.items() if n in truth] if result == "correct" else []
+    inside = covered(report, truth) if result == "correct" else None
+    print(f"  {name} seed {seed}: {result}, named {report.named}, not judged "
+          f"{report.not_judged}, truth within 3 SE {covered(report, truth)}, {seconds:.0f} s",
+          flush=True)
+    return dict(result=result, null=not hidden, seconds=seconds, errors=errors, inside=inside,
+                found=found, extra=sorted(set().union(*classes) - {e.id for e in hidden}))
+
+
+def summary(name, done):
+    """One scenario's row from its cases (`run_one`'s records): `(name, detected or silent
+    %, wrong %, missed %, blew up %, median relative error % of the named parameters in the
+    truth, % of correct cases whose every estimate in the truth holds it within 3 standard
+    errors, median s per run, % with every hidden effect named whatever else is, the other
+    effects named in any case)`. Detection: every hidden effect named (or its class),
+    nothing else."""
+    share = lambda key: 100.0 * sum(d["result"] == key for d in done) / len(done)
+    null = done[0]["null"]
+    errors = [x for d in done for x in d["errors"]]
+    inside = [d["inside"] for d in done if d["inside"] is not None]
+    found = np.nan if null else 100.0 * np.mean([d["found"] for d in done])
+    extra = sorted({x for d in done for x in d["extra"]})
+    row = (name, share("nothing") if null else share("correct"), share("wrong"),
+           share("missed"), share("blew up"), np.median(errors) * 100 if errors else np.nan,
+           100.0 * np.mean(inside) if inside else np.nan,
+           np.median([d["seconds"] for d in done]), found, ", ".join(extra) or "-")
+    print(f"{name:34s} {'silent' if null else 'detected':>8s} {row[1]:5.1f} %  "
+          f"wrong {row[2]:5.1f} %  missed {row[3]:5.1f} %  blew up {row[4]:5.1f} %  "
+          f"recovery err {row[5]:6.2f} %  within 3 SE {row[6]:5.1f} %  "
+          f"{row[7]:5.1f} s/run", flush=True)
     return row
 
 

@@ -31,7 +31,7 @@ PUBLIC = set(ast.literal_eval(next(  # the names of `jaxship.__all__`, read with
     if isinstance(n, ast.Assign) and n.targets[0].id == "__all__")))
 # imported inside functions on purpose: optional dependencies, and the CLI's heavy imports
 # deferred so that `jaxship --help` answers at once
-OPTIONAL = {"pandas", "sklearn", "matplotlib", "tqdm"}
+OPTIONAL = {"pandas", "sklearn", "matplotlib", "tqdm", "shipmmg"}
 
 
 def modules():

@@ -843,32 +843,18 @@ def test_ctrl_c_during_a_long_xla_computation_ends_the_command_within_grace():
     assert err.rstrip().endswith("jaxship: interrupted.") and "Traceback" not in err, err
 
 
-TEARDOWN = """
-import atexit, time
-from jaxship import cli
-
-atexit.register(time.sleep, 5.0)  # a slow interpreter teardown after the results
-
-def main(argv=None):
-    print("done", flush=True)
-    return 0
-
-cli.main = main
-cli.run()
-"""
-
-
 def test_ctrl_c_after_the_results_ends_with_130_and_its_line():
-    """The audit of the trust fixes: a Ctrl-C that lands after the command returned, in
-    the interpreter's teardown, killed the process by the signal without "jaxship:
-    interrupted."; now it ends with 130 and that line."""
+    """The audit of the trust fixes: a Ctrl-C that lands after the command returned (it
+    landed in the interpreter's teardown and killed the process by the signal without
+    "jaxship: interrupted."; today there is no teardown, and the last step after the
+    results is the stage report) ends with 130 and that line."""
     import signal
     import subprocess
     import sys
     import time
 
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    process = subprocess.Popen([sys.executable, "-c", TEARDOWN], stdout=subprocess.PIPE,
+    process = subprocess.Popen([sys.executable, "-c", AFTER_RESULTS], stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, env=env)
     assert process.stdout.readline().strip() == "done"
     time.sleep(0.5)
@@ -876,6 +862,53 @@ def test_ctrl_c_after_the_results_ends_with_130_and_its_line():
     err = process.communicate(timeout=60)[1]
     assert process.returncode == 130, (process.returncode, err)
     assert err.rstrip().endswith("jaxship: interrupted.") and "Traceback" not in err, err
+
+
+def test_the_command_ends_without_the_interpreters_teardown(tmp_path):
+    """Issue 70: after the results the command leaves at once with its status
+    (`os._exit`), its output flushed: an exit hook (as JAX's own, which clears its
+    backends and caches) does not run."""
+    import subprocess
+    import sys
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    marker = tmp_path / "teardown ran"
+    done = subprocess.run([sys.executable, "-c", TEARDOWN, str(marker)], capture_output=True,
+                          text=True, env=env, timeout=60)
+    assert done.returncode == 3 and done.stdout == "done\nunflushed", done
+    assert "Traceback" not in done.stderr, done.stderr
+    assert not marker.exists()
+
+
+AFTER_RESULTS = """
+import time
+from jaxship import cli
+
+def main(argv=None):
+    print("done", flush=True)
+    return 0
+
+cli.main = main
+cli.CLOCK.report = lambda: time.sleep(5.0)  # slow, after the results
+cli.run()
+"""
+
+TEARDOWN = """
+import atexit, pathlib, sys
+from jaxship import cli
+
+marker = pathlib.Path(sys.argv[1])
+atexit.register(marker.write_text, "")  # the interpreter's teardown after the results
+sys.argv[1:] = []
+
+def main(argv=None):
+    print("done")
+    sys.stdout.write("unflushed")
+    return 3
+
+cli.main = main
+cli.run()
+"""
 
 
 SLOW_TO_START = """

@@ -164,7 +164,23 @@ def run(started: float | None = None) -> None:
         _end(128 + _SIGNAL[0])
     CLOCK.mark("summary")
     CLOCK.report()
-    sys.exit(status)
+    _leave(status)
+
+
+def _leave(status: int):
+    """Exit with `status` without the interpreter's teardown, which only frees memory
+    (JAX's backends and caches cleared, every module's objects collected: 0.4-0.45 s of
+    the README's identify example, `benchmarks/results/latency.md`): by now every result
+    is written whole and closed (`staged_folder`), every child process joined, and JAX's
+    ordered effects are waited for here (`jax.effects_barrier`, as JAX's exit hook
+    does)."""
+    jax.effects_barrier()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except OSError:  # a closed pipe (`jaxship ... | head`): nothing more to say
+            pass
+    os._exit(status)
 
 
 def _say(signum):

@@ -25,8 +25,11 @@ the track, $\\dot x = u\\cos\\psi - v\\sin\\psi + V_N$, $\\dot y = u\\sin\\psi +
 the logged u, v are over ground, $u_g = u + V_N\\cos\\psi + V_E\\sin\\psi$,
 $v_g = v - V_N\\sin\\psi + V_E\\cos\\psi$; a rudder `offset` [rad]: the ship feels
 $\\delta + \\delta_0$ and the log shows $\\delta$; a yaw-rate sensor `gyro_bias` [rad/s]:
-the log shows $r + b_r$. Noise as `jaxship.studies.discovery.vessel_records`: heading
-0.1 deg, yaw rate 0.05 deg/s, u and v 0.02 m/s, positions 1 m; rudder exact.
+the log shows $r + b_r$; an `added_mass` error $s_r$ [-]: the ship's yaw inertia
+$I_z - N_{\\dot r}$ is $(1 + s_r)$ times the published one (as
+`jaxship.effects.AddedMassError`, Fossen 2021, eq. 6.1). Noise as
+`jaxship.studies.discovery.vessel_records`: heading 0.1 deg, yaw rate 0.05 deg/s, u and v
+0.02 m/s, positions 1 m; rudder exact.
 
 Sign convention: MSS takes the rudder command $u_i$ with $\\delta_{MSS} = -u_i$; here the
 rudder angle $\\delta$ is $u_i$ (a positive angle turns the ship to positive yaw rate),
@@ -67,12 +70,14 @@ TRAIN = tuple((a, s) for a in (10, 20) for s in (1, -1))  # zig-zag angle [deg],
 class MarinerScipy:
     """The Mariner (module text) with its servo, autopilot hold and hidden effects:
     `offset` [rad] (felt, not logged), `current` `(north, east)` [m/s], `gyro_bias`
-    [rad/s]; servo `max_angle` [rad], `max_rate` [rad/s], `time_constant` [s];
-    autopilot `control_dt` [s]; integrator tolerances `rtol`, `atol`."""
+    [rad/s], `added_mass` $s_r$ [-] (yaw inertia scaled by $1 + s_r$); servo
+    `max_angle` [rad], `max_rate` [rad/s], `time_constant` [s]; autopilot `control_dt`
+    [s]; integrator tolerances `rtol`, `atol`."""
 
     offset: float = 0.0
     current: tuple = (0.0, 0.0)
     gyro_bias: float = 0.0
+    added_mass: float = 0.0
     max_angle: float = 40.0 * DEG
     max_rate: float = 5.0 * DEG
     time_constant: float = 1.0
@@ -103,7 +108,8 @@ class MarinerScipy:
              + c["Nvvd"] * vp**2 * d + c["N0"] + c["N0u"] * up + c["N0uu"] * up**2)
         m11 = c["m"] - c["Xudot"]
         m22, m23 = c["m"] - c["Yvdot"], c["m"] * c["xG"] - c["Yrdot"]
-        m32, m33 = c["m"] * c["xG"] - c["Nvdot"], c["Iz"] - c["Nrdot"]
+        m32 = c["m"] * c["xG"] - c["Nvdot"]
+        m33 = (c["Iz"] - c["Nrdot"]) * (1.0 + self.added_mass)
         det = m22 * m33 - m23 * m32
         target = min(max(command, -self.max_angle), self.max_angle)
         delta_dot = min(max((target - delta) / self.time_constant, -self.max_rate),
@@ -187,10 +193,11 @@ class TurnPilot:
         return self.angle
 
 
-def logged(generator, clean, rng, *, noise=NOISE, name="record"):
+def logged(generator, clean, rng, *, noise=NOISE, name="record", n=0.0):
     """The record a user's logger writes of `clean` (`MarinerScipy.run`): u, v over
-    ground, the gyro's r, the servo's rudder without the offset, and noise (module
-    text). A `jaxship.Experiment` with `over_ground` semantics."""
+    ground, the gyro's r, the servo's rudder without the offset, the propeller rate `n`
+    [rev/s] and noise (module text). A `jaxship.Experiment` with `over_ground`
+    semantics."""
 
     t, psi = clean["t"], clean["psi"]
     north, east = generator.current
@@ -201,7 +208,7 @@ def logged(generator, clean, rng, *, noise=NOISE, name="record"):
     return js.Experiment(
         t, clean["delta"], psi=noisy(psi, noise[0] * DEG), r=noisy(r, noise[1] * DEG),
         u=noisy(u, noise[2]), v=noisy(v, noise[3]), x=noisy(clean["x"], noise[4]),
-        y=noisy(clean["y"], noise[4]), n=np.zeros(t.size), name=name,
+        y=noisy(clean["y"], noise[4]), n=np.full(t.size, n), name=name,
         metadata=(("velocities", "over ground"),))
 
 
@@ -224,9 +231,11 @@ def mariner_scipy_records(generator: MarinerScipy, seed, *, duration=400.0, dt=0
     return train, holdout
 
 
-def generator_from_effects(effects) -> MarinerScipy:
-    """The generator with jaxship effects' sizes hidden (`rudder_offset.delta0`,
-    `current.north/east`, `yaw_rate_sensor_bias.bias`; others raise `ValueError`)."""
+def generator_from_effects(effects, kind=MarinerScipy):
+    """The generator `kind` (`MarinerScipy`, or `KVLCC2Shipmmg` of
+    `jaxship.studies.kvlcc2_shipmmg`) with jaxship effects' sizes hidden
+    (`rudder_offset.delta0`, `current.north/east`, `yaw_rate_sensor_bias.bias`,
+    `added_mass_error.s_r` with `s_v = 0`; others raise `ValueError`)."""
     options = {}
     for e in effects:
         if e.id == "rudder_offset":
@@ -235,6 +244,8 @@ def generator_from_effects(effects) -> MarinerScipy:
             options["current"] = (float(e.north), float(e.east))
         elif e.id == "yaw_rate_sensor_bias":
             options["gyro_bias"] = float(e.bias)
+        elif e.id == "added_mass_error" and float(e.s_v) == 0.0:
+            options["added_mass"] = float(e.s_r)
         else:
-            raise ValueError(f"the mariner-scipy generator cannot hide {e.id!r}")
-    return MarinerScipy(**options)
+            raise ValueError(f"the {kind.__name__} generator cannot hide {e.id!r}")
+    return kind(**options)
