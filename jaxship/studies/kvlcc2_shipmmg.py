@@ -10,7 +10,7 @@ jaxship's `kvlcc2` preset as a second implementation of the same paper does:
 
 - its wake fraction is $w_P = w_{P0}\\exp(-4\\beta_P^2)$ with $x'_P = -0.690$ (its tests'
   KVLCC2 set), not the paper's $C_1, C_2$ form with $x'_P = -0.48$;
-- its U and beta use the sway velocity at the centre of gravity, $v - x_G r$;
+- its U and drift angle use $v - x_G r$ where the paper uses the midship sway velocity v;
 - it has no steering gear: the rudder angle is a prescribed series, interpolated by a
   natural cubic spline whose derivative is integrated.
 
@@ -24,8 +24,8 @@ to shipmmg's own equations; nothing of jaxship's model code runs here.
 Hidden effects as in `jaxship.studies.generators`: a rudder `offset` felt and not
 logged, a `current` drifting the track and in the over-ground u, v, a `gyro_bias` in
 the logged r, an `added_mass` error $s_r$ scaling $I_{zG} + x_G^2 m + J_z$ by $1 + s_r$.
-Model-scale defaults: the full-scale Mariner scenarios' sizes Froude-scaled to the 7 m
-model (scale 1:45.7: speeds and rates times $1/\\sqrt{45.7}$ and $\\sqrt{45.7}$).
+The noise is a model basin's (`NOISE`: heading 0.1 deg, yaw rate 0.05 deg/s, u and v
+0.003 m/s, positions 0.02 m).
 """
 
 import dataclasses
