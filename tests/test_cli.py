@@ -864,20 +864,22 @@ def test_ctrl_c_after_the_results_ends_with_130_and_its_line():
     assert err.rstrip().endswith("jaxship: interrupted.") and "Traceback" not in err, err
 
 
-def test_the_command_ends_without_the_interpreters_teardown(tmp_path):
+@pytest.mark.parametrize("profiled", [False, True])
+def test_the_command_ends_without_the_interpreters_teardown(tmp_path, profiled):
     """Issue 70: after the results the command leaves at once with its status
     (`os._exit`), its output flushed: an exit hook (as JAX's own, which clears its
-    backends and caches) does not run."""
+    backends and caches) does not run. Under a profiler (`python -m cProfile`), which
+    writes its results at exit, the usual exit."""
     import subprocess
     import sys
 
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     marker = tmp_path / "teardown ran"
-    done = subprocess.run([sys.executable, "-c", TEARDOWN, str(marker)], capture_output=True,
-                          text=True, env=env, timeout=60)
+    done = subprocess.run([sys.executable, "-c", TEARDOWN, str(marker), str(profiled)],
+                          capture_output=True, text=True, env=env, timeout=60)
     assert done.returncode == 3 and done.stdout == "done\nunflushed", done
     assert "Traceback" not in done.stderr, done.stderr
-    assert not marker.exists()
+    assert marker.exists() == profiled
 
 
 AFTER_RESULTS = """
@@ -897,9 +899,11 @@ TEARDOWN = """
 import atexit, pathlib, sys
 from jaxship import cli
 
-marker = pathlib.Path(sys.argv[1])
+marker, profiled = pathlib.Path(sys.argv[1]), sys.argv[2] == "True"
 atexit.register(marker.write_text, "")  # the interpreter's teardown after the results
 sys.argv[1:] = []
+if profiled:
+    sys.setprofile(lambda frame, event, arg: None)
 
 def main(argv=None):
     print("done")

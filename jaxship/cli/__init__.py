@@ -173,7 +173,10 @@ def _leave(status: int):
     the README's identify example, `benchmarks/results/latency.md`): by now every result
     is written whole and closed (`staged_folder`), every child process joined, and JAX's
     ordered effects are waited for here (`jax.effects_barrier`, as JAX's exit hook
-    does)."""
+    does). Under a profiler, a debugger or coverage, which write their results at exit,
+    the usual exit."""
+    if sys.getprofile() or sys.gettrace() or "coverage" in sys.modules:
+        sys.exit(status)  # a profiler, debugger or coverage writes its results at exit
     jax.effects_barrier()
     for stream in (sys.stdout, sys.stderr):
         try:
