@@ -14,7 +14,8 @@ signature asks for one:
 - how Lu & Zhao's discrete models map to continuous ones (`DiscreteResponse`):
   `ExactDiscretisation`, `EulerDiscretisation`;
 - the units of a written trial file (`write_trial_csv`): `DisplayUnits`, `SIUnits`;
-- what is known of the coefficients before the data (`PredictionError.prior`): `Prior`.
+- what is known of the coefficients before the data (`PredictionError.prior`,
+  `Innovations.prior`, `ARMAX.prior`): `Prior`.
 
     import jaxship as js
     js.Replay(delta, dt=0.5, delta_hold=js.strategies.FirstOrderHold())

@@ -111,3 +111,44 @@ def test_fit_with_the_armax_estimator_gives_a_fit_result():
     assert res.metrics["r"].fit_percent > 90.0
     with pytest.raises(ValueError, match="ARMAXModel"):
         js.fit(js.Nomoto1(K=0.1, T=10.0), data, estimator=js.ARMAX())
+
+
+def test_the_armax_estimator_takes_a_prior():
+    """`ARMAX(prior=...)`: an infinitely wide prior is the plain fit, an infinitely narrow
+    one its mean; in between, on a short record, the MAP is nearer the mean than the plain
+    estimate, its posterior errors are narrower than the prior, and FPE charges the
+    effective number of parameters, $\\mathrm{tr}\\,J(J^TJ + P)^{-1}J^T$."""
+    rng = np.random.default_rng(6)
+    u = np.repeat(rng.choice([-0.2, 0.2], 20), 4)  # 80 samples: a short record
+    a, b, c = [1.0, -1.5, 0.56], [0.0, 0.02, 0.015], [1.0, 0.3, 0.1]
+    y = lfilter(b, a, u) + lfilter(c, a, 0.004 * rng.standard_normal(u.size))
+    data = js.Experiment(0.5 * np.arange(u.size), u, r=y, psi=np.cumsum(y) * 0.5)
+    truth = ARMAXModel(a1=-1.5, a2=0.56, b0=0.02, b1=0.015, c1=0.3, c2=0.1, dt=0.5)
+    fit = lambda prior=None: js.fit(truth, data, estimator=js.ARMAX(prior=prior))
+    plain = fit()
+    assert plain.prior is None and plain.effective_params is None
+    wide = fit(js.strategies.Prior(scale=1e8))
+    # the same optimum: c1 is near zero and flat in 80 samples, so compared in its errors
+    assert wide.cost == pytest.approx(plain.cost, rel=1e-9)
+    assert np.all(np.abs(wide.values - plain.values) < 1e-3 * plain.std)
+    assert wide.effective_params == pytest.approx(6.0, abs=1e-6)
+    mean = ARMAXModel(a1=-1.4, a2=0.5, b0=0.03, b1=0.01, c1=0.2, c2=0.05, dt=0.5)
+    narrow = fit(js.strategies.Prior(mean=mean, scale=1e-8))
+    np.testing.assert_allclose(narrow.values, [-1.4, 0.5, 0.03, 0.01, 0.2, 0.05], rtol=1e-5)
+    assert narrow.effective_params < 1e-3
+    fitted = fit(js.strategies.Prior(mean=mean, scale=0.2))
+    assert fitted.success
+    centre = np.array([-1.4, 0.5, 0.03, 0.01, 0.2, 0.05])
+    distance = lambda v: np.sum(((v - centre) / (0.2 * np.abs(centre))) ** 2)
+    assert distance(fitted.values) < distance(plain.values) and fitted.cost >= plain.cost
+    assert 0.0 < fitted.effective_params < 6.0
+    assert np.all(fitted.std < [row["prior_std"] for row in fitted.prior.values()])
+    assert all(0.0 <= row["data_share"] <= 1.0 for row in fitted.prior.values())
+    assert fitted.metrics["r"].num_params == fitted.effective_params
+    # the posterior covariance by hand: lambda^2 (J^T J + P)^-1, P = lambda^2 / s^2
+    direct = fit_armax(y, u, dt=0.5, **dict(na=2, nb=2, nc=2, nk=1),
+                       prior=(centre, 0.2 * np.abs(centre)))
+    np.testing.assert_allclose(direct.A[1:], fitted.values[:2], rtol=1e-12)
+    jac, lam2 = direct.jacobian, direct.noise_variance
+    by_hand = lam2 * np.linalg.inv(jac.T @ jac + np.diag(lam2 / (0.2 * centre) ** 2))
+    np.testing.assert_allclose(direct.covariance, by_hand, rtol=1e-3)

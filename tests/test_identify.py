@@ -442,6 +442,13 @@ def test_armax_recovers_its_polynomials(tmp_path, capsys):
             assert m["fit_percent"] > 99.999 and math.isfinite(m["fpe"])
     assert result["correlation"]["names"] == list(values)
     assert isinstance(result["identifiability"]["flags"], list)
+    # --prior reaches the ARMAX estimator: centred on the start, reported per coefficient
+    code, _, err = run([paths[0], "--model", "armax", "--prior", "0.5", "--out",
+                        str(tmp_path / "prior"), "--no-figures"], capsys)
+    assert code == 0, err
+    result = json.loads((tmp_path / "prior" / "result.json").read_text())
+    assert result["fit"]["prior"]["scale"] == 0.5 and 0 < result["fit"]["effective_params"] <= 6
+    assert all("data_share" in row for row in result["parameters"].values())
     # one training record only
     code, _, err = run([*paths, "--model", "armax", "--out", str(tmp_path / "two")], capsys)
     assert code == 2 and "armax is fitted to one record" in err

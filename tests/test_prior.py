@@ -104,6 +104,44 @@ def test_per_coefficient_and_absolute_scales():
         _fit(js.strategies.Prior(scale={"Tau": 1.0}))
 
 
+@pytest.mark.parametrize("criterion", [js.MaximumLikelihood(), js.InnovationsLeastSquares()],
+                         ids=["ml", "pem"])
+def test_the_innovations_estimators_take_a_prior(criterion):
+    """`Innovations(prior=...)`: the same limits as the prediction-error fit's, the MAP
+    between the mean and the plain estimate on a short record, and the effective number
+    of parameters charged by FPE (the noise variances count in full: no prior on them)."""
+    short = _record(seed=4, num=160)
+    fit = lambda prior=None: js.fit(START, short, free=FREE, estimator=js.Innovations(
+        criterion=criterion, prior=prior))
+    plain = fit()
+    estimated = len(plain.noise) - (criterion.name == "pem")  # PEM holds the first channel's
+    assert plain.prior is None and plain.effective_params is None
+    wide = fit(js.strategies.Prior(scale=1e8))
+    np.testing.assert_allclose(wide.values, plain.values, rtol=1e-6)
+    assert wide.effective_params == pytest.approx(2 + estimated, abs=1e-5)
+    mean = js.Nomoto1(K=0.05, T=30.0)
+    narrow = fit(js.strategies.Prior(mean=mean, scale=1e-7))
+    np.testing.assert_allclose(narrow.values, [0.05, 30.0], rtol=1e-5)
+    assert narrow.effective_params == pytest.approx(estimated, abs=1e-3)
+    assert all(row["data_share"] < 1e-3 for row in narrow.prior.values())
+    fitted = fit(js.strategies.Prior(scale=0.1))
+    assert fitted.success and plain.success
+    centre = np.array([START.get_parameter(n) for n in FREE])
+    distance = lambda values: np.sum(((values - centre) / (0.1 * centre)) ** 2)
+    assert distance(fitted.values) < distance(plain.values) and fitted.cost >= plain.cost
+    assert 2 + estimated - 2 < fitted.effective_params < 2 + estimated
+    for i, name in enumerate(FREE):
+        row = fitted.prior[name]
+        assert row["prior_std"] == pytest.approx(0.1 * centre[i])
+        assert 0.0 < row["data_share"] < 1.0 and fitted.std[i] < row["prior_std"]
+        if criterion.name == "ml":  # the inverse Hessian of the log posterior
+            assert row["data_share"] == pytest.approx(1 - (fitted.std[i] / row["prior_std"]) ** 2)
+    for m in fitted.metrics.values():
+        assert m.num_params == fitted.effective_params
+    assert "data share" in fitted.summary()
+    json.dumps(fitted.to_dict())
+
+
 def test_posterior_covariance_and_effective_parameters_by_hand():
     """A linear-in-parameters problem with a known Jacobian: y = J theta + e."""
     rng = np.random.default_rng(3)

@@ -20,17 +20,20 @@ the filters are recursions of a few coefficients.
 
 import dataclasses
 import math
+from typing import NamedTuple
 
 import numpy as np
 import optimistix as optx
 import scipy  # scipy.signal loads on first use (an import-time saving)
 
 from .._foundation._contract import parameter_fields
+from .._foundation._covariance import effective_parameters
 from .._foundation._parameter_report import parameter_report
 from .._models._armax_model import ARMAX_NAMES, ARMAX_ORDERS, ARMAXModel
 from ._discrete import continuous_parameters
 from ._excitation import excitation_flags
 from ._fit import AbstractEstimator
+from ._prior import PRIOR_PASSES, PRIOR_RTOL, GaussianPrior, Prior, posterior_fields
 from ._result import FitResult, Prediction, Validation, assemble_result
 from ._windows import as_dataset, check_data
 
@@ -48,7 +51,8 @@ class ARMAXResult:
     interval `dt` [s] (or None), the innovation variance `noise_variance`
     $\\hat\\lambda^2$, the covariance `covariance` of $\\theta = (a, b, c)$ (Gauss-Newton,
     $\\hat\\lambda^2(J^TJ)^{-1}$), the loss `loss` (mean squared one-step error), the
-    number of iterations and whether the iteration `converged`."""
+    number of iterations, whether the iteration `converged` and the one-step errors'
+    Jacobian (n, d) at the estimate."""
 
     A: np.ndarray
     B: np.ndarray
@@ -60,6 +64,7 @@ class ARMAXResult:
     loss: float
     iterations: int
     converged: bool
+    jacobian: np.ndarray | None = None
 
     @property
     def std(self) -> np.ndarray:
@@ -100,6 +105,13 @@ class ARMAXResult:
             p = continuous_parameters("linear2", c, self.dt)
             return {k: p[k] for k in ("K", "T1", "T2", "T3", "T")}
         return None
+
+
+class _Coefficient(NamedTuple):
+    """An ARMAX coefficient as `GaussianPrior.build` reads a free parameter."""
+
+    name: str
+    start: float
 
 
 def _delay(u, nk):
@@ -151,7 +163,7 @@ def _pseudo_linear_start(y, ud, start: int, orders, arx_order) -> np.ndarray:
 
 def fit_armax(y, u, *, na: int = 2, nb: int = 2, nc: int = 2, nk: int = 1,
               dt: float | None = None, max_iter: int = 100, tol: float = 1e-10,
-              arx_order: int | None = None) -> ARMAXResult:
+              arx_order: int | None = None, prior=None) -> ARMAXResult:
     """Fit an ARMAX model (Astrom & Kallstrom 1979, eq. 7) by prediction-error
     minimisation.
 
@@ -164,6 +176,13 @@ def fit_armax(y, u, *, na: int = 2, nb: int = 2, nc: int = 2, nk: int = 1,
 
     The loss uses the samples t >= max(na, nk + nb - 1, nc); errors before are
     computed with zero initial conditions of $1/C$ and left out.
+
+    `prior`: `(mean, sd)` (d,) of a Gaussian prior on $\\theta = (a, b, c)$ (sd inf: none):
+    the estimate is the maximum a posteriori one, minimising $\\sum\\varepsilon^2 +
+    \\hat\\lambda^2\\sum_i((\\theta_i - \\mu_i)/s_i)^2$ with $\\hat\\lambda^2 =
+    \\sum\\varepsilon^2/(n - d_\\text{eff})$ refitted until it settles, and the covariance
+    the posterior $\\hat\\lambda^2(J^TJ + P)^{-1}$, $P = \\hat\\lambda^2\\mathrm{diag}(1/s_i^2)$
+    (`jaxship/_estimate/_prior.py`); `ARMAXResult.jacobian` keeps $J$ for its report.
 
     **Raises:** `ValueError` for bad orders or data.
     """
@@ -195,16 +214,56 @@ def fit_armax(y, u, *, na: int = 2, nb: int = 2, nc: int = 2, nk: int = 1,
 
     if nc and np.any(np.abs(np.roots(polys(theta)[2])) >= 1.0):
         theta[na + nb:] *= 0.0  # an unstable C from the start: begin from C = 1
-    loss, eps = evaluate(theta)
-    lam, converged, it = 1e-3, False, 0
-    for it in range(1, max_iter + 1):
+    n = y.size - start
+    mean, sd = (np.zeros(theta.size), np.full(theta.size, np.inf)) if prior is None else \
+        (np.asarray(prior[0], dtype=np.float64), np.asarray(prior[1], dtype=np.float64))
+    weight = np.zeros(theta.size)  # the prior's rows weight (theta - mean), sigma / sd
+    if prior is not None:
+        weight = math.sqrt(evaluate(theta)[0]) / sd  # weighed by the start's variance
+    iterations = 0
+    for _ in range(1 if prior is None else PRIOR_PASSES):
+        theta, eps, it, converged = _levenberg_marquardt(
+            theta, lambda th: evaluate(th) + (weight * (th - mean) / math.sqrt(n),),
+            jacobian, weight / math.sqrt(n), start, max_iter, tol)
+        iterations += it
         J = jacobian(theta, eps)
-        g = J.T @ eps[start:]
+        precision = weight**2
+        d_eff = effective_parameters(J, precision)
+        sigma2 = float(np.sum(eps[start:] ** 2) / max(n - d_eff, 1))
+        new = np.sqrt(sigma2) / sd
+        if prior is None or np.allclose(new**2, precision, rtol=PRIOR_RTOL, atol=0):
+            break
+        weight = new
+    A, B, C = polys(theta)
+    try:
+        cov = sigma2 * np.linalg.inv(J.T @ J + np.diag(precision))
+    except np.linalg.LinAlgError:
+        cov = np.full((theta.size, theta.size), np.nan)
+    return ARMAXResult(A, B, C, int(nk), None if dt is None else float(dt), sigma2, cov,
+                       float(np.mean(eps[start:] ** 2)), iterations, converged, J)
+
+
+def _levenberg_marquardt(theta, evaluate, jacobian, prior_weight, start, max_iter, tol):
+    """Gauss-Newton with Levenberg-Marquardt damping from `theta` on the mean squared
+    one-step error plus the prior's rows' mean square: `evaluate(theta)` returns `(loss,
+    eps, prior_rows / sqrt(n))` (loss inf where C is unstable), `jacobian(theta, eps)` the
+    errors' (n, d); the prior's Jacobian is `diag(prior_weight)`. Returns `(theta, eps,
+    iterations, converged)`."""
+    def total(out):
+        loss, eps, rows = out
+        return loss + float(np.sum(rows**2)), eps, rows
+
+    loss, eps, rows = total(evaluate(theta))
+    lam, converged, it = 1e-3, False, 0
+    n = eps.size - start
+    for it in range(1, max_iter + 1):
+        J = np.vstack([jacobian(theta, eps) / math.sqrt(n), np.diag(prior_weight)])
+        g = J.T @ np.concatenate([eps[start:] / math.sqrt(n), rows])
         H = J.T @ J
         improved = False
         for _ in range(30):
             step = np.linalg.solve(H + lam * np.diag(np.diag(H) + 1e-300), -g)
-            new_loss, new_eps = evaluate(theta + step)
+            new_loss, new_eps, new_rows = total(evaluate(theta + step))
             if new_loss <= loss:
                 improved = True
                 break
@@ -214,21 +273,12 @@ def fit_armax(y, u, *, na: int = 2, nb: int = 2, nc: int = 2, nk: int = 1,
             break
         small = (loss - new_loss <= tol * loss
                  and np.linalg.norm(step) <= math.sqrt(tol) * (1 + np.linalg.norm(theta)))
-        theta, loss, eps = theta + step, new_loss, new_eps
+        theta, loss, eps, rows = theta + step, new_loss, new_eps, new_rows
         lam = max(lam / 10.0, 1e-12)
         if small or loss == 0.0:
             converged = True
             break
-    A, B, C = polys(theta)
-    J = jacobian(theta, eps)
-    n = y.size - start
-    sigma2 = float(np.sum(eps[start:] ** 2) / max(n - theta.size, 1))
-    try:
-        cov = sigma2 * np.linalg.inv(J.T @ J)
-    except np.linalg.LinAlgError:
-        cov = np.full((theta.size, theta.size), np.nan)
-    return ARMAXResult(A, B, C, int(nk), None if dt is None else float(dt), sigma2, cov, loss,
-                       it, converged)
+    return theta, eps, it, converged
 
 
 class ARMAX(AbstractEstimator):
@@ -236,11 +286,14 @@ class ARMAX(AbstractEstimator):
     prediction error, Gauss-Newton; Astrom & Kallstrom 1979, eq. 7) on one record's
     yaw rate and replayed rudder `rudder`, reported as a `FitResult` with the one-step
     predictions (horizon one sample). `free` must be None: all six coefficients are
-    estimated."""
+    estimated. `prior`: a Gaussian prior on them (`jaxship.strategies.Prior`, its mean
+    by default the model given, e.g. a sampled Nomoto model's polynomials), which makes
+    the estimate the maximum a posteriori one (`fit_armax`)."""
 
     rudder: str = "delta"
     max_iter: int = 100
     max_lag: int = 25
+    prior: Prior | None = None
 
     def fit(self, model, dataset, free=None, progress=None) -> FitResult:
         if not isinstance(model, ARMAXModel):
@@ -258,10 +311,17 @@ class ARMAX(AbstractEstimator):
         y = np.asarray(ds.r, dtype=np.float64)[0, :n]
         u = np.asarray(getattr(ds, self.rudder), dtype=np.float64)[0, :n]
         dt = float(np.asarray(ds.dt)[0])
-        res = fit_armax(y, u, dt=dt, max_iter=self.max_iter, **ARMAX_ORDERS)
+        specs = [_Coefficient(k, float(getattr(model, k))) for k in ARMAX_NAMES]
+        prior = GaussianPrior.build(self.prior, specs, model)
+        res = fit_armax(y, u, dt=dt, max_iter=self.max_iter, **ARMAX_ORDERS,
+                        prior=None if prior is None else (prior.mean, prior.sd))
         fitted = ARMAXModel.from_result(res, dt)
         fields = parameter_fields(fitted)
         values = np.array([float(getattr(fitted, k)) for k in ARMAX_NAMES])
+        if prior is not None:  # weighed by the estimate's innovation variance
+            prior = dataclasses.replace(prior, variance=res.noise_variance)
+        precision = None if prior is None else prior.precision(len(ARMAX_NAMES))
+        posterior = posterior_fields(prior, precision, res.jacobian, values, blown=False)
         flags, no_excitation = excitation_flags(ds, self.rudder)
         report = parameter_report(ARMAX_NAMES, values, np.asarray(res.covariance),
                                   units=tuple(fields[k].unit for k in ARMAX_NAMES),
@@ -274,12 +334,14 @@ class ARMAX(AbstractEstimator):
         line[0, :n], mask[0, first:n] = y - eps, True
         return assemble_result(
             fitted, report, ds, {"r": line}, mask,
-            validation=Validation(self.rudder, len(ARMAX_NAMES), self.max_lag),
+            validation=Validation(self.rudder, posterior.get("effective_params",
+                                                             len(ARMAX_NAMES)), self.max_lag),
             result=optx.RESULTS.successful if res.converged
             else optx.RESULTS.nonlinear_max_steps_reached, num_steps=res.iterations,
             cost=0.5 * float(np.sum(eps[first:] ** 2)), weights={"r": 1.0},
             window_samples=(1,), horizon=dt, criterion="one-step prediction error (ARMAX)",
-            noise={"innovations": float(res.noise_variance)}, noise_std={"innovations": math.nan})
+            noise={"innovations": float(res.noise_variance)}, noise_std={"innovations": math.nan},
+            **{k: v for k, v in posterior.items() if k != "robust"})
 
     def predict(self, model, dataset) -> Prediction:
         """One-step-ahead predictions of r by `model`'s polynomials,

@@ -51,7 +51,14 @@ from ._lm import (
     value_and_jacfwd,
 )
 from ._prepare import prepare_fit, start_strategy
-from ._prior import PRIOR_PASSES, PRIOR_RTOL, GaussianPrior, Prior, posterior_fields
+from ._prior import (
+    PRIOR_PASSES,
+    PRIOR_RTOL,
+    GaussianPrior,
+    Prior,
+    posterior_fields,
+    with_prior_rows,
+)
 from ._result import FitError, FitResult, Prediction, Validation, assemble_result
 from ._step import MAX_SUBSTEPS, stable_substeps
 from ._verdict import final_verdict, optimiser_verdict
@@ -261,10 +268,8 @@ def _residual_fn(z, args):
     out = _residuals(rebuild(model, transform.names, physical), w, offsets)
     if prior is None:
         return out
-    mean, weight = prior  # the prior's rows sigma (p - mu) / s (`_prior.py`), laid in one
-    rows = weight * (physical - mean)  # more channel of zeros: the windows' layout stays
-    slab = jnp.zeros(math.prod(out.shape[1:]), out.dtype).at[: rows.shape[0]].set(rows)
-    return jnp.concatenate([out, slab.reshape((1,) + out.shape[1:])])
+    mean, weight = prior  # the prior's rows sigma (p - mu) / s (`_prior.py`) as one
+    return with_prior_rows(out, weight * (physical - mean))  # more channel
 
 
 @persistent  # traced and lowered once per installation

@@ -3,6 +3,7 @@ noise (`fit_ml`), by the extended Kalman filter of `jaxship._estimate._kalman` (
 model, the filter and the likelihood are described there).
 """
 
+import dataclasses
 import math
 
 import equinox as eqx
@@ -27,6 +28,15 @@ from ._kalman import (
     _variance,
 )
 from ._lm import LevenbergMarquardt, solve_least_squares
+from ._prior import (
+    PRIOR_PASSES,
+    PRIOR_RTOL,
+    GaussianPrior,
+    Prior,
+    posterior_fields,
+    prior_report,
+    with_prior_rows,
+)
 from ._result import Prediction, Validation, assemble_result
 from ._windows import channel_weights
 
@@ -72,39 +82,52 @@ def _split(z, d, transform, model):
     return rebuild(model, transform.names, p), z[d:]
 
 
+def _prior_rows(z, transform, prior):
+    """The prior's rows $w_i(\\theta_i - \\mu_i)$ of `prior = (mean, w)` at z
+    (`GaussianPrior.arrays`)."""
+    mean, weight = prior
+    return weight * (transform.to_physical(z[: len(transform.names)]) - mean)
+
+
 def _nll(z, args):
-    model, transform, noise, rec = args
+    """$-\\log L$, plus $\\tfrac12\\sum_i((\\theta_i - \\mu_i)/s_i)^2$ with a prior:
+    the negative log posterior (`_prior.py`)."""
+    model, transform, noise, rec, prior = args
     m, log_var = _split(z, len(transform.names), transform, model)
     Q, q, R = noise.matrices(log_var)
-    return jnp.sum(_batch_filter(m, rec, Q, q, R).neg_log_likelihood)
+    nll = jnp.sum(_batch_filter(m, rec, Q, q, R).neg_log_likelihood)
+    return nll if prior is None else nll + 0.5 * jnp.sum(_prior_rows(z, transform, prior)**2)
 
 
 def _pem_residuals(z, args):
-    model, transform, noise, rec, weights = args
+    model, transform, noise, rec, weights, prior = args
     m, log_var = _split(z, len(transform.names), transform, model)
     Q, q, R = noise.matrices(log_var)
-    e = _batch_filter(m, rec, Q, q, R).innovations  # (E, N, C), 0 where masked
-    return e * weights
+    e = _batch_filter(m, rec, Q, q, R).innovations * weights  # (E, N, C), 0 where masked
+    return e if prior is None else with_prior_rows(e, _prior_rows(z, transform, prior))
 
 
 @eqx.filter_jit
-def _ml_solve(z0, model, transform, noise, rec, solver, max_steps):
+def _ml_solve(z0, model, transform, noise, rec, prior, solver, max_steps):
     # the loss per sample keeps the tolerances independent of the record length
     count = jnp.sum(rec.mask[:, 1:])
     fn = lambda z, args: _nll(z, args) / count
-    sol = optx.minimise(fn, solver, z0, args=(model, transform, noise, rec),
+    sol = optx.minimise(fn, solver, z0, args=(model, transform, noise, rec, prior),
                         max_steps=max_steps, throw=False)
     return sol.value, sol.result, sol.stats["num_steps"]
 
 
 @eqx.filter_jit
-def _pem_solve(z0, model, transform, noise, rec, weights, solver, max_steps):
-    """LM on the weighted innovations; z, result, steps, the innovations and their
-    Jacobian with respect to the physical parameters and log variances."""
-    d = len(transform.names)
+def _pem_solve(z0, args, solver, max_steps):
+    """LM on the weighted innovations (and a prior's rows) of `_pem_residuals(z, args)`;
+    z, result, steps, the innovations and their Jacobian with respect to the physical
+    parameters and log variances (the prior's rows left out)."""
+    transform, prior = args[1], args[-1]
     z, result, steps, _, res, jac = solve_least_squares(
-        _pem_residuals, solver, z0, (model, transform, noise, rec, weights), max_steps,
-        lambda z: _physical(z, d, transform))
+        _pem_residuals, solver, z0, args, max_steps,
+        lambda z: _physical(z, len(transform.names), transform))
+    if prior is not None:
+        res, jac = res[:-1], jac[:-1]
     return z, result, steps, res, jac
 
 
@@ -142,8 +165,8 @@ def _report(model, problem: "_Problem", specs, rudder, estimate, criterion,
             max_lag=25) -> FitResult:
     """The `FitResult` of an innovations fit: the parameter report, the noise, and the
     one-step-ahead predictions of the filter validated per channel. `estimate`: the
-    criterion's `(z, result, steps, cov, loss)`."""
-    z, result, steps, cov, loss = estimate
+    criterion's `(z, result, steps, cov, loss, posterior)` (`posterior_fields`)."""
+    z, result, steps, cov, loss, posterior = estimate
     transform, layout, rec, ds, channels = (problem.transform, problem.layout, problem.rec,
                                             problem.ds, problem.channels)
     d = len(specs)
@@ -167,12 +190,14 @@ def _report(model, problem: "_Problem", specs, rudder, estimate, criterion,
                    for c, name in enumerate(channels)}
     return assemble_result(
         fitted, report, ds, predictions, predicted,
-        validation=Validation(rudder, int(q.shape[0]), max_lag), result=result,
+        validation=Validation(rudder, posterior.get("effective_params", int(q.shape[0])),
+                              max_lag), result=result,
         num_steps=steps, cost=loss,
         weights=dict(zip(channels, channel_weights(ds, channels, None).tolist())),
         window_samples=(1,) * ds.num_experiments, horizon=float(np.min(ds.dt)),
         criterion=criterion, noise={n: float(v) for n, v in zip(layout.names, var)},
-        noise_std={n: float(v * s) for n, v, s in zip(layout.names, var, log_std)})
+        noise_std={n: float(v * s) for n, v, s in zip(layout.names, var, log_std)},
+        **{k: v for k, v in posterior.items() if k != "robust"})
 
 
 class ProcessNoise(eqx.Module):
@@ -277,7 +302,7 @@ def _noise_layout(model, ds, channels, process, noise, noise_start, criterion):
 def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_CHANNELS,
            criterion=None, process=ProcessNoise(), noise=EstimatedNoise(), noise_start=None,
            rudder: str = "delta", substeps: int = 1, max_steps: int = 512,
-           solver=None, hold=None) -> FitResult:
+           solver=None, hold=None, prior: Prior | None = None) -> FitResult:
     """Estimate a steering model with its noise by the Kalman filter's innovations.
 
     **Arguments:**
@@ -307,6 +332,11 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
     - `max_steps`, `solver`: optimiser step limit and an optimistix solver (default
       `BFGS(rtol=1e-8, atol=1e-8)` for ML, jaxship's `LevenbergMarquardt(rtol=1e-9,
       atol=1e-9)` with MINPACK's cost test for PEM).
+    - `prior`: a Gaussian prior on the free model coefficients (`jaxship.strategies.Prior`,
+      none on the noise variances): the fit is the maximum a posteriori estimate, its
+      covariance the posterior one, and the result reports the effective number of
+      parameters and per coefficient the prior and the data's share of its information
+      (`FitResult.prior`; `_prior.py`). None (default): no prior.
 
     **Returns:** a `FitResult` with the noise variances (`noise`, `noise_std`), the
     criterion, and the filter's one-step-ahead predictions and their metrics.
@@ -322,7 +352,8 @@ def fit_ml(model: AbstractSteeringModel, dataset, *, free=None, channels=KALMAN_
     rec = _records(ds, channels, rudder, substeps, hold)
     z0 = jnp.asarray(np.concatenate([transform.to_unconstrained([s.start for s in specs]),
                                      z_noise]), dtype=float)
-    problem = _Problem(as_arrays(model), transform, layout, rec, ds, channels)
+    problem = _Problem(as_arrays(model), transform, layout, rec, ds, channels,
+                       GaussianPrior.build(prior, specs, model))
     estimate = criterion.estimate(problem, z0, solver, int(max_steps))
     return _report(model, problem, specs, rudder, estimate, criterion.name)
 
@@ -337,6 +368,7 @@ class _Problem(eqx.Module):
     rec: eqx.Module
     ds: eqx.Module
     channels: tuple[str, ...] = eqx.field(static=True)
+    prior: GaussianPrior | None = None  # in the log likelihood's scale (variance 1)
 
 
 class MaximumLikelihood(eqx.Module):
@@ -351,22 +383,38 @@ class MaximumLikelihood(eqx.Module):
         return estimated
 
     def estimate(self, problem: _Problem, z0, solver, max_steps: int):
-        """`(z, result, steps, cov, loss)`: BFGS (default `rtol = atol = 1e-8`) on
-        $-\\log L$, the covariance the inverse of its Hessian (infinite variances where
-        the Hessian is not positive definite)."""
+        """`(z, result, steps, cov, loss, posterior)`: BFGS (default `rtol = atol = 1e-8`)
+        on $-\\log L$ (with a prior, the negative log posterior), the covariance the
+        inverse of its Hessian $H + P$, $P = \\mathrm{diag}(1/s_i^2)$ (infinite variances
+        where it is not positive definite); with a prior, `posterior` has the effective
+        number of parameters $\\mathrm{tr}\\,H(H + P)^{-1}$ and the data's share of each
+        coefficient's information $1 - [(H + P)^{-1}]_{ii}/s_i^2$ (`_prior.py`)."""
         p = problem
         solver = optx.BFGS(rtol=1e-8, atol=1e-8) if solver is None else solver
-        z, result, steps = _ml_solve(z0, p.model, p.transform, p.layout, p.rec, solver,
+        z, result, steps = _ml_solve(z0, p.model, p.transform, p.layout, p.rec,
+                                     None if p.prior is None else p.prior.arrays(), solver,
                                      max_steps)
         loss, hess = _ml_hessian(z, p.model, p.transform, p.layout, p.rec)
         hess = np.asarray(hess, dtype=np.float64)
+        precision = np.zeros(hess.shape[0]) if p.prior is None else \
+            p.prior.precision(hess.shape[0])
         try:
-            cov = np.linalg.inv(hess)
+            cov = np.linalg.inv(hess + np.diag(precision))
         except np.linalg.LinAlgError:
             cov = np.full_like(hess, np.inf)
         if not np.all(np.isfinite(cov)) or np.any(np.diag(cov) <= 0):
             cov = np.where(np.eye(hess.shape[0], dtype=bool), np.inf, 0.0)
-        return z, result, steps, cov, float(loss)
+        posterior = {}
+        if p.prior is not None:
+            d = p.prior.columns
+            determined = bool(np.all(np.isfinite(cov)))
+            share = 1.0 - np.diag(cov)[:d] * precision[:d] if determined else np.full(d, np.nan)
+            values = np.asarray(_physical(z, d, p.transform), dtype=np.float64)[:d]
+            posterior = {
+                "effective_params": float(np.trace(hess @ cov)) if determined else math.nan,
+                "prior": prior_report(p.prior.names, p.prior.mean, p.prior.sd, values, share),
+                "prior_settings": p.prior.prior.to_dict()}
+        return z, result, steps, cov, float(loss), posterior
 
 
 class InnovationsLeastSquares(eqx.Module):
@@ -385,23 +433,48 @@ class InnovationsLeastSquares(eqx.Module):
         return estimated
 
     def estimate(self, problem: _Problem, z0, solver, max_steps: int):
-        """`(z, result, steps, cov, loss)`: Levenberg-Marquardt (default `rtol = atol =
-        1e-9`) on the weighted innovations $W\\varepsilon_k$, the covariance of
-        `least_squares_covariance` over the predicted samples."""
+        """`(z, result, steps, cov, loss, posterior)`: Levenberg-Marquardt (default `rtol =
+        atol = 1e-9`) on the weighted innovations $W\\varepsilon_k$, the covariance of
+        `least_squares_covariance` over the predicted samples; with a prior, its rows
+        $\\hat\\sigma(\\theta_i - \\mu_i)/s_i$ join them, refitted until the noise variance
+        $\\hat\\sigma^2$ settles, and the covariance is the posterior one (`_prior.py`, as
+        `PredictionError`)."""
         p = problem
         solver = LevenbergMarquardt(rtol=1e-9, atol=1e-9) if solver is None else solver
         weights = jnp.asarray(channel_weights(p.ds, p.channels, None), dtype=float)
-        z, result, steps, res, jac = _pem_solve(z0, p.model, p.transform, p.layout, p.rec,
-                                                weights, solver, max_steps)
         mask = np.asarray(p.ds.mask).copy()
         mask[:, 0] = False  # sample 0 is the prior, never predicted
-        res, jac = np.asarray(res), np.asarray(jac)
         count = len(p.channels)
-        rows = np.concatenate([res[..., c][mask] for c in range(count)])
-        jrows = np.concatenate([jac[..., c, :][mask] for c in range(count)])
+
+        def rows_of(res, jac):
+            res, jac = np.asarray(res), np.asarray(jac)
+            return (np.concatenate([res[..., c][mask] for c in range(count)]),
+                    np.concatenate([jac[..., c, :][mask] for c in range(count)]))
+
+        prior, total = p.prior, 0
+        if prior is not None:  # weighed by the start's residual variance, then refitted
+            e, _ = _innovations(z0, p.model, p.transform, p.layout, p.rec)
+            start = np.asarray(e * weights)[mask]
+            prior = dataclasses.replace(prior, variance=float(np.mean(start**2)) or 1.0)
+        for _ in range(1 if prior is None else PRIOR_PASSES):
+            args = (p.model, p.transform, p.layout, p.rec, weights,
+                    None if prior is None else prior.arrays())
+            z, result, steps, res, jac = _pem_solve(z0, args, solver, max_steps)
+            total += int(steps)
+            rows, jrows = rows_of(res, jac)
+            if prior is None:
+                break
+            variance = prior.noise_variance(rows, jrows)
+            if not abs(variance - prior.variance) > PRIOR_RTOL * prior.variance:
+                break
+            prior, z0 = dataclasses.replace(prior, variance=variance), z
         groups = np.repeat(np.arange(count), int(mask.sum()))
-        cov, _ = least_squares_covariance(jrows, rows, groups)
-        return z, result, steps, cov, 0.5 * float(np.sum(rows**2))
+        precision = None if prior is None else prior.precision(jrows.shape[1])
+        cov, _ = least_squares_covariance(jrows, rows, groups, prior_precision=precision)
+        values = np.asarray(_physical(z, len(p.transform.names), p.transform))
+        posterior = posterior_fields(prior, precision, jrows,
+                                     values[: len(p.transform.names)], blown=False)
+        return z, result, total, cov, 0.5 * float(np.sum(rows**2)), posterior
 
 
 class Innovations(AbstractEstimator):
@@ -421,13 +494,14 @@ class Innovations(AbstractEstimator):
     max_steps: int = 512
     solver: object = None
     hold: ZeroOrderHold | FirstOrderHold | dict | None = None
+    prior: Prior | None = None
 
     def fit(self, model, dataset, free=None, progress=None) -> FitResult:
         return fit_ml(model, dataset, free=free, channels=self.channels,
                       criterion=self.criterion, process=self.process, noise=self.noise,
                       noise_start=self.noise_start, rudder=self.rudder,
                       substeps=self.substeps, max_steps=self.max_steps, solver=self.solver,
-                      hold=self.hold)
+                      hold=self.hold, prior=self.prior)
 
     def predict(self, model, dataset) -> Prediction:
         """The filter's one-step-ahead predictions with the noise variances `noise`

@@ -42,8 +42,9 @@ PRIOR_PASSES = 8
 
 
 class Prior(eqx.Module):
-    """A Gaussian prior on the free coefficients of `PredictionError(prior=...)`: the fit
-    returns the maximum a posteriori estimate, its posterior covariance, the effective
+    """A Gaussian prior on the free coefficients of `PredictionError(prior=...)` (and of
+    `Innovations` and `ARMAX`, whose docstrings say how): the fit returns the maximum a
+    posteriori estimate, its posterior covariance, the effective
     number of parameters (`FitResult.effective_params`) and per coefficient the prior, the
     estimate and the data's share of its information (`FitResult.prior`).
 
@@ -124,10 +125,11 @@ class GaussianPrior:
     variance: float
 
     @classmethod
-    def build(cls, prior, specs, model, start_residuals) -> "GaussianPrior | None":
+    def build(cls, prior, specs, model, start_residuals=None) -> "GaussianPrior | None":
         """None without a prior (or with no finite scale), else the start's: the variance
         of the start's weighted residuals `start_residuals()` (1, the measured spread,
-        where not finite)."""
+        where not finite), or 1 without them (a log likelihood, which has its own noise
+        scale: the prior's rows are then $(\\theta_i - \\mu_i)/s_i$)."""
         if prior is None:
             return None
         if not isinstance(prior, Prior):
@@ -137,6 +139,8 @@ class GaussianPrior:
         mean, sd = prior.resolve(names, [s.start for s in specs], model)
         if not np.isfinite(sd).any():
             return None
+        if start_residuals is None:
+            return cls(prior, names, mean, sd, len(specs), 1.0)
         resid = start_residuals()
         if resid.size < len(specs):
             raise ValueError(f"a prior on {len(specs)} coefficients needs at least as many "
@@ -160,6 +164,14 @@ class GaussianPrior:
         """$\\hat\\sigma^2 = \\sum\\varepsilon^2 / (N - d_\\text{eff})$ at this MAP."""
         d_eff = effective_parameters(jrows, self.precision(jrows.shape[1]))
         return float(np.sum(rows**2)) / max(rows.size - d_eff, 1.0)
+
+
+def with_prior_rows(out, rows):
+    """The residuals `out` (K, ...) with the prior's rows (d,) laid in one more leading
+    slice of zeros (K + 1, ...): the residuals' layout stays, and the solver sees them all
+    (needs d <= the size of one slice)."""
+    slab = jnp.zeros(math.prod(out.shape[1:]), out.dtype).at[: rows.shape[0]].set(rows)
+    return jnp.concatenate([out, slab.reshape((1,) + out.shape[1:])])
 
 
 def posterior_fields(prior, precision, jrows, values, blown) -> dict:

@@ -38,14 +38,16 @@ def start_armax(train: js.Dataset, context: StartContext) -> ARMAXModel:
 
 def fit_armax_entry(start: ARMAXModel, train: js.Dataset, context: StartContext) -> js.FitResult:
     """`jaxship.fit` with the `ARMAX` estimator on the training record: the one-step
-    prediction of r is the criterion (horizon one sample)."""
+    prediction of r is the criterion (horizon one sample), with `identify`'s prior
+    (`--prior`) where one is given."""
     if context.estimator.horizon is not None:
         context.note(f"armax is fitted by its one-step prediction error (maximum likelihood); "
                      f"--horizon {context.estimator.horizon:g} is not used.")
     if tuple(context.channels) != ("r",):
         raise ValueError("armax models the yaw rate: fit it with channels 'r'.")
     _record(train, context.rudder)  # one record, named in the error otherwise
-    estimator = js.ARMAX(rudder=context.rudder, max_lag=context.estimator.max_lag)
+    estimator = js.ARMAX(rudder=context.rudder, max_lag=context.estimator.max_lag,
+                         prior=context.estimator.prior)  # `--prior`, centred on the start
     try:
         result = js.fit(start, train, estimator=estimator)
     except ValueError as error:
