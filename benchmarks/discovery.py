@@ -24,8 +24,9 @@ nulls, wrong names <= 5 %, both of two effects >= 80 %. Issue 60: two effects bo
     python benchmarks/discovery.py --generator kvlcc2-shipmmg --seeds 20 --jobs 2
 
 `--generator NAME` runs instead issue 71's scenarios (the null; a 1.5 deg rudder offset, a
-(0.3, -0.4) m/s current or a 0.05 deg/s gyro bias; offset + current; current + a 20 % yaw
-added-inertia error; all three; u, v over ground) on the records of `jaxship`
+(0.3, -0.4) m/s current, a 0.05 deg/s gyro bias or, but on shipmmg, a 1.5 s rudder delay;
+offset + current; current + a 20 % yaw added-inertia error; all three; u, v over ground) on
+the records of `jaxship`
 (`vessel_records`), `mariner-scipy` (`jaxship/studies/generators.py`: the published
 equations in NumPy, `solve_ivp`, its own servo and autopilot hold) or `kvlcc2-shipmmg`
 (`jaxship/studies/kvlcc2_shipmmg.py`: shipmmg's MMG code, Froude-scaled sizes).
@@ -134,14 +135,16 @@ GENERATORS = {"jaxship": ("mariner", 1.0), "mariner-scipy": ("mariner", 1.0),
               "kvlcc2-shipmmg": ("kvlcc2", (320.0 / 7.0) ** 0.5)}
 
 
-def generator_scenarios(froude=1.0) -> dict:
-    """`{name: (hidden effects, truth)}` of issue 71 at the Froude scale factor `froude`."""
+def generator_scenarios(froude=1.0, delay=True) -> dict:
+    """`{name: (hidden effects, truth)}` of issue 71 at the Froude scale factor `froude`;
+    with `delay` a 1.5 s rudder delay too (the generators that can hide one)."""
     north, east, bias = 0.3 / froude, -0.4 / froude, 0.05 * DEG * froude
     offset, current = effects.RudderOffset(delta0=1.5 * DEG), effects.UniformCurrent(
         north=north, east=east)
     gyro, added = effects.YawRateSensorBias(bias=bias), effects.AddedMassError(s_r=0.2)
     truth = {"rudder_offset.delta0": 1.5 * DEG, "current.north": north, "current.east": east,
-             "yaw_rate_sensor_bias.bias": bias, "added_mass_error.s_r": 0.2}
+             "yaw_rate_sensor_bias.bias": bias, "added_mass_error.s_r": 0.2,
+             "rudder_delay.delay": 1.5}
     return {name: (hidden, {k: v for k, v in truth.items()
                             if k.split(".")[0] in {e.id for e in hidden}})
             for name, hidden in (
@@ -149,6 +152,7 @@ def generator_scenarios(froude=1.0) -> dict:
                 ("offset 1.5 deg", (offset,)),
                 ("current", (current,)),
                 ("gyro bias", (gyro,)),
+                *((("rudder delay 1.5 s", (effects.RudderDelay(delay=1.5),)),) if delay else ()),
                 ("offset + current", (offset, current)),
                 ("current + added mass s_r 0.2", (current, added)),
                 ("offset + current + added mass s_r 0.2", (offset, current, added)),
@@ -265,7 +269,8 @@ def build_cases(generator, prior=None) -> dict:
     """`{name: (effects, truth, run)}`: the generator's scenarios or the ordinary ones."""
     if generator:
         return {name: (hidden, truth, generator_case(generator, prior)) for name, (hidden, truth)
-                in generator_scenarios(GENERATORS[generator][1]).items()}
+                in generator_scenarios(GENERATORS[generator][1],
+                                       delay=generator != "kvlcc2-shipmmg").items()}
     return ordinary_cases()
 
 

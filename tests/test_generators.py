@@ -113,6 +113,26 @@ def test_a_yaw_added_inertia_error_agrees_with_jaxships_effect():
     assert abs(ours[0] - plain[0]) > 0.1 * plain[0], (ours, plain[:2])
 
 
+def test_a_rudder_delay_is_the_logged_rudder_late_and_agrees_with_jaxships_effect():
+    """The generator's `delay` $\\tau$: the hull feels the servo's angle exactly $\\tau$ late
+    (1.5 s, three samples), and the 20/20 zig-zag's first two overshoots agree with
+    jaxship's Mariner with `effects.RudderDelay(1.5)` (a Pade approximant of the delay)
+    as closely as without it, while they differ from the undelayed ship's by more."""
+    g = MarinerScipy(delay=1.5)
+    zz = g.run(ZigZagPilot(20 * DEG, 20 * DEG), 600.0)
+    np.testing.assert_allclose(zz["delta_felt"][3:], zz["delta"][:-3], atol=1e-6)
+    assert np.all(zz["delta_felt"][:3] == 0.0)
+    m = js.augment(js.get_vessel("mariner"), effects.RudderDelay(delay=1.5))
+    jz = js.simulate(m, js.ZigZag(20 * DEG, 20 * DEG, duration=600.0, dt=0.5,
+                                  switch_at=js.strategies.SwitchAtNearestStep()),
+                     js.straight_run(m), simulator=FINE)
+    ours, theirs = overshoots(zz["psi"], 20)[:2], overshoots(jz.state.psi, 20)[:2]
+    np.testing.assert_allclose(ours, theirs, rtol=0.03)
+    plain = overshoots(MarinerScipy().run(ZigZagPilot(20 * DEG, 20 * DEG), 600.0)["psi"], 20)
+    assert abs(ours[0] - plain[0]) > 0.1 * plain[0], (ours, plain[:2])
+    assert generator_from_effects((effects.RudderDelay(delay=1.5),)).delay == 1.5
+
+
 def test_shipmmgs_kvlcc2_is_another_implementation_of_jaxships():
     """The second generator (`jaxship.studies.kvlcc2_shipmmg`, shipmmg's MMG code with the
     paper's KVLCC2 L7 coefficients) runs the same ship as jaxship's `kvlcc2` preset up to

@@ -277,31 +277,35 @@ def closed_loop_metrics(run: ClosedLoop, sample_interval: float = 1.0,
     sampled = np.zeros_like(inside)
     sampled[first::every] = True
     sampled &= inside
-    error = ssa(run.psi_d - run.psi)
+    # on the host in NumPy: op by op in JAX, each operation was a program of its own to
+    # lower and look up in the compilation cache (55 in `reproduce --quick`; issue 70)
+    psi, psi_ref, delta_c = (np.asarray(x, dtype=np.float64)
+                             for x in (run.psi, run.psi_ref, run.delta_c))
+    error = np.mod(np.asarray(run.psi_d, dtype=np.float64) - psi + np.pi, 2 * np.pi) - np.pi
     pick = lambda a, mask: a[..., np.flatnonzero(mask)]
-    final = run.psi_ref[..., -1:]
-    changed = jnp.abs(jnp.diff(run.psi_ref, axis=-1)) > 0
-    last = jnp.max(jnp.where(changed, jnp.arange(1, t.size), 0), axis=-1, keepdims=True)
-    size = final - jnp.take_along_axis(run.psi_ref, jnp.maximum(last - 1, 0), axis=-1)
-    after = jnp.arange(t.size) >= last
-    past = jnp.where(after, jnp.sign(size) * (run.psi - final), 0.0)
-    outside = after & (jnp.abs(run.psi - final) > 0.02 * jnp.abs(size))
-    j = jnp.max(jnp.where(outside, jnp.arange(t.size), -1), axis=-1)
-    t_last = jnp.asarray(t)[last[..., 0]]
-    settle = jnp.where(j < 0, 0.0, jnp.asarray(t)[jnp.minimum(j + 1, t.size - 1)] - t_last)
-    delta = pick(run.delta, inside)
-    command = pick(run.delta_c, inside)
-    limit = (run.max_rate * jnp.maximum(dt, run.control_period))[:, None, None]
-    moved = jnp.abs(jnp.diff(command, axis=-1)) >= (1 - 1e-6) * limit
+    final = psi_ref[..., -1:]
+    changed = np.abs(np.diff(psi_ref, axis=-1)) > 0
+    last = np.max(np.where(changed, np.arange(1, t.size), 0), axis=-1, keepdims=True)
+    size = final - np.take_along_axis(psi_ref, np.maximum(last - 1, 0), axis=-1)
+    after = np.arange(t.size) >= last
+    past = np.where(after, np.sign(size) * (psi - final), 0.0)
+    outside = after & (np.abs(psi - final) > 0.02 * np.abs(size))
+    j = np.max(np.where(outside, np.arange(t.size), -1), axis=-1)
+    t_last = t[last[..., 0]]
+    settle = np.where(j < 0, 0.0, t[np.minimum(j + 1, t.size - 1)] - t_last)
+    delta = pick(np.asarray(run.delta, dtype=np.float64), inside)
+    command = pick(delta_c, inside)
+    period = np.maximum(dt, np.asarray(run.control_period, dtype=np.float64))
+    limit = (np.asarray(run.max_rate, dtype=np.float64) * period)[:, None, None]
+    moved = np.abs(np.diff(command, axis=-1)) >= (1 - 1e-6) * limit
     return ClosedLoopMetrics(
-        residual_sum=jnp.sum(jnp.abs(pick(error, sampled)), axis=-1),
-        rms_error=jnp.sqrt(jnp.mean(pick(error, sampled) ** 2, axis=-1)),
-        overshoot=jnp.maximum(jnp.max(past, axis=-1), 0.0),
-        settling_time=jnp.where(j >= t.size - 1, jnp.inf, settle),
-        mean_abs_rudder=jnp.mean(jnp.abs(delta), axis=-1),
-        rudder_travel=jnp.sum(jnp.abs(jnp.diff(delta, axis=-1)), axis=-1),
-        time_at_rate_limit=jnp.sum(moved, axis=-1) * jnp.maximum(dt, run.control_period)[
-            :, None],
+        residual_sum=np.sum(np.abs(pick(error, sampled)), axis=-1),
+        rms_error=np.sqrt(np.mean(pick(error, sampled) ** 2, axis=-1)),
+        overshoot=np.maximum(np.max(past, axis=-1), 0.0),
+        settling_time=np.where(j >= t.size - 1, np.inf, settle),
+        mean_abs_rudder=np.mean(np.abs(delta), axis=-1),
+        rudder_travel=np.sum(np.abs(np.diff(delta, axis=-1)), axis=-1),
+        time_at_rate_limit=np.sum(moved, axis=-1) * period[:, None],
         sample_interval=float(sample_interval),
     )
 

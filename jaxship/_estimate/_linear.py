@@ -24,7 +24,7 @@ import math
 import equinox as eqx
 import numpy as np
 
-from .._foundation._params import resolve_free
+from .._foundation._params import as_arrays, resolve_free
 from .._models._holds import FirstOrderHold, ZeroOrderHold
 from .._models._steering._base import AuxInputs
 from .._models._steering.nomoto import Nomoto1, NonlinearNomoto
@@ -195,20 +195,25 @@ def _ross(model: RossAutopilot, dataset, *, free=None, rudder: str = "delta", sp
     held = dict(resolve_holds(rudder, hold, ("delta",)))["delta"]
     order = tuple(h for h, _ in HULL_TERMS) + RUDDER_TERMS
     gain = (float(model.speed) / float(model.length)) ** 2
+    # the inputs over each interval: held, or (first-order hold) at its midpoint; every
+    # record's intervals in one evaluation of the regressors (one program, not op by op)
+    lengths = [int(num) for num in ds.lengths]
+    get = lambda key: [np.asarray(getattr(ds, key), dtype=np.float64)[i, :num]
+                       for i, num in enumerate(lengths)]
+    over = lambda rows: np.concatenate([held.interval_mean(a[:-1], a[1:]) for a in rows])
+    records = get("r")
+    aux = AuxInputs(u=over(get("u")), v=over(get("v")), n=over(get("n")))
+    r_mid = np.concatenate([0.5 * (r[:-1] + r[1:]) for r in records])
+    phi_all = np.asarray(_regressors(as_arrays(model), r_mid, over(get(rudder)), aux),
+                         np.float64)
     rows, targets = [], []
-    for i, num in enumerate(ds.lengths):
-        get = lambda key: np.asarray(getattr(ds, key), dtype=np.float64)[i, :num]
-        r, d = get("r"), get(rudder)
-        dt = float(np.asarray(ds.dt)[i])
-        # the inputs over each interval: held, or (first-order hold) at its midpoint
-        over = lambda a: held.interval_mean(a[:-1], a[1:])
-        aux = AuxInputs(u=over(get("u")), v=over(get("v")), n=over(get("n")))
-        phi = np.asarray(model.regressors(0.5 * (r[:-1] + r[1:]), over(d), aux), np.float64)
+    for i, (num, r, phi) in enumerate(zip(lengths, records, np.split(
+            phi_all, np.cumsum([num - 1 for num in lengths])[:-1]))):
         count = (num - 1) // span
         if count == 0:
             continue
-        phi = phi[: count * span].reshape(count, span, -1).sum(axis=1) * dt * gain
-        rows.append(phi)
+        dt = float(np.asarray(ds.dt)[i])
+        rows.append(phi[: count * span].reshape(count, span, -1).sum(axis=1) * dt * gain)
         targets.append(r[span: count * span + 1: span] - r[: count * span: span])
     if not rows:
         raise ValueError(f"RossAutopilot start: no experiment has more than `span` = {span} "
@@ -220,3 +225,9 @@ def _ross(model: RossAutopilot, dataset, *, free=None, rudder: str = "delta", sp
     known = phi[:, frozen] @ a[frozen] if frozen else 0.0
     coef = _lstsq(phi[:, columns], y - known, names, "RossAutopilot start")
     return _replace(model, dict(zip(names, coef)))
+
+
+@eqx.filter_jit
+def _regressors(model, r, delta, aux):
+    """`model.regressors(r, delta, aux)` as one compiled program."""
+    return model.regressors(r, delta, aux)

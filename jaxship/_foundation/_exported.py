@@ -32,7 +32,7 @@ except ImportError:  # another equinox layout: nothing to translate
 
 
 _FOLDER: list[pathlib.Path | None] = [None]
-_LOADED: dict[str, tuple] = {}  # key -> (Exported, output's static part, output treedef)
+_LOADED: dict[str, tuple] = {}  # key -> (jitted call, output's static part, output treedef)
 _LIBRARIES = ("jax", "jaxlib", "equinox", "optimistix", "diffrax", "lineax", "numpy")
 
 
@@ -66,14 +66,18 @@ def persistent(fn):
             key = _key(raw, treedef, static, leaves)
         except Exception:  # a static argument that does not pickle
             return fn(*args)
-        program = _LOADED.get(key) or _read(folder / f"{key}.jaxexport") \
-            or _export(fn, treedef, static, leaves, folder / f"{key}.jaxexport")
+        program = _LOADED.get(key)
         if program is None:
-            return fn(*args)
-        _LOADED[key] = program
-        exported, out_static, out_treedef = program
-        return eqx.combine(jax.tree.unflatten(out_treedef, exported.call(*leaves)),
-                           out_static)
+            program = _read(folder / f"{key}.jaxexport") \
+                or _export(fn, treedef, static, leaves, folder / f"{key}.jaxexport")
+            if program is None:
+                return fn(*args)
+            # jitted once: `Exported.call` alone lowers its module again at every call
+            # (8-12 ms each, 268 calls in `reproduce --quick`; issue 70)
+            exported, out_static, out_treedef = program
+            program = _LOADED[key] = (jax.jit(exported.call), out_static, out_treedef)
+        caller, out_static, out_treedef = program
+        return eqx.combine(jax.tree.unflatten(out_treedef, caller(*leaves)), out_static)
 
     call.__wrapped__ = raw
     return call

@@ -4,7 +4,7 @@ the thesis states."""
 
 import numpy as np
 
-from ._common import plt
+from ._common import _fixed_layout, _inches, plt
 
 
 def _thesis_marks(ax, bands=(), lines=()):
@@ -41,9 +41,13 @@ def plot_trial_vs_thesis(traj, *, bands=None, lines=None, track_note="", title="
     bands, lines = bands or {}, lines or {}
     s = traj.state
     t = np.asarray(traj.t, dtype=np.float64)
-    # a track as wide as the time panels: the thesis manoeuvre's spans a kilometre
-    fig = plt.figure(figsize=(13, 7), constrained_layout=True)
+    # a track as wide as the time panels: the thesis manoeuvre's spans a kilometre; a fixed
+    # layout [in], not the constrained one (which measures every artist first: half of
+    # the figure's time, issue 70), its right margin the legends' measured width
+    fig = plt.figure(figsize=(13.0, 7.0))
     grid = fig.add_gridspec(3, 2, width_ratios=[1.3, 1.4])
+    _inch_margins(fig, grid, left=0.8, right=3.0, bottom=0.55, top=0.65, wspace=0.95,
+                  hspace=0.4)
     track = fig.add_subplot(grid[:, 0])
     axes = {k: fig.add_subplot(grid[i, 1]) for i, k in enumerate(("heading", "yaw_rate",
                                                                    "speed"))}
@@ -76,7 +80,21 @@ def plot_trial_vs_thesis(traj, *, bands=None, lines=None, track_note="", title="
     axes["speed"].set(xlabel="time [s]")
     track.grid(True, alpha=0.3)
     fig.suptitle(title)
+    panel = axes["speed"].get_position().width * fig.get_figwidth()
+    widest = max(_inches(ax.get_legend(), fig)[0] for ax in axes.values())
+    _inch_margins(fig, grid, left=0.8, right=0.13 * panel + widest + 0.1, bottom=0.55,
+                  top=0.65, wspace=0.95, hspace=0.4)
     return fig
+
+
+def _inch_margins(fig, grid, *, left, right, bottom, top, wspace, hspace):
+    """Set the margins and gaps of `grid` (a `GridSpec` of `fig`) in inches."""
+    width, height = fig.get_size_inches()
+    rows, cols = grid.get_geometry()
+    grid.update(left=left / width, right=1 - right / width, bottom=bottom / height,
+                top=1 - top / height,
+                wspace=wspace / ((width - left - right - (cols - 1) * wspace) / cols),
+                hspace=hspace / ((height - bottom - top - (rows - 1) * hspace) / rows))
 
 
 def plot_model_outputs(t, measured, panels, *, ylabel="yaw rate [deg/s]", title="",
@@ -96,7 +114,7 @@ def plot_model_outputs(t, measured, panels, *, ylabel="yaw rate [deg/s]", title=
     names = list(panels)
     many = isinstance(t, (list, tuple))
     fig, axes = plt.subplots(len(names), 1, figsize=(12, 3.0 * len(names)), squeeze=False,
-                             sharex=not many, constrained_layout=True)
+                             sharex=not many)
     for i, (ax, name) in enumerate(zip(axes[:, 0], names)):
         ti = np.asarray(t[i] if many else t, dtype=np.float64)
         yi = np.asarray(measured[i] if many else measured, dtype=np.float64)
@@ -111,7 +129,17 @@ def plot_model_outputs(t, measured, panels, *, ylabel="yaw rate [deg/s]", title=
                   fontsize="small")
     axes[-1, 0].set(xlabel="time [s]")
     fig.suptitle(title)
+    _layout_beside_legends(fig, axes[:, 0], top=0.75, hspace=0.75)
     return fig
+
+
+def _layout_beside_legends(fig, axes, *, top, hspace):
+    """A fixed layout (`_fixed_layout`) of a column of `axes` whose legends stand right of
+    them: the right margin the widest legend's measured width, the left one the y labels'
+    (constrained layout measured every artist: half of a figure's time, issue 70)."""
+    widest = max(_inches(ax.get_legend(), fig)[0] for ax in axes)
+    _fixed_layout(fig, (len(axes), 1), right=widest + 0.3, top=top, bottom=0.6,
+                  hspace=hspace)
 
 
 def plot_heading_tracking(t, desired, runs, *, window=None, bands=None, title=""):
@@ -132,7 +160,7 @@ def plot_heading_tracking(t, desired, runs, *, window=None, bands=None, title=""
     bands = bands or {}
     t = np.asarray(t, dtype=np.float64)
     desired = np.asarray(desired, dtype=np.float64)
-    fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True, constrained_layout=True)
+    fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
     heading, error, rudder = axes
     heading.plot(t, desired, "k--", lw=1.4, label="desired (reference model)")
     # runs that agree lie on one another: each later one thinner and dashed, so that
@@ -156,4 +184,5 @@ def plot_heading_tracking(t, desired, runs, *, window=None, bands=None, title=""
     rudder.set(ylabel="rudder [deg]", xlabel="time [s]")
     if window is not None:
         rudder.set_xlim(*window)
+    _layout_beside_legends(fig, axes, top=0.45, hspace=0.25)
     return fig

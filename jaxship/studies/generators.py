@@ -27,7 +27,10 @@ $v_g = v - V_N\\sin\\psi + V_E\\cos\\psi$; a rudder `offset` [rad]: the ship fee
 $\\delta + \\delta_0$ and the log shows $\\delta$; a yaw-rate sensor `gyro_bias` [rad/s]:
 the log shows $r + b_r$; an `added_mass` error $s_r$ [-]: the ship's yaw inertia
 $I_z - N_{\\dot r}$ is $(1 + s_r)$ times the published one (as
-`jaxship.effects.AddedMassError`, Fossen 2021, eq. 6.1). Noise as
+`jaxship.effects.AddedMassError`, Fossen 2021, eq. 6.1); a `delay` $\\tau$ [s]: the hull
+feels the rudder the log showed $\\tau$ before, $\\delta(t - \\tau)$ exactly (a second
+servo driven by the command of $\\tau$ before; jaxship's `RudderDelay` is a Pade
+approximant of it). Noise as
 `jaxship.studies.discovery.vessel_records`: heading 0.1 deg, yaw rate 0.05 deg/s, u and v
 0.02 m/s, positions 1 m; rudder exact.
 
@@ -70,14 +73,16 @@ TRAIN = tuple((a, s) for a in (10, 20) for s in (1, -1))  # zig-zag angle [deg],
 class MarinerScipy:
     """The Mariner (module text) with its servo, autopilot hold and hidden effects:
     `offset` [rad] (felt, not logged), `current` `(north, east)` [m/s], `gyro_bias`
-    [rad/s], `added_mass` $s_r$ [-] (yaw inertia scaled by $1 + s_r$); servo
-    `max_angle` [rad], `max_rate` [rad/s], `time_constant` [s]; autopilot `control_dt`
-    [s]; integrator tolerances `rtol`, `atol`."""
+    [rad/s], `added_mass` $s_r$ [-] (yaw inertia scaled by $1 + s_r$), `delay` [s] (the
+    hull feels the logged rudder that much later); servo `max_angle` [rad], `max_rate`
+    [rad/s], `time_constant` [s]; autopilot `control_dt` [s]; integrator tolerances
+    `rtol`, `atol`."""
 
     offset: float = 0.0
     current: tuple = (0.0, 0.0)
     gyro_bias: float = 0.0
     added_mass: float = 0.0
+    delay: float = 0.0
     max_angle: float = 40.0 * DEG
     max_rate: float = 5.0 * DEG
     time_constant: float = 1.0
@@ -85,16 +90,19 @@ class MarinerScipy:
     rtol: float = 1e-9
     atol: float = 1e-9
 
-    def rates(self, t, state, command):
-        """$\\dot x$ of `state` = (u, v, r, x, y, psi, delta) (u, v through the water,
-        u the total surge speed) at the held rudder `command` [rad]: MSS mariner.m's
-        $(m' - X'_{\\dot u})\\dot u' = X'$ and the sway-yaw 2x2 mass system, with
-        $u' = (u - U_0)/U$, $v' = v/U$, $r' = rL/U$, $U = \\sqrt{u^2 + v^2}$."""
+    def rates(self, t, state, command, felt_command=None):
+        """$\\dot x$ of `state` = (u, v, r, x, y, psi, delta, felt delta) (u, v through
+        the water, u the total surge speed) at the held rudder `command` [rad]: MSS
+        mariner.m's $(m' - X'_{\\dot u})\\dot u' = X'$ and the sway-yaw 2x2 mass system,
+        with $u' = (u - U_0)/U$, $v' = v/U$, $r' = rL/U$, $U = \\sqrt{u^2 + v^2}$. With a
+        `delay` $\\tau$ the hull feels a second servo's angle, driven by the command of
+        $\\tau$ before, `felt_command(t)`: the servo's own angle $\\tau$ late, exactly (a
+        time-invariant system from rest)."""
         c, L = MARINER, LENGTH
-        u, v, r, _, _, psi, delta = state
+        u, v, r, _, _, psi, delta, felt = state
         U = math.hypot(u, v)
         up, vp, rp = (u - U0) / U, v / U, r * L / U
-        d = -(delta + self.offset)  # MSS's rudder sign
+        d = -((felt if self.delay > 0 else delta) + self.offset)  # MSS's rudder sign
         X = (c["Xu"] * up + c["Xuu"] * up**2 + c["Xuuu"] * up**3 + c["Xvv"] * vp**2
              + c["Xrr"] * rp**2 + c["Xrv"] * rp * vp + c["Xdd"] * d**2
              + c["Xudd"] * up * d**2 + c["Xvd"] * vp * d + c["Xuvd"] * up * vp * d)
@@ -111,16 +119,20 @@ class MarinerScipy:
         m32 = c["m"] * c["xG"] - c["Nvdot"]
         m33 = (c["Iz"] - c["Nrdot"]) * (1.0 + self.added_mass)
         det = m22 * m33 - m23 * m32
-        target = min(max(command, -self.max_angle), self.max_angle)
-        delta_dot = min(max((target - delta) / self.time_constant, -self.max_rate),
-                        self.max_rate)
+        delta_dot = self._servo(command, delta)
+        felt_dot = delta_dot if self.delay <= 0 else self._servo(felt_command(t), felt)
         north, east = self.current
         return (X * U**2 / L / m11,
                 (m33 * Y - m23 * N) / det * U**2 / L,
                 (m22 * N - m32 * Y) / det * U**2 / L**2,
                 u * math.cos(psi) - v * math.sin(psi) + north,
                 u * math.sin(psi) + v * math.cos(psi) + east,
-                r, delta_dot)
+                r, delta_dot, felt_dot)
+
+    def _servo(self, command, delta):
+        """The servo's $\\dot\\delta$ (module text) towards `command` [rad]."""
+        target = min(max(command, -self.max_angle), self.max_angle)
+        return min(max((target - delta) / self.time_constant, -self.max_rate), self.max_rate)
 
     def run(self, commands, duration, dt=0.5):
         """The clean trajectory at the samples `t = 0, dt, ..., duration` from the
@@ -129,11 +141,19 @@ class MarinerScipy:
         heading and the command held so far (None at the start); with attribute
         `limit(held)` (a heading [rad] whose crossing changes the command, or None) the
         integrator stops at each crossing and the command changes at the next control
-        instant. Returns `{t, u, v, r, x, y, psi, delta}` (through the water)."""
+        instant. Returns `{t, u, v, r, x, y, psi, delta, delta_felt}` (through the water;
+        `delta_felt` the angle the hull feels, `delta` that of the servo and the log)."""
         t = np.round(np.arange(0.0, duration + dt / 2, dt), 9)
-        out = np.empty((7, t.size))
-        state = np.array([U0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+        out = np.empty((8, t.size))
+        state = np.array([U0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
         now, held = 0.0, commands(0.0, None)
+        changes, values = [0.0], [held]  # the commands and when they were set (from rest)
+
+        def felt_command(time):  # the command in force `delay` s before `time`
+            k = np.searchsorted(changes, time - self.delay, side="right")
+            return values[k - 1] if k else 0.0
+
+        args = (held, felt_command)
         while now < duration - 1e-9:
             limit = getattr(commands, "limit", lambda held: None)(held)
             events = None
@@ -142,7 +162,7 @@ class MarinerScipy:
                 event.terminal, event.direction = True, (1 if limit > 0 else -1)
                 events = [event]
             sol = solve_ivp(self.rates, (now, duration), state, method="RK45", rtol=self.rtol,
-                            atol=self.atol, dense_output=True, events=events, args=(held,))
+                            atol=self.atol, dense_output=True, events=events, args=args)
             end = sol.t[-1]
             if sol.status == 1:  # the heading crossed the limit: on to the next control instant
                 instant = math.ceil(end / self.control_dt - 1e-9) * self.control_dt
@@ -150,7 +170,7 @@ class MarinerScipy:
                 if instant > end:
                     sol2 = solve_ivp(self.rates, (end, instant), sol.y[:, -1], method="RK45",
                                      rtol=self.rtol, atol=self.atol, dense_output=True,
-                                     args=(held,))
+                                     args=args)
                     pieces = [(sol, now, end), (sol2, end, instant)]
                     state = sol2.y[:, -1]
                 else:
@@ -158,6 +178,9 @@ class MarinerScipy:
                 end = instant
                 psi = state[5]
                 held = commands(psi, held)
+                changes.append(end)
+                values.append(held)
+                args = (held, felt_command)
             else:
                 pieces, state = [(sol, now, end)], sol.y[:, -1]
             for piece, a, b in pieces:
@@ -165,7 +188,7 @@ class MarinerScipy:
                 if inside.any():
                     out[:, inside] = piece.sol(t[inside])
             now = end
-        names = ("u", "v", "r", "x", "y", "psi", "delta")
+        names = ("u", "v", "r", "x", "y", "psi", "delta", "delta_felt")
         return dict(t=t, **dict(zip(names, out)))
 
 
@@ -235,7 +258,8 @@ def generator_from_effects(effects, kind=MarinerScipy):
     """The generator `kind` (`MarinerScipy`, or `KVLCC2Shipmmg` of
     `jaxship.studies.kvlcc2_shipmmg`) with jaxship effects' sizes hidden
     (`rudder_offset.delta0`, `current.north/east`, `yaw_rate_sensor_bias.bias`,
-    `added_mass_error.s_r` with `s_v = 0`; others raise `ValueError`)."""
+    `added_mass_error.s_r` with `s_v = 0`, and for `MarinerScipy` `rudder_delay.delay`;
+    others raise `ValueError`)."""
     options = {}
     for e in effects:
         if e.id == "rudder_offset":
@@ -246,6 +270,8 @@ def generator_from_effects(effects, kind=MarinerScipy):
             options["gyro_bias"] = float(e.bias)
         elif e.id == "added_mass_error" and float(e.s_v) == 0.0:
             options["added_mass"] = float(e.s_r)
+        elif e.id == "rudder_delay" and kind is MarinerScipy:
+            options["delay"] = float(e.delay)
         else:
             raise ValueError(f"the {kind.__name__} generator cannot hide {e.id!r}")
     return kind(**options)
