@@ -7,6 +7,9 @@ import equinox as eqx
 import jax
 import numpy as np
 
+from .._foundation._exported import persistent
+from .._foundation._params import as_arrays
+
 
 # the most substeps the start model may ask for: beyond, a time constant that short is
 # no steering dynamics the samples can show
@@ -21,7 +24,7 @@ def stable_substeps(model, windows, refuse: bool = True) -> int:
     # the first window's start and inputs, indexed on the host (no dispatch per leaf)
     start = jax.tree.map(lambda a: np.asarray(a)[0, 0], windows.start)
     inputs = {k: np.asarray(a)[0, 0, 0] for k, a in windows.records.items()}
-    jac = np.asarray(_field_jacobian(model, start, inputs, windows.servo))
+    jac = np.asarray(_field_jacobian(as_arrays(model), start, inputs, windows.servo))
     rho = float(np.max(np.abs(np.linalg.eigvals(jac)))) if np.all(np.isfinite(jac)) \
         else math.inf
     dt = float(np.max(np.asarray(windows.dt)))
@@ -34,6 +37,7 @@ def stable_substeps(model, windows, refuse: bool = True) -> int:
     return needed
 
 
+@persistent  # traced once per installation: a dozen model types in one `discover`
 @eqx.filter_jit
 def _field_jacobian(model, start, inputs, servo: bool):
     """The replay field's Jacobian at a window `start` with the replayed `inputs` there

@@ -14,6 +14,7 @@ random walk of 2e-4 (m/s)^2 per second (`ACCELERATION_NOISE`): the missing loads
 the states, so a filter that trusted the model would hide them.
 """
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -21,6 +22,7 @@ import scipy  # scipy.signal loads on first use (an import-time saving)
 
 from ..._estimate._kalman import _augmented_names, smooth_states
 from ..._estimate._windows import as_dataset
+from ..._foundation._params import as_arrays
 from ..._models._environment import Wind
 
 
@@ -86,17 +88,25 @@ def residual_loads(vessel, data, *, smoothing: float = 10.0, wind: bool = False,
         smoothed = smoothed or smoothed_vessel_states(vessel, ds, smoothing=smoothing)
         if smoothed is None:
             return None
+    records = []
     for e in range(ds.num_experiments):
         n, dt = int(ds.lengths[e]), float(ds.dt[e])
         span = _span(smoothing, dt)
         if span < 5 or span > n:
             return None
-        get = lambda c: np.asarray(getattr(ds, c)[e, :n], dtype=np.float64)
+        get = lambda c, e=e, n=n: np.asarray(getattr(ds, c)[e, :n], dtype=np.float64)
         nu = np.stack([get("u"), get("v"), get("r")] if logged else
                       [smoothed[e].state(c) for c in ("u", "v", "r")])
+        records.append((get, nu, span, dt))
+    # the loads of every record's samples in one program (op by op, each operation of the
+    # vessel's loads was a program to lower and look up: 250 in the README's `discover`)
+    signals = [np.concatenate(parts) for parts in zip(*[
+        (get("t"), *nu, get("delta"), get("n")) for get, nu, _, _ in records])]
+    loads = np.split(np.asarray(_sample_loads(as_arrays(vessel), *signals)),
+                     np.cumsum([nu.shape[1] for _, nu, _, _ in records])[:-1], axis=0)
+    for (get, nu, span, dt), tau in zip(records, loads):
         nu_dot = scipy.signal.savgol_filter(nu, span, 3, deriv=1, delta=dt, axis=1)
-        signals = [jnp.asarray(a) for a in (get("t"), *nu, get("delta"), get("n"))]
-        tau = np.asarray(jax.vmap(vessel.loads)(*signals)).T  # sample by sample
+        tau = tau.T
         if wind:
             gust = Wind(jnp.asarray(get("wind_speed")), jnp.asarray(get("wind_dir")))
             tau = tau + np.stack(np.broadcast_arrays(*gust.loads(
@@ -106,3 +116,9 @@ def residual_loads(vessel, data, *, smoothing: float = 10.0, wind: bool = False,
         for i, (name, _) in enumerate(LOADS):
             out[name].append(missing[i])
     return out
+
+
+@eqx.filter_jit
+def _sample_loads(vessel, *signals):
+    """`vessel.loads` sample by sample (N, 3) of the signals (t, u, v, r, delta, n) (N,)."""
+    return jax.vmap(vessel.loads)(*signals)
