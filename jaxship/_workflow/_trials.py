@@ -138,11 +138,10 @@ class StandardTrial:
         (display units in the names): the largest yaw rate and the speed's range, then
         the trial's own (`js.indices.turning_indices`, `zigzag_indices`, `spiral_curve`
         with its loop, `reverse_spiral_curve`, `pull_out_indices`, `stopping_indices`)."""
-        speed = np.hypot(np.asarray(traj.state.u), np.asarray(traj.state.v))  # in NumPy
         base = {
-            "max_yaw_rate_deg_s": float(np.rad2deg(np.max(np.abs(np.asarray(traj.state.r))))),
-            "min_speed_m_s": float(np.min(speed)),
-            "max_speed_m_s": float(np.max(speed)),
+            "max_yaw_rate_deg_s": float(np.rad2deg(np.max(np.abs(traj.state.r)))),
+            "min_speed_m_s": float(np.min(traj.speed)),
+            "max_speed_m_s": float(np.max(traj.speed)),
         }
         if self.kind in ("spiral", "reverse-spiral"):
             curve = self.curve(manoeuvre, traj)
