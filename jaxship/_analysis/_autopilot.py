@@ -9,9 +9,7 @@ import numpy as np
 import optimistix as optx
 from jaxtyping import Array
 
-from .._foundation._exported import persistent
 from .._foundation._kinematics import ssa
-from .._foundation._params import as_arrays
 from .._foundation._results import RESULTS, as_code
 from .._foundation._state import ShipState
 from .._models._control import (
@@ -53,21 +51,13 @@ def yaw_inertia(model, *, speed=None, n=None) -> tuple[Array, Array]:
     of eq. 5.3-5.5. **Raises** `ValueError` where the rudder has no effect (e.g. a
     speed-dependent model at zero speed: give `speed`)."""
     state = operating_point(model, speed, n)
-    f_delta, m, d = _yaw_slopes(as_arrays(model), as_arrays(state))
-    if not float(f_delta) != 0:
-        raise ValueError(f"the rudder of {type(model).__name__} has no yaw effect at u = "
-                         f"{float(state.u)} m/s, n = {float(state.n)} rev/s: give `speed`/`n`.")
-    return m, d
-
-
-@persistent  # one program, traced once per installation (op by op: a dozen; issue 70)
-@eqx.filter_jit
-def _yaw_slopes(model, state):
-    """$f_\\delta$, $m = 1/f_\\delta$ and $d = -f_r/f_\\delta$ of `yaw_inertia`."""
     zero = jnp.zeros(())
     f_r, f_delta = jax.jacfwd(lambda r, d: yaw_acceleration(model, r, d, state),
                               argnums=(0, 1))(zero, zero)
-    return f_delta, 1.0 / f_delta, -f_r / f_delta
+    if not float(f_delta) != 0:
+        raise ValueError(f"the rudder of {type(model).__name__} has no yaw effect at u = "
+                         f"{float(state.u)} m/s, n = {float(state.n)} rev/s: give `speed`/`n`.")
+    return 1.0 / f_delta, -f_r / f_delta
 
 
 def natural_frequency_of(bandwidth, damping):
