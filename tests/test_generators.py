@@ -96,14 +96,11 @@ def test_generator_from_effects_hides_the_four_effects_only():
         generator_from_effects((effects.AddedMassError(s_v=0.2),))
 
 
-def test_a_yaw_added_inertia_error_agrees_with_jaxships_effect():
-    """The generator's `added_mass` $s_r$ scales $I_z - N_{\\dot r}$ as
-    `effects.AddedMassError(s_r)` scales $M_{33}$: the 20/20 zig-zag's first two
-    overshoots agree with jaxship's Mariner with that effect as they do without it (3 %,
-    the switching instant), and they differ from the unaltered ship's by more."""
-    g = MarinerScipy(added_mass=0.2)
-    m = js.augment(js.get_vessel("mariner"), effects.AddedMassError(s_r=0.2))
-    zz = g.run(ZigZagPilot(20 * DEG, 20 * DEG), 600.0)
+def _agrees_with_jaxships_effect(zz, effect):
+    """The generator's 20/20 zig-zag `zz` against jaxship's Mariner with `effect`: the
+    first two overshoots agree to 3 % (as without effects: the switching instant), and
+    the first differs from the unaltered generator's by more than 10 %."""
+    m = js.augment(js.get_vessel("mariner"), effect)
     jz = js.simulate(m, js.ZigZag(20 * DEG, 20 * DEG, duration=600.0, dt=0.5,
                                   switch_at=js.strategies.SwitchAtNearestStep()),
                      js.straight_run(m), simulator=FINE)
@@ -111,6 +108,15 @@ def test_a_yaw_added_inertia_error_agrees_with_jaxships_effect():
     np.testing.assert_allclose(ours, theirs, rtol=0.03)
     plain = overshoots(MarinerScipy().run(ZigZagPilot(20 * DEG, 20 * DEG), 600.0)["psi"], 20)
     assert abs(ours[0] - plain[0]) > 0.1 * plain[0], (ours, plain[:2])
+
+
+def test_a_yaw_added_inertia_error_agrees_with_jaxships_effect():
+    """The generator's `added_mass` $s_r$ scales $I_z - N_{\\dot r}$ as
+    `effects.AddedMassError(s_r)` scales $M_{33}$: the 20/20 zig-zag's first two
+    overshoots agree with jaxship's Mariner with that effect as they do without it (3 %,
+    the switching instant), and they differ from the unaltered ship's by more."""
+    zz = MarinerScipy(added_mass=0.2).run(ZigZagPilot(20 * DEG, 20 * DEG), 600.0)
+    _agrees_with_jaxships_effect(zz, effects.AddedMassError(s_r=0.2))
 
 
 def test_a_rudder_delay_is_the_logged_rudder_late_and_agrees_with_jaxships_effect():
@@ -118,18 +124,10 @@ def test_a_rudder_delay_is_the_logged_rudder_late_and_agrees_with_jaxships_effec
     (1.5 s, three samples), and the 20/20 zig-zag's first two overshoots agree with
     jaxship's Mariner with `effects.RudderDelay(1.5)` (a Pade approximant of the delay)
     as closely as without it, while they differ from the undelayed ship's by more."""
-    g = MarinerScipy(delay=1.5)
-    zz = g.run(ZigZagPilot(20 * DEG, 20 * DEG), 600.0)
+    zz = MarinerScipy(delay=1.5).run(ZigZagPilot(20 * DEG, 20 * DEG), 600.0)
     np.testing.assert_allclose(zz["delta_felt"][3:], zz["delta"][:-3], atol=1e-6)
     assert np.all(zz["delta_felt"][:3] == 0.0)
-    m = js.augment(js.get_vessel("mariner"), effects.RudderDelay(delay=1.5))
-    jz = js.simulate(m, js.ZigZag(20 * DEG, 20 * DEG, duration=600.0, dt=0.5,
-                                  switch_at=js.strategies.SwitchAtNearestStep()),
-                     js.straight_run(m), simulator=FINE)
-    ours, theirs = overshoots(zz["psi"], 20)[:2], overshoots(jz.state.psi, 20)[:2]
-    np.testing.assert_allclose(ours, theirs, rtol=0.03)
-    plain = overshoots(MarinerScipy().run(ZigZagPilot(20 * DEG, 20 * DEG), 600.0)["psi"], 20)
-    assert abs(ours[0] - plain[0]) > 0.1 * plain[0], (ours, plain[:2])
+    _agrees_with_jaxships_effect(zz, effects.RudderDelay(delay=1.5))
     assert generator_from_effects((effects.RudderDelay(delay=1.5),)).delay == 1.5
 
 

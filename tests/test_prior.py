@@ -41,6 +41,24 @@ def _record(seed=0, num=600, name="train"):
     return js.Experiment(np.asarray(tr.t), delta, psi=psi, r=r, name=name)
 
 
+def _exact_record(seed, num):
+    """`TRUTH`'s record under a zero-order-hold rudder, sampled exactly in NumPy (no
+    jaxship simulator): $r_{k+1} = ar_k + K(1 - a)\\delta_k$, $a = e^{-h/T}$, and $\\psi$ the
+    exact integral of r over each interval; noise as `_record`."""
+    rng = np.random.default_rng(seed)
+    delta = np.repeat(rng.choice([-10 * DEG, 10 * DEG], num // 20 + 1), 20)[:num]
+    K, T = TRUTH.K, TRUTH.T
+    a = np.exp(-DT / T)
+    r, psi = np.zeros(num), np.full(num, 0.1)
+    for k in range(num - 1):
+        steady = K * delta[k]
+        r[k + 1] = a * r[k] + (1 - a) * steady
+        psi[k + 1] = psi[k] + steady * DT + (r[k] - steady) * T * (1 - a)
+    return js.Experiment(DT * np.arange(num), delta,
+                         psi=psi + 0.3 * DEG * rng.standard_normal(num),
+                         r=r + 0.03 * DEG * rng.standard_normal(num), name="exact")
+
+
 DATA = _record()
 START = js.Nomoto1(K=0.08, T=18.0)  # about 30 % off the truth
 FREE = ("K", "T")
@@ -109,8 +127,9 @@ def test_per_coefficient_and_absolute_scales():
 def test_the_innovations_estimators_take_a_prior(criterion):
     """`Innovations(prior=...)`: the same limits as the prediction-error fit's, the MAP
     between the mean and the plain estimate on a short record, and the effective number
-    of parameters charged by FPE (the noise variances count in full: no prior on them)."""
-    short = _record(seed=4, num=160)
+    of parameters charged by FPE (the noise variances count in full: no prior on them).
+    The record is not jaxship's: Nomoto 1's exact zero-order-hold recursion in NumPy."""
+    short = _exact_record(seed=4, num=160)
     fit = lambda prior=None: js.fit(START, short, free=FREE, estimator=js.Innovations(
         criterion=criterion, prior=prior))
     plain = fit()
